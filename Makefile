@@ -1,0 +1,29 @@
+# Two entry points: `make repro` (paper-scale pipeline) and `make test` (pytest suite).
+# Both create .venv with the pinned dependencies of requirements.lock if it is missing or stale.
+PYTHON ?= python3.11
+VENV := .venv
+BIN := $(CURDIR)/$(VENV)/bin
+export PATH := $(BIN):$(PATH)
+# Papermill's `-k python3` must resolve to this venv's kernel, never to one of the user's.
+export JUPYTER_PATH := $(CURDIR)/$(VENV)/share/jupyter
+
+.PHONY: help repro test install
+
+help: ## list the targets
+	@grep -E '^[a-z]+:.*## ' $(MAKEFILE_LIST) | sed 's/:.*## /\t/'
+
+$(VENV)/.installed: requirements.lock pyproject.toml
+	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV) || python3 -m venv $(VENV)
+	$(BIN)/python -m pip install --quiet --upgrade pip
+	$(BIN)/python -m pip install --quiet -r requirements.lock
+	$(BIN)/python -m pip install --quiet --no-deps --no-build-isolation -e .
+	$(BIN)/python -m ipykernel install --sys-prefix --name python3 > /dev/null
+	touch $@
+
+install: $(VENV)/.installed ## create .venv and install the pinned dependencies
+
+repro: $(VENV)/.installed ## run the paper-scale pipeline (dvc repro)
+	$(BIN)/dvc repro
+
+test: $(VENV)/.installed ## run the pytest suite (notebooks executed with tiny parameters)
+	$(BIN)/python -m pytest -n 2 --dist loadgroup

@@ -1,0 +1,1 @@
+"""Figure and table helpers shared by the notebooks, and the summary report."""

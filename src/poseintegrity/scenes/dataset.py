@@ -1,0 +1,162 @@
+"""Stage 01: write the robot datasets of Windsor et al. IV-D to disk.
+
+Layout of ``<root>/<dataset>/``: ``meta.json`` (scene, targets, trajectory, intrinsics, board, model pair),
+``frames.parquet`` (one row per image: stop, image, theta_deg, x_mm, file, T_cam_board, T_cam_target as
+row-major 16-float lists), ``model/`` (the two model images and their target masks) and ``images/``.
+A dataset is written into a hidden temporary folder and renamed when complete, so an interrupted run leaves
+nothing that looks finished; ``<root>/index.parquet`` is written last.
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+from dataclasses import dataclass
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pandas as pd
+from joblib import Parallel, delayed
+from tqdm.auto import tqdm
+
+from poseintegrity.scenes import catalog, renderer, trajectories
+from poseintegrity.scenes.camera import Intrinsics, inverse
+from poseintegrity.scenes.params import GenerateParams
+from poseintegrity.scenes.textures import build_atlas
+
+PNG_FLAGS = [cv2.IMWRITE_PNG_COMPRESSION, 3]
+
+
+@dataclass(frozen=True)
+class DatasetPlan:
+    """One dataset to render: ``trajectory`` is "arc" (``azimuth_deg``) or "line" (``offset_deg``)."""
+
+    dataset: str
+    scene_index: int
+    trajectory: str
+    azimuth_deg: float
+    offset_deg: float
+
+
+def plan_datasets(params: GenerateParams) -> list[DatasetPlan]:
+    """Arcs: every scene x every azimuth; lines: every offset on ``lines.scene`` (IV-D)."""
+    plans = [DatasetPlan(f"{spec.name}_arc{az:03.0f}", i, "arc", az, 0.0)
+             for i, spec in enumerate(params.scenes) for az in params.arcs.azimuths_deg]
+    if params.lines is not None:
+        i = [s.name for s in params.scenes].index(params.lines.scene)
+        plans += [DatasetPlan(f"{params.lines.scene}_line{off:02.0f}", i, "line", 0.0, off)
+                  for off in params.lines.offsets_deg]
+    return plans
+
+
+@dataclass(frozen=True)
+class _World:
+    scene: catalog.Scene
+    geometry: renderer.SceneGeometry
+    target_ids: np.ndarray
+
+
+_WORLDS: dict[tuple[str, int], _World] = {}
+
+
+def _world(params: GenerateParams, scene_index: int) -> _World:
+    """The scene and its renderable geometry, built once per process and scene."""
+    key = (params.model_dump_json(), scene_index)
+    if key not in _WORLDS:
+        _WORLDS.clear()
+        _WORLDS[key] = _build_world(params, scene_index)
+    return _WORLDS[key]
+
+
+def _build_world(params: GenerateParams, scene_index: int) -> _World:
+    scene = catalog.build_scene(params.scenes[scene_index], scene_index, params.textures)
+    geometry = renderer.SceneGeometry.from_meshes(scene.placed, build_atlas(scene.textures), scene.light_dir)
+    target_ids = np.array([i for i, name in enumerate(geometry.object_names) if name in scene.target_objects])
+    return _World(scene, geometry, target_ids)
+
+
+def _flat(T: np.ndarray) -> list[float]:
+    return [float(v) for v in T.ravel()]
+
+
+def write_dataset(params: GenerateParams, plan: DatasetPlan, root: Path) -> dict:
+    """Render one dataset into ``root / plan.dataset``; returns its row of the index."""
+    world = _world(params, plan.scene_index)
+    spec = params.scenes[plan.scene_index]
+    cam = Intrinsics.from_params(params.camera)
+    scene = world.scene
+    model_views = trajectories.model_pair(scene.aim, scene.view_dir, spec.distance_mm, params.model_baseline_mm)
+    if plan.trajectory == "arc":
+        stops = trajectories.arc(model_views[0], scene.aim, plan.azimuth_deg, params.arcs.span_deg,
+                                 params.arcs.n_stops)
+    else:
+        stops = trajectories.line(model_views[0], scene.aim, plan.offset_deg, params.lines.step_mm,
+                                  params.lines.n_stops)
+
+    final = root / plan.dataset
+    tmp = root / f".{plan.dataset}.partial"
+    shutil.rmtree(tmp, ignore_errors=True)
+    (tmp / "model").mkdir(parents=True)
+    (tmp / "images").mkdir()
+
+    def shoot(T_world_cam: np.ndarray, rng_key: tuple[int, ...], n: int) -> tuple[renderer.Render, list[np.ndarray]]:
+        frame = renderer.render(world.geometry, cam.K, cam.width, cam.height, inverse(T_world_cam))
+        images = [renderer.expose(frame.radiance, params.sensor, np.random.default_rng([params.seed, *rng_key, i]))
+                  for i in range(n)]
+        return frame, images
+
+    model = {"images": [], "masks": [], "T_cam_board": [], "T_cam_target": []}
+    for k, T_world_cam in enumerate(model_views):
+        # model images depend on the scene only: datasets of one scene share them byte for byte
+        frame, (image,) = shoot(T_world_cam, (plan.scene_index, 1000 + k), 1)
+        mask = np.isin(frame.object_index, world.target_ids).astype(np.uint8) * 255
+        cv2.imwrite(str(tmp / f"model/model_{k}.png"), image, PNG_FLAGS)
+        cv2.imwrite(str(tmp / f"model/mask_{k}.png"), mask, PNG_FLAGS)
+        T_cam_world = inverse(T_world_cam)
+        model["images"].append(f"model/model_{k}.png")
+        model["masks"].append(f"model/mask_{k}.png")
+        model["T_cam_board"].append((T_cam_world @ scene.T_world_board).tolist())
+        model["T_cam_target"].append((T_cam_world @ scene.T_world_target).tolist())
+
+    dataset_index = [p.dataset for p in plan_datasets(params)].index(plan.dataset)
+    rows = []
+    for s, stop in enumerate(stops):
+        _, images = shoot(stop.T_world_cam, (dataset_index, s), params.images_per_stop)
+        T_cam_world = inverse(stop.T_world_cam)
+        for i, image in enumerate(images):
+            file = f"images/s{s:02d}_i{i:02d}.png"
+            cv2.imwrite(str(tmp / file), image, PNG_FLAGS)
+            rows.append({"dataset": plan.dataset, "stop": s, "image": i, "theta_deg": stop.theta_deg,
+                         "x_mm": stop.x_mm, "file": file, "T_cam_board": _flat(T_cam_world @ scene.T_world_board),
+                         "T_cam_target": _flat(T_cam_world @ scene.T_world_target)})
+    pd.DataFrame(rows).to_parquet(tmp / "frames.parquet", index=False)
+    meta = {
+        "dataset": plan.dataset, "scene": spec.name, "targets": list(spec.targets), "trajectory": plan.trajectory,
+        "azimuth_deg": plan.azimuth_deg, "offset_deg": plan.offset_deg, "n_stops": len(stops),
+        "images_per_stop": params.images_per_stop, "image_size": [cam.width, cam.height], "K": cam.K.tolist(),
+        "dist": [0.0] * 5, "board": scene.board.as_dict(), "model": model,
+        "model_baseline_mm": params.model_baseline_mm, "distance_mm": spec.distance_mm,
+    }
+    (tmp / "meta.json").write_text(json.dumps(meta, indent=1))
+    shutil.rmtree(final, ignore_errors=True)
+    tmp.rename(final)
+    return {"dataset": plan.dataset, "scene": spec.name, "trajectory": plan.trajectory,
+            "azimuth_deg": plan.azimuth_deg, "offset_deg": plan.offset_deg, "n_frames": len(rows),
+            "path": f"datasets/{plan.dataset}"}
+
+
+def generate(params: GenerateParams, root: Path, progress: bool = True) -> pd.DataFrame:
+    """Render every planned dataset under ``root`` (in parallel, ``params.n_jobs``); returns and writes the index."""
+    root = Path(root)
+    root.mkdir(parents=True, exist_ok=True)
+    (root / "index.parquet").unlink(missing_ok=True)
+    plans = plan_datasets(params)
+    # datasets of one scene go to the same worker in sequence, so it builds each scene once
+    plans_sorted = sorted(plans, key=lambda p: p.scene_index)
+    jobs = Parallel(n_jobs=params.n_jobs, return_as="generator")(
+        delayed(write_dataset)(params, plan, root) for plan in plans_sorted)
+    rows = list(tqdm(jobs, total=len(plans), desc="datasets", disable=not progress))
+    index = pd.DataFrame(rows).set_index("dataset").loc[[p.dataset for p in plans]].reset_index()
+    index.to_parquet(root / "index.parquet", index=False)
+    return index

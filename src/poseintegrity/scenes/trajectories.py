@@ -1,0 +1,77 @@
+"""Camera poses of the data-collection protocol (Windsor et al., IV-D): the model pair, arcs about the target,
+straight lines away from it. All poses are T_world_cam (4x4, mm); the eye-in-hand camera moves, the scene is still.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from poseintegrity.scenes.camera import look_at
+
+
+@dataclass(frozen=True)
+class Stop:
+    """One robot stop: the camera pose, the viewing-angle change theta from the model view (deg) and the camera
+    translation x from the trajectory start (mm)."""
+
+    T_world_cam: np.ndarray
+    theta_deg: float
+    x_mm: float
+
+
+def model_pair(aim: np.ndarray, view_dir: np.ndarray, distance_mm: float, baseline_mm: float) -> list[np.ndarray]:
+    """The two model-generation views: the camera looking at ``aim`` from ``view_dir``, then translated by
+    ``baseline_mm`` along its own x axis (same orientation)."""
+    T0 = look_at(aim + distance_mm * view_dir, aim)
+    T1 = T0.copy()
+    T1[:3, 3] += baseline_mm * T0[:3, 0]
+    return [T0, T1]
+
+
+def _rotate_about(T_world_cam: np.ndarray, centre: np.ndarray, rotation: Rotation) -> np.ndarray:
+    """The camera pose rotated rigidly about the point ``centre`` (world frame)."""
+    T = np.eye(4)
+    R = rotation.as_matrix()
+    T[:3, :3] = R @ T_world_cam[:3, :3]
+    T[:3, 3] = centre + R @ (T_world_cam[:3, 3] - centre)
+    return T
+
+
+def arc_axis(T_world_cam: np.ndarray, azimuth_deg: float) -> np.ndarray:
+    """Rotation axis of an arc whose camera starts moving along the image direction at ``azimuth_deg``
+    (0 = camera +x, 90 = camera +y, i.e. down in the image); unit (3,) in the world frame.
+
+    The camera centre moves along u = cos(az) x_cam + sin(az) y_cam, so the axis is u x z_cam.
+    """
+    a = np.deg2rad(azimuth_deg)
+    x_cam, y_cam, z_cam = T_world_cam[:3, 0], T_world_cam[:3, 1], T_world_cam[:3, 2]
+    u = np.cos(a) * x_cam + np.sin(a) * y_cam
+    axis = np.cross(u, z_cam)
+    return axis / np.linalg.norm(axis)
+
+
+def arc(T_start: np.ndarray, aim: np.ndarray, azimuth_deg: float, span_deg: float, n_stops: int) -> list[Stop]:
+    """Stops k = 1..n_stops at theta = k * span / n_stops along a circle about ``aim``, camera pointed at ``aim``.
+
+    Rotating the camera rigidly about the aim point keeps it pointed at the target, and the change of camera
+    orientation from the model view is exactly theta.
+    """
+    axis = arc_axis(T_start, azimuth_deg)
+    thetas = span_deg * np.arange(1, n_stops + 1) / n_stops
+    return [Stop(_rotate_about(T_start, aim, Rotation.from_rotvec(np.deg2rad(t) * axis)), float(t), 0.0)
+            for t in thetas]
+
+
+def line(T_model: np.ndarray, aim: np.ndarray, offset_deg: float, step_mm: float, n_stops: int) -> list[Stop]:
+    """Straight line along the camera's -z axis from a start view ``offset_deg`` away from the model view
+    (about the aim point, horizontally); stops at x = k * step_mm, k = 1..n_stops."""
+    start = _rotate_about(T_model, aim, Rotation.from_rotvec(np.deg2rad(offset_deg) * arc_axis(T_model, 0.0)))
+    stops = []
+    for k in range(1, n_stops + 1):
+        T = start.copy()
+        T[:3, 3] -= k * step_mm * start[:3, 2]
+        stops.append(Stop(T, float(offset_deg), float(k * step_mm)))
+    return stops

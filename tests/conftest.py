@@ -1,0 +1,22 @@
+"""Shared fixtures: the repository root and the tiny parameters every notebook test runs with."""
+
+from pathlib import Path
+
+import pytest
+import yaml
+
+from poseintegrity.config import parse_params
+
+ROOT = Path(__file__).resolve().parents[1]
+TINY_PARAMS = ROOT / "tests" / "params_tiny.yaml"
+
+
+@pytest.fixture
+def tiny_raw() -> dict:
+    """tests/params_tiny.yaml as a plain dict, to be altered by a test."""
+    return yaml.safe_load(TINY_PARAMS.read_text())
+
+
+@pytest.fixture
+def tiny_params(tiny_raw):
+    return parse_params(tiny_raw)

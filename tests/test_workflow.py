@@ -1,0 +1,77 @@
+"""The workflow's contracts: output-free notebooks with stable ids and a parameters cell, dvc stages that
+depend on data (never on executed notebooks), params sections validated by config, the two README commands."""
+
+import json
+from pathlib import Path
+
+import pytest
+import yaml
+
+from poseintegrity.config import Params
+
+ROOT = Path(__file__).resolve().parents[1]
+NOTEBOOKS = sorted((ROOT / "notebooks").glob("*.ipynb"))
+DVC = yaml.safe_load((ROOT / "dvc.yaml").read_text())
+
+
+@pytest.mark.parametrize("notebook", NOTEBOOKS, ids=[p.stem for p in NOTEBOOKS])
+def test_source_notebook_is_output_free_with_parameters_cell(notebook):
+    nb = json.loads(notebook.read_text())
+    cells = nb["cells"]
+    for cell in cells:
+        assert cell.get("outputs", []) == [], f"{notebook.name}: cell {cell.get('id')} carries outputs"
+        assert cell.get("execution_count") is None, f"{notebook.name}: cell {cell.get('id')} has an execution count"
+    ids = [cell.get("id") for cell in cells]
+    assert all(ids) and len(set(ids)) == len(ids), "every cell needs a unique, stable id"
+    assert not any(i.count("-") == 4 and len(i) == 36 for i in ids), "ids look random (uuid): keep readable ids"
+    code = [c for c in cells if c["cell_type"] == "code"]
+    assert "parameters" in code[0].get("metadata", {}).get("tags", [])
+    source = "".join(code[0]["source"])
+    for name in ("params_path", "data_dir", "reports_dir"):
+        assert name in source
+    assert nb["metadata"]["kernelspec"]["name"] == "python3"
+
+
+def test_every_notebook_has_a_stage_running_it_with_papermill():
+    stages = DVC["stages"]
+    for notebook in NOTEBOOKS:
+        stage = stages[notebook.stem]
+        assert f"papermill -k python3 --log-level WARNING notebooks/{notebook.name}" in stage["cmd"]
+        assert f"reports/notebooks/{notebook.name}" in stage["cmd"]
+        assert "nbconvert" in stage["cmd"] and "mkdir -p reports/notebooks" in stage["cmd"]
+        assert f"notebooks/{notebook.name}" in stage["deps"]
+
+
+def test_no_stage_depends_on_an_executed_notebook():
+    for name, stage in DVC["stages"].items():
+        assert not any(str(d).startswith("reports/notebooks") for d in stage.get("deps", [])), name
+
+
+def test_stage_params_are_validated_sections():
+    params = yaml.safe_load((ROOT / "params.yaml").read_text())
+    sections = set(Params.model_fields)
+    assert set(params) == sections
+    for name, stage in DVC["stages"].items():
+        for section in stage.get("params", []):
+            assert section in sections, f"{name} tracks unknown params section {section}"
+
+
+def test_tiny_params_cover_every_section():
+    tiny = yaml.safe_load((ROOT / "tests" / "params_tiny.yaml").read_text())
+    assert set(tiny) == set(Params.model_fields)
+
+
+def test_declared_metrics_are_stage_outputs_kept_in_git():
+    outs = {}
+    for stage in DVC["stages"].values():
+        for out in stage.get("outs", []):
+            if isinstance(out, dict):
+                outs.update(out)
+    for metric in DVC["metrics"]:
+        assert outs.get(metric) == {"cache": False}, metric
+
+
+def test_readme_and_ci_use_the_two_commands():
+    readme = (ROOT / "README.md").read_text()
+    assert "make repro" in readme and "make test" in readme
+    assert "make test" in (ROOT / ".ci" / "run").read_text()
