@@ -39,12 +39,13 @@ for scene_index in (0, 2, 4):  # a bone, a block, a bone + block
     rng = np.random.default_rng(0)
     renderer.render(world.geometry, cam.K, cam.width, cam.height, T_cam_world)  # compile / warm up
     frame = renderer.render(world.geometry, cam.K, cam.width, cam.height, T_cam_world)
-    image = renderer.expose(frame.radiance, params.sensor, rng)
+    image = renderer.expose(renderer.optics(frame.radiance, params.sensor), params.sensor, rng)
     H = np.array([[1.02, 0.05, -10], [0.01, 0.98, 5], [1e-5, 2e-5, 1]])
 
     render_ms = median_ms(lambda: renderer.render(world.geometry, cam.K, cam.width, cam.height, T_cam_world), 15)
-    full_ms = median_ms(lambda: renderer.expose(
-        renderer.render(world.geometry, cam.K, cam.width, cam.height, T_cam_world).radiance, params.sensor, rng), 15)
+    full_ms = median_ms(lambda: renderer.expose(renderer.optics(
+        renderer.render(world.geometry, cam.K, cam.width, cam.height, T_cam_world).radiance, params.sensor),
+        params.sensor, rng), 15)
     sift_ms = median_ms(lambda: sift.detectAndCompute(image, None), 7)
     warp_ms = median_ms(lambda: cv2.warpPerspective(image, H, (cam.width, cam.height)), 15)
     print(f"{spec.name} ({'+'.join(spec.targets)}, {len(world.geometry.faces)} triangles, {cam.width}x{cam.height})")

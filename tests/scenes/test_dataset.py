@@ -70,7 +70,7 @@ def test_board_ground_truth_agrees_with_opencv_aruco_pose(tiny_root):
     T_world_cam = trajectories.model_pair(world.scene.aim, world.scene.view_dir, params.scenes[1].distance_mm,
                                           20.0)[0]
     frame = renderer.render(world.geometry, cam.K, cam.width, cam.height, inverse(T_world_cam))
-    image = renderer.expose(frame.radiance, params.sensor, np.random.default_rng(0))
+    image = renderer.expose(renderer.optics(frame.radiance, params.sensor), params.sensor, np.random.default_rng(0))
     board = world.scene.board.board()
     detector = cv2.aruco.ArucoDetector(board.getDictionary(), cv2.aruco.DetectorParameters())
     corners, ids, _ = detector.detectMarkers(image)

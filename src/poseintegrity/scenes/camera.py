@@ -7,10 +7,12 @@ mapping coordinates of frame b into frame a.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from poseintegrity.scenes.params import CameraParams
+if TYPE_CHECKING:
+    from poseintegrity.scenes.params import CameraParams
 
 
 @dataclass(frozen=True)
@@ -25,7 +27,7 @@ class Intrinsics:
     K: np.ndarray
 
     @classmethod
-    def from_params(cls, camera: CameraParams) -> "Intrinsics":
+    def from_params(cls, camera: "CameraParams") -> "Intrinsics":
         """IDS U3-3060CP: f_px = f_mm / pixel pitch (FACTS.md), principal point at the centre, downscaled."""
         scale = 1.0 / camera.downscale
         f_px = camera.lens_mm / (camera.pixel_um * 1e-3) * scale
@@ -47,16 +49,17 @@ def look_at(eye: np.ndarray, target: np.ndarray, up: np.ndarray = np.array([0.0,
     if np.linalg.norm(x) < 1e-9:  # looking straight along `up`: any horizontal x will do
         x = np.cross(z, np.array([0.0, 1.0, 0.0]))
     x = x / np.linalg.norm(x)
-    y = np.cross(z, x)
+    return rigid(np.column_stack([x, np.cross(z, x), z]), eye)
+
+
+def rigid(R: np.ndarray, t) -> np.ndarray:
+    """The 4x4 homogeneous transform with rotation R (3, 3) and translation t (3,)."""
     T = np.eye(4)
-    T[:3, :3] = np.column_stack([x, y, z])
-    T[:3, 3] = eye
+    T[:3, :3] = R
+    T[:3, 3] = t
     return T
 
 
 def inverse(T: np.ndarray) -> np.ndarray:
     """Inverse of a rigid 4x4 transform."""
-    Ti = np.eye(4)
-    Ti[:3, :3] = T[:3, :3].T
-    Ti[:3, 3] = -T[:3, :3].T @ T[:3, 3]
-    return Ti
+    return rigid(T[:3, :3].T, -T[:3, :3].T @ T[:3, 3])

@@ -14,6 +14,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from poseintegrity.scenes import mesh as meshes
+from poseintegrity.scenes.camera import rigid
 from poseintegrity.scenes import textures as tex
 
 if TYPE_CHECKING:
@@ -56,13 +57,6 @@ def target_mesh(name: str) -> meshes.Mesh:
     return meshes.box(BLOCK_SIZE_MM, name, material=meshes.Material(specular=0.08, shininess=30.0))
 
 
-def _pose(R: np.ndarray, t) -> np.ndarray:
-    T = np.eye(4)
-    T[:3, :3] = R
-    T[:3, 3] = t
-    return T
-
-
 @dataclass
 class Scene:
     """A laid-out scene: placed meshes, which of them are targets, the board, the model-view direction.
@@ -103,11 +97,11 @@ def build_scene(spec: "SceneSpec", index: int, texture_overrides: dict | None = 
             R = np.column_stack([x, np.cross(z, x), z])
             centre = side + np.array([0.0, 0.0, 95.0])
             placed.append((f"{name}_stand", meshes.cylinder(9.0, 95.0 - 25.0, "clutter_c").transformed(
-                _pose(np.eye(3), side))))
+                rigid(np.eye(3), side))))
         else:
             R = Rotation.from_euler("z", yaw + rng.uniform(-0.6, 0.6)).as_matrix()
             centre = side + np.array([0.0, 0.0, BLOCK_SIZE_MM[2] / 2])
-        T = _pose(R, centre)
+        T = rigid(R, centre)
         target_poses.append(T)
         placed.append((name, target_mesh(name).transformed(T)))
     aim = np.mean([T[:3, 3] for T in target_poses], axis=0)
@@ -122,11 +116,11 @@ def build_scene(spec: "SceneSpec", index: int, texture_overrides: dict | None = 
     board_centre = target_poses[0][:2, 3] - 112.0 * np.array([np.cos(yaw), np.sin(yaw)]) + 20.0 * view_dir[
         :2] / np.linalg.norm(view_dir[:2])
     origin = np.append(board_centre, 0.4) - R_world_board @ np.array([bw / 2, bh / 2, 0.0])
-    T_world_board = _pose(R_world_board, origin)
+    T_world_board = rigid(R_world_board, origin)
     m = board.margin_mm
     # plane() faces +z with texture v along -y; flip about x so it faces -z (the board's printed side) with v along +y
     board_mesh = meshes.plane(bw + 2 * m, bh + 2 * m, 12, 9, "aruco_board", material=meshes.Material(0.02, 10.0))
-    board_mesh = board_mesh.transformed(_pose(np.diag([1.0, -1.0, -1.0]), [bw / 2, bh / 2, 0.0]))
+    board_mesh = board_mesh.transformed(rigid(np.diag([1.0, -1.0, -1.0]), [bw / 2, bh / 2, 0.0]))
     placed.append(("aruco_board", board_mesh.transformed(T_world_board)))
 
     # clutter: boxes and cylinders around, off the line of sight of the model view and off the board
@@ -148,10 +142,10 @@ def build_scene(spec: "SceneSpec", index: int, texture_overrides: dict | None = 
         if rng.random() < 0.5:
             size = (2 * radius, rng.uniform(0.5, 1.5) * radius, rng.uniform(25, 140))
             obj = meshes.box(size, texture, n_sub=4)
-            T = _pose(Rotation.from_euler("z", rng.uniform(0, np.pi)).as_matrix(), [*xy, size[2] / 2])
+            T = rigid(Rotation.from_euler("z", rng.uniform(0, np.pi)).as_matrix(), [*xy, size[2] / 2])
         else:
             obj = meshes.cylinder(0.8 * radius, rng.uniform(40, 160), texture, n_seg=40)
-            T = _pose(np.eye(3), [*xy, 0.0])
+            T = rigid(np.eye(3), [*xy, 0.0])
         placed.append((f"clutter_{n_placed}", obj.transformed(T)))
         n_placed += 1
 

@@ -102,7 +102,8 @@ def write_dataset(params: GenerateParams, plan: DatasetPlan, root: Path) -> dict
 
     def shoot(T_world_cam: np.ndarray, rng_key: tuple[int, ...], n: int) -> tuple[renderer.Render, list[np.ndarray]]:
         frame = renderer.render(world.geometry, cam.K, cam.width, cam.height, inverse(T_world_cam))
-        images = [renderer.expose(frame.radiance, params.sensor, np.random.default_rng([params.seed, *rng_key, i]))
+        irradiance = renderer.optics(frame.radiance, params.sensor)  # the robot is still: one optical image
+        images = [renderer.expose(irradiance, params.sensor, np.random.default_rng([params.seed, *rng_key, i]))
                   for i in range(n)]
         return frame, images
 

@@ -11,6 +11,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from poseintegrity.scenes.camera import rigid
+
 
 @dataclass(frozen=True)
 class Material:
@@ -90,13 +92,6 @@ def merge(meshes: list[Mesh]) -> Mesh:
     )
 
 
-def _pose(R: np.ndarray, t) -> np.ndarray:
-    T = np.eye(4)
-    T[:3, :3] = R
-    T[:3, 3] = t
-    return T
-
-
 def box(size: tuple[float, float, float], texture: str, n_sub: int = 6, material: Material = Material()) -> Mesh:
     """A box centred on the origin with flat-shaded faces; each face shows its own sixth of the texture.
 
@@ -117,7 +112,7 @@ def box(size: tuple[float, float, float], texture: str, n_sub: int = 6, material
         R, (a, b), d = rot[name]
         u0, v0 = (k % 3) / 3, (k // 3) / 2
         face = plane(a, b, n_sub, n_sub, texture, (u0, v0, u0 + 1 / 3, v0 + 1 / 2), material)
-        faces.append(face.transformed(_pose(R, R @ [0, 0, d])))
+        faces.append(face.transformed(rigid(R, R @ [0, 0, d])))
     return merge(faces)
 
 

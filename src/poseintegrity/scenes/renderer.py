@@ -1,6 +1,6 @@
 """A small software renderer: perspective z-buffer rasterisation of textured triangle meshes, trilinear
 mip-mapped texture sampling, Gouraud-interpolated Lambert + Blinn-Phong shading under a light on the camera (ring light) and a
-light fixed to the scene, then the sensor: exposure, illumination flicker, optical blur, shot and read noise.
+light fixed to the scene, then the optics (blur) and the sensor: exposure, illumination flicker, shot and read noise.
 
 Two passes (deferred shading): :func:`_rasterize` keeps, per pixel, the nearest triangle and its
 perspective-correct barycentric coordinates; :func:`_shade` then shades each pixel once, with the light
@@ -216,16 +216,27 @@ def render(scene: SceneGeometry, K: np.ndarray, width: int, height: int, T_cam_w
     return Render(radiance, object_index, depth_mm)
 
 
-def expose(radiance: np.ndarray, sensor: SensorParams, rng: np.random.Generator) -> np.ndarray:
-    """The sensor: (h, w) radiance -> (h, w) uint8 image.
+def optics(radiance: np.ndarray, sensor: SensorParams) -> np.ndarray:
+    """The lens: (h, w) radiance -> (h, w) irradiance on the sensor, blurred by a Gaussian of the sensor's sigma.
 
-    DN = exposure x flicker gain x radiance, blurred by the optics (Gaussian), plus Gaussian noise of variance
-    read_noise^2 + shot_noise x DN (the Poisson-Gaussian model of a CMOS sensor), rounded and clipped to 8 bit.
+    Done once per robot stop: blur is linear and flicker is a scalar gain, so the two commute.
+    """
+    if sensor.blur_sigma_px <= 0:
+        return radiance
+    return cv2.GaussianBlur(radiance, (0, 0), sensor.blur_sigma_px)
+
+
+def expose(irradiance: np.ndarray, sensor: SensorParams, rng: np.random.Generator) -> np.ndarray:
+    """The sensor: (h, w) irradiance -> (h, w) uint8 image.
+
+    DN = exposure x flicker gain x irradiance, plus Gaussian noise of variance read_noise^2 + shot_noise x DN
+    (the Poisson-Gaussian model of a CMOS sensor), rounded and clipped to 8 bit.
     """
     gain = sensor.exposure * (1.0 + sensor.flicker * rng.standard_normal())
-    dn = radiance * np.float32(gain)
-    if sensor.blur_sigma_px > 0:
-        dn = cv2.GaussianBlur(dn, (0, 0), sensor.blur_sigma_px)
-    sigma = np.sqrt(sensor.read_noise_dn**2 + sensor.shot_noise_dn_per_dn * np.maximum(dn, 0))
-    dn = dn + sigma * rng.standard_normal(dn.shape, dtype=np.float32)
-    return np.clip(np.rint(dn), 0, 255).astype(np.uint8)
+    dn = irradiance * np.float32(gain)
+    noise = rng.standard_normal(dn.shape, dtype=np.float32)
+    noise *= np.sqrt(np.float32(sensor.read_noise_dn**2) + np.float32(sensor.shot_noise_dn_per_dn) * np.maximum(dn, 0))
+    dn += noise
+    np.rint(dn, out=dn)
+    np.clip(dn, 0, 255, out=dn)
+    return dn.astype(np.uint8)

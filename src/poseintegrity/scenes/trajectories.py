@@ -9,7 +9,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from poseintegrity.scenes.camera import look_at
+from poseintegrity.scenes.camera import look_at, rigid
 
 
 @dataclass(frozen=True)
@@ -33,11 +33,8 @@ def model_pair(aim: np.ndarray, view_dir: np.ndarray, distance_mm: float, baseli
 
 def _rotate_about(T_world_cam: np.ndarray, centre: np.ndarray, rotation: Rotation) -> np.ndarray:
     """The camera pose rotated rigidly about the point ``centre`` (world frame)."""
-    T = np.eye(4)
     R = rotation.as_matrix()
-    T[:3, :3] = R @ T_world_cam[:3, :3]
-    T[:3, 3] = centre + R @ (T_world_cam[:3, 3] - centre)
-    return T
+    return rigid(R @ T_world_cam[:3, :3], centre + R @ (T_world_cam[:3, 3] - centre))
 
 
 def arc_axis(T_world_cam: np.ndarray, azimuth_deg: float) -> np.ndarray:
