@@ -7,7 +7,15 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 NOTEBOOKS = sorted((ROOT / "notebooks").glob("*.ipynb"))
-METRICS = {"01_generate_datasets": "generate.json", "07_report": None}
+METRICS = {  # notebook -> the metrics file it must write
+    "01_generate_datasets": "generate.json",
+    "02_extract_artifacts": "artifacts.json",
+    "03_fit_artifact_models": "fits.json",
+    "04_predictor_sweeps": "predictors.json",
+    "05_pnp_variants": "pnp.json",
+    "06_marker_tracking": "tracking.json",
+    "07_report": None,
+}
 
 
 @pytest.fixture(scope="module")
@@ -26,7 +34,7 @@ def test_notebook_runs_with_tiny_params(notebook, workdir):
         parameters={"params_path": str(ROOT / "tests" / "params_tiny.yaml"), "data_dir": str(workdir / "data"),
                     "reports_dir": str(workdir / "reports")},
     )
-    metrics = METRICS.get(notebook.stem, f"{notebook.stem.split('_', 1)[1]}.json")
+    metrics = METRICS[notebook.stem]
     if metrics:
         assert (workdir / "reports" / "metrics" / metrics).is_file()
     if notebook.stem == "07_report":

@@ -13,7 +13,11 @@ from typing import Any
 import yaml
 from pydantic import BaseModel, ConfigDict, ValidationError
 
+from poseintegrity.artifacts.params import FitParams
+from poseintegrity.localization.params import ExtractParams
+from poseintegrity.prediction.params import PredictParams
 from poseintegrity.scenes.params import GenerateParams
+from poseintegrity.tracking.params import TrackParams
 
 
 class ParamsError(ValueError):
@@ -25,13 +29,17 @@ class Params(BaseModel):
 
     model_config = ConfigDict(extra="forbid", frozen=True)
 
-    generate: GenerateParams
+    generate: GenerateParams  # stage 01
+    extract: ExtractParams  # stages 02 and 05
+    fit: FitParams  # stage 03
+    predict: PredictParams  # stage 04
+    track: TrackParams  # stage 06
 
 
-def _format_errors(error: ValidationError) -> str:
+def _format_errors(error: ValidationError, prefix: tuple = ()) -> str:
     lines = []
     for item in error.errors():
-        key = ".".join(str(part) for part in item["loc"]) or "<root>"
+        key = ".".join(str(part) for part in (*prefix, *item["loc"])) or "<root>"
         lines.append(f"  {key}: {item['msg']} (got {item.get('input')!r:.80})")
     return "\n".join(lines)
 
@@ -46,13 +54,29 @@ def parse_params(raw: dict[str, Any], source: str = "params") -> Params:
         raise ParamsError(f"{source} has invalid values:\n{_format_errors(error)}") from None
 
 
-def load_params(path: str | Path = "params.yaml") -> Params:
-    """Read and validate a params file (``params.yaml`` or the tiny test variant)."""
-    path = Path(path)
+def _read(path: Path) -> Any:
     try:
-        raw = yaml.safe_load(path.read_text())
+        return yaml.safe_load(path.read_text())
     except OSError as error:
         raise ParamsError(f"cannot read params file {path}: {error.strerror}") from None
     except yaml.YAMLError as error:
         raise ParamsError(f"{path} is not valid YAML: {error}") from None
-    return parse_params(raw, source=str(path))
+
+
+def load_params(path: str | Path = "params.yaml") -> Params:
+    """Read and validate a whole params file (``params.yaml`` or the tiny test variant)."""
+    return parse_params(_read(Path(path)), source=str(path))
+
+
+def load_section(path: str | Path, section: str) -> BaseModel:
+    """Read and validate one stage's section only: a stage is not stopped by another stage's bad values
+    (DVC tracks each stage's own section too)."""
+    if section not in Params.model_fields:
+        raise ParamsError(f"unknown params section {section!r}; sections: {list(Params.model_fields)}")
+    raw = _read(Path(path))
+    if not isinstance(raw, dict) or section not in raw:
+        raise ParamsError(f"{path}: section {section!r} is missing")
+    try:
+        return Params.model_fields[section].annotation.model_validate(raw[section])
+    except ValidationError as error:
+        raise ParamsError(f"{path} has invalid values:\n{_format_errors(error, (section,))}") from None

@@ -38,6 +38,15 @@ class Intrinsics:
         return cls(width, height, K)
 
 
+def defocus_sigma_px(depth_mm: float, focus_mm: float, camera: "CameraParams") -> float:
+    """Gaussian sigma (rendered pixels) of the defocus blur of a point at ``depth_mm`` when the lens is focused
+    at ``focus_mm``: the thin-lens circle of confusion c = f^2 / N * |d - d_f| / (d (d_f - f)), taken as a
+    Gaussian of sigma c / 2 (the lens is focused once, at the model view, and never refocused)."""
+    f = camera.lens_mm
+    c_mm = f**2 / camera.f_number * abs(depth_mm - focus_mm) / (depth_mm * (focus_mm - f))
+    return 0.5 * c_mm / (camera.pixel_um * 1e-3) / camera.downscale
+
+
 def look_at(eye: np.ndarray, target: np.ndarray, up: np.ndarray = np.array([0.0, 0.0, 1.0])) -> np.ndarray:
     """T_world_cam of a camera at ``eye`` whose optical axis points at ``target``; image "up" is towards ``up``.
 

@@ -21,7 +21,7 @@ from joblib import Parallel, delayed
 from tqdm.auto import tqdm
 
 from poseintegrity.scenes import catalog, renderer, trajectories
-from poseintegrity.scenes.camera import Intrinsics, inverse
+from poseintegrity.scenes.camera import Intrinsics, defocus_sigma_px, inverse
 from poseintegrity.scenes.params import GenerateParams
 from poseintegrity.scenes.textures import build_atlas
 
@@ -86,7 +86,9 @@ def write_dataset(params: GenerateParams, plan: DatasetPlan, root: Path) -> dict
     spec = params.scenes[plan.scene_index]
     cam = Intrinsics.from_params(params.camera)
     scene = world.scene
-    model_views = trajectories.model_pair(scene.aim, scene.view_dir, spec.distance_mm, params.model_baseline_mm)
+    # the straight lines have their own model pair (IV-D), closer to the target: the robot backs away from it
+    distance_mm = spec.distance_mm if plan.trajectory == "arc" else params.lines.distance_mm
+    model_views = trajectories.model_pair(scene.aim, scene.view_dir, distance_mm, params.model_baseline_mm)
     if plan.trajectory == "arc":
         stops = trajectories.arc(model_views[0], scene.aim, plan.azimuth_deg, params.arcs.span_deg,
                                  params.arcs.n_stops)
@@ -101,16 +103,19 @@ def write_dataset(params: GenerateParams, plan: DatasetPlan, root: Path) -> dict
     (tmp / "images").mkdir()
 
     def shoot(T_world_cam: np.ndarray, rng_key: tuple[int, ...], n: int) -> tuple[renderer.Render, list[np.ndarray]]:
-        frame = renderer.render(world.geometry, cam.K, cam.width, cam.height, inverse(T_world_cam))
-        irradiance = renderer.optics(frame.radiance, params.sensor)  # the robot is still: one optical image
+        T_cam_world = inverse(T_world_cam)
+        frame = renderer.render(world.geometry, cam.K, cam.width, cam.height, T_cam_world)
+        depth_mm = (T_cam_world[:3, :3] @ scene.aim + T_cam_world[:3, 3])[2]
+        defocus = defocus_sigma_px(depth_mm, distance_mm, params.camera)  # focused at the model view
+        irradiance = renderer.optics(frame.radiance, params.sensor, defocus)  # the robot is still: one image
         images = [renderer.expose(irradiance, params.sensor, np.random.default_rng([params.seed, *rng_key, i]))
                   for i in range(n)]
         return frame, images
 
     model = {"images": [], "masks": [], "T_cam_board": [], "T_cam_target": []}
     for k, T_world_cam in enumerate(model_views):
-        # model images depend on the scene only: datasets of one scene share them byte for byte
-        frame, (image,) = shoot(T_world_cam, (plan.scene_index, 1000 + k), 1)
+        # model images depend on the scene and trajectory kind only: datasets sharing them share them byte for byte
+        frame, (image,) = shoot(T_world_cam, (plan.scene_index, 1000 + k + 10 * (plan.trajectory == "line")), 1)
         mask = np.isin(frame.object_index, world.target_ids).astype(np.uint8) * 255
         cv2.imwrite(str(tmp / f"model/model_{k}.png"), image, PNG_FLAGS)
         cv2.imwrite(str(tmp / f"model/mask_{k}.png"), mask, PNG_FLAGS)
@@ -137,7 +142,7 @@ def write_dataset(params: GenerateParams, plan: DatasetPlan, root: Path) -> dict
         "azimuth_deg": plan.azimuth_deg, "offset_deg": plan.offset_deg, "n_stops": len(stops),
         "images_per_stop": params.images_per_stop, "image_size": [cam.width, cam.height], "K": cam.K.tolist(),
         "dist": [0.0] * 5, "board": scene.board.as_dict(), "model": model,
-        "model_baseline_mm": params.model_baseline_mm, "distance_mm": spec.distance_mm,
+        "model_baseline_mm": params.model_baseline_mm, "distance_mm": distance_mm,
     }
     (tmp / "meta.json").write_text(json.dumps(meta, indent=1))
     shutil.rmtree(final, ignore_errors=True)

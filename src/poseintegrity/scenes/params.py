@@ -23,6 +23,7 @@ class CameraParams(BaseModel):
     pixel_um: float = Field(5.86, gt=0)
     lens_mm: float = Field(12.0, gt=0, description="focal length of the (unpublished) lens; ours")
     downscale: PositiveInt = Field(2, description="images are rendered at sensor size / downscale")
+    f_number: float = Field(4.0, gt=0, description="aperture; sets the depth of field (focus at the model view)")
 
 
 class SensorParams(BaseModel):
@@ -71,6 +72,7 @@ class LineParams(BaseModel):
 
     model_config = _frozen
     scene: str = Field("scene_2", description="scene holding the drilled bone-like target")
+    distance_mm: float = Field(220.0, gt=50, description="camera to target centre at the lines' own model pair")
     offsets_deg: list[float] = Field(default=[0.0, 5.0, 10.0, 15.0])
     n_stops: PositiveInt = 15
     step_mm: float = Field(10.0, gt=0)

@@ -216,14 +216,17 @@ def render(scene: SceneGeometry, K: np.ndarray, width: int, height: int, T_cam_w
     return Render(radiance, object_index, depth_mm)
 
 
-def optics(radiance: np.ndarray, sensor: SensorParams) -> np.ndarray:
-    """The lens: (h, w) radiance -> (h, w) irradiance on the sensor, blurred by a Gaussian of the sensor's sigma.
+def optics(radiance: np.ndarray, sensor: SensorParams, defocus_sigma_px: float = 0.0) -> np.ndarray:
+    """The lens: (h, w) radiance -> (h, w) irradiance on the sensor, blurred by a Gaussian combining the lens'
+    own blur and the defocus of the target's depth (one sigma for the whole frame: the scene's objects of
+    interest lie near the target's depth).
 
     Done once per robot stop: blur is linear and flicker is a scalar gain, so the two commute.
     """
-    if sensor.blur_sigma_px <= 0:
+    sigma = float(np.hypot(sensor.blur_sigma_px, defocus_sigma_px))
+    if sigma <= 0:
         return radiance
-    return cv2.GaussianBlur(radiance, (0, 0), sensor.blur_sigma_px)
+    return cv2.GaussianBlur(radiance, (0, 0), sigma)
 
 
 def expose(irradiance: np.ndarray, sensor: SensorParams, rng: np.random.Generator) -> np.ndarray:

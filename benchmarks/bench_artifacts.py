@@ -1,0 +1,103 @@
+"""Speed of stage 03 (artifact models), as ratios against references measured in the same run.
+
+    1. one EMG fit (eq. 1) on 4 stops x 10 images          target: median <= 5 ms
+       reference: a plain curve_fit of alpha * scipy.stats.exponnorm.pdf(theta - mu, K) (lm, no bounds)
+    2. the MLP recipes (pretrain + fine-tune; scratch)      target: pretrained <= 2 s
+       reference: a 500 x 500 float64 numpy matmul
+    3. the whole Fig. 2 experiment at paper scale           target: <= 5 min on 2 cores
+       (21 arcs + 4 lines of synthetic eq. 1 data, k = 3 .. all, all models, n_jobs from params)
+
+Usage: PYTHONPATH=src .venv/bin/python benchmarks/bench_artifacts.py [--params params.yaml] [--skip-stage]
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+import yaml
+from joblib import effective_n_jobs
+from scipy.optimize import curve_fit
+from scipy.stats import exponnorm
+
+from poseintegrity.artifacts import EMG, FitParams, emg, fig2_rmse, fit_mlp, fits_metrics
+from poseintegrity.artifacts.synthetic import synthetic_artifacts
+
+
+def paired_medians(reference: Callable[[], object], subject: Callable[[], object], repeats: int) -> tuple[float, float]:
+    """Median seconds of reference and subject, timed alternately so that both see the same machine load."""
+    times = np.empty((repeats, 2))
+    for i in range(repeats):
+        for j, fn in enumerate((reference, subject)):
+            start = time.perf_counter()
+            fn()
+            times[i, j] = time.perf_counter() - start
+    return float(np.median(times[:, 0])), float(np.median(times[:, 1]))
+
+
+def report(label: str, seconds: float, reference: float, target: float | None = None) -> None:
+    verdict = "" if target is None else ("  [meets target]" if seconds <= target else "  [MISSES target]")
+    print(f"  {label:<42s} {seconds * 1e3:10.2f} ms   {seconds / reference:8.2f} x reference{verdict}")
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--params", type=Path, default=Path("params.yaml"), help="YAML file with a `fit` section")
+    parser.add_argument("--skip-stage", action="store_true", help="skip the paper-scale stage run (3)")
+    args = parser.parse_args()
+    params = FitParams.model_validate(yaml.safe_load(args.params.read_text())["fit"])
+    rng = np.random.default_rng(0)
+
+    theta = np.repeat(2.25 * np.arange(1, 5), 10)  # 4 stops x 10 images, deg
+    f = emg(theta, 3000.0, 9.0, 1.0)
+    n = np.maximum(np.round(f + rng.normal(0.0, 2.0 + 0.1 * f)), 0.0)
+    p0 = EMG.initial_guess(theta, n)[0]
+
+    def scipy_reference() -> None:
+        curve_fit(lambda t, alpha, K, mu: alpha * exponnorm.pdf(t - mu, K), theta, n, p0=p0)
+
+    print("1. EMG fit, 4 stops x 10 images")
+    reference, seconds = paired_medians(scipy_reference, lambda: EMG.fit(theta, n, params.max_nfev), 200)
+    report("reference: curve_fit(alpha * exponnorm.pdf)", reference, reference)
+    report("EMG.fit (bounded trf, analytic Jacobian)", seconds, reference, 5e-3)
+
+    print("2. MLP recipes, 4 stops x 10 images (params.fit.mlp)")
+    a, b = rng.random((500, 500)), rng.random((500, 500))
+    for pretrain, target in ((True, 2.0), (False, None)):
+        reference, seconds = paired_medians(
+            lambda: a @ b,
+            lambda: fit_mlp(theta, n, theta_max=params.theta_max_deg, mlp=params.mlp, rng=rng, pretrain=pretrain),
+            7,
+        )
+        report("reference: 500 x 500 numpy matmul", reference, reference)
+        report("mlp_pretrained (pretrain + fine-tune)" if pretrain else "mlp_scratch", seconds, reference, target)
+
+    if args.skip_stage:
+        return
+    print(f"3. Fig. 2 experiment at paper scale (21 arcs + 4 lines, n_jobs = {params.n_jobs})")
+    artifacts, _ = synthetic_artifacts(np.random.default_rng(1), n_arcs=21, n_lines=4)
+    reference = paired_medians(scipy_reference, scipy_reference, 50)[0]
+    # CPU seconds of one arc and one line dataset run serially: a load-independent estimate of the stage
+    sample = artifacts[artifacts.dataset.isin(["arc_00", "line_00"])]
+    cpu_start = time.process_time()
+    sample_table = fig2_rmse(sample, params.model_copy(update={"n_jobs": 1}), progress=False)
+    cpu_per_fit = (time.process_time() - cpu_start) / len(sample_table)
+    start = time.perf_counter()
+    table = fig2_rmse(artifacts, params, progress=False)
+    seconds = time.perf_counter() - start
+    workers = effective_n_jobs(params.n_jobs)
+    estimate = cpu_per_fit * len(table) / workers
+    print(f"  {len(table)} fits in {seconds:.1f} s wall = {seconds / reference:.0f} x the curve_fit reference  "
+          f"[{'meets' if seconds <= 300 else 'MISSES'} target 300 s]")  # fmt: skip
+    print(f"  CPU-time estimate on {workers} free cores: {estimate:.0f} s "
+          f"({cpu_per_fit * 1e3:.0f} ms CPU per fit, from a serial run of 2 datasets)")  # fmt: skip
+    metrics = fits_metrics(table, params)
+    print("  mean RMSE at k = 4 (arcs):", {k: round(v, 1) for k, v in metrics[f"rmse_k{params.k_report_arc}"].items()})
+    print("  converged fraction:", {k: round(v, 4) for k, v in metrics["converged"].items()})
+
+
+if __name__ == "__main__":
+    main()

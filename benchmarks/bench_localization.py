@@ -1,0 +1,108 @@
+"""Speed of the localization pipeline as ratios against SIFT detectAndCompute on the same frame (one run).
+
+Figures of issue 3:
+- per frame, CLAHE + SIFT + matching + PnP-RANSAC (USAC) <= 1.3 x SIFT detectAndCompute alone;
+- each extra PnP method of stage 05 (features and matches reused) <= 0.10 x SIFT.
+Frames: five stops spread evenly along the first arc dataset in ``data_dir`` (stage 01 output), or, without
+rendered data, the synthetic scene of the tests. OpenCV runs single-threaded (one joblib worker per core).
+
+    PYTHONPATH=src .venv/bin/python benchmarks/bench_localization.py [--data-dir data] [--repeats 5]
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+from poseintegrity.localization.dataset import load_dataset, load_index
+from poseintegrity.localization.extract import correspondences, dataset_model, localize
+from poseintegrity.localization.features import detect_features, read_gray
+from poseintegrity.localization.ground_truth import board_pose, make_board
+from poseintegrity.localization.params import ExtractParams
+from poseintegrity.localization.pnp import CLASSIC_FLAGS
+
+
+def interleaved_seconds(functions: dict, repeats: int) -> dict[str, float]:
+    """Median time of each function, measured in interleaved rounds (the machine is shared and noisy)."""
+    times = {name: [] for name in functions}
+    for _ in range(repeats):
+        for name, function in functions.items():
+            start = time.perf_counter()
+            function()
+            times[name].append(time.perf_counter() - start)
+    return {name: float(np.median(values)) for name, values in times.items()}
+
+
+def arc_dataset(data_dir: Path):
+    """The first arc dataset of data_dir, or a synthetic one written to a temporary folder."""
+    try:
+        index = load_index(data_dir)
+        row = index[index["trajectory"] == "arc"].iloc[0]
+        return load_dataset(data_dir, row["path"]), data_dir
+    except FileNotFoundError:
+        sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "localization"))
+        import loc_synthetic  # noqa: PLC0415 (test helper, only without rendered data)
+
+        tmp = Path(tempfile.mkdtemp())
+        stops = tuple(np.linspace(5.0, 50.0, 10))
+        loc_synthetic.write_index(tmp, [loc_synthetic.write_dataset(tmp, "synthetic", np.random.default_rng(0), stops=stops)])
+        print(f"no datasets in {data_dir}: synthetic 640 x 400 scene instead")
+        return load_dataset(tmp, "datasets/synthetic"), tmp
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--data-dir", type=Path, default=Path("data"))
+    parser.add_argument("--repeats", type=int, default=9)
+    args = parser.parse_args()
+    cv2.setNumThreads(1)
+    params = ExtractParams()
+    dataset, data_dir = arc_dataset(args.data_dir)
+    with tempfile.TemporaryDirectory() as cache:
+        model = dataset_model(dataset, params, Path(cache))
+    board = make_board(dataset.meta["board"])
+    sift = cv2.SIFT_create()
+    stops = sorted(dataset.frames["stop"].unique())
+    print(f"dataset {dataset.name}: model size {model.size}, image {dataset.meta['image_size']}")
+    header = f"{'stop':>4} {'theta':>6} {'kp':>5} {'match':>5} {'n_i':>4} {'SIFT ms':>8} {'pipeline/SIFT':>13} " + " ".join(
+        f"{m:>9}" for m in CLASSIC_FLAGS
+    ) + f" {'board':>6}"
+    print(header)
+    ratios, extra = [], {m: [] for m in CLASSIC_FLAGS}
+    for stop in [stops[i] for i in np.linspace(0, len(stops) - 1, 5).round().astype(int)]:
+        frame = dataset.frames[dataset.frames["stop"] == stop].iloc[0]
+        image = read_gray(dataset.path(frame["file"]))
+
+        def pipeline(method: str = "usac_magsac"):
+            features = detect_features(image, params.clahe, params.sift)
+            X, x = correspondences(features, model, params.ratio_test)
+            return localize(X, x, features.n_keypoints, model.size, dataset.K, method, params, seed=1)
+
+        features = detect_features(image, params.clahe, params.sift)
+        X, x = correspondences(features, model, params.ratio_test)
+        functions = {"sift": lambda: sift.detectAndCompute(image, None), "pipeline": pipeline}
+        functions |= {m: lambda m=m: localize(X, x, features.n_keypoints, model.size, dataset.K, m, params, 1)
+                      for m in CLASSIC_FLAGS}
+        functions["board"] = lambda: board_pose(image, board, dataset.K)
+        seconds = interleaved_seconds(functions, args.repeats)
+        t_sift, t_pipeline, t_board = seconds["sift"], seconds["pipeline"], seconds["board"]
+        t_methods = {m: seconds[m] for m in CLASSIC_FLAGS}
+        n_i = pipeline()[1]["n_inliers"]
+        ratios.append(t_pipeline / t_sift)
+        for m in CLASSIC_FLAGS:
+            extra[m].append(t_methods[m] / t_sift)
+        print(f"{stop:>4} {frame['theta_deg']:>6.2f} {features.n_keypoints:>5} {len(x):>5} {n_i:>4} {1e3 * t_sift:>8.1f} "
+              f"{t_pipeline / t_sift:>13.2f} " + " ".join(f"{t_methods[m] / t_sift:>9.3f}" for m in CLASSIC_FLAGS)
+              + f" {t_board / t_sift:>6.3f}")
+    print(f"mean pipeline / SIFT: {np.mean(ratios):.2f} (target <= 1.3)")
+    print("mean extra method / SIFT: " + ", ".join(f"{m} {np.mean(v):.3f}" for m, v in extra.items()) + " (target <= 0.10)")
+
+
+if __name__ == "__main__":
+    main()

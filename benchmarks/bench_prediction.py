@@ -1,0 +1,127 @@
+"""Speed of stage 04 (predictor sweeps), as ratios against references measured in the same run.
+
+    1. theta_p for all 97 thresholds from one fitted EMG             (vectorized scan + bisection)
+       reference: artifacts.envelope_boundary called once per threshold (scan + brentq each)
+    2. the whole n_t sweep at paper scale                             target: <= 60 s on this machine
+       (21 arcs + 4 lines of synthetic eq. 1 data x 10 images per stop, 6 PnP methods; long range,
+       its lower-bound variant, MLP and next-step on the paper's path, long range + static on the others)
+       reference: the same datasets' long range predictor with the per-threshold reference of 1.
+
+Usage: PYTHONPATH=src .venv/bin/python benchmarks/bench_prediction.py [--params params.yaml]
+(the ``fit`` and ``predict`` sections of --params; the paper-scale ones below when a section is missing)
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+from poseintegrity.artifacts import FitParams, emg, envelope_boundary, fit_model
+from poseintegrity.artifacts.fig2 import dataset_series
+from poseintegrity.artifacts.synthetic import synthetic_artifacts
+from poseintegrity.prediction import PredictParams, boundaries, sweep
+
+PAPER_SECTIONS = yaml.safe_load(
+    """
+fit:
+  pnp_method: usac_magsac
+  models: [emg, mlp_pretrained]
+  k_min: 3
+  k_max: null
+  k_report_arc: 4
+  k_report_line: 5
+  theta_max_deg: 45.0
+  x_max_mm: 150.0
+  max_nfev: 400
+  seed: 20240
+  n_jobs: 2
+  mlp: {hidden_layers: 3, hidden_units: 10, max_iter_scratch: 300, max_iter_pretrain: 100, max_iter_finetune: 20,
+        tolerance_change: 1.0e-12, n_pretrain_points: 100, n_artificial: 10}
+predict:
+  pnp_method: usac_magsac
+  n_t_min: 4
+  n_t_max: 100
+  long_range_stops_arc: 4
+  long_range_stops_line: 5
+  next_step_first_stops: 4
+  static_max_deg: 45.0
+  static_max_mm: 150.0
+  n_static: 181
+  tolerance_fig6_fig7: 2mm_3deg
+  n_grid: 256
+  models: {long_range: emg, next_step: emg, mlp: mlp_pretrained}
+  live_n_t: 15
+  live_tolerance: 4mm_10deg
+  loso_target_rates: [0.0, 0.05]
+  uncertainty: {method: covariance, level: 0.9, n_bootstrap: 50}
+  seed: 20241
+  n_jobs: 2
+"""
+)
+METHODS = ("usac_magsac", "epnp", "p3p", "ap3p", "sqpnp", "iterative")
+
+
+def paired_medians(reference: Callable[[], object], subject: Callable[[], object], repeats: int) -> tuple[float, float]:
+    """Median seconds of reference and subject, timed alternately so that both see the same machine load."""
+    times = np.empty((repeats, 2))
+    for i in range(repeats):
+        for j, fn in enumerate((reference, subject)):
+            start = time.perf_counter()
+            fn()
+            times[i, j] = time.perf_counter() - start
+    return float(np.median(times[:, 0])), float(np.median(times[:, 1]))
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--params", type=Path, default=Path("params.yaml"))
+    args = parser.parse_args()
+    raw = yaml.safe_load(args.params.read_text()) if args.params.exists() else {}
+    fit = FitParams.model_validate(raw.get("fit", PAPER_SECTIONS["fit"]))
+    predict = PredictParams.model_validate(raw.get("predict", PAPER_SECTIONS["predict"]))
+    n_t = predict.thresholds
+
+    print(f"1. theta_p for {n_t.size} thresholds from one fitted EMG")
+    theta = np.repeat(2.25 * np.arange(1, 5), 10)
+    rng = np.random.default_rng(0)
+    n = np.maximum(np.round(emg(theta, 3000.0, 9.0, 1.0) + rng.normal(0.0, 4.0, theta.size)), 0.0)
+    fitted = fit_model("emg", theta, n, theta_max=45.0, params=fit, rng=rng)
+
+    def per_threshold() -> list:
+        return [envelope_boundary(fitted.predict, t, 2.25, 45.0, n_scan=predict.n_grid) for t in n_t]
+
+    def vectorized() -> object:
+        return boundaries(fitted.predict, n_t, 2.25, 45.0, predict.n_grid)
+
+    reference, subject = paired_medians(per_threshold, vectorized, repeats=15)
+    print(f"   per-threshold envelope_boundary (reference) {reference * 1e3:8.2f} ms")
+    ratio = subject / reference
+    print(f"   vectorized boundaries                       {subject * 1e3:8.2f} ms   {ratio:6.3f} x reference")
+
+    print("2. the whole n_t sweep at paper scale (21 arcs + 4 lines, 10 images per stop, 6 PnP methods)")
+    artifacts, _ = synthetic_artifacts(np.random.default_rng(1), n_arcs=21, n_lines=4, methods=METHODS)
+    start = time.perf_counter()
+    for method in METHODS:
+        for series in dataset_series(artifacts, method):
+            k = predict.long_range_stops(series.trajectory)
+            model = fit_model("emg", *series.first_stops(k), theta_max=fit.range_end(series.trajectory), params=fit,
+                              rng=rng)  # fmt: skip
+            first = float(np.min(series.theta))
+            [envelope_boundary(model.predict, t, first, fit.range_end(series.trajectory), predict.n_grid) for t in n_t]
+    reference = time.perf_counter() - start
+    start = time.perf_counter()
+    table = sweep(artifacts, predict, fit, progress=False)
+    seconds = time.perf_counter() - start
+    verdict = "meets" if seconds <= 60.0 else "MISSES"
+    print(f"   reference: long range only, per-threshold root finding {reference:7.2f} s")
+    print(f"   whole sweep ({len(table)} rows, n_jobs={predict.n_jobs})        {seconds:7.2f} s   "
+          f"{seconds / reference:6.2f} x reference   [{verdict} target 60 s]")  # fmt: skip
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,170 @@
+"""The Fig. 2 experiment of Windsor et al.: which artifact model extrapolates best from the first k stops?
+
+For every dataset and k = k_min .. all stops, each model is fitted to the images of the first k stops
+(theta_deg for arcs, x_mm for lines) and its RMSE is measured over every image of the dataset; the figure
+shows the mean RMSE across datasets per model and k (III-D, Fig. 2; lines as in V-C).
+
+Input: the artifacts table of stage 02, one row per image and PnP method, with at least the columns
+``dataset, trajectory ("arc"|"line"), stop (0-based), theta_deg, x_mm, method, n_inliers``.
+"""
+
+from __future__ import annotations
+
+import zlib
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+from joblib import Parallel, delayed
+from tqdm import tqdm
+
+from poseintegrity.artifacts.fitted import FittedModel
+from poseintegrity.artifacts.models import fit_model
+from poseintegrity.artifacts.params import FitParams
+
+VARIABLE = {"arc": "theta_deg", "line": "x_mm"}  # independent variable of the artifact model per trajectory
+COLUMNS = ["trajectory", "dataset", "k", "model", "rmse", "converged", "reason", "n_samples"]  # of fig2_rmse
+
+
+@dataclass(frozen=True)
+class Series:
+    """One dataset's samples for one PnP method, in stop order.
+
+    stop : (m,) int, 0-based;  theta : (m,) float, deg (arc) or mm (line);  n_inliers : (m,) float
+    """
+
+    dataset: str
+    trajectory: str
+    stop: np.ndarray
+    theta: np.ndarray
+    n_inliers: np.ndarray
+
+    @property
+    def n_stops(self) -> int:
+        return int(np.unique(self.stop).size)
+
+    def first_stops(self, k: int) -> tuple[np.ndarray, np.ndarray]:
+        """(theta, n_inliers) of the images of the first k stops: what a robot has seen after k stops."""
+        keep = np.isin(self.stop, np.unique(self.stop)[:k])
+        return self.theta[keep], self.n_inliers[keep]
+
+
+def dataset_series(artifacts: pd.DataFrame, pnp_method: str) -> list[Series]:
+    """Split the artifacts table into one :class:`Series` per (trajectory, dataset) for ``pnp_method``."""
+    rows = artifacts[artifacts["method"] == pnp_method]
+    if rows.empty:
+        raise ValueError(f"no rows with method {pnp_method!r}; methods present: {sorted(artifacts['method'].unique())}")
+    unknown = set(rows["trajectory"]) - set(VARIABLE)
+    if unknown:
+        raise ValueError(f"unknown trajectory type(s) {sorted(unknown)}; expected {sorted(VARIABLE)}")
+    series = []
+    for (trajectory, dataset), group in rows.groupby(["trajectory", "dataset"], sort=True):
+        group = group.sort_values(["stop", "image"], kind="stable")
+        series.append(
+            Series(
+                dataset=str(dataset),
+                trajectory=str(trajectory),
+                stop=group["stop"].to_numpy(dtype=int),
+                theta=group[VARIABLE[trajectory]].to_numpy(dtype=float),
+                n_inliers=group["n_inliers"].to_numpy(dtype=float),
+            )
+        )
+    return series
+
+
+def fit_first_stops(series: Series, k: int, params: FitParams) -> dict[str, FittedModel]:
+    """Every model of ``params.models`` fitted to the first k stops of ``series``.
+
+    Each fit draws from ``np.random.default_rng([seed, crc32(trajectory/dataset), k, crc32(model)])``:
+    the same for any n_jobs, any order of work, any other datasets in the table and any other models.
+    """
+    theta, n_inliers = series.first_stops(k)
+    theta_max = params.range_end(series.trajectory)
+    key = [params.seed, _crc32(f"{series.trajectory}/{series.dataset}"), k]
+    return {
+        name: fit_model(
+            name, theta, n_inliers, theta_max=theta_max, params=params, rng=np.random.default_rng([*key, _crc32(name)])
+        )
+        for name in params.models
+    }
+
+
+def _crc32(text: str) -> int:
+    return zlib.crc32(text.encode())
+
+
+def rmse(model: FittedModel, theta: np.ndarray, n_inliers: np.ndarray) -> float:
+    """Root mean square error of model.predict(theta) vs n_inliers over the finite samples (Fig. 2)."""
+    keep = np.isfinite(theta) & np.isfinite(n_inliers)
+    return float(np.sqrt(np.mean((model.predict(theta[keep]) - n_inliers[keep]) ** 2)))
+
+
+def _fig2_rows(series: Series, k: int, params: FitParams) -> list[dict]:
+    return [
+        {
+            "trajectory": series.trajectory,
+            "dataset": series.dataset,
+            "k": k,
+            "model": name,
+            "rmse": rmse(model, series.theta, series.n_inliers),
+            "converged": model.converged,
+            "reason": model.reason,
+            "n_samples": model.n_samples,
+        }
+        for name, model in fit_first_stops(series, k, params).items()
+    ]
+
+
+def fig2_rmse(artifacts: pd.DataFrame, params: FitParams, progress: bool = True) -> pd.DataFrame:
+    """The Fig. 2 experiment: one row per (trajectory, dataset, k, model).
+
+    Columns: trajectory, dataset, k, model, rmse (inliers, over every image of the dataset), converged,
+    reason ("ok" or why the fit failed; the RMSE is then that of the fallback line), n_samples.
+    Runs on ``params.n_jobs`` joblib workers. Raises ValueError when no dataset has k_min stops.
+    """
+    all_series = dataset_series(artifacts, params.pnp_method)
+    tasks = [
+        (series, k)
+        for series in all_series
+        for k in range(params.k_min, min(params.k_max or series.n_stops, series.n_stops) + 1)
+    ]
+    if not tasks:
+        most = max(series.n_stops for series in all_series)
+        raise ValueError(f"no dataset has k_min = {params.k_min} stops (the longest has {most}): lower fit.k_min")
+    results = Parallel(n_jobs=params.n_jobs, return_as="generator")(
+        delayed(_fig2_rows)(series, k, params) for series, k in tasks
+    )
+    rows = [row for result in tqdm(results, total=len(tasks), disable=not progress) for row in result]
+    return pd.DataFrame(rows, columns=COLUMNS)
+
+
+def mean_rmse(table: pd.DataFrame) -> pd.DataFrame:
+    """Fig. 2's curves: per (trajectory, model, k) the mean RMSE across datasets and the converged fraction."""
+    return (
+        table.groupby(["trajectory", "model", "k"], sort=True)
+        .agg(mean_rmse=("rmse", "mean"), converged=("converged", "mean"), n_datasets=("dataset", "nunique"))
+        .reset_index()
+    )
+
+
+def fits_metrics(table: pd.DataFrame, params: FitParams) -> dict[str, dict[str, float]]:
+    """Headline figures of stage 03 for ``reports/metrics/fits.json``.
+
+    rmse_k<k_report_arc>.<model> : mean RMSE across arc datasets at k = k_report_arc (paper: 4)
+    line_rmse_k<k_report_line>.<model> : the same for line datasets at k = k_report_line (paper: 5)
+    converged.<model> : fraction of all fits (every dataset, every k) that converged
+    Every model of ``params.models`` has every key; the value is None where there was no fit (e.g. no
+    dataset with k_report_arc stops).
+    """
+    means = mean_rmse(table)
+    converged = table.groupby("model")["converged"].mean()
+
+    def at(trajectory: str, k: int) -> dict[str, float | None]:
+        rows = means[(means["trajectory"] == trajectory) & (means["k"] == k)].set_index("model")["mean_rmse"]
+        return {m: float(rows[m]) if m in rows.index else None for m in params.models}
+
+    return {
+        f"rmse_k{params.k_report_arc}": at("arc", params.k_report_arc),
+        f"line_rmse_k{params.k_report_line}": at("line", params.k_report_line),
+        "converged": {m: float(converged[m]) if m in converged.index else None for m in params.models},
+    }

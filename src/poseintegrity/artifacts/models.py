@@ -1,0 +1,35 @@
+"""One entry point for every artifact model of Fig. 2: base functions (curve_fit) and the two MLP recipes."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from poseintegrity.artifacts.base_functions import BASE_FUNCTIONS
+from poseintegrity.artifacts.fitted import FittedModel
+from poseintegrity.artifacts.mlp import fit_mlp
+from poseintegrity.artifacts.params import FitParams
+
+MLP_RECIPES = {"mlp_scratch": False, "mlp_pretrained": True}  # name -> pretrain on the EMG curve?
+MODEL_NAMES: tuple[str, ...] = (*BASE_FUNCTIONS, *MLP_RECIPES)
+
+
+def fit_model(
+    name: str,
+    theta: np.ndarray,
+    n_inliers: np.ndarray,
+    *,
+    theta_max: float,
+    params: FitParams,
+    rng: np.random.Generator,
+) -> FittedModel:
+    """Fit artifact model ``name`` (one of :data:`MODEL_NAMES`) to samples; never raises on bad data.
+
+    theta : (m,) float, deg (arcs) or mm (lines);  n_inliers : (m,) counts
+    theta_max : end of the trajectory range (MLP scaling and artificial points; unused by base functions)
+    rng : seeds the MLP weights (unused by base functions)
+    """
+    if name in BASE_FUNCTIONS:
+        return BASE_FUNCTIONS[name].fit(theta, n_inliers, max_nfev=params.max_nfev)
+    if name in MLP_RECIPES:
+        return fit_mlp(theta, n_inliers, theta_max=theta_max, mlp=params.mlp, rng=rng, pretrain=MLP_RECIPES[name])
+    raise ValueError(f"unknown artifact model {name!r}; expected one of {MODEL_NAMES}")

@@ -1,0 +1,68 @@
+"""Schema of the ``fit`` section of ``params.yaml`` (stage 03, artifact models).
+
+Every value is explicit in ``params.yaml``: none of these choices were published by Windsor et al.
+(see /work/shared/reference/FACTS.md), so each is ours and documented here.
+"""
+
+from __future__ import annotations
+
+from typing import Literal
+
+from pydantic import BaseModel, ConfigDict, Field, model_validator
+
+ModelName = Literal[
+    "emg", "exponential", "gaussian", "logistic", "power_law", "mlp_scratch", "mlp_pretrained"
+]
+
+
+class MLPParams(BaseModel):
+    """The MLP of Windsor et al. IV-E and its training (full batch, L-BFGS with strong Wolfe line search)."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+    hidden_layers: int = Field(ge=1, le=10, description="hidden layers (paper: 3)")
+    hidden_units: int = Field(ge=1, le=1000, description="neurons per hidden layer (paper: 10)")
+    max_iter_scratch: int = Field(ge=1, description="L-BFGS iterations of the scratch recipe (samples only)")
+    max_iter_pretrain: int = Field(ge=1, description="L-BFGS iterations on the EMG starting curve")
+    max_iter_finetune: int = Field(
+        ge=1, description="L-BFGS iterations on samples + artificial points after pretraining (few: a longer"
+        " fine-tune forgets the pretrained shape between the last stop and theta_max)"
+    )
+    tolerance_change: float = Field(
+        gt=0, description="early stop: L-BFGS stops when the loss or the step changes by less (scaled units)"
+    )
+    n_pretrain_points: int = Field(ge=2, description="grid points of the EMG curve used for pretraining")
+    n_artificial: int = Field(ge=1, description="copies of the artificial sample (range end, 0)")
+
+
+class FitParams(BaseModel):
+    """Stage 03: fit artifact models f: theta -> n_inliers and run the Fig. 2 experiment."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+    pnp_method: str = Field(min_length=1, description="PnP method whose n_inliers are modelled")
+    models: tuple[ModelName, ...] = Field(min_length=1, description="artifact models compared in Fig. 2")
+    k_min: int = Field(ge=2, description="fewest stops (from the start) used for a fit")
+    k_max: int | None = Field(ge=2, description="most stops used for a fit; null = all stops")
+    k_report_arc: int = Field(ge=2, description="k of the headline RMSE for arcs (paper: 4)")
+    k_report_line: int = Field(ge=2, description="k of the headline RMSE for lines (paper: 5)")
+    theta_max_deg: float = Field(gt=0, description="end of the arc range: artificial MLP point (45, 0)")
+    x_max_mm: float = Field(gt=0, description="end of the line range: artificial MLP point (150, 0)")
+    max_nfev: int = Field(ge=10, description="curve_fit evaluation budget per base-function fit")
+    seed: int = Field(ge=0, description="seed of every random draw of the stage (MLP initial weights)")
+    n_jobs: int = Field(description="joblib workers; -1 = all cores")
+    mlp: MLPParams
+
+    @model_validator(mode="after")
+    def _check_ranges(self) -> FitParams:
+        if self.k_max is not None and self.k_max < self.k_min:
+            raise ValueError(f"k_max ({self.k_max}) must be null or >= k_min ({self.k_min})")
+        if self.n_jobs == 0:
+            raise ValueError("n_jobs must be a positive count or negative (joblib convention), not 0")
+        if len(set(self.models)) != len(self.models):
+            raise ValueError(f"models has duplicates: {list(self.models)}")
+        return self
+
+    def range_end(self, trajectory: str) -> float:
+        """End of the search / extrapolation range of a trajectory type ("arc": deg, "line": mm)."""
+        return {"arc": self.theta_max_deg, "line": self.x_max_mm}[trajectory]

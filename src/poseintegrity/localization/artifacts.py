@@ -1,0 +1,178 @@
+"""Pose estimation artifacts per frame (paper III-C) and the realism checks of the rendered world.
+
+Artifacts of one PnP-RANSAC run (columns of ``artifacts.parquet``):
+
+- ``n_inliers``: n_i, inliers of the returned pose (recounted, see :mod:`pnp`); 0 on failure
+- ``n_inliers_reported``: OpenCV's own inlier count
+- ``n_keypoints``, ``n_matches``: SIFT keypoints in the frame, ratio-test matches to M_t
+- ``inlier_ratio``: n_i / n_matches (0 without matches)
+- ``reproj_error_px``: mean reprojection error of the inliers
+- ``inlier_spread_px``: RMS distance of the inlier keypoints from their centroid (image-space spread)
+- ``inlier_hull_area_px2``: area of the convex hull of the inlier keypoints (coverage; Windsor et al. [4]
+  studied keypoint distribution artifacts)
+- ``model_coverage``: n_i / |M_t|, the fraction of the target model seen
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import cv2
+import numpy as np
+import pandas as pd
+from scipy.stats import spearmanr
+
+from poseintegrity.localization.params import tolerance_name
+from poseintegrity.localization.pnp import PnPResult, reprojection_errors
+
+ARTIFACT_COLUMNS = [
+    "n_inliers", "n_inliers_reported", "n_keypoints", "n_matches", "inlier_ratio", "reproj_error_px",
+    "inlier_spread_px", "inlier_hull_area_px2", "model_coverage",
+]
+
+
+def frame_artifacts(
+    result: PnPResult, object_points: np.ndarray, image_points: np.ndarray, K: np.ndarray, n_keypoints: int, model_size: int
+) -> dict[str, Any]:
+    """Artifact values of one PnP result.
+
+    object_points : (n, 3) mm and image_points : (n, 2) px are the n ratio-test matches given to PnP.
+    A failed result has n_i = 0 and NaN for the inlier geometry.
+    """
+    n_matches = len(image_points)
+    row = dict(
+        n_inliers=result.n_inliers, n_inliers_reported=result.n_inliers_reported, n_keypoints=n_keypoints,
+        n_matches=n_matches, inlier_ratio=result.n_inliers / n_matches if n_matches else 0.0,
+        reproj_error_px=np.nan, inlier_spread_px=np.nan, inlier_hull_area_px2=np.nan,
+        model_coverage=result.n_inliers / model_size if model_size else 0.0,
+    )
+    if result.status != "ok":
+        return row
+    x = image_points[result.inliers].astype(np.float64)
+    errors = reprojection_errors(object_points[result.inliers], x, K, result.T_cam_model)
+    row["reproj_error_px"] = float(errors.mean())
+    row["inlier_spread_px"] = float(np.sqrt(np.mean(np.sum((x - x.mean(axis=0)) ** 2, axis=1))))
+    row["inlier_hull_area_px2"] = float(cv2.contourArea(cv2.convexHull(x.astype(np.float32))))
+    return row
+
+
+def realism_metrics(table: pd.DataFrame, envelope_table: pd.DataFrame, method: str = "usac_magsac") -> dict[str, Any]:
+    """Properties of the rendered world that the paper's real datasets had (issue 3, "Realism").
+
+    table : artifacts rows; envelope_table : :func:`envelope.envelopes` rows. Only ``method`` rows are used.
+    Keys (bars in ``passed``):
+    - ``min_abs_spearman``: weakest decay of mean n_i with theta over the arc datasets, as min over datasets of
+      -rho (Spearman of stop theta vs mean n_i per stop); equals |rho| when rho < 0 (bar: >= 0.8)
+    - ``min_first_stop_mean_inliers``: smallest mean n_i at the first stop over all datasets (bar: >= 50)
+    - ``error_ratio_low_vs_high_inliers``: median E_t of frames with n_i < 15 over that of frames with n_i > 50,
+      frames with a pose only (bar: >= 3)
+    - ``n_uncensored_4mm10deg``: arc datasets with theta_a < arc end at 4 mm/10 deg (bar: >= 18 of 21, scaled
+      as >= 6/7 of the arc datasets)
+    - ``min_theta_a_2mm3deg``, ``cv_theta_a_2mm3deg``: smallest theta_a and coefficient of variation
+      (std/mean, ddof 0) across arc datasets at 2 mm/3 deg (bars: <= 12 deg, >= 0.25); the same at
+      4 mm/10 deg for reference
+    """
+    rows = table[table["method"] == method]
+    arcs = rows[rows["trajectory"] == "arc"]
+    per_stop = arcs.groupby(["dataset", "stop"]).agg(theta=("theta_deg", "mean"), n_i=("n_inliers", "mean"))
+    spearman = {
+        dataset: float(spearmanr(stops["theta"], stops["n_i"]).statistic) for dataset, stops in per_stop.groupby("dataset")
+    }
+    first_stop = rows[rows["stop"] == rows["stop"].min()].groupby("dataset")["n_inliers"].mean()
+    posed = rows[rows["status"] == "ok"]
+    median_low = posed.loc[posed["n_inliers"] < 15, "E_t_mm"].median()
+    median_high = posed.loc[posed["n_inliers"] > 50, "E_t_mm"].median()
+    arc_envelopes = envelope_table[(envelope_table["method"] == method) & (envelope_table["trajectory"] == "arc")]
+
+    def theta_a(tolerance: tuple[float, float]) -> pd.Series:
+        return arc_envelopes.loc[arc_envelopes["tolerance"] == tolerance_name(tolerance)].set_index("dataset")
+
+    strict, loose = theta_a((2.0, 3.0)), theta_a((4.0, 10.0))
+    n_arcs = int(arcs["dataset"].nunique())
+    metrics = dict(
+        method=method,
+        n_datasets=int(rows["dataset"].nunique()),
+        n_arc_datasets=n_arcs,
+        spearman_theta_vs_mean_inliers=spearman,
+        min_abs_spearman=_nanmin([-rho for rho in spearman.values()]),  # a one-stop dataset has no rho
+        first_stop_mean_inliers={k: float(v) for k, v in first_stop.items()},
+        min_first_stop_mean_inliers=float(first_stop.min()) if len(first_stop) else float("nan"),
+        median_E_t_mm_low_inliers=float(median_low),
+        median_E_t_mm_high_inliers=float(median_high),
+        error_ratio_low_vs_high_inliers=float(median_low / median_high),
+        n_uncensored_4mm10deg=int((~loose["censored"]).sum()) if len(loose) else 0,
+        min_theta_a_2mm3deg=float(strict["theta_a"].min()) if len(strict) else float("nan"),
+        cv_theta_a_2mm3deg=_cv(strict["theta_a"]),
+        min_theta_a_4mm10deg=float(loose["theta_a"].min()) if len(loose) else float("nan"),
+        cv_theta_a_4mm10deg=_cv(loose["theta_a"]),
+        theta_a_2mm3deg={k: float(v) for k, v in strict["theta_a"].items()},
+        theta_a_4mm10deg={k: float(v) for k, v in loose["theta_a"].items()},
+    )
+    metrics["passed"] = dict(
+        spearman=bool(metrics["min_abs_spearman"] >= 0.8),
+        first_stop_inliers=bool(metrics["min_first_stop_mean_inliers"] >= 50),
+        error_ratio=bool(metrics["error_ratio_low_vs_high_inliers"] >= 3),
+        uncensored=bool(n_arcs > 0 and metrics["n_uncensored_4mm10deg"] >= np.ceil(n_arcs * 18 / 21)),
+        min_theta_a=bool(metrics["min_theta_a_2mm3deg"] <= 12),
+        cv_theta_a=bool(metrics["cv_theta_a_2mm3deg"] >= 0.25),
+    )
+    return metrics
+
+
+def _nanmin(values: list[float]) -> float:
+    """Smallest non-NaN value; NaN when there is none."""
+    finite = [value for value in values if not np.isnan(value)]
+    return float(min(finite)) if finite else float("nan")
+
+
+def _cv(values: pd.Series) -> float:
+    """Coefficient of variation std / mean (ddof 0); NaN for an empty series."""
+    return float(values.std(ddof=0) / values.mean()) if len(values) else float("nan")
+
+
+def method_summary(table: pd.DataFrame, envelope_table: pd.DataFrame) -> pd.DataFrame:
+    """One row per PnP method: frames, failure rate, n_i at the first stop, median errors, mean theta_a per
+    tolerance and trajectory type, and how many envelopes are censored (stage 05, paper Fig. 6)."""
+    first_stop = table[table["stop"] == 0]
+    summary = table.groupby("method").agg(
+        n_frames=("status", "size"),
+        failure_rate=("status", lambda status: float((status != "ok").mean())),
+        median_n_inliers=("n_inliers", "median"),
+        median_E_t_mm=("E_t_mm", "median"),
+        median_E_r_deg=("E_r_deg", "median"),
+    )
+    summary["mean_n_inliers_first_stop"] = first_stop.groupby("method")["n_inliers"].mean()
+    theta_a = envelope_table.pivot_table(
+        index="method", columns=["trajectory", "tolerance"], values="theta_a", aggfunc="mean"
+    )
+    theta_a.columns = [f"mean_theta_a_{trajectory}_{tolerance}" for trajectory, tolerance in theta_a.columns]
+    censored = envelope_table.groupby("method")["censored"].sum().rename("n_censored")
+    return summary.join(theta_a).join(censored).reset_index()
+
+
+def board_summary(table: pd.DataFrame) -> dict[str, float]:
+    """How far the ArUco ground truth is from the exact renderer pose (one row per frame is enough)."""
+    frames = table.drop_duplicates(["dataset", "stop", "image"])
+    detected = frames[frames["board_status"] == "ok"]
+    return dict(
+        detection_rate=float(len(detected) / len(frames)) if len(frames) else float("nan"),
+        median_E_t_mm=float(detected["E_t_board_exact_mm"].median()),
+        p95_E_t_mm=float(detected["E_t_board_exact_mm"].quantile(0.95)),
+        median_E_r_deg=float(detected["E_r_board_exact_deg"].median()),
+        p95_E_r_deg=float(detected["E_r_board_exact_deg"].quantile(0.95)),
+    )
+
+
+def json_ready(value: Any) -> Any:
+    """Nested dicts/lists with numpy scalars and NaN/inf turned into plain JSON values (NaN -> null)."""
+    if isinstance(value, dict):
+        return {str(key): json_ready(item) for key, item in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [json_ready(item) for item in value]
+    if isinstance(value, (bool, np.bool_)):
+        return bool(value)
+    if isinstance(value, (int, np.integer)):
+        return int(value)
+    if isinstance(value, (float, np.floating)):
+        return float(value) if np.isfinite(value) else None
+    return value

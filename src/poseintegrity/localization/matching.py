@@ -1,0 +1,37 @@
+"""Descriptor matching with Lowe's ratio test (used for the target model, III-B, and every frame).
+
+Exact L2 nearest neighbours by one matrix product, ||q - t||^2 = ||q||^2 + ||t||^2 - 2 q.t: the same matches
+as ``cv2.BFMatcher(cv2.NORM_L2).knnMatch(k=2)`` (tested) at about half its time.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def match_ratio_test(query: np.ndarray, train: np.ndarray, ratio: float) -> np.ndarray:
+    """Nearest-neighbour matches that pass the ratio test.
+
+    query : (n, 128) float32 descriptors (the frame), train : (m, 128) float32 descriptors (the model).
+    A query descriptor is kept when its nearest train descriptor is closer than ``ratio`` times the second
+    nearest (Lowe 2004, section 7.1), L2 distance.
+    Returns (k, 2) int: rows of (query index, train index); (0, 2) when the query is empty or the train
+    set has fewer than the 2 descriptors a ratio test needs.
+    """
+    if len(query) == 0 or len(train) < 2:
+        return np.empty((0, 2), dtype=np.intp)
+    query = np.asarray(query, dtype=np.float32)
+    train = np.asarray(train, dtype=np.float32)
+    d2 = query @ train.T  # (n, m): squared distances up to the per-row constant ||q||^2
+    d2 *= -2.0
+    d2 += np.einsum("ij,ij->i", train, train)[None, :]
+    rows = np.arange(len(query))
+    nearest = d2.argmin(axis=1)
+    d2_first = d2[rows, nearest]
+    d2[rows, nearest] = np.inf
+    d2_second = d2.min(axis=1)
+    q2 = np.einsum("ij,ij->i", query, query)
+    first = np.sqrt(np.maximum(d2_first + q2, 0.0))
+    second = np.sqrt(np.maximum(d2_second + q2, 0.0))
+    keep = first < ratio * second
+    return np.column_stack([rows[keep], nearest[keep]]).astype(np.intp)

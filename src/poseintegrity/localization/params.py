@@ -1,0 +1,87 @@
+"""Schema of the ``extract`` section of ``params.yaml`` (stages 02 and 05).
+
+Windsor et al. published no SIFT, CLAHE or RANSAC settings (FACTS.md, "Camera of the Windsor et al.
+experiments"): every value here is our choice and is documented next to its field.
+"""
+
+from __future__ import annotations
+
+from typing import Literal
+
+from pydantic import BaseModel, ConfigDict, Field, field_validator
+
+PnPMethod = Literal["usac_magsac", "epnp", "p3p", "ap3p", "sqpnp", "iterative"]
+
+
+class _Section(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class ClaheParams(_Section):
+    """Contrast limited adaptive histogram equalization before SIFT (paper IV-C)."""
+
+    clip_limit: float = Field(2.0, gt=0, description="cv2.createCLAHE clipLimit")
+    tile_grid: int = Field(8, ge=1, le=64, description="tiles per image side (tileGridSize = (n, n))")
+
+
+class SiftParams(_Section):
+    """cv2.SIFT_create arguments (Lowe 2004 defaults unless changed)."""
+
+    n_features: int = Field(0, ge=0, description="keep the n strongest keypoints; 0 keeps all")
+    n_octave_layers: int = Field(3, ge=1, le=8)
+    contrast_threshold: float = Field(0.04, gt=0)
+    edge_threshold: float = Field(10.0, gt=0)
+    sigma: float = Field(1.6, gt=0)
+
+
+class ExtractParams(_Section):
+    """Target localization pipeline, artifact extraction and actual envelopes (stages 02 and 05)."""
+
+    clahe: ClaheParams = ClaheParams()
+    sift: SiftParams = SiftParams()
+    ratio_test: float = Field(0.8, gt=0, lt=1, description="Lowe ratio: best / second-best distance")
+    model_max_reprojection_px: float = Field(
+        2.0, gt=0, description="III-B: drop triangulated model points reprojecting worse than this in either view"
+    )
+    reprojection_threshold_px: float = Field(
+        4.0, gt=0, description="RANSAC inlier threshold; also the recount threshold that defines n_i"
+    )
+    ransac_confidence: float = Field(0.999, gt=0, lt=1)
+    usac_max_iterations: int = Field(1000, ge=1, description="USAC_MAGSAC iteration cap (paper path)")
+    ransac_max_iterations: int = Field(
+        2000, ge=1,
+        description="classic RANSAC iteration cap (stage 05). FACTS.md: EPnP needed ~10 000 at 80 % outliers;"
+        " 2000 keeps a low-inlier frame near 0.15 s per method, so EPnP-type solvers fail earlier there",
+    )
+    pnp_method: PnPMethod = Field("usac_magsac", description="stage 02: the paper's PnP-RANSAC (OpenCV USAC)")
+    pnp_methods: list[PnPMethod] = Field(
+        ["epnp", "p3p", "ap3p", "sqpnp", "iterative"], min_length=1, description="stage 05 (paper Fig. 6)"
+    )
+    tolerances: list[tuple[float, float]] = Field(
+        [(2.0, 3.0), (4.0, 10.0)], min_length=1, description="(E_t mm, E_r deg) error tolerances of IV-E"
+    )
+    seed: int = Field(0, ge=0, description="seeds every RANSAC run (one derived seed per frame)")
+    n_jobs: int = Field(2, description="joblib workers over images (-1: all cores)")
+    features_dir: str = Field("features", min_length=1, description="SIFT cache, relative to data_dir")
+    datasets: list[str] | None = Field(None, description="dataset ids to process; null: every dataset")
+
+    @field_validator("tolerances")
+    @classmethod
+    def _positive_tolerances(cls, tolerances: list[tuple[float, float]]) -> list[tuple[float, float]]:
+        for E_t_mm, E_r_deg in tolerances:
+            if E_t_mm <= 0 or E_r_deg <= 0:
+                raise ValueError(f"tolerances must be positive (mm, deg), got ({E_t_mm}, {E_r_deg})")
+        return tolerances
+
+    @field_validator("n_jobs")
+    @classmethod
+    def _valid_n_jobs(cls, n_jobs: int) -> int:
+        if n_jobs == 0 or n_jobs < -1:
+            raise ValueError("n_jobs must be a positive number of workers or -1 (all cores)")
+        return n_jobs
+
+
+def tolerance_name(tolerance: tuple[float, float]) -> str:
+    """``(2, 3)`` -> ``"2mm_3deg"`` (the ``tolerance`` column of the envelope tables)."""
+    E_t_mm, E_r_deg = tolerance
+    return f"{E_t_mm:g}mm_{E_r_deg:g}deg"

@@ -1,0 +1,151 @@
+"""PnP-RANSAC (paper III-B, IV-C; Fig. 6 variants of V-A).
+
+Two paths, both through ``cv2.solvePnPRansac``:
+
+- ``usac_magsac``: the paper's path, OpenCV USAC with MAGSAC++ scoring, sigma-consensus local optimisation and a
+  MAGSAC final polish; USAC always uses a P3P minimal solver (FACTS.md, OpenCV 5.0).
+- ``epnp``, ``p3p``, ``ap3p``, ``sqpnp``, ``iterative``: classic RANSAC with that ``SOLVEPNP_*`` flag. In
+  OpenCV the minimal samples are solved with P3P/AP3P for those flags and with EPnP otherwise, and the final
+  refit on the inliers uses the flag (EPnP for P3P/AP3P).
+
+n_i: classic RANSAC reports the inliers of the best *hypothesis*, not of the refined pose it returns (OpenCV
+issue 29573, FACTS.md). For every method the inliers are therefore recounted on the returned pose with
+``cv2.projectPoints`` and the same threshold; OpenCV's own count is kept as ``n_inliers_reported``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+# names of FACTS.md (OpenCV 5 renumbered the flags: never use the integers)
+CLASSIC_FLAGS = {
+    "epnp": cv2.SOLVEPNP_EPNP,
+    "p3p": cv2.SOLVEPNP_P3P,
+    "ap3p": cv2.SOLVEPNP_AP3P,
+    "sqpnp": cv2.SOLVEPNP_SQPNP,
+    "iterative": cv2.SOLVEPNP_ITERATIVE,
+}
+METHODS = ("usac_magsac", *CLASSIC_FLAGS)
+MIN_CORRESPONDENCES = 4  # a unique pose needs 4 points; P3P with 3 leaves up to 4 solutions
+NAN_POSE = np.full((4, 4), np.nan)
+
+
+@dataclass(frozen=True)
+class PnPResult:
+    """Outcome of one PnP-RANSAC run.
+
+    T_cam_model : (4, 4) float, model (board) -> camera, mm; all NaN on failure
+    inliers : (k,) int, indices of correspondences reprojecting within the threshold under T_cam_model
+    n_inliers_reported : int, size of OpenCV's own inlier set
+    status : "ok", "too_few_matches", "degenerate_points" or "pnp_failed"
+    """
+
+    T_cam_model: np.ndarray
+    inliers: np.ndarray
+    n_inliers_reported: int
+    status: str
+
+    @property
+    def n_inliers(self) -> int:
+        return len(self.inliers)
+
+
+def failed(status: str) -> PnPResult:
+    """The documented failed value: NaN pose, no inliers, a reason."""
+    return PnPResult(NAN_POSE.copy(), np.empty(0, dtype=np.intp), 0, status)
+
+
+def pose_from_rvec_tvec(rvec: np.ndarray, tvec: np.ndarray) -> np.ndarray:
+    """(4, 4) pose from OpenCV's Rodrigues vector (3,) and translation (3,)."""
+    T = np.eye(4)
+    T[:3, :3] = cv2.Rodrigues(np.asarray(rvec, dtype=np.float64).reshape(3))[0]
+    T[:3, 3] = np.asarray(tvec, dtype=np.float64).reshape(3)
+    return T
+
+
+def reprojection_errors(object_points: np.ndarray, image_points: np.ndarray, K: np.ndarray, T_cam_model: np.ndarray) -> np.ndarray:
+    """Pixel distance between image points (n, 2) and projections of object points (n, 3, mm) under T_cam_model.
+
+    Points behind the camera get an infinite error (they can never be inliers).
+    """
+    X_cam = object_points @ T_cam_model[:3, :3].T + T_cam_model[:3, 3]
+    in_front = X_cam[:, 2] > 0
+    x = X_cam @ K.T
+    with np.errstate(divide="ignore", invalid="ignore"):
+        projected = x[:, :2] / x[:, 2:3]
+    errors = np.linalg.norm(projected - image_points, axis=1)
+    return np.where(in_front, errors, np.inf)
+
+
+def _is_degenerate(object_points: np.ndarray) -> bool:
+    """True when the 3D points are (nearly) collinear or coincident: no PnP pose is defined."""
+    centred = object_points - object_points.mean(axis=0)
+    singular_values = np.linalg.svd(centred, compute_uv=False)
+    return singular_values[1] <= 1e-6 * max(singular_values[0], 1e-12)
+
+
+def _usac_params(threshold_px: float, confidence: float, max_iterations: int, seed: int) -> cv2.UsacParams:
+    usac = cv2.UsacParams()
+    usac.sampler = cv2.SAMPLING_UNIFORM
+    usac.score = cv2.SCORE_METHOD_MAGSAC
+    usac.loMethod = cv2.LOCAL_OPTIM_SIGMA
+    usac.final_polisher = cv2.MAGSAC
+    usac.threshold = threshold_px
+    usac.confidence = confidence
+    usac.maxIterations = max_iterations
+    usac.randomGeneratorState = seed
+    return usac
+
+
+def solve_pnp_ransac(
+    object_points: np.ndarray,
+    image_points: np.ndarray,
+    K: np.ndarray,
+    method: str,
+    threshold_px: float,
+    confidence: float,
+    max_iterations: int,
+    seed: int,
+) -> PnPResult:
+    """Robust pose of the model from 2D-3D correspondences.
+
+    object_points : (n, 3) float, model (board) frame, mm
+    image_points : (n, 2) float, pixels (no lens distortion)
+    K : (3, 3) float, camera matrix, pixels
+    method : one of :data:`METHODS`
+    seed : seeds OpenCV's RANSAC sampler (USAC state or cv2.setRNGSeed), so runs repeat exactly
+    Fails (see :class:`PnPResult`) with fewer than 4 correspondences, collinear object points, an OpenCV
+    error, a non-finite pose or fewer than 4 recounted inliers; never raises for bad data.
+    """
+    if method not in METHODS:
+        raise ValueError(f"unknown PnP method {method!r}; expected one of {METHODS}")
+    object_points = np.ascontiguousarray(object_points, dtype=np.float64).reshape(-1, 3)
+    image_points = np.ascontiguousarray(image_points, dtype=np.float64).reshape(-1, 2)
+    K = np.asarray(K, dtype=np.float64)
+    if len(object_points) < MIN_CORRESPONDENCES:
+        return failed("too_few_matches")
+    if _is_degenerate(object_points):
+        return failed("degenerate_points")
+    try:
+        if method == "usac_magsac":
+            usac = _usac_params(threshold_px, confidence, max_iterations, seed)
+            found, _, rvec, tvec, reported = cv2.solvePnPRansac(object_points, image_points, K, None, params=usac)
+        else:
+            cv2.setRNGSeed(seed)
+            found, rvec, tvec, reported = cv2.solvePnPRansac(
+                object_points, image_points, K, None, iterationsCount=max_iterations,
+                reprojectionError=threshold_px, confidence=confidence, flags=CLASSIC_FLAGS[method],
+            )
+    except cv2.error:
+        return failed("pnp_failed")
+    if not found or rvec is None or not (np.all(np.isfinite(rvec)) and np.all(np.isfinite(tvec))):
+        return failed("pnp_failed")
+    T_cam_model = pose_from_rvec_tvec(rvec, tvec)
+    inliers = np.flatnonzero(reprojection_errors(object_points, image_points, K, T_cam_model) <= threshold_px)
+    if len(inliers) < MIN_CORRESPONDENCES:
+        return failed("pnp_failed")
+    n_reported = 0 if reported is None else len(reported)
+    return PnPResult(T_cam_model, inliers, n_reported, "ok")

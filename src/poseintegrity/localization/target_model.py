@@ -1,0 +1,96 @@
+"""Static sparse feature model of the target, M_t (paper III-B).
+
+Two model images taken with a known relative camera pose (IV-D: 20 mm apart along the camera x axis) ->
+CLAHE + SIFT -> ratio-test matches -> ``cv2.triangulatePoints`` -> keep points on the target (the paper trims
+by hand; we keep keypoints inside the renderer's target mask in both images) -> coordinates in the board
+frame, so that the model origin coincides with the ArUco board origin (IV-C) and a PnP pose of the model
+is directly an estimate of T_cam_board.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+from poseintegrity.localization.features import Features
+from poseintegrity.localization.matching import match_ratio_test
+from poseintegrity.localization.pnp import reprojection_errors
+
+
+@dataclass(frozen=True)
+class TargetModel:
+    """M_t = [f_0, ..., f_n]: each feature a descriptor and a 3D point.
+
+    points : (n, 3) float64, board frame, mm
+    descriptors : (n, 128) float32, SIFT descriptors from the first model image
+    """
+
+    points: np.ndarray
+    descriptors: np.ndarray
+
+    @property
+    def size(self) -> int:
+        return len(self.points)
+
+
+def triangulate(K: np.ndarray, T_cam1_cam0: np.ndarray, x0: np.ndarray, x1: np.ndarray) -> np.ndarray:
+    """Linear (DLT) triangulation: (n, 3) points in camera-0 coordinates from pixels x0, x1 (n, 2).
+
+    Projection matrices P0 = K [I | 0] and P1 = K [R | t] with (R, t) of T_cam1_cam0 (camera 0 -> camera 1).
+    """
+    P0 = K @ np.hstack([np.eye(3), np.zeros((3, 1))])
+    P1 = K @ T_cam1_cam0[:3, :]
+    X_h = cv2.triangulatePoints(P0, P1, x0.T.astype(np.float64), x1.T.astype(np.float64))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return (X_h[:3] / X_h[3]).T
+
+
+def _inside(mask: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """(n,) bool: pixel x (n, 2) lies on a nonzero mask pixel (h, w)."""
+    h, w = mask.shape
+    col = np.clip(np.round(x[:, 0]).astype(int), 0, w - 1)
+    row = np.clip(np.round(x[:, 1]).astype(int), 0, h - 1)
+    in_image = (x[:, 0] >= 0) & (x[:, 0] <= w - 1) & (x[:, 1] >= 0) & (x[:, 1] <= h - 1)
+    return in_image & (mask[row, col] > 0)
+
+
+def build_target_model(
+    features: tuple[Features, Features],
+    masks: tuple[np.ndarray, np.ndarray],
+    T_cam_board: tuple[np.ndarray, np.ndarray],
+    K: np.ndarray,
+    ratio: float,
+    max_reprojection_px: float,
+) -> TargetModel:
+    """M_t from the two model views.
+
+    features : CLAHE + SIFT features of model image 0 and 1
+    masks : (h, w) uint8 target masks of both images (nonzero = target)
+    T_cam_board : (4, 4) board -> camera poses of both model images, mm
+    A point is kept when it lies in front of both cameras, reprojects within ``max_reprojection_px`` in both
+    images and its keypoints lie inside both masks. An empty model (no texture, no overlap) is returned
+    as such; every frame then fails with ``too_few_matches``.
+    """
+    K = np.asarray(K, dtype=np.float64)
+    pairs = match_ratio_test(features[0].descriptors, features[1].descriptors, ratio)
+    x0 = features[0].points[pairs[:, 0]].astype(np.float64)
+    x1 = features[1].points[pairs[:, 1]].astype(np.float64)
+    T_cam1_cam0 = T_cam_board[1] @ np.linalg.inv(T_cam_board[0])
+    X_cam0 = triangulate(K, T_cam1_cam0, x0, x1)
+    finite = np.all(np.isfinite(X_cam0), axis=1)
+    X_cam0 = np.where(finite[:, None], X_cam0, 0.0)
+    error0 = reprojection_errors(X_cam0, x0, K, np.eye(4))
+    error1 = reprojection_errors(X_cam0, x1, K, T_cam1_cam0)
+    keep = (
+        finite
+        & (error0 <= max_reprojection_px)
+        & (error1 <= max_reprojection_px)
+        & _inside(masks[0], x0)
+        & _inside(masks[1], x1)
+    )
+    T_board_cam0 = np.linalg.inv(T_cam_board[0])
+    points = X_cam0[keep] @ T_board_cam0[:3, :3].T + T_board_cam0[:3, 3]
+    descriptors = features[0].descriptors[pairs[keep, 0]]
+    return TargetModel(points.reshape(-1, 3), descriptors.reshape(-1, 128).astype(np.float32))

@@ -1,0 +1,92 @@
+"""Choosing n_t from a failure tolerance by leave-one-scene-out cross-validation (Windsor et al. VI, future work).
+
+For a target incursion rate r*, the threshold is chosen on every scene but one as the operating point with the
+largest mean SPL among those with R_i <= r* (the most conservative one if none is that safe, flagged
+``feasible`` False), then scored on the held-out scene's datasets. Pooled over folds: the held-out R_i = I / n
+(eq. 4) and mean SPL (eq. 3) say whether a threshold chosen on some scenes stays safe on unseen ones.
+
+The scene of a dataset id is the part before ``_arc`` / ``_line`` (``scene_3_arc090`` -> ``scene_3``).
+"""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+import pandas as pd
+
+from poseintegrity.prediction.metrics import best_operating_point, operating_curves
+
+FOLD_COLUMNS = [
+    "predictor", "tolerance", "target_rate", "scene", "operating_point", "feasible", "heldout_incursions",
+    "heldout_n", "heldout_spl_sum",
+]  # fmt: skip
+
+
+def scene_of(dataset: str) -> str:
+    """``scene_3_arc090`` -> ``scene_3``; an id without ``_arc`` / ``_line`` is its own scene."""
+    return re.split(r"_(?:arc|line)", dataset, maxsplit=1)[0]
+
+
+def loso_folds(table: pd.DataFrame, target_rate: float, conservative_high: bool) -> pd.DataFrame:
+    """One row per held-out scene for one predictor / tolerance / method / trajectory of a prediction table.
+
+    table : rows of one curve family with columns dataset, operating_point, theta_p, spl, incursion (and the
+        curve keys). Needs at least two scenes; with one scene the result is empty.
+    """
+    scenes = table["dataset"].map(scene_of)
+    rows = []
+    for scene in sorted(scenes.unique()):
+        train, test = table[scenes != scene], table[scenes == scene]
+        if train.empty:
+            continue
+        curve = operating_curves(train)
+        _, point = best_operating_point(curve, target_rate, conservative_high)
+        feasible = bool(np.isfinite(point))
+        if not feasible:  # nothing that safe on the training scenes: the most conservative operating point
+            points = curve["operating_point"]
+            point = float(points.max() if conservative_high else points.min())
+        held = test[(test["operating_point"] == point) & test["theta_p"].notna()]
+        rows.append(
+            dict(predictor=str(table["predictor"].iloc[0]), tolerance=str(table["tolerance"].iloc[0]),
+                 target_rate=target_rate, scene=scene, operating_point=point, feasible=feasible,
+                 heldout_incursions=float(held["incursion"].sum()), heldout_n=int(len(held)),
+                 heldout_spl_sum=float(held["spl"].sum()))
+        )  # fmt: skip
+    return pd.DataFrame(rows, columns=FOLD_COLUMNS)
+
+
+def loso(
+    table: pd.DataFrame, target_rates: tuple[float, ...], predictors: tuple[str, ...], method: str,
+    trajectory: str = "arc",
+) -> pd.DataFrame:  # fmt: skip
+    """LOSO folds for every predictor, tolerance and target rate on one PnP method and trajectory type."""
+    rows = table[(table["method"] == method) & (table["trajectory"] == trajectory)]
+    folds = [
+        loso_folds(group, rate, conservative_high=predictor != "static")
+        for (predictor, _), group in rows[rows["predictor"].isin(predictors)].groupby(["predictor", "tolerance"])
+        for rate in target_rates
+    ]
+    return pd.concat(folds, ignore_index=True) if folds else pd.DataFrame(columns=FOLD_COLUMNS)
+
+
+def loso_summary(folds: pd.DataFrame, target_rate: float) -> dict:
+    """predictor -> tolerance -> pooled held-out figures at ``target_rate``.
+
+    heldout_incursion_rate : sum of held-out incursions / held-out datasets (eq. 4 over all folds)
+    heldout_mean_spl : mean SPL over all held-out datasets;  n_infeasible_folds : folds where no threshold met
+    the target on the training scenes;  thresholds : the operating point chosen per held-out scene
+    """
+    summary: dict = {}
+    for (predictor, tolerance), group in folds[folds["target_rate"] == target_rate].groupby(
+        ["predictor", "tolerance"], sort=True
+    ):
+        n = group["heldout_n"].sum()
+        summary.setdefault(str(predictor), {})[str(tolerance)] = {
+            "target_incursion_rate": float(target_rate),
+            "heldout_incursion_rate": float(group["heldout_incursions"].sum() / n) if n else float("nan"),
+            "heldout_mean_spl": float(group["heldout_spl_sum"].sum() / n) if n else float("nan"),
+            "n_infeasible_folds": int((~group["feasible"].astype(bool)).sum()),
+            "thresholds": {str(s): float(p) for s, p in zip(group["scene"], group["operating_point"], strict=True)},
+        }
+    return summary

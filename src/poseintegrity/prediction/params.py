@@ -1,0 +1,94 @@
+"""Schema of the ``predict`` section of ``params.yaml`` (stage 04, localization-envelope predictors).
+
+The artifact models themselves are configured by the ``fit`` section (:class:`poseintegrity.artifacts.FitParams`:
+curve_fit budget, MLP recipe, range ends theta_max / x_max); this section says how the predictors of
+Windsor et al. III-E use them and how the operating points are swept (IV-A, V). Lengths in mm, angles in deg.
+"""
+
+from __future__ import annotations
+
+from typing import Literal
+
+import numpy as np
+from pydantic import BaseModel, ConfigDict, Field, model_validator
+
+from poseintegrity.artifacts.params import ModelName
+
+IntervalMethod = Literal["covariance", "bootstrap"]
+
+
+class PredictorModels(BaseModel):
+    """Artifact model behind each predictor (a name of :data:`poseintegrity.artifacts.MODEL_NAMES`)."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+    long_range: ModelName = Field(description="long range predictor (paper: eq. 1, the EMG)")
+    next_step: ModelName = Field(description="next-step predictor (paper: the EMG)")
+    mlp: ModelName = Field(description="the MLP baseline of IV-A (paper: the EMG-pretrained, fine-tuned MLP)")
+
+
+class UncertaintyParams(BaseModel):
+    """Prediction interval on theta_p (beyond the paper)."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+    method: IntervalMethod = Field(
+        description="covariance: delta method from the EMG fit's parameter covariance; bootstrap: refits on images"
+        " resampled with replacement (any model)"
+    )
+    level: float = Field(gt=0, lt=1, description="two-sided coverage of the interval, e.g. 0.9")
+    n_bootstrap: int = Field(ge=2, description="bootstrap refits per dataset (method bootstrap)")
+
+
+class PredictParams(BaseModel):
+    """Stage 04: predictors, the n_t sweep, the static baseline, LOSO threshold choice, live-trial simulation."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+    pnp_method: str = Field(min_length=1, description="the paper's PnP path (Tables I-III); others only in Fig. 6")
+    n_t_min: int = Field(ge=1, description="smallest inlier threshold of the sweep (paper: 4)")
+    n_t_max: int = Field(ge=1, description="largest inlier threshold of the sweep (paper: 100)")
+    long_range_stops_arc: int = Field(ge=2, description="stops the long range predictor fits on arcs (paper: 4)")
+    long_range_stops_line: int = Field(ge=2, description="the same on straight lines (paper: 5)")
+    next_step_first_stops: int = Field(ge=2, description="stops of the next-step predictor's first fit (paper: 4)")
+    static_max_deg: float = Field(gt=0, description="static baseline swept from 0 to this on arcs (paper: 45)")
+    static_max_mm: float = Field(gt=0, description="static baseline swept from 0 to this on lines (paper: 150)")
+    n_static: int = Field(ge=2, description="envelope sizes of the static sweep (evenly spaced, both ends included)")
+    tolerance_fig6_fig7: str = Field(
+        min_length=1, description="tolerance of the PnP (Fig. 6) and straight-line (Fig. 7) curves (paper: 2mm_3deg)"
+    )
+    n_grid: int = Field(ge=16, description="grid points of the theta_p crossing scan per fitted curve")
+    models: PredictorModels
+    live_n_t: int = Field(ge=1, description="fixed n_t of the simulated live trials (paper: 15, from Table III)")
+    live_tolerance: str = Field(min_length=1, description="tolerance of the simulated live trials (paper: 4mm_10deg)")
+    loso_target_rates: tuple[float, ...] = Field(
+        min_length=1, description="target incursion rates of the leave-one-scene-out threshold choice; first = headline"
+    )
+    uncertainty: UncertaintyParams
+    seed: int = Field(ge=0, description="seed of every random draw of the stage (MLP weights, bootstrap)")
+    n_jobs: int = Field(description="joblib workers; -1 = all cores")
+
+    @model_validator(mode="after")
+    def _check(self) -> PredictParams:
+        if self.n_t_max < self.n_t_min:
+            raise ValueError(f"n_t_max ({self.n_t_max}) must be >= n_t_min ({self.n_t_min})")
+        if self.n_jobs == 0:
+            raise ValueError("n_jobs must be a positive count or negative (joblib convention), not 0")
+        bad = [r for r in self.loso_target_rates if not 0.0 <= r <= 1.0]
+        if bad:
+            raise ValueError(f"loso_target_rates must lie in [0, 1], got {bad}")
+        return self
+
+    @property
+    def thresholds(self) -> np.ndarray:
+        """The swept inlier thresholds n_t : (T,) float, n_t_min .. n_t_max in steps of 1."""
+        return np.arange(self.n_t_min, self.n_t_max + 1, dtype=float)
+
+    def long_range_stops(self, trajectory: str) -> int:
+        """Stops the long range predictor fits ("arc": 4, "line": 5 in the paper)."""
+        return {"arc": self.long_range_stops_arc, "line": self.long_range_stops_line}[trajectory]
+
+    def static_sizes(self, trajectory: str) -> np.ndarray:
+        """Static baseline envelope sizes : (n_static,) float, deg (arcs) or mm (lines)."""
+        end = {"arc": self.static_max_deg, "line": self.static_max_mm}[trajectory]
+        return np.linspace(0.0, end, self.n_static)

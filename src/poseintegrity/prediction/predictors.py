@@ -1,0 +1,224 @@
+"""The localization-envelope predictors of Windsor et al. (III-E, IV-A) and the static baseline.
+
+    boundaries        theta_p for every inlier threshold n_t at once from one fitted artifact model (III-E)
+    long_range        fit the first k stops (4 on arcs, 5 on lines), theta_p per n_t (III-E, V-A)
+    next_step         refit at every stop from the 4th on; stop when theta_p < theta_i + theta_b (III-E, V-B)
+    static_baseline   one envelope size for every dataset (IV-A)
+
+The artifact fit does not depend on n_t, so every predictor fits once per dataset (and stop) and finds the
+crossings of all thresholds on one evaluation of the fitted curve. theta is deg for arcs, mm for lines.
+
+Statuses of a theta_p (the first four as in :func:`poseintegrity.artifacts.envelope_boundary`):
+    "root"            the fitted curve falls to n_t inside [theta_1, theta_end]
+    "censored"        it stays above n_t up to the range end: theta_p = theta_end
+    "below_at_start"  it is at or below n_t already at the first stop: theta_p = 0 (no safe motion predicted)
+    "non_finite"      the curve is nan/inf before any crossing: theta_p = the last finite point before it
+    "bad_threshold"   n_t is not finite: theta_p = NaN (a flagged row)
+    "too_few_stops"   fewer stops with a valid inlier count than the predictor needs: theta_p = NaN (flagged)
+    "stopped" / "end_of_path"   next-step only: the robot was stopped (theta_p = its stop) / reached the last stop
+"""
+
+from __future__ import annotations
+
+import zlib
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from poseintegrity.artifacts import FitParams, FittedModel, fit_model
+from poseintegrity.artifacts.fig2 import Series
+
+BISECTION_XTOL = 1e-9  # theta units; the root refinement of :func:`boundaries`
+
+
+@dataclass(frozen=True)
+class Boundaries:
+    """theta_p : (T,) float, deg or mm;  status : (T,) str, one per threshold (module docstring)."""
+
+    theta_p: np.ndarray
+    status: np.ndarray
+
+
+def boundaries(
+    predict: Callable[[np.ndarray], np.ndarray],
+    thresholds: np.ndarray,
+    theta_start: float,
+    theta_end: float,
+    n_grid: int = 256,
+) -> Boundaries:
+    """theta_p in [theta_start, theta_end] where predict first falls to each threshold n_t (III-E, vectorized).
+
+    The same answers as :func:`poseintegrity.artifacts.envelope_boundary` with ``n_scan = n_grid`` (checked in
+    the tests): f is evaluated once on the grid; the first grid point at or below n_t is found for every
+    threshold through the running minimum of f; each bracketing interval is then refined by a bisection run on
+    all brackets at once (one call of ``predict`` per halving) down to BISECTION_XTOL.
+
+    predict : f, (m,) float -> (m,) float inlier counts;  thresholds : (T,) float n_t
+    """
+    if not theta_end > theta_start:
+        raise ValueError(f"empty search range [{theta_start}, {theta_end}]")
+    n_t = np.atleast_1d(np.asarray(thresholds, dtype=float))
+    theta = np.linspace(theta_start, theta_end, n_grid)
+    f = np.asarray(predict(theta), dtype=float)
+    bad = ~np.isfinite(f)
+    first_bad = int(np.argmax(bad)) if bad.any() else n_grid
+    running_min = np.minimum.accumulate(f[:first_bad]) if first_bad else np.empty(0)
+    # first grid index with f <= n_t, or first_bad if f stays above n_t on the finite prefix
+    first_below = np.searchsorted(-running_min, -np.nan_to_num(n_t, nan=-np.inf), side="left")
+
+    theta_p = np.full(n_t.shape, np.nan)
+    status = np.full(n_t.shape, "root", dtype=object)
+    censored = first_below == n_grid
+    non_finite = (first_below == first_bad) & ~censored
+    at_start = (first_below == 0) & ~non_finite
+    theta_p[censored], status[censored] = theta_end, "censored"
+    theta_p[non_finite], status[non_finite] = theta[max(first_bad - 1, 0)], "non_finite"
+    theta_p[at_start], status[at_start] = theta_start, "below_at_start"
+    bad_n_t = ~np.isfinite(n_t)
+    theta_p[bad_n_t], status[bad_n_t] = np.nan, "bad_threshold"
+
+    root = (status == "root").nonzero()[0]
+    i = first_below[root]
+    lo, hi = theta[i - 1], theta[i]
+    exact = f[i] == n_t[root]
+    theta_p[root[exact]] = hi[exact]
+    root, lo, hi, target = root[~exact], lo[~exact], hi[~exact], n_t[root[~exact]]
+    failed = np.zeros(root.shape, dtype=bool)
+    for _ in range(int(np.ceil(np.log2(max((theta[1] - theta[0]) / BISECTION_XTOL, 2.0))))):
+        mid = 0.5 * (lo + hi)
+        excess = np.asarray(predict(mid), dtype=float) - target if mid.size else mid
+        failed |= ~np.isfinite(excess)
+        above = excess > 0.0
+        lo, hi = np.where(above, mid, lo), np.where(above, hi, mid)
+    theta_p[root] = np.where(failed, theta[first_below[root] - 1], 0.5 * (lo + hi))
+    status[root[failed]] = "non_finite"
+    return Boundaries(theta_p, status.astype(str))
+
+
+def stop_positions(series: Series) -> tuple[np.ndarray, np.ndarray]:
+    """(stops, theta) of the stops with at least one valid inlier count, in stop order : (s,) int, (s,) float."""
+    valid = np.isfinite(series.n_inliers) & (series.n_inliers >= 0) & np.isfinite(series.theta)
+    stops = np.unique(series.stop[valid])
+    theta = np.array([series.theta[series.stop == s].mean() for s in stops])
+    return stops, theta
+
+
+def fit_rng(seed: int, method: str, series: Series, k: int) -> np.random.Generator:
+    """The Generator of one fit: the same for any n_jobs, order of work and other datasets in the table."""
+    return np.random.default_rng([seed, zlib.crc32(f"{method}/{series.trajectory}/{series.dataset}".encode()), k])
+
+
+def fit_stops(
+    series: Series, stops: np.ndarray, model: str, fit: FitParams, rng: np.random.Generator
+) -> tuple[FittedModel, np.ndarray, np.ndarray]:
+    """The artifact model fitted to the images of ``stops`` : (fitted, theta (m,), n_inliers (m,))."""
+    keep = np.isin(series.stop, stops)
+    theta, n_inliers = series.theta[keep], series.n_inliers[keep]
+    fitted = fit_model(model, theta, n_inliers, theta_max=fit.range_end(series.trajectory), params=fit, rng=rng)
+    return fitted, theta, n_inliers
+
+
+def envelope_prediction(
+    predict: Callable[[np.ndarray], np.ndarray], thresholds: np.ndarray, theta_1: float, theta_end: float, n_grid: int
+) -> Boundaries:
+    """theta_p per threshold from a fitted curve (e.g. ``FittedModel.predict``), searched from the first stop (III-E).
+
+    The robot starts inside the envelope (III-E) and the model vouches for nothing before its first sample,
+    so the search starts at theta_1; a curve already at or below n_t there predicts failure at once: 0.
+    """
+    found = boundaries(predict, thresholds, theta_1, theta_end, n_grid)
+    return Boundaries(np.where(found.status == "below_at_start", 0.0, found.theta_p), found.status)
+
+
+def flagged(thresholds: np.ndarray, status: str) -> Boundaries:
+    """Every threshold flagged with ``status`` and theta_p NaN."""
+    return Boundaries(np.full(np.shape(thresholds), np.nan), np.full(np.shape(thresholds), status))
+
+
+@dataclass(frozen=True)
+class LongRange:
+    """The long range predictor's answer for one dataset: theta_p per threshold and the fit behind it."""
+
+    prediction: Boundaries
+    fitted: FittedModel | None  # None when there were too few stops
+    theta: np.ndarray  # (m,) the fitted samples
+    n_inliers: np.ndarray  # (m,)
+
+
+def long_range(
+    series: Series, k: int, model: str, thresholds: np.ndarray, fit: FitParams, rng: np.random.Generator, n_grid: int
+) -> LongRange:
+    """Long range predictor (III-E, V-A): fit the first k stops once, theta_p for every n_t.
+
+    "too_few_stops" (theta_p NaN) when fewer than k stops have a valid inlier count, e.g. all-NaN counts.
+    """
+    stops, theta_stops = stop_positions(series)
+    if stops.size < k:
+        return LongRange(flagged(thresholds, "too_few_stops"), None, np.empty(0), np.empty(0))
+    fitted, theta, n_inliers = fit_stops(series, stops[:k], model, fit, rng)
+    theta_end = fit.range_end(series.trajectory)
+    prediction = envelope_prediction(fitted.predict, thresholds, theta_stops[0], theta_end, n_grid)
+    return LongRange(prediction, fitted, theta, n_inliers)
+
+
+def next_step_stops(theta_p: np.ndarray, theta_i: float, theta_b: float) -> np.ndarray:
+    """III-E's rule: stop the robot when theta_p < theta_i + theta_b. (T,) float -> (T,) bool (True: stop)."""
+    return np.asarray(theta_p, dtype=float) < theta_i + theta_b
+
+
+def sampling_interval(theta_stops: np.ndarray) -> float:
+    """theta_b of the next-step predictor: the dataset's sampling interval (median gap between stops)."""
+    return float(np.median(np.diff(theta_stops)))
+
+
+@dataclass(frozen=True)
+class NextStep:
+    """Next-step answer for one dataset: the stop angle per threshold (its theta_p for SPL, V-B), status, fits."""
+
+    prediction: Boundaries  # theta_p = where the robot stops; status "stopped" | "end_of_path" | "too_few_stops"
+    boundary: np.ndarray  # (T,) the model's theta_p at the stop that stopped the robot (NaN: never stopped)
+    n_fits: int
+
+
+def next_step(
+    series: Series, k0: int, model: str, thresholds: np.ndarray, fit: FitParams, seed: int, method: str, n_grid: int
+) -> NextStep:
+    """Next-step predictor (III-E, V-B) run over a recorded dataset for every threshold at once.
+
+    From the k0-th stop on, at every stop i the model is refitted on all stops so far and theta_p(n_t) found;
+    a threshold whose theta_p < theta_i + theta_b stops the robot at min(theta_i, theta_p): the first k0 stops
+    are a sampling phase as for the long range predictor, and a model that puts the boundary behind the robot
+    sends it back there (our reading of V-B, where the SPL of the next-step predictor is "the viewing angle where
+    the predictor would stop the robot" and its zero-incursion SPL, 13.9 deg, needs stops before the 4th stop on
+    datasets whose theta_a is about 7 deg). Thresholds never stopped reach the last stop ("end_of_path"); a
+    non-finite n_t is flagged "bad_threshold". Fits stop once every threshold has stopped.
+    """
+    stops, theta_stops = stop_positions(series)
+    if stops.size < max(k0, 2):
+        return NextStep(flagged(thresholds, "too_few_stops"), np.full(np.shape(thresholds), np.nan), 0)
+    theta_b, theta_end = sampling_interval(theta_stops), fit.range_end(series.trajectory)
+    stop_at = np.full(np.shape(thresholds), theta_stops[-1])
+    boundary = np.full(np.shape(thresholds), np.nan)
+    moving = np.isfinite(thresholds)
+    n_fits = 0
+    for i in range(k0 - 1, stops.size):
+        if not moving.any():
+            break
+        fitted, _, _ = fit_stops(series, stops[: i + 1], model, fit, fit_rng(seed, method, series, i + 1))
+        n_fits += 1
+        theta_p = envelope_prediction(fitted.predict, thresholds[moving], theta_stops[0], theta_end, n_grid).theta_p
+        stop = next_step_stops(theta_p, theta_stops[i], theta_b)
+        index = moving.nonzero()[0][stop]
+        stop_at[index], boundary[index] = np.minimum(theta_stops[i], theta_p[stop]), theta_p[stop]
+        moving[index] = False
+    status = np.where(moving, "end_of_path", "stopped").astype(object)
+    bad = ~np.isfinite(thresholds)
+    stop_at[bad], status[bad] = np.nan, "bad_threshold"
+    return NextStep(Boundaries(stop_at, status.astype(str)), boundary, n_fits)
+
+
+def static_baseline(sizes: np.ndarray) -> Boundaries:
+    """The naive baseline (IV-A): theta_p = the envelope size, whatever the dataset. sizes : (S,) deg or mm."""
+    sizes = np.asarray(sizes, dtype=float)
+    return Boundaries(sizes.copy(), np.full(sizes.shape, "static"))

@@ -1,0 +1,109 @@
+"""The next-step predictor as a component of a robot loop (Windsor et al. III-E; the live trials of V-C).
+
+    supervisor = NextStepSupervisor(n_t=15, theta_b=1.5, theta_end=45.0, fit=fit_params, rng=rng)
+    for theta, n_inliers in stops:                  # the robot pauses at each stop and localizes
+        decision = supervisor.update(theta, n_inliers)
+        if not decision.proceed:
+            break                                   # failure predicted before the next step: stop here
+
+Until ``first_stops`` stops are seen the supervisor lets the robot move on (it cannot fit yet: the robot
+starts inside the envelope, III-E). From then on it refits the artifact model on every stop so far and stops
+the robot when theta_p < theta_i + theta_b (or, with ``stop_on_lower_bound``, when the lower end of the
+prediction interval on theta_p is). A theta_p below the current theta puts the boundary behind the robot: the
+offline evaluation (:func:`poseintegrity.prediction.next_step`) then counts the stop at theta_p, i.e. the robot
+backs off to it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from poseintegrity.artifacts import FitParams, fit_model
+from poseintegrity.prediction.params import UncertaintyParams
+from poseintegrity.prediction.predictors import envelope_prediction, next_step_stops
+from poseintegrity.prediction.uncertainty import prediction_interval
+
+
+@dataclass(frozen=True)
+class Decision:
+    """What the supervisor says after a stop.
+
+    proceed : True: move on to the next step;  theta_p : predicted envelope boundary (NaN before the first fit)
+    interval : (lower, upper) on theta_p (NaN without one);  status : theta_p's status ("collecting" before the
+    first fit);  reason : the fit's "ok" or why it failed (a failed fit falls back to a line, still used)
+    """
+
+    proceed: bool
+    theta_p: float
+    interval: tuple[float, float]
+    status: str
+    reason: str
+
+
+@dataclass
+class NextStepSupervisor:
+    """Next-step supervision over one trajectory; theta in deg (arcs) or mm (lines), increasing.
+
+    n_t : inlier threshold;  theta_b : step size (the distance to the next stop);  theta_end : end of the range
+    model : artifact model name;  first_stops : stops needed before the first fit (paper: 4)
+    uncertainty : how to put an interval on theta_p (None: no interval);  stop_on_lower_bound : use its lower end
+    """
+
+    n_t: float
+    theta_b: float
+    theta_end: float
+    fit: FitParams
+    rng: np.random.Generator
+    model: str = "emg"
+    first_stops: int = 4
+    uncertainty: UncertaintyParams | None = None
+    stop_on_lower_bound: bool = False
+    n_grid: int = 256
+    theta: list[float] = field(default_factory=list, init=False)  # every image's theta so far
+    n_inliers: list[float] = field(default_factory=list, init=False)
+
+    def __post_init__(self) -> None:
+        if self.stop_on_lower_bound and self.uncertainty is None:
+            raise ValueError("stop_on_lower_bound needs an uncertainty method (uncertainty=None)")
+        if not (np.isfinite(self.n_t) and self.theta_b > 0 and np.isfinite(self.theta_end)):
+            raise ValueError(f"need a finite n_t, theta_b > 0 and a finite theta_end; got {self.n_t}, "
+                             f"{self.theta_b}, {self.theta_end}")  # fmt: skip
+
+    def update(self, theta: float, n_inliers: float | np.ndarray) -> Decision:
+        """Add the inlier counts of the images taken at stop ``theta`` and decide (III-E).
+
+        theta : float, the current stop (>= the previous one; equal = more images at the same stop)
+        n_inliers : float or (m,) counts of the images at this stop (0 for a frame that failed to localize)
+        Raises ValueError on a NaN theta or count, or on a theta smaller than the previous stop.
+        """
+        counts = np.atleast_1d(np.asarray(n_inliers, dtype=float)).ravel()
+        if not np.isfinite(theta):
+            raise ValueError(f"theta must be finite, got {theta}")
+        if counts.size == 0 or not np.all(np.isfinite(counts)):
+            raise ValueError(f"n_inliers must be finite counts (0 for a failed frame), got {n_inliers}")
+        if self.theta and theta < self.theta[-1]:
+            raise ValueError(f"theta must not decrease: {theta} after {self.theta[-1]}")
+        self.theta.extend([float(theta)] * counts.size)
+        self.n_inliers.extend(counts.tolist())
+        samples_theta, samples_n = np.asarray(self.theta), np.asarray(self.n_inliers)
+        nan2 = (float("nan"), float("nan"))
+        if np.unique(samples_theta).size < self.first_stops:
+            return Decision(True, float("nan"), nan2, "collecting", "ok")
+        fitted = fit_model(
+            self.model, samples_theta, samples_n, theta_max=self.theta_end, params=self.fit, rng=self.rng
+        )
+        n_t = np.array([float(self.n_t)])
+        found = envelope_prediction(fitted.predict, n_t, samples_theta[0], self.theta_end, self.n_grid)
+        theta_p, interval = float(found.theta_p[0]), nan2
+        if self.uncertainty is not None:
+            bounds = prediction_interval(
+                self.model, fitted, samples_theta, samples_n, n_t, theta_end=self.theta_end, fit=self.fit,
+                uncertainty=self.uncertainty, rng=self.rng, n_grid=self.n_grid,
+            )  # fmt: skip
+            interval = (float(bounds.lower[0]), float(bounds.upper[0]))
+        # a NaN lower bound (no interval) never lets the robot on: NaN < x is False, so compare the negation
+        guard = interval[0] if self.stop_on_lower_bound else theta_p
+        proceed = not bool(next_step_stops(np.array([guard]), float(theta), self.theta_b)[0]) and np.isfinite(guard)
+        return Decision(bool(proceed), theta_p, interval, str(found.status[0]), fitted.reason)

@@ -1,0 +1,228 @@
+"""The operating-point sweeps of Windsor et al. V (Figs. 5-8, Tables I-III) on a stage-02 artifacts table.
+
+    sweep             theta_p of every predictor for every dataset, PnP method and operating point
+                      (n_t = n_t_min .. n_t_max; static sizes 0 .. 45 deg / 0 .. 150 mm), fitted once per
+                      dataset (and stop for the next-step predictor), on ``predict.n_jobs`` joblib workers
+    attach_envelopes  joins the actual envelopes theta_a per tolerance and adds SPL (eq. 3), incursion (eq. 4)
+    live_trials       the simulated live trials (V-C): next-step supervision at one fixed n_t vs the static baseline
+    headline_metrics  the keys of ``reports/metrics/predictors.json``
+
+Predictors (column ``predictor``): "long_range", "long_range_lower" (stops on the lower bound of the
+prediction interval, :mod:`.uncertainty`), "mlp", "next_step", "static". Only "long_range" and "static" run
+on PnP methods other than ``predict.pnp_method`` (Fig. 6).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+from joblib import Parallel, delayed
+from tqdm import tqdm
+
+from poseintegrity.artifacts import FitParams
+from poseintegrity.artifacts.fig2 import Series, dataset_series
+from poseintegrity.prediction.loso import loso_summary
+from poseintegrity.prediction.metrics import best_operating_point, relative_improvement, with_metrics
+from poseintegrity.prediction.params import PredictParams
+from poseintegrity.prediction.predictors import (
+    Boundaries,
+    LongRange,
+    fit_rng,
+    long_range,
+    next_step,
+    static_baseline,
+)
+from poseintegrity.prediction.uncertainty import prediction_interval
+
+COLUMNS = [
+    "predictor", "model", "method", "trajectory", "dataset", "operating_point", "theta_p", "status", "converged",
+    "reason",
+]  # fmt: skip
+PAPER_PREDICTORS = ("static", "long_range", "mlp", "next_step")  # the keys of predictors.json
+CONSERVATIVE_HIGH = {"static": False}  # a larger operating point is more conservative for n_t, not for a size
+
+
+def _rows(
+    predictor: str, model: str, method: str, series: Series, operating_point: np.ndarray, found: Boundaries,
+    converged: bool, reason: str,
+) -> pd.DataFrame:  # fmt: skip
+    return pd.DataFrame(
+        {
+            "predictor": predictor, "model": model, "method": method, "trajectory": series.trajectory,
+            "dataset": series.dataset, "operating_point": operating_point, "theta_p": found.theta_p,
+            "status": found.status, "converged": converged, "reason": reason,
+        },
+        columns=COLUMNS,
+    )  # fmt: skip
+
+
+def predict_dataset(series: Series, method: str, predict: PredictParams, fit: FitParams) -> pd.DataFrame:
+    """Every predictor's theta_p over the operating points for one dataset and PnP method (rows of COLUMNS)."""
+    n_t, k, models = predict.thresholds, predict.long_range_stops(series.trajectory), predict.models
+    sizes = predict.static_sizes(series.trajectory)
+    tables = [_rows("static", "", method, series, sizes, static_baseline(sizes), True, "ok")]
+
+    def long_range_rows(predictor: str, model: str) -> tuple[pd.DataFrame, LongRange]:
+        answer = long_range(series, k, model, n_t, fit, fit_rng(predict.seed, method, series, k), predict.n_grid)
+        fitted = answer.fitted
+        converged, reason = (fitted.converged, fitted.reason) if fitted else (False, "too few stops")
+        return _rows(predictor, model, method, series, n_t, answer.prediction, converged, reason), answer
+
+    table, answer = long_range_rows("long_range", models.long_range)
+    tables.append(table)
+    if method != predict.pnp_method:  # Fig. 6: the long range predictor alone on the other PnP methods
+        return pd.concat(tables, ignore_index=True)
+
+    interval = prediction_interval(
+        models.long_range, answer.fitted, answer.theta, answer.n_inliers, n_t,
+        theta_end=fit.range_end(series.trajectory), fit=fit, uncertainty=predict.uncertainty,
+        rng=fit_rng(predict.seed + 1, method, series, k), n_grid=predict.n_grid,
+    )  # fmt: skip
+    no_interval = np.isnan(interval.lower) & ~np.isnan(answer.prediction.theta_p)
+    lower = Boundaries(interval.lower, np.where(no_interval, "no_interval", answer.prediction.status))
+    converged = bool(answer.fitted is not None and answer.fitted.converged)
+    tables.append(_rows("long_range_lower", models.long_range, method, series, n_t, lower, converged, interval.reason))
+    tables.append(long_range_rows("mlp", models.mlp)[0])
+    step = next_step(series, predict.next_step_first_stops, models.next_step, n_t, fit, predict.seed, method,
+                     predict.n_grid)  # fmt: skip
+    tables.append(_rows("next_step", models.next_step, method, series, n_t, step.prediction, True,
+                        f"{step.n_fits} fits"))  # fmt: skip
+    return pd.concat(tables, ignore_index=True)
+
+
+def sweep(artifacts: pd.DataFrame, predict: PredictParams, fit: FitParams, progress: bool = True) -> pd.DataFrame:
+    """theta_p of every predictor, dataset, PnP method and operating point (rows of COLUMNS).
+
+    artifacts : the stage-02 table (dataset, trajectory, stop, image, theta_deg, x_mm, method, n_inliers, ...)
+    """
+    tasks = [
+        (series, str(method))
+        for method in sorted(artifacts["method"].unique())
+        for series in dataset_series(artifacts, str(method))
+    ]
+    results = Parallel(n_jobs=predict.n_jobs, return_as="generator")(
+        delayed(predict_dataset)(series, method, predict, fit) for series, method in tasks
+    )
+    return pd.concat(list(tqdm(results, total=len(tasks), disable=not progress)), ignore_index=True)
+
+
+def attach_envelopes(theta_p: pd.DataFrame, envelopes: pd.DataFrame) -> pd.DataFrame:
+    """The prediction table: one row per sweep row and tolerance, with theta_a, censored, spl, incursion.
+
+    A dataset / method without an actual envelope is dropped (it cannot be scored).
+    """
+    keys = ["dataset", "trajectory", "method"]
+    table = theta_p.merge(envelopes[[*keys, "tolerance", "theta_a", "censored"]], on=keys, how="inner")
+    return with_metrics(table)
+
+
+def best_table(curves: pd.DataFrame, max_incursion_rate: float = 0.0) -> pd.DataFrame:
+    """Tables I-III: per (predictor, method, trajectory, tolerance) the max mean SPL at R_i <= rate and its point."""
+    rows = []
+    for (predictor, method, trajectory, tolerance), curve in curves.groupby(
+        ["predictor", "method", "trajectory", "tolerance"], sort=True
+    ):
+        spl, point = best_operating_point(curve, max_incursion_rate, CONSERVATIVE_HIGH.get(predictor, True))
+        rows.append(dict(predictor=predictor, method=method, trajectory=trajectory, tolerance=tolerance,
+                         max_mean_spl=spl, best_operating_point=point))  # fmt: skip
+    return pd.DataFrame(rows)
+
+
+def live_trials(table: pd.DataFrame, predict: PredictParams, static_size: float) -> pd.DataFrame:
+    """The simulated live trials (V-C): next-step at n_t = live_n_t vs the static baseline at ``static_size``.
+
+    One row per arc dataset of ``predict.pnp_method`` at ``predict.live_tolerance``: theta_a, the stop angle and
+    its incursion, the share of the actual envelope used (SPL / theta_a), and the same for the static baseline.
+    """
+    rows = table[
+        (table["trajectory"] == "arc") & (table["method"] == predict.pnp_method)
+        & (table["tolerance"] == predict.live_tolerance)
+    ]  # fmt: skip
+    ours = rows[(rows["predictor"] == "next_step") & (rows["operating_point"] == predict.live_n_t)]
+    static = rows[(rows["predictor"] == "static") & np.isclose(rows["operating_point"], static_size)]
+    merged = ours.merge(static[["dataset", "spl", "incursion"]], on="dataset", suffixes=("", "_static"))
+    return pd.DataFrame(
+        {
+            "dataset": merged["dataset"], "theta_a": merged["theta_a"], "stop_angle": merged["theta_p"],
+            "incursion": merged["incursion"], "share": merged["spl"] / merged["theta_a"],
+            "static_size": static_size, "static_incursion": merged["incursion_static"],
+            "static_share": merged["spl_static"] / merged["theta_a"],
+        }
+    )  # fmt: skip
+
+
+def headline_metrics(
+    table: pd.DataFrame, curves: pd.DataFrame, loso: pd.DataFrame, live: pd.DataFrame, predict: PredictParams
+) -> dict:
+    """The content of ``reports/metrics/predictors.json`` (issue 5's keys; NaN written as null).
+
+    <predictor>.<tolerance>.{max_mean_spl_zero_incursion, best_n_t} on the arc datasets of the paper's PnP path
+    (best_n_t is null for "static", whose operating point is ``best_size``); <predictor>.relative_improvement
+    over static on the mean across tolerances (Tables I, II), long_range.relative_improvement_vs_mlp,
+    next_step.relative_improvement_vs_long_range; straight_line.relative_improvement (Fig. 7);
+    pnp.<method>.{max_mean_spl_zero_incursion, static_max_mean_spl_zero_incursion} (Fig. 6);
+    loso.<predictor>.<tolerance>.{heldout_incursion_rate, heldout_mean_spl, ...} at the first target rate;
+    live.{n_t, incursions, n_trials, envelope_share, static_*} (V-C).
+    """
+    best = best_table(curves)
+
+    def get(predictor: str, trajectory: str, tolerance: str, method: str = predict.pnp_method) -> tuple[float, float]:
+        row = best[(best.predictor == predictor) & (best.trajectory == trajectory) & (best.tolerance == tolerance)
+                   & (best.method == method)]  # fmt: skip
+        return (float(row.max_mean_spl.iloc[0]), float(row.best_operating_point.iloc[0])) if len(row) else (np.nan,) * 2
+
+    tolerances = sorted(table["tolerance"].unique())
+    metrics: dict = {}
+    for predictor in (*PAPER_PREDICTORS, "long_range_lower"):
+        entry: dict = {}
+        for tolerance in tolerances:
+            spl, point = get(predictor, "arc", tolerance)
+            entry[tolerance] = {"max_mean_spl_zero_incursion": spl,
+                                "best_n_t" if predictor != "static" else "best_size": point}  # fmt: skip
+            if predictor == "static":
+                entry[tolerance]["best_n_t"] = None
+        mean_spl = float(np.mean([entry[t]["max_mean_spl_zero_incursion"] for t in tolerances]))
+        static_mean = float(np.mean([get("static", "arc", t)[0] for t in tolerances]))
+        entry["mean_max_mean_spl_zero_incursion"] = mean_spl
+        if predictor != "static":
+            entry["relative_improvement"] = relative_improvement(mean_spl, static_mean)
+        metrics[predictor] = entry
+    mean = {p: metrics[p]["mean_max_mean_spl_zero_incursion"] for p in ("long_range", "mlp", "next_step")}
+    metrics["long_range"]["relative_improvement_vs_mlp"] = relative_improvement(mean["long_range"], mean["mlp"])
+    metrics["next_step"]["relative_improvement_vs_long_range"] = relative_improvement(
+        mean["next_step"], mean["long_range"]
+    )  # Table I: +7.4 % over the MLP; V-B: +9.8 % over the long range predictor
+    tol = predict.tolerance_fig6_fig7
+    metrics["straight_line"] = {
+        "tolerance": tol,
+        "long_range_max_mean_spl_zero_incursion": get("long_range", "line", tol)[0],
+        "static_max_mean_spl_zero_incursion": get("static", "line", tol)[0],
+        "relative_improvement": relative_improvement(get("long_range", "line", tol)[0], get("static", "line", tol)[0]),
+    }
+    metrics["pnp"] = {
+        str(method): {
+            "tolerance": tol,
+            "max_mean_spl_zero_incursion": get("long_range", "arc", tol, method)[0],
+            "best_n_t": get("long_range", "arc", tol, method)[1],
+            "static_max_mean_spl_zero_incursion": get("static", "arc", tol, method)[0],
+        }
+        for method in sorted(table["method"].unique())
+    }
+    metrics["loso"] = loso_summary(loso, predict.loso_target_rates[0])
+    metrics["live"] = {
+        "n_t": predict.live_n_t, "tolerance": predict.live_tolerance, "n_trials": int(len(live)),
+        "incursions": float(live["incursion"].sum()), "envelope_share": float(live["share"].mean()),
+        "static_size": float(live["static_size"].iloc[0]) if len(live) else np.nan,
+        "static_incursions": float(live["static_incursion"].sum()),
+        "static_envelope_share": float(live["static_share"].mean()),
+    }  # fmt: skip
+    return _nan_to_none(metrics)
+
+
+def _nan_to_none(value):
+    """NaN -> None throughout a nested dict (JSON null); numpy scalars -> Python numbers."""
+    if isinstance(value, dict):
+        return {k: _nan_to_none(v) for k, v in value.items()}
+    if isinstance(value, (float, np.floating)):
+        return None if np.isnan(value) else float(value)
+    return value

@@ -1,0 +1,124 @@
+"""The state-space model tracked by both unscented filters (section II-E, eqs. 3-12, 16, 29-30).
+
+State (eq. 3), N = 3n + 6:  x = [r^1; ...; r^n; omega; c_dot]  (marker centres in the world frame, metres;
+angular velocity, rad/s, world frame; velocity of the body centre, m/s).
+Measurement (eq. 4): the rows of x that were measured, i.e. any subset of the marker centres and omega.
+
+``ell`` is the marker geometry centred on its centroid (n, 3), so that the body origin c of the paper is
+the centroid of the markers and ``r^i = c + R ell^i``.
+"""
+
+from __future__ import annotations
+
+import numba
+import numpy as np
+
+from poseintegrity.tracking.geometry import skew
+from poseintegrity.tracking.kabsch import centred_cross_covariance, horn_rotation, kabsch
+
+
+def state_dim(n_markers: int) -> int:
+    """N = 3n + 6 (eq. 3)."""
+    return 3 * n_markers + 6
+
+
+def centred(points_body: np.ndarray) -> np.ndarray:
+    """ell^i: the geometry (n, 3) metres, shifted so that its centroid is the origin."""
+    return points_body - points_body.mean(axis=0)
+
+
+@numba.njit(cache=True)
+def _process_model_kernel(X, dt, ell):  # pragma: no cover - compiled
+    n = ell.shape[0]
+    X_next = X.copy()
+    r = np.empty((n, 3))
+    for k in range(X.shape[1]):  # one sigma point per column
+        for i in range(n):
+            r[i] = X[3 * i : 3 * i + 3, k]
+        R = horn_rotation(centred_cross_covariance(r, ell))  # R_k by Alg. 4, recomputed every step
+        w = X[3 * n : 3 * n + 3, k]
+        v = X[3 * n + 3 : 3 * n + 6, k]
+        for i in range(n):
+            a0 = R[0, 0] * ell[i, 0] + R[0, 1] * ell[i, 1] + R[0, 2] * ell[i, 2]  # a = R_k ell^i
+            a1 = R[1, 0] * ell[i, 0] + R[1, 1] * ell[i, 1] + R[1, 2] * ell[i, 2]
+            a2 = R[2, 0] * ell[i, 0] + R[2, 1] * ell[i, 1] + R[2, 2] * ell[i, 2]
+            X_next[3 * i + 0, k] += dt * (v[0] + w[1] * a2 - w[2] * a1)  # r + dt (c_dot + [w]x R ell)
+            X_next[3 * i + 1, k] += dt * (v[1] + w[2] * a0 - w[0] * a2)
+            X_next[3 * i + 2, k] += dt * (v[2] + w[0] * a1 - w[1] * a0)
+    return X_next
+
+
+def process_model(X: np.ndarray, dt: float, ell: np.ndarray) -> np.ndarray:
+    """f of eq. 10 applied to every column of X (compiled loop over the sigma points).
+
+    X : (N, b) states as columns; dt : seconds; ell : (n, 3) centred geometry, metres.
+    R_k of each column comes from Kabsch (Alg. 4, via :func:`~poseintegrity.tracking.kabsch.horn_rotation`)
+    on its own marker positions, so the rigid body constraint holds:
+    r^i <- r^i + dt (c_dot + [omega]x R ell^i); omega and c_dot are unchanged.
+    """
+    return _process_model_kernel(np.ascontiguousarray(X, dtype=np.float64), float(dt), np.ascontiguousarray(ell, dtype=np.float64))
+
+
+def process_noise_sqrt(x: np.ndarray, dt: float, ell: np.ndarray, sigma_c: float, sigma_alpha: float) -> np.ndarray:
+    """A square root B of the process covariance, ``P_proc = B @ B.T`` (eqs. 11, 17-30).
+
+    x : (N,) state mean; dt : s; ell : (n, 3) m; sigma_c : m/s^2; sigma_alpha : rad/s^2.
+    Returns B : (N, 7).  Columns 0-2 carry c_ddot ~ N(0, sigma_c^2 I) (eq. 8), columns 3-5 carry
+    alpha ~ N(0, sigma_alpha^2 I) (eq. 9) through the noise vector v_k of eq. 11, and column 6 carries the
+    centripetal term (dt^2 / 2) [omega]x^2 R ell^i that the paper keeps inside E_rr (eq. 29).
+
+    Derived again from eq. 11 rather than copied from eqs. 26-28, whose text conversion is garbled:
+    E{[alpha]x a_i a_j^T [alpha]x^T} = sigma_alpha^2 ((a_i . a_j) I - a_j a_i^T) with a_i = R ell^i
+    (eq. 28's G^ij lacks the off-diagonal term and has a sign slip in its (2, 2) entry), and the
+    marker/omega block is -(dt^3 / 2) sigma_alpha^2 [a_i]x (eq. 26 is its transpose).  P_proc has rank
+    7 < N, so it has no Cholesky factor; the rectangular B feeds the QR of Alg. 5 directly.
+    """
+    n = ell.shape[0]
+    N = state_dim(n)
+    R = horn_rotation(centred_cross_covariance(x[: 3 * n].reshape(n, 3), ell))
+    a = ell @ R.T  # (n, 3)
+    omega = x[3 * n : 3 * n + 3]
+    W = skew(omega)
+    half_dt2 = 0.5 * dt * dt
+    B_r = np.zeros((n, 3, 7))  # marker rows, one (3, 7) block per marker
+    B_r[:, :, 0:3] = half_dt2 * sigma_c * np.eye(3)
+    B_r[:, :, 3:6] = -half_dt2 * sigma_alpha * skew(a)  # [alpha]x a_i = -[a_i]x alpha
+    B_r[:, :, 6] = half_dt2 * a @ (W @ W).T  # [omega]x^2 a_i
+    B = np.zeros((N, 7))
+    B[: 3 * n] = B_r.reshape(3 * n, 7)
+    B[3 * n : 3 * n + 3, 3:6] = dt * sigma_alpha * np.eye(3)  # omega_{k+1} = omega_k + dt alpha_k
+    B[3 * n + 3 :, 0:3] = dt * sigma_c * np.eye(3)  # c_dot_{k+1} = c_dot_k + dt c_ddot_k
+    return B
+
+
+def measurement_rows(observed: np.ndarray, gyro: bool) -> np.ndarray:
+    """Indices of the state rows measured now (eq. 4 restricted to what arrived).
+
+    observed : (n,) bool, markers measured in this frame; gyro : whether omega was measured.
+    Returns (3 * observed.sum() + 3 * gyro,) int.
+    """
+    n = observed.shape[0]
+    rows = [np.arange(3 * i, 3 * i + 3) for i in np.flatnonzero(observed)]
+    if gyro:
+        rows.append(np.arange(3 * n, 3 * n + 3))
+    return np.concatenate(rows) if rows else np.zeros(0, dtype=int)
+
+
+def measurement_noise_std(observed: np.ndarray, gyro: bool, sigma_r: float, sigma_omega: float) -> np.ndarray:
+    """Square root of the diagonal of P_mes (eq. 16) for the measured rows: sigma_r (m) or sigma_omega (rad/s)."""
+    return np.concatenate([np.full(3 * int(observed.sum()), sigma_r), np.full(3 * int(gyro), sigma_omega)])
+
+
+def process_model_reference(x: np.ndarray, dt: float, markers_body: np.ndarray) -> np.ndarray:
+    """f of eq. 10 for one state, written plainly with the SVD Kabsch of Alg. 4.
+
+    x : (N,) state; dt : s; markers_body : (n, 3) geometry, metres.  Returns (N,).
+    The compiled :func:`process_model` is tested against it, and it is the ``fx`` given to filterpy.
+    """
+    n = markers_body.shape[0]
+    r = x[: 3 * n].reshape(n, 3)
+    omega, c_dot = x[3 * n : 3 * n + 3], x[3 * n + 3 :]
+    R, _ = kabsch(r, markers_body)
+    a = centred(markers_body) @ R.T  # R ell^i
+    r_next = r + dt * (c_dot + np.cross(omega, a))
+    return np.concatenate([r_next.ravel(), omega, c_dot])

@@ -1,0 +1,145 @@
+"""What the SR-UKF (Alg. 5) and the plain UKF share: scaled sigma points, weights, the model calls.
+
+Sigma points and weights are those of Alg. 5 (van der Merwe's scaled unscented transform):
+lambda = alpha^2 (N + kappa) - N, Wm[0] = lambda / (N + lambda), Wc[0] = Wm[0] + 1 - alpha^2 + beta,
+Wm[i] = Wc[i] = 1 / (2 (N + lambda)) for i = 1..2N; X = [x, x + sqrt(N + lambda) S, x - sqrt(N + lambda) S].
+A subclass decides how the covariance is carried (factor S or matrix P).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from poseintegrity.tracking.kabsch import pose_from_points
+from poseintegrity.tracking.params import FilterParams
+from poseintegrity.tracking.model import (
+    centred,
+    measurement_noise_std,
+    measurement_rows,
+    process_model,
+    process_noise_sqrt,
+    state_dim,
+)
+
+
+def unscented_weights(N: int, alpha: float, beta: float, kappa: float) -> tuple[np.ndarray, np.ndarray, float]:
+    """(Wm, Wc, gamma) of Alg. 5: (2N + 1,) mean and covariance weights and gamma = sqrt(N + lambda)."""
+    lam = alpha**2 * (N + kappa) - N
+    Wm = np.full(2 * N + 1, 1.0 / (2.0 * (N + lam)))
+    Wc = Wm.copy()
+    Wm[0] = lam / (N + lam)
+    Wc[0] = lam / (N + lam) + 1.0 - alpha**2 + beta
+    return Wm, Wc, float(np.sqrt(N + lam))
+
+
+class UnscentedMarkerFilter:
+    """Base of the marker-position filters; use :class:`SquareRootUKF` or :class:`UnscentedKalmanFilter`.
+
+    markers_body : (n, 3) marker geometry, metres (any origin; it is centred internally).
+    settings : alpha, beta, kappa (None: 3 - N); sigma_r (m) and sigma_omega (rad/s) of eq. 16; sigma_c
+    (m/s^2) and sigma_alpha (rad/s^2) of eqs. 8-9; init_std_omega / init_std_velocity, the initial
+    uncertainty of the unmeasured states; max_position_std (m): a larger marker std counts as divergence.
+    Attributes: x (N,) state of eq. 3; initialized; failed_downdates (count of failed Cholesky
+    downdates, see the subclass for the recovery); n_divergences; last_reason (why the last step failed).
+    """
+
+    def __init__(self, markers_body: np.ndarray, settings: FilterParams = FilterParams()):
+        self.markers_body = np.asarray(markers_body, dtype=float)
+        self.ell = centred(self.markers_body)
+        self.n = self.ell.shape[0]
+        self.N = state_dim(self.n)
+        self.settings = settings
+        kappa = 3.0 - self.N if settings.kappa is None else settings.kappa
+        self.Wm, self.Wc, self.gamma = unscented_weights(self.N, settings.alpha, settings.beta, kappa)
+        self.x = np.zeros(self.N)
+        self.initialized = False
+        self.failed_downdates = 0
+        self.n_divergences = 0
+        self.last_reason = ""
+
+    # -- covariance representation, provided by the subclass -------------------------------------
+    def sqrt_covariance(self) -> np.ndarray:
+        """A lower-triangular S with P = S S^T, (N, N)."""
+        raise NotImplementedError
+
+    def covariance(self) -> np.ndarray:
+        """P, (N, N)."""
+        raise NotImplementedError
+
+    def covariance_diagonal(self) -> np.ndarray:
+        """Variances diag(P), (N,)."""
+        return np.diag(self.covariance())
+
+    def _set_covariance(self, std: np.ndarray) -> None:
+        raise NotImplementedError
+
+    def _time_update(self, X_f: np.ndarray, x_prior: np.ndarray, B: np.ndarray) -> None:
+        raise NotImplementedError
+
+    def _measurement_update(self, X: np.ndarray, Y: np.ndarray, z: np.ndarray, noise_std: np.ndarray) -> None:
+        raise NotImplementedError
+
+    # -- the filter ------------------------------------------------------------------------------
+    def initialize(self, markers: np.ndarray, omega: np.ndarray | None = None) -> None:
+        """Start from a good measurement (Alg. 5): markers (n, 3) m in geometry order, omega (3,) rad/s or None."""
+        s = self.settings
+        self.x = np.concatenate([np.asarray(markers, float).ravel(), np.zeros(3) if omega is None else omega, np.zeros(3)])
+        std = np.concatenate([np.full(3 * self.n, s.sigma_r), np.full(3, s.init_std_omega), np.full(3, s.init_std_velocity)])
+        self._set_covariance(std)
+        self.initialized = True
+        self.last_reason = ""
+
+    def sigma_points(self) -> np.ndarray:
+        """X_{k-1} of Alg. 5: (N, 2N + 1), the state and x +/- gamma S as columns."""
+        S = self.sqrt_covariance()
+        return self.x[:, None] + self.gamma * np.hstack([np.zeros((self.N, 1)), S, -S])
+
+    def predict(self, dt: float) -> bool:
+        """Time update over dt seconds (Alg. 5, "State Update").  Returns False if the filter diverged."""
+        X_f = process_model(self.sigma_points(), dt, self.ell)  # X_{k|k-1} = f(X_{k-1})
+        B = process_noise_sqrt(self.x, dt, self.ell, self.settings.sigma_c, self.settings.sigma_alpha)
+        self.x = X_f @ self.Wm  # x_k^- = X_{k|k-1} w_m
+        self._time_update(X_f, self.x, B)
+        return self._check_health()
+
+    def update(self, z: np.ndarray, observed: np.ndarray, gyro: bool) -> bool:
+        """Measurement update with whatever arrived (Alg. 5, "Measurement Update"; partial updates).
+
+        The sigma points are redrawn from (x^-, S^-) instead of reusing X_{k|k-1} as Alg. 5 writes: then
+        P_yy and P_xy include P_proc (with the reused points they miss it), updates may follow each other
+        without a predict between them, and the filter is the one filterpy implements.
+
+        z : measured rows in state order: the observed markers (3 each, metres) then omega (3, rad/s)
+        if gyro.  observed : (n,) bool.  With nothing measured the call is a no-op.
+        Returns False if the filter diverged (then ``initialized`` is False and it must be restarted).
+        """
+        rows = measurement_rows(np.asarray(observed, bool), gyro)
+        if rows.size == 0:
+            return True
+        X = self.sigma_points()
+        noise_std = measurement_noise_std(np.asarray(observed, bool), gyro, self.settings.sigma_r, self.settings.sigma_omega)
+        self._measurement_update(X, X[rows], np.asarray(z, float), noise_std)  # Y = h(X): rows of X (eq. 4)
+        return self._check_health()
+
+    def markers(self) -> np.ndarray:
+        """Estimated marker centres (n, 3), metres, world frame."""
+        return self.x[: 3 * self.n].reshape(self.n, 3).copy()
+
+    def pose(self) -> np.ndarray:
+        """T_world_body (4, 4) of the marker geometry, from the estimated markers by Kabsch (Alg. 4)."""
+        return pose_from_points(self.markers(), self.markers_body)
+
+    def _check_health(self) -> bool:
+        """Divergence test: NaN/inf anywhere or a marker standard deviation above max_position_std."""
+        P_diag = self.covariance_diagonal()
+        bad = ""
+        if not (np.all(np.isfinite(self.x)) and np.all(np.isfinite(P_diag))):
+            bad = "non-finite state or covariance"
+        elif np.sqrt(P_diag[: 3 * self.n].max()) > self.settings.max_position_std:
+            bad = "runaway covariance"
+        if bad:
+            self.initialized = False
+            self.n_divergences += 1
+            self.last_reason = bad
+            return False
+        return True

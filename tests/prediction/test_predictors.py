@@ -1,0 +1,92 @@
+"""Long range, next-step and static predictors on data whose envelope is known, and every bad-input case."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+
+from poseintegrity.artifacts.base_functions import emg
+from poseintegrity.artifacts.fig2 import Series
+from poseintegrity.prediction import NextStepSupervisor, long_range, next_step, static_baseline
+
+ALPHA, K, MU = 3000.0, 8.0, -1.0  # exact eq. 1: ~290 inliers at the first stop, 18 at 45 deg
+THETA_STOPS = 2.25 * np.arange(1, 21)
+N_T = np.arange(4.0, 101.0)
+
+
+def exact_series(n_inliers=None, n_stops: int = 20, images: int = 3) -> Series:
+    theta = np.repeat(THETA_STOPS[:n_stops], images)
+    counts = emg(theta, ALPHA, K, MU) if n_inliers is None else n_inliers
+    return Series("scene_1_arc000", "arc", np.repeat(np.arange(n_stops), images), theta, np.asarray(counts, float))
+
+
+def true_crossing(n_t: float) -> float:
+    return brentq(lambda t: emg(np.array([t]), ALPHA, K, MU)[0] - n_t, 2.25, 45.0)
+
+
+def test_long_range_on_an_exact_emg_finds_the_true_crossing(tiny_fit):
+    answer = long_range(exact_series(), 4, "emg", N_T, tiny_fit, np.random.default_rng(0), 256)
+    assert answer.fitted.converged
+    root = answer.prediction.status == "root"
+    assert root.sum() > 50
+    expected = [true_crossing(n) for n in N_T[root]]
+    np.testing.assert_allclose(answer.prediction.theta_p[root], expected, atol=1e-3)
+    assert np.all(np.diff(answer.prediction.theta_p) <= 1e-12)  # conservative as n_t grows (III-F)
+
+
+def test_thresholds_outside_the_data_range_have_documented_answers(tiny_fit):
+    n_t = np.array([1e4, 0.5, np.nan])  # above every count, below every count, not a number
+    answer = long_range(exact_series(), 4, "emg", n_t, tiny_fit, np.random.default_rng(0), 256)
+    assert list(answer.prediction.status) == ["below_at_start", "censored", "bad_threshold"]
+    assert answer.prediction.theta_p[0] == 0.0 and answer.prediction.theta_p[1] == 45.0
+    assert np.isnan(answer.prediction.theta_p[2])
+
+
+def test_next_step_flags_a_non_finite_threshold(tiny_fit):
+    step = next_step(exact_series(), 4, "emg", np.array([30.0, np.nan]), tiny_fit, 0, "usac_magsac", 256)
+    assert list(step.prediction.status) == ["stopped", "bad_threshold"] and np.isnan(step.prediction.theta_p[1])
+
+
+@pytest.mark.parametrize("series", [exact_series(n_stops=3), exact_series(np.full(60, np.nan))])
+def test_too_few_stops_or_all_nan_counts_are_flagged_not_raised(series, tiny_fit):
+    answer = long_range(series, 4, "emg", N_T, tiny_fit, np.random.default_rng(0), 256)
+    assert set(answer.prediction.status) == {"too_few_stops"} and np.all(np.isnan(answer.prediction.theta_p))
+    step = next_step(series, 4, "emg", N_T, tiny_fit, 0, "usac_magsac", 256)
+    assert set(step.prediction.status) == {"too_few_stops"} and step.n_fits == 0
+
+
+def test_next_step_stops_where_the_supervisor_does(tiny_fit):
+    series = exact_series()
+    step = next_step(series, 4, "emg", N_T, tiny_fit, 0, "usac_magsac", 256)
+    assert set(step.prediction.status) <= {"stopped", "end_of_path"}
+    assert np.all(np.diff(step.prediction.theta_p) <= 0.0)  # a larger n_t never lets the robot further
+    for index in (0, 20, 60):
+        supervisor = NextStepSupervisor(n_t=N_T[index], theta_b=2.25, theta_end=45.0, fit=tiny_fit,
+                                        rng=np.random.default_rng(0))  # fmt: skip
+        stopped_at = THETA_STOPS[-1]
+        for theta in THETA_STOPS:
+            decision = supervisor.update(theta, emg(np.full(3, theta), ALPHA, K, MU))
+            if not decision.proceed:
+                stopped_at = min(theta, decision.theta_p)  # a boundary behind the robot sends it back
+                break
+        assert step.prediction.theta_p[index] == stopped_at
+        if step.prediction.status[index] == "stopped":  # the stop is at or before the boundary that caused it
+            assert stopped_at <= step.boundary[index]
+
+
+def test_next_step_on_exact_data_stops_one_step_before_the_true_crossing(tiny_fit):
+    step = next_step(exact_series(), 4, "emg", N_T, tiny_fit, 0, "usac_magsac", 256)
+    for n_t, stop, status in zip(N_T, step.prediction.theta_p, step.prediction.status, strict=True):
+        crossing = true_crossing(n_t) if emg(np.array([45.0]), ALPHA, K, MU)[0] < n_t else np.inf
+        if status == "stopped":
+            assert stop <= crossing + 1e-3  # never past the true boundary
+            if crossing > THETA_STOPS[3] + 2.25:
+                assert crossing - 2.25 <= stop + 1e-3  # and at most one step before it
+
+
+def test_static_baseline_is_the_size_for_every_dataset():
+    sizes = np.linspace(0.0, 45.0, 11)
+    found = static_baseline(sizes)
+    np.testing.assert_array_equal(found.theta_p, sizes)
+    assert set(found.status) == {"static"}

@@ -1,0 +1,75 @@
+import warnings
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+from poseintegrity.tracking.detection import detect_markers, validate_frame
+from poseintegrity.tracking.frames import Phantom, intrinsics, render_frame, unit_plane_lut
+from poseintegrity.tracking.geometry import MARKER_DIAMETER_M, MARKERS_BODY
+from poseintegrity.tracking.params import CameraParams, DetectionParams, FrameParams
+
+CAMERA, FRAMES, DETECTION = CameraParams(), FrameParams(), DetectionParams()
+K = intrinsics(CAMERA)
+
+
+def _frame(seed=0, phantoms=()):
+    rng = np.random.default_rng(seed)
+    markers = MARKERS_BODY @ Rotation.from_rotvec([0.3, 0.2, 0.1]).as_matrix().T + [0.02, -0.01, 0.45]
+    ir, depth = render_frame(markers, list(phantoms), CAMERA, FRAMES, MARKER_DIAMETER_M / 2, rng)
+    return markers, ir, depth
+
+
+def _nearest(points, markers):
+    return np.linalg.norm(points[:, None] - markers[None], axis=-1).min(axis=0)
+
+
+def test_detects_every_marker_within_a_few_millimetres():
+    markers, ir, depth = _frame()
+    assert ir.dtype == np.uint16 and depth.dtype == np.uint16 and ir.shape == (512, 512)
+    points = detect_markers(ir, depth, K, **DETECTION.model_dump())
+    assert len(points) == 4
+    assert _nearest(points, markers).max() < 0.012  # frame-level depth bias (3 mm std) included
+
+
+def test_lut_and_pinhole_give_the_same_points_and_extrinsics_apply():
+    markers, ir, depth = _frame(1)
+    by_k = detect_markers(ir, depth, K, **DETECTION.model_dump())
+    by_lut = detect_markers(ir, depth, unit_plane_lut(K, 512, 512), **DETECTION.model_dump())
+    np.testing.assert_allclose(by_lut, by_k, atol=1e-9)
+    T = np.eye(4)
+    T[:3, 3] = [1.0, 2.0, 3.0]
+    np.testing.assert_allclose(detect_markers(ir, depth, K, T_world_cam=T, **DETECTION.model_dump()), by_k + [1.0, 2.0, 3.0])
+
+
+def test_uint8_input_is_thresholded_directly():
+    markers, ir, depth = _frame(2)
+    ir8 = (np.clip(ir, 0, 1000) * 255.0 / 1000.0).astype(np.uint8)
+    points = detect_markers(ir8, depth, K, **DETECTION.model_dump())
+    assert len(points) == 4 and _nearest(points, markers).max() < 0.012
+
+
+def test_round_phantoms_pass_and_elongated_ones_are_rejected():
+    round_ph = Phantom(u=60, v=60, radius_px=3.0, elongation=1.0, angle=0.0, depth_mm=500.0)
+    long_ph = Phantom(u=450, v=450, radius_px=2.0, elongation=6.0, angle=0.7, depth_mm=500.0)
+    _, ir, depth = _frame(3, [round_ph, long_ph])
+    points = detect_markers(ir, depth, K, **DETECTION.model_dump())
+    assert len(points) == 5  # the 4 markers and the round phantom
+
+
+def test_invalid_depth_drops_the_blob_and_bad_frames_do_not_crash():
+    markers, ir, depth = _frame(4)
+    zeroed = depth.copy()
+    zeroed[:, :] = 0
+    assert detect_markers(ir, zeroed, K).shape == (0, 3)
+    nan_depth = depth.astype(float)
+    nan_depth[:] = np.nan
+    assert detect_markers(ir, nan_depth, K).shape == (0, 3)
+    with pytest.warns(RuntimeWarning, match="lookup table"):
+        assert detect_markers(ir, depth, np.zeros((10, 10, 2))).shape == (0, 3)
+    with pytest.warns(RuntimeWarning, match="differs"):
+        assert detect_markers(ir, depth[:10], K).shape == (0, 3)
+    assert validate_frame(ir, depth, K) == ""
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert detect_markers(np.zeros((512, 512), np.uint16), depth, K).shape == (0, 3)

@@ -1,0 +1,101 @@
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+from poseintegrity.tracking.evaluation import filterpy_filter
+from poseintegrity.tracking.geometry import MARKERS_BODY
+from poseintegrity.tracking.params import FilterParams
+from poseintegrity.tracking.srukf import SquareRootUKF
+from poseintegrity.tracking.ukf import UnscentedKalmanFilter
+from poseintegrity.tracking.unscented import unscented_weights
+
+
+def _measurements(n_steps, seed=0):
+    """Rotating, translating body: (markers (4, 3) with noise, omega_world (3,)) per step."""
+    rng = np.random.default_rng(seed)
+    omega = np.array([0.8, -0.5, 1.2])
+    out = []
+    for k in range(n_steps):
+        R = Rotation.from_rotvec(omega * 0.01 * k).as_matrix()
+        markers = MARKERS_BODY @ R.T + [0.001 * k, 0.0, 0.45] + rng.normal(0, 0.001, (4, 3))
+        out.append((markers, omega + rng.normal(0, 0.05, 3)))
+    return out
+
+
+def _run(cls, params, steps):
+    f = cls(MARKERS_BODY, params)
+    f.initialize(steps[0][0])
+    states = []
+    for k, (markers, omega) in enumerate(steps):
+        f.predict(0.01)
+        observed = np.array([k % 5 != 1, True, k % 7 != 3, True])  # partial updates
+        f.update(markers[observed].ravel(), observed, gyro=False)
+        if k % 2:
+            f.update(omega, np.zeros(4, bool), gyro=True)  # gyro-only update
+        states.append(f.x.copy())
+    return np.array(states), f
+
+
+@pytest.mark.parametrize("alpha, rtol", [(1.0, 1e-8), (1e-3, 1e-5)])
+def test_square_root_ukf_equals_plain_ukf(alpha, rtol):
+    params = FilterParams(alpha=alpha, sigma_r=0.002, sigma_c=3.0, sigma_alpha=10.0)
+    steps = _measurements(60)
+    x_sr, f_sr = _run(SquareRootUKF, params, steps)
+    x_ukf, f_ukf = _run(UnscentedKalmanFilter, params, steps)
+    assert np.max(np.abs(x_sr - x_ukf) / np.abs(x_ukf).max(axis=0)) < rtol
+    np.testing.assert_allclose(f_sr.covariance(), f_ukf.covariance(), atol=rtol * np.abs(f_ukf.covariance()).max())
+
+
+def test_square_root_ukf_equals_filterpy_on_full_measurements():
+    params = FilterParams(alpha=1.0, sigma_r=0.002, sigma_c=3.0, sigma_alpha=10.0)
+    steps = _measurements(30, seed=1)
+    f = SquareRootUKF(MARKERS_BODY, params)
+    f.initialize(steps[0][0])
+    ref, step = filterpy_filter(MARKERS_BODY, params)
+    ref.x, ref.P = f.x.copy(), f.covariance().copy()
+    for markers, omega in steps:
+        z = np.r_[markers.ravel(), omega]
+        f.predict(0.01)
+        f.update(z, np.ones(4, bool), gyro=True)
+        step(z, 0.01)
+    np.testing.assert_allclose(f.x, ref.x, rtol=0, atol=1e-8 * np.abs(ref.x).max())
+
+
+def test_weights_and_unscented_transform_of_a_linear_map():
+    Wm, Wc, gamma = unscented_weights(18, 1e-3, 2.0, 3 - 18)
+    assert np.isclose(Wm.sum(), 1.0) and Wm[0] < -1e6  # the paper's alpha gives weights near -6e6
+    rng = np.random.default_rng(0)
+    x, A = rng.normal(size=18), rng.normal(size=(18, 18))
+    S = np.linalg.cholesky(A @ A.T + np.eye(18))
+    X = x[:, None] + gamma * np.hstack([np.zeros((18, 1)), S, -S])
+    M = rng.normal(size=(5, 18))
+    Y = M @ X
+    y_mean = Y @ Wm
+    np.testing.assert_allclose(y_mean, M @ x, atol=1e-6)
+    dy = Y - y_mean[:, None]
+    np.testing.assert_allclose((dy * Wc) @ dy.T, M @ S @ S.T @ M.T, rtol=1e-4)
+
+
+def test_filter_tracks_and_counts_failed_downdates_without_crashing():
+    f = SquareRootUKF(MARKERS_BODY, FilterParams(sigma_r=0.002, sigma_c=3.0, sigma_alpha=10.0))
+    steps = _measurements(80, seed=2)
+    f.initialize(steps[0][0])
+    for markers, omega in steps:
+        f.predict(0.01)
+        assert f.update(np.r_[markers.ravel(), omega], np.ones(4, bool), gyro=True)
+    assert np.linalg.norm(f.markers() - steps[-1][0], axis=1).max() < 0.005
+    n_failed = f.failed_downdates
+    S_before = f.S.copy()
+    S_after = f._downdate(f.S, 10.0 * np.sqrt(np.diag(f.covariance())), -1.0)  # removes more than P holds
+    assert f.failed_downdates == n_failed + 1
+    np.testing.assert_array_equal(S_after, S_before)  # the documented recovery: keep the factor
+
+
+def test_divergence_is_detected_and_the_filter_stops():
+    f = SquareRootUKF(MARKERS_BODY)
+    f.initialize(MARKERS_BODY + [0, 0, 0.5])
+    assert not f.update(np.full(12, np.nan), np.ones(4, bool), gyro=False)
+    assert not f.initialized and f.n_divergences == 1 and f.last_reason == "non-finite state or covariance"
+    f.initialize(MARKERS_BODY + [0, 0, 0.5])
+    f.S = f.S * 1e4  # runaway covariance
+    assert not f.predict(0.0025) and f.last_reason == "runaway covariance"

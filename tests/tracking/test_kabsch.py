@@ -1,0 +1,39 @@
+import numpy as np
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from scipy.spatial.transform import Rotation
+
+from poseintegrity.tracking.geometry import MARKERS_BODY
+from poseintegrity.tracking.kabsch import kabsch, kabsch_residuals, kabsch_rotations, pose_from_points
+
+
+@settings(deadline=None, max_examples=40)
+@given(seed=st.integers(0, 2**32 - 1), n=st.integers(3, 8), noise=st.floats(0.0, 0.01))
+def test_kabsch_matches_scipy_align_vectors(seed, n, noise):
+    rng = np.random.default_rng(seed)
+    body = rng.normal(0, 0.05, (n, 3))
+    R_true = Rotation.random(random_state=seed).as_matrix()
+    world = body @ R_true.T + rng.normal(0, 0.3, 3) + rng.normal(0, noise, (n, 3))
+    R, t = kabsch(world, body)
+    R_ref, _ = Rotation.align_vectors(world - world.mean(0), body - body.mean(0))
+    np.testing.assert_allclose(R, R_ref.as_matrix(), atol=1e-8)
+    np.testing.assert_allclose(t, world.mean(0) - R @ body.mean(0), atol=1e-12)  # least-squares translation
+
+
+def test_kabsch_exact_pose_and_proper_rotation_for_reflected_input():
+    T = pose_from_points(MARKERS_BODY @ Rotation.from_rotvec([0.3, -1.0, 2.0]).as_matrix().T + [0.1, 0.2, 0.5], MARKERS_BODY)
+    np.testing.assert_allclose(T[:3, :3], Rotation.from_rotvec([0.3, -1.0, 2.0]).as_matrix(), atol=1e-12)
+    np.testing.assert_allclose(T[:3, 3], [0.1, 0.2, 0.5], atol=1e-12)
+    body = np.array([[0.0, 0.0, 0.0], [0.05, 0.0, 0.0], [0.0, 0.04, 0.0], [0.0, 0.0, 0.03]])  # not planar
+    R, _ = kabsch(body * [1, 1, -1], body)  # a mirror image has no exact proper rotation
+    assert np.isclose(np.linalg.det(R), 1.0)
+    assert kabsch_residuals(body * [1, 1, -1], body).max() > 1e-3
+
+
+@settings(deadline=None, max_examples=30)
+@given(seed=st.integers(0, 2**32 - 1))
+def test_horn_batch_equals_svd_kabsch(seed):
+    rng = np.random.default_rng(seed)
+    body = rng.normal(0, 0.05, (4, 3))
+    world = np.einsum("bij,nj->bni", Rotation.random(9, random_state=seed).as_matrix(), body) + rng.normal(0, 0.004, (9, 4, 3))
+    np.testing.assert_allclose(kabsch_rotations(world, body), kabsch(world, body)[0], atol=1e-9)

@@ -1,0 +1,53 @@
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from poseintegrity.tracking.geometry import MARKERS_BODY, transform_points
+from poseintegrity.tracking.kabsch import pose_from_points
+from poseintegrity.tracking.params import FilterParams
+from poseintegrity.tracking.tracker import MarkerTracker
+
+FILTER = FilterParams(sigma_r=0.002, sigma_c=3.0, sigma_alpha=30.0)
+
+
+def _pose(t):
+    return pose_from_points(MARKERS_BODY @ Rotation.from_rotvec([0.3 * t, -0.2 * t, 0.5 * t]).as_matrix().T + [0.01 * t, 0.0, 0.45], MARKERS_BODY)
+
+
+def test_bad_frames_are_flagged_and_the_filter_keeps_predicting():
+    rng = np.random.default_rng(0)
+    tracker = MarkerTracker(MARKERS_BODY, FILTER)
+    assert tracker.frame(0.0, np.zeros((0, 3))).flag == "no_points"
+    assert tracker.frame(0.05, transform_points(_pose(0.05), MARKERS_BODY)[:2]).flag == "no_markers"
+    for k in range(2, 30):
+        t = 0.05 * k
+        points = transform_points(_pose(t), MARKERS_BODY) + rng.normal(0, 0.0005, (4, 3))
+        result = tracker.frame(t, points[rng.permutation(4)])
+        assert result.flag in ("initialized", "ok")
+        tracker.gyro(t + 0.02, np.array([0.3, -0.2, 0.5]) @ np.eye(3))
+    t_before = tracker.t
+    bad_inputs = [np.zeros((0, 3)), np.full((4, 3), np.nan), np.vstack([points, points]), rng.uniform(-1, 1, (3, 3))]
+    for k, points in enumerate(bad_inputs):
+        result = tracker.frame(t_before + 0.05 * (k + 1), points)
+        assert tracker.filter.initialized and np.isfinite(result.T_filtered).all()
+    assert tracker.t > t_before
+
+
+def test_restart_after_a_second_without_markers_and_reinitialisation():
+    tracker = MarkerTracker(MARKERS_BODY, FILTER, use_gyro=False)
+    tracker.frame(0.0, transform_points(_pose(0.0), MARKERS_BODY))
+    assert tracker.filter.initialized
+    assert tracker.frame(1.5, np.zeros((0, 3))).flag == "restart" and not tracker.filter.initialized
+    result = tracker.frame(1.6, transform_points(_pose(1.6), MARKERS_BODY))
+    assert result.flag == "initialized"
+    np.testing.assert_allclose(result.T_filtered, _pose(1.6), atol=1e-9)
+
+
+def test_divergence_is_recovered_from_the_next_good_frame():
+    tracker = MarkerTracker(MARKERS_BODY, FILTER)
+    tracker.frame(0.0, transform_points(_pose(0.0), MARKERS_BODY))
+    tracker.filter.x[:] = np.nan  # e.g. a NaN from a bad update
+    result = tracker.frame(0.05, transform_points(_pose(0.05), MARKERS_BODY))
+    assert result.flag == "diverged" and tracker.filter.initialized  # restarted from this good frame
+    np.testing.assert_allclose(result.T_filtered, _pose(0.05), atol=1e-9)
+    assert tracker.frame(0.10, transform_points(_pose(0.10), MARKERS_BODY)).flag == "ok"
+    assert tracker.filter.n_divergences == 1
