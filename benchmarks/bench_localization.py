@@ -6,7 +6,7 @@ Figures of issue 3:
 Frames: five stops spread evenly along the first arc dataset in ``data_dir`` (stage 01 output), or, without
 rendered data, the synthetic scene of the tests. OpenCV runs single-threaded (one joblib worker per core).
 
-    PYTHONPATH=src .venv/bin/python benchmarks/bench_localization.py [--data-dir data] [--repeats 5]
+    PYTHONPATH=src .venv/bin/python benchmarks/bench_localization.py [--data-dir data] [--repeats 5] [--params params.yaml]
 """
 
 from __future__ import annotations
@@ -20,6 +20,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
+from poseintegrity.config import load_section
 from poseintegrity.localization.dataset import load_dataset, load_index
 from poseintegrity.localization.extract import correspondences, dataset_model, localize
 from poseintegrity.localization.features import detect_features, read_gray
@@ -60,9 +61,10 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--data-dir", type=Path, default=Path("data"))
     parser.add_argument("--repeats", type=int, default=9)
+    parser.add_argument("--params", type=Path, default=None, help="params.yaml to take the extract section from")
     args = parser.parse_args()
     cv2.setNumThreads(1)
-    params = ExtractParams()
+    params = load_section(args.params, "extract") if args.params else ExtractParams()
     dataset, data_dir = arc_dataset(args.data_dir)
     with tempfile.TemporaryDirectory() as cache:
         model = dataset_model(dataset, params, Path(cache))

@@ -42,6 +42,29 @@ HEADLINES: list[Headline] = [
              "CLAHE used 'to improve feature detection on low texture bone phantoms'"),
     Headline("generate", "disk_gb", "disk (GB)", "-", "<= 3"),
     Headline("generate", "wall_time_s", "stage wall time (s, n_jobs 2)", "-", "<= 480"),
+    Headline("artifacts", "realism.min_abs_spearman", "weakest |Spearman(theta, mean n_i per stop)| over arcs",
+             "n_i 'decays' with viewing angle", ">= 0.8"),
+    Headline("artifacts", "realism.min_first_stop_mean_inliers", "smallest mean n_i at the first stop", "-",
+             ">= 50"),
+    Headline("artifacts", "realism.error_ratio_low_vs_high_inliers",
+             "median E_t: frames with n_i < 15 over frames with n_i > 50", "error blows up at low n_i", ">= 3"),
+    Headline("artifacts", "realism.n_uncensored_4mm10deg", "arcs whose envelope ends inside 45 deg, 4 mm/10 deg",
+             "-", ">= 18 of 21"),
+    Headline("artifacts", "realism.min_theta_a_2mm3deg", "smallest theta_a at 2 mm/3 deg (deg)",
+             "~7 (static baseline best)", "<= 12"),
+    Headline("artifacts", "realism.cv_theta_a_2mm3deg", "coefficient of variation of theta_a, 2 mm/3 deg", "-",
+             ">= 0.25"),
+    Headline("artifacts", "board_vs_exact.median_E_t_mm", "ArUco ground truth vs exact pose, median E_t (mm)",
+             "ArUco board used as ground truth"),
+    Headline("artifacts", "board_vs_exact.detection_rate", "frames with the board detected"),
+    Headline("pnp", "methods.usac_magsac.mean_n_inliers_first_stop", "USAC (P3P + MAGSAC): mean n_i, first stop"),
+    Headline("pnp", "methods.epnp.mean_n_inliers_first_stop", "EPnP: mean n_i, first stop"),
+    Headline("pnp", "methods.p3p.mean_n_inliers_first_stop", "P3P: mean n_i, first stop"),
+    Headline("pnp", "methods.ap3p.mean_n_inliers_first_stop", "AP3P: mean n_i, first stop"),
+    Headline("pnp", "methods.sqpnp.mean_n_inliers_first_stop", "SQPnP: mean n_i, first stop"),
+    Headline("pnp", "methods.usac_magsac.mean_theta_a_arc_2mm_3deg", "USAC: mean theta_a, arcs, 2 mm/3 deg (deg)"),
+    Headline("pnp", "methods.epnp.mean_theta_a_arc_2mm_3deg", "EPnP: mean theta_a, arcs, 2 mm/3 deg (deg)"),
+    Headline("pnp", "methods.sqpnp.mean_theta_a_arc_2mm_3deg", "SQPnP: mean theta_a, arcs, 2 mm/3 deg (deg)"),
     Headline("fits", "rmse_k4.emg", "EMG (eq. 1)", "lowest of the least-squares fits"),
     Headline("fits", "rmse_k4.exponential", "exponential"),
     Headline("fits", "rmse_k4.gaussian", "Gaussian"),
@@ -65,6 +88,22 @@ HEADLINES: list[Headline] = [
     Headline("predictors", "static.4mm_10deg.max_mean_spl_zero_incursion", "static baseline, 4 mm/10 deg (deg)"),
     Headline("predictors", "straight_line.relative_improvement", "straight lines: long range over static",
              "+46.2 %"),
+    Headline("predictors", "long_range.relative_improvement", "long range over static (mean of both tolerances)",
+             "+84.1 %"),
+    Headline("predictors", "next_step.relative_improvement", "next step over static", "+102.1 %"),
+    Headline("predictors", "long_range.relative_improvement_vs_mlp", "long range over MLP", "+7.4 %"),
+    Headline("predictors", "live.incursions", "simulated live trials: incursions (next step, fixed n_t)", "0 of 10"),
+    Headline("predictors", "live.envelope_share", "simulated live trials: share of the actual envelope used",
+             "74.7 %"),
+    Headline("predictors", "live.static_envelope_share", "... static baseline", "60.4 %"),
+    Headline("predictors", "loso.long_range.2mm_3deg.heldout_incursion_rate",
+             "beyond the paper: n_t chosen for 0 incursions on the other scenes, held-out R_i (2 mm/3 deg)"),
+    Headline("predictors", "loso.long_range.2mm_3deg.heldout_mean_spl", "... held-out mean SPL (deg)"),
+    Headline("predictors", "loso.next_step.2mm_3deg.heldout_incursion_rate", "... next step, held-out R_i"),
+    Headline("predictors", "pnp.epnp.max_mean_spl_zero_incursion", "long range on EPnP, 2 mm/3 deg (deg)",
+             "similar to USAC (Fig. 6)"),
+    Headline("predictors", "pnp.p3p.max_mean_spl_zero_incursion", "long range on P3P, 2 mm/3 deg (deg)"),
+    Headline("predictors", "pnp.ap3p.max_mean_spl_zero_incursion", "long range on AP3P, 2 mm/3 deg (deg)"),
     Headline("tracking", "rms_mm.no_filter", "RMS position error, no filter (mm)", "3.01"),
     Headline("tracking", "rms_mm.ukf", "RMS position error, UKF (mm)", "1.77"),
     Headline("tracking", "rms_mm.ukf_gyro", "RMS position error, UKF + gyro (mm)"),
@@ -84,19 +123,25 @@ def read_metrics(metrics_dir: Path) -> dict[str, dict]:
     return {p.stem: json.loads(p.read_text()) for p in sorted(Path(metrics_dir).glob("*.json"))}
 
 
+MISSING = object()  # the stage has not run, or its metrics lack the key
+
+
 def lookup(metrics: dict[str, dict], stage: str, key: str):
-    """The value at dotted ``key`` of a stage's metrics, or None when the stage or key is missing."""
-    value = metrics.get(stage)
+    """The value at dotted ``key`` of a stage's metrics; :data:`MISSING` when the stage or key is missing
+    (None is a value: the stage ran and found nothing, e.g. no operating point with zero incursions)."""
+    value = metrics.get(stage, MISSING)
     for part in key.split("."):
         if not isinstance(value, dict) or part not in value:
-            return None
+            return MISSING
         value = value[part]
     return value
 
 
 def _fmt(value) -> str:
-    if value is None:
+    if value is MISSING:
         return "not run"
+    if value is None:
+        return "none"
     if isinstance(value, float):
         return f"{value:.4g}"
     return str(value)
@@ -106,7 +151,8 @@ def render_summary(metrics: dict[str, dict]) -> str:
     """Markdown: one table per stage, ours beside the paper's and the target."""
     lines = ["# Summary of the latest run", "",
              "Generated by stage 07 from `reports/metrics/*.json`. Paper figures: Windsor et al. (RA-L 2024) and",
-             "Black & Salcudean (2023), see `../shared/papers/README.md`.", ""]
+             "Black & Salcudean (2023), see `../shared/papers/README.md`. \"none\": the stage ran and found no such",
+             "value (e.g. no threshold n_t <= 100 reaches zero incursions); \"not run\": no metrics yet.", ""]
     for stage, title in SECTIONS.items():
         lines += [f"## {title}", "", "| figure | ours | paper | target |", "| --- | --- | --- | --- |"]
         for h in (h for h in HEADLINES if h.stage == stage):

@@ -18,7 +18,7 @@ import numpy as np
 
 from poseintegrity.scenes.mesh import Mesh
 from poseintegrity.scenes.params import SensorParams
-from poseintegrity.scenes.textures import N_MIP_LEVELS, TextureAtlas
+from poseintegrity.scenes.textures import TextureAtlas
 
 NEAR_MM = 20.0
 BACKGROUND = 0.08  # radiance behind everything (a dim room)
