@@ -26,4 +26,4 @@ repro: $(VENV)/.installed ## run the paper-scale pipeline (dvc repro)
 	$(BIN)/dvc repro
 
 test: $(VENV)/.installed ## run the pytest suite (notebooks executed with tiny parameters)
-	$(BIN)/python -m pytest -n 2 --dist loadgroup
+	$(BIN)/python -m pytest -n 2

@@ -81,11 +81,13 @@ def test_dvc_lock_matches_committed_notebooks_and_params():
     """On a fresh clone `dvc status` may miss outputs, but never sees a changed notebook or changed params."""
     import hashlib
 
+    from ruamel.yaml import YAML  # YAML 1.2 as DVC reads it (PyYAML would take the lock's 1e-12 for a string)
+
     lock_path = ROOT / "dvc.lock"
     if not lock_path.exists():
         pytest.skip("no dvc.lock yet: the pipeline has not been run")
-    lock = yaml.safe_load(lock_path.read_text())
-    params = yaml.safe_load((ROOT / "params.yaml").read_text())
+    lock = YAML(typ="safe").load(lock_path.read_text())
+    params = YAML(typ="safe").load((ROOT / "params.yaml").read_text())
     for name, stage in lock["stages"].items():
         for dep in stage.get("deps", []):
             if dep["path"].startswith("notebooks/"):
