@@ -8,7 +8,7 @@
        reference: the same datasets' long range predictor with the per-threshold reference of 1.
 
 Usage: PYTHONPATH=src .venv/bin/python benchmarks/bench_prediction.py [--params params.yaml]
-(the ``fit`` and ``predict`` sections of --params; the paper-scale ones below when a section is missing)
+(the ``fit`` and ``predict`` sections of --params)
 """
 
 from __future__ import annotations
@@ -19,50 +19,13 @@ from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
-import yaml
 
-from poseintegrity.artifacts import FitParams, emg, envelope_boundary, fit_model
+from poseintegrity.artifacts import emg, envelope_boundary, fit_model
 from poseintegrity.artifacts.fig2 import dataset_series
 from poseintegrity.artifacts.synthetic import synthetic_artifacts
-from poseintegrity.prediction import PredictParams, boundaries, sweep
+from poseintegrity.config import load_section
+from poseintegrity.prediction import boundaries, sweep
 
-PAPER_SECTIONS = yaml.safe_load(
-    """
-fit:
-  pnp_method: usac_magsac
-  models: [emg, mlp_pretrained]
-  k_min: 3
-  k_max: null
-  k_report_arc: 4
-  k_report_line: 5
-  theta_max_deg: 45.0
-  x_max_mm: 150.0
-  max_nfev: 400
-  seed: 20240
-  n_jobs: 2
-  mlp: {hidden_layers: 3, hidden_units: 10, max_iter_scratch: 300, max_iter_pretrain: 100, max_iter_finetune: 20,
-        tolerance_change: 1.0e-12, n_pretrain_points: 100, n_artificial: 10}
-predict:
-  pnp_method: usac_magsac
-  n_t_min: 4
-  n_t_max: 100
-  long_range_stops_arc: 4
-  long_range_stops_line: 5
-  next_step_first_stops: 4
-  static_max_deg: 45.0
-  static_max_mm: 150.0
-  n_static: 181
-  tolerance_fig6_fig7: 2mm_3deg
-  n_grid: 256
-  models: {long_range: emg, next_step: emg, mlp: mlp_pretrained}
-  live_n_t: 15
-  live_tolerance: 4mm_10deg
-  loso_target_rates: [0.0, 0.05]
-  uncertainty: {method: covariance, level: 0.9, n_bootstrap: 50}
-  seed: 20241
-  n_jobs: 2
-"""
-)
 METHODS = ("usac_magsac", "epnp", "p3p", "ap3p", "sqpnp", "iterative")
 
 
@@ -81,9 +44,8 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--params", type=Path, default=Path("params.yaml"))
     args = parser.parse_args()
-    raw = yaml.safe_load(args.params.read_text()) if args.params.exists() else {}
-    fit = FitParams.model_validate(raw.get("fit", PAPER_SECTIONS["fit"]))
-    predict = PredictParams.model_validate(raw.get("predict", PAPER_SECTIONS["predict"]))
+    fit = load_section(args.params, "fit")
+    predict = load_section(args.params, "predict")
     n_t = predict.thresholds
 
     print(f"1. theta_p for {n_t.size} thresholds from one fitted EMG")

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import typing
+from pathlib import Path
 
 import pytest
 import yaml
@@ -11,30 +12,7 @@ from pydantic import ValidationError
 from poseintegrity.artifacts import MODEL_NAMES, FitParams
 from poseintegrity.artifacts.params import ModelName
 
-# The paper-scale section proposed for params.yaml (kept here so that the proposal is known to validate).
-PAPER_FIT_YAML = """
-fit:
-  pnp_method: usac_magsac
-  models: [emg, exponential, gaussian, logistic, power_law, mlp_scratch, mlp_pretrained]
-  k_min: 3
-  k_max: null
-  k_report_arc: 4
-  k_report_line: 5
-  theta_max_deg: 45.0
-  x_max_mm: 150.0
-  max_nfev: 400
-  seed: 20240
-  n_jobs: 2
-  mlp:
-    hidden_layers: 3
-    hidden_units: 10
-    max_iter_scratch: 300
-    max_iter_pretrain: 100
-    max_iter_finetune: 20
-    tolerance_change: 1.0e-12
-    n_pretrain_points: 100
-    n_artificial: 10
-"""
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def with_change(raw: dict, path: str, value: object) -> dict:
@@ -47,7 +25,7 @@ def with_change(raw: dict, path: str, value: object) -> dict:
 
 
 def test_paper_scale_section_validates():
-    params = FitParams.model_validate(yaml.safe_load(PAPER_FIT_YAML)["fit"])
+    params = FitParams.model_validate(yaml.safe_load((ROOT / "params.yaml").read_text())["fit"])
     assert params.k_max is None
     assert (params.mlp.hidden_layers, params.mlp.hidden_units) == (3, 10)  # Windsor et al. IV-E
     assert params.range_end("arc") == 45.0 and params.range_end("line") == 150.0
