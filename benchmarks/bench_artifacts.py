@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import argparse
 import time
-from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -25,17 +24,7 @@ from scipy.stats import exponnorm
 
 from poseintegrity.artifacts import EMG, FitParams, emg, fig2_rmse, fit_mlp, fits_metrics
 from poseintegrity.artifacts.synthetic import synthetic_artifacts
-
-
-def paired_medians(reference: Callable[[], object], subject: Callable[[], object], repeats: int) -> tuple[float, float]:
-    """Median seconds of reference and subject, timed alternately so that both see the same machine load."""
-    times = np.empty((repeats, 2))
-    for i in range(repeats):
-        for j, fn in enumerate((reference, subject)):
-            start = time.perf_counter()
-            fn()
-            times[i, j] = time.perf_counter() - start
-    return float(np.median(times[:, 0])), float(np.median(times[:, 1]))
+from timing import paired_medians  # benchmarks/timing.py
 
 
 def report(label: str, seconds: float, reference: float, target: float | None = None) -> None:

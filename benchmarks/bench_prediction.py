@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import argparse
 import time
-from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -25,19 +24,9 @@ from poseintegrity.artifacts.fig2 import dataset_series
 from poseintegrity.artifacts.synthetic import synthetic_artifacts
 from poseintegrity.config import load_section
 from poseintegrity.prediction import boundaries, sweep
+from timing import paired_medians  # benchmarks/timing.py
 
 METHODS = ("usac_magsac", "epnp", "p3p", "ap3p", "sqpnp", "iterative")
-
-
-def paired_medians(reference: Callable[[], object], subject: Callable[[], object], repeats: int) -> tuple[float, float]:
-    """Median seconds of reference and subject, timed alternately so that both see the same machine load."""
-    times = np.empty((repeats, 2))
-    for i in range(repeats):
-        for j, fn in enumerate((reference, subject)):
-            start = time.perf_counter()
-            fn()
-            times[i, j] = time.perf_counter() - start
-    return float(np.median(times[:, 0])), float(np.median(times[:, 1]))
 
 
 def main() -> None:
