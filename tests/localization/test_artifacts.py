@@ -56,6 +56,10 @@ def test_realism_metrics_of_a_world_with_known_answers():
     assert 36.0 < metrics["min_theta_a_2mm3deg"] == metrics["theta_a_2mm3deg"]["b"] < 38.25
     assert metrics["theta_a_2mm3deg"]["a"] == metrics["theta_a_2mm3deg"]["c"] == 45.0
     assert metrics["n_uncensored_4mm10deg"] == 1
+    # b fails at 4 mm once E_t = 50 / n_i > 4, i.e. between the stops with mean n_i 14 and 10 (theta 42.75, 45)
+    assert 10 < metrics["median_inliers_at_theta_a_4mm10deg"] == metrics["inliers_at_theta_a_4mm10deg"]["b"] <= 14
+    assert set(metrics["inliers_at_theta_a_2mm3deg"]) == {"b"}
+    assert metrics["passed"]["inliers_at_failure"]
     assert metrics["passed"]["spearman"] and metrics["passed"]["first_stop_inliers"]
     assert not metrics["passed"]["uncensored"]
 

@@ -74,7 +74,7 @@ def test_board_ground_truth_agrees_with_opencv_aruco_pose(tiny_root):
     board = world.scene.board.board()
     detector = cv2.aruco.ArucoDetector(board.getDictionary(), cv2.aruco.DetectorParameters())
     corners, ids, _ = detector.detectMarkers(image)
-    assert ids is not None and len(ids) >= 8
+    assert ids is not None and len(ids) >= 4  # of 6; the target may hide one
     obj, img = board.matchImagePoints(corners, ids)
     ok, rvec, tvec = cv2.solvePnP(obj, img, cam.K, None)
     T_true = inverse(T_world_cam) @ world.scene.T_world_board

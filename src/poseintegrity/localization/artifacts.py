@@ -71,6 +71,11 @@ def realism_metrics(table: pd.DataFrame, envelope_table: pd.DataFrame, method: s
     - ``min_theta_a_2mm3deg``, ``cv_theta_a_2mm3deg``: smallest theta_a and coefficient of variation
       (std/mean, ddof 0) across arc datasets at 2 mm/3 deg (bars: <= 12 deg, >= 0.25); the same at
       4 mm/10 deg for reference
+    - ``median_inliers_at_theta_a_4mm10deg``: median over uncensored arc datasets of the mean n_i per stop,
+      linearly interpolated at theta_a (bar: <= 30). The paper's thresholds at zero incursion (n_t 12-28,
+      Table III) say that its localization failed once inliers ran short; a world that fails with 100 inliers
+      left fails for reasons n_i cannot see, and no inlier threshold predicts it. The same at 2 mm/3 deg for
+      reference.
     """
     rows = table[table["method"] == method]
     arcs = rows[rows["trajectory"] == "arc"]
@@ -88,6 +93,13 @@ def realism_metrics(table: pd.DataFrame, envelope_table: pd.DataFrame, method: s
         return arc_envelopes.loc[arc_envelopes["tolerance"] == tolerance_name(tolerance)].set_index("dataset")
 
     strict, loose = theta_a((2.0, 3.0)), theta_a((4.0, 10.0))
+
+    def inliers_at_failure(envelope: pd.DataFrame) -> dict[str, float]:
+        """Mean n_i per stop interpolated at theta_a, per uncensored dataset."""
+        return {dataset: float(np.interp(row["theta_a"], per_stop.loc[dataset, "theta"], per_stop.loc[dataset, "n_i"]))
+                for dataset, row in envelope[~envelope["censored"]].iterrows()}
+
+    at_failure_strict, at_failure_loose = inliers_at_failure(strict), inliers_at_failure(loose)
     n_arcs = int(arcs["dataset"].nunique())
     metrics = dict(
         method=method,
@@ -105,6 +117,10 @@ def realism_metrics(table: pd.DataFrame, envelope_table: pd.DataFrame, method: s
         cv_theta_a_2mm3deg=_cv(strict["theta_a"]),
         min_theta_a_4mm10deg=float(loose["theta_a"].min()) if len(loose) else float("nan"),
         cv_theta_a_4mm10deg=_cv(loose["theta_a"]),
+        inliers_at_theta_a_2mm3deg=at_failure_strict,
+        inliers_at_theta_a_4mm10deg=at_failure_loose,
+        median_inliers_at_theta_a_2mm3deg=_nanmedian(list(at_failure_strict.values())),
+        median_inliers_at_theta_a_4mm10deg=_nanmedian(list(at_failure_loose.values())),
         theta_a_2mm3deg={k: float(v) for k, v in strict["theta_a"].items()},
         theta_a_4mm10deg={k: float(v) for k, v in loose["theta_a"].items()},
     )
@@ -115,6 +131,7 @@ def realism_metrics(table: pd.DataFrame, envelope_table: pd.DataFrame, method: s
         uncensored=bool(n_arcs > 0 and metrics["n_uncensored_4mm10deg"] >= np.ceil(n_arcs * 18 / 21)),
         min_theta_a=bool(metrics["min_theta_a_2mm3deg"] <= 12),
         cv_theta_a=bool(metrics["cv_theta_a_2mm3deg"] >= 0.25),
+        inliers_at_failure=bool(metrics["median_inliers_at_theta_a_4mm10deg"] <= 30),
     )
     return metrics
 
@@ -123,6 +140,11 @@ def _nanmin(values: list[float]) -> float:
     """Smallest non-NaN value; NaN when there is none."""
     finite = [value for value in values if not np.isnan(value)]
     return float(min(finite)) if finite else float("nan")
+
+
+def _nanmedian(values: list[float]) -> float:
+    """Median of the values; NaN when there are none."""
+    return float(np.median(values)) if values else float("nan")
 
 
 def _cv(values: pd.Series) -> float:

@@ -41,12 +41,25 @@ def procedural_texture(name: str) -> np.ndarray:
     if name == "bone_offcut":
         return tex.bone_texture(rng, 512)
     if name == "block_print":
-        return tex.collage_texture(rng, (1024, 1536), density=3.0, contrast=0.45, text=True)
+        return _plain_lid(tex.collage_texture(rng, (1024, 1536), density=3.0, contrast=0.45, text=True), rng)
     if name == "block_mosaic":
-        return tex.collage_texture(rng, (1024, 1536), density=5.0, contrast=0.35, text=False)
+        return _plain_lid(tex.collage_texture(rng, (1024, 1536), density=5.0, contrast=0.35, text=False), rng)
     if name == "table":
         return tex.wood_texture(rng, 2048)
     return tex.collage_texture(rng, (512, 512), density=0.8, contrast=0.25, text=name == "clutter_a")
+
+
+def _plain_lid(albedo: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+    """A printed box with an unprinted cardboard lid: the +z face's sixth of the box texture (see
+    :func:`~poseintegrity.scenes.mesh.box`) becomes plain, faintly mottled board. With a printed lid, the only
+    features left when the camera looks straight down are on one plane, whose tilt PnP cannot pin down from a
+    20 mm-baseline model; real printed boxes mostly look like this anyway."""
+    h, w = albedo.shape
+    rows, cols = slice(h // 2, h), slice(w // 3, 2 * w // 3)
+    lid = 0.62 + 0.02 * tex.fractal_noise(rng, (h - h // 2, 2 * w // 3 - w // 3), 3, 3)
+    out = albedo.copy()
+    out[rows, cols] = tex.to_u8(lid)
+    return out
 
 
 def target_mesh(name: str) -> meshes.Mesh:
@@ -99,7 +112,8 @@ def build_scene(spec: "SceneSpec", index: int, texture_overrides: dict | None = 
             placed.append((f"{name}_stand", meshes.cylinder(9.0, 95.0 - 25.0, "clutter_c").transformed(
                 rigid(np.eye(3), side))))
         else:
-            R = Rotation.from_euler("z", yaw + rng.uniform(-0.6, 0.6)).as_matrix()
+            # a corner towards the model camera, so that two printed sides are in view (a 3D point set)
+            R = Rotation.from_euler("z", yaw + np.pi / 4 + rng.uniform(-0.25, 0.25)).as_matrix()
             centre = side + np.array([0.0, 0.0, BLOCK_SIZE_MM[2] / 2])
         T = rigid(R, centre)
         target_poses.append(T)
@@ -109,11 +123,13 @@ def build_scene(spec: "SceneSpec", index: int, texture_overrides: dict | None = 
     # the ArUco board lies flat on the table beside the target, printed side up (board z points into the table)
     board = tex.BoardSpec()
     bw, bh = board.size_mm
-    board_yaw = yaw + rng.uniform(-0.3, 0.3)
+    # board x points away from the target, so its origin (the model origin, where E_t is measured) is the
+    # corner nearest the target
+    board_yaw = yaw + np.pi + rng.uniform(-0.3, 0.3)
     x_b = np.array([np.cos(board_yaw), np.sin(board_yaw), 0.0])
     R_world_board = np.column_stack([x_b, np.cross([0.0, 0.0, -1.0], x_b), [0.0, 0.0, -1.0]])
     # beside the first target and in front of it, so that both stay in view along the arcs
-    board_centre = target_poses[0][:2, 3] - 112.0 * np.array([np.cos(yaw), np.sin(yaw)]) + 20.0 * view_dir[
+    board_centre = target_poses[0][:2, 3] - 92.0 * np.array([np.cos(yaw), np.sin(yaw)]) + 20.0 * view_dir[
         :2] / np.linalg.norm(view_dir[:2])
     origin = np.append(board_centre, 0.4) - R_world_board @ np.array([bw / 2, bh / 2, 0.0])
     T_world_board = rigid(R_world_board, origin)

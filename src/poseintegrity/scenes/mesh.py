@@ -154,8 +154,10 @@ def bone_plate(rng: np.random.Generator, texture: str, size_mm: float = 150.0, t
     x = (RHO * r_outline[None, :] * np.cos(PHI)).ravel()
     y = (RHO * r_outline[None, :] * np.sin(PHI)).ravel()
     half_t = 0.5 * thickness_mm * np.sqrt(np.clip(1 - RHO.ravel() ** 4, 0, 1))
-    bend = -(x**2) / (2 * 2.2 * size_mm) + 0.15 * y**2 / (2 * size_mm)  # saddle-like curvature of the blade
-    ridge = 7.0 * np.exp(-(((y - 0.15 * x - 0.1 * size_mm) / (0.06 * size_mm)) ** 2)) * (x > -0.35 * size_mm)
+    bend = -(x**2) / (2 * 1.3 * size_mm) + 0.15 * y**2 / (2 * size_mm)  # saddle-like curvature of the blade
+    # the scapular spine: a crest standing ~20 mm proud of the blade, so the phantom is not a plane
+    ridge = 20.0 * np.exp(-(((y - 0.15 * x - 0.1 * size_mm) / (0.08 * size_mm)) ** 2)) * np.clip(
+        (x + 0.4 * size_mm) / (0.15 * size_mm), 0, 1)
     cup_c = 0.36 * size_mm * np.array([np.cos(0.1), np.sin(0.1)])
     cup = -5.0 * np.exp(-((x - cup_c[0]) ** 2 + (y - cup_c[1]) ** 2) / (2 * (0.07 * size_mm) ** 2))
     u = (x - x.min()) / np.ptp(x)

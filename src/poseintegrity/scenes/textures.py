@@ -30,7 +30,7 @@ def fractal_noise(rng: np.random.Generator, shape: tuple[int, int], base_cells: 
     return (out - out.mean()) / out.std()
 
 
-def _to_u8(albedo: np.ndarray) -> np.ndarray:
+def to_u8(albedo: np.ndarray) -> np.ndarray:
     return np.clip(np.rint(albedo * 255), 0, 255).astype(np.uint8)
 
 
@@ -49,14 +49,14 @@ def bone_texture(rng: np.random.Generator, size: int = 1024, hole_uv: tuple[floa
     albedo -= cv2.GaussianBlur(spots, (0, 0), 1.5)
     if hole_uv is not None:
         cv2.circle(albedo, (int(hole_uv[0] * size), int(hole_uv[1] * size)), size // 60, 0.25, -1, cv2.LINE_AA)
-    return _to_u8(albedo)
+    return to_u8(albedo)
 
 
 def collage_texture(rng: np.random.Generator, shape: tuple[int, int], density: float, contrast: float,
                     text: bool) -> np.ndarray:
     """A printed, highly textured surface: overlapping shapes, stripes and (optionally) words on noise."""
     h, w = shape
-    img = _to_u8(0.55 + 0.1 * fractal_noise(rng, shape, 3, 3))  # drawn in 8 bit (putText needs it)
+    img = to_u8(0.55 + 0.1 * fractal_noise(rng, shape, 3, 3))  # drawn in 8 bit (putText needs it)
     n_shapes = int(density * h * w / 2000)
     for _ in range(n_shapes):
         value = int(255 * np.clip(0.5 + contrast * rng.uniform(-1, 1), 0.02, 0.98))
@@ -83,7 +83,7 @@ def wood_texture(rng: np.random.Generator, size: int = 2048) -> np.ndarray:
     grain = fractal_noise(rng, (size // 16, size), 24, 4)
     grain = cv2.resize(grain, (size, size), interpolation=cv2.INTER_CUBIC)
     rings = np.sin(np.linspace(0, 40 * np.pi, size)[None, :] + 3.0 * fractal_noise(rng, (size, size), 2, 2))
-    return _to_u8(0.42 + 0.05 * grain + 0.03 * rings)
+    return to_u8(0.42 + 0.05 * grain + 0.03 * rings)
 
 
 @dataclass(frozen=True)
@@ -91,8 +91,8 @@ class BoardSpec:
     """An ArUco GridBoard (cv2.aruco.GridBoard); the board frame is that of ``board.getObjPoints()`` (mm)."""
 
     dictionary: str = "DICT_4X4_50"
-    markers_x: int = 4
-    markers_y: int = 3
+    markers_x: int = 3
+    markers_y: int = 2
     marker_length_mm: float = 24.0
     separation_mm: float = 6.0
     first_id: int = 0
@@ -117,7 +117,7 @@ class BoardSpec:
         margin = int(round(self.margin_mm * self.px_per_mm))
         size = (int(round(w_mm * self.px_per_mm)) + 2 * margin, int(round(h_mm * self.px_per_mm)) + 2 * margin)
         img = self.board().generateImage(size, marginSize=margin, borderBits=1).astype(np.float32) / 255
-        return _to_u8(0.06 + 0.79 * img)
+        return to_u8(0.06 + 0.79 * img)
 
     def as_dict(self) -> dict:
         return {"dictionary": self.dictionary, "markers_x": self.markers_x, "markers_y": self.markers_y,
