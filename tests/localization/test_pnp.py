@@ -96,3 +96,18 @@ def test_usac_recovers_random_poses_from_clean_points(seed):
     result = solve_pnp_ransac(X, x, K, "usac_magsac", 1.0, 0.999, 200, seed=seed)
     E_t_mm, E_r_deg = pose_errors(result.T_cam_model, T)
     assert result.n_inliers == 60 and E_t_mm < 0.01 and E_r_deg < 0.005  # MAGSAC polish stops near, not at, 0
+
+
+def test_usac_pose_polished_by_lm_is_the_least_squares_pose_of_its_inliers():
+    """With refine_lm the USAC pose is a reprojection least-squares optimum of its inliers: OpenCV's iterative
+    solver started from it does not move it, and it reprojects the inliers no worse than the unpolished pose."""
+    X, x, T, _ = scene(seed=3, noise_px=0.8)
+    raw = solve_pnp_ransac(X, x, K, "usac_magsac", 2.0, 0.999, 1000, seed=7, refine_lm=False)
+    polished = solve_pnp_ransac(X, x, K, "usac_magsac", 2.0, 0.999, 1000, seed=7, refine_lm=True)
+    inl = polished.inliers
+    rvec0 = cv2.Rodrigues(polished.T_cam_model[:3, :3])[0]
+    ok, rvec, tvec = cv2.solvePnP(X[inl], x[inl], K, None, rvec0.copy(), polished.T_cam_model[:3, 3].copy(),
+                                  useExtrinsicGuess=True, flags=cv2.SOLVEPNP_ITERATIVE)
+    assert ok and np.abs(tvec.ravel() - polished.T_cam_model[:3, 3]).max() < 1e-3
+    rms = lambda result: np.sqrt(np.mean(reprojection_errors(X[inl], x[inl], K, result.T_cam_model) ** 2))  # noqa: E731
+    assert rms(polished) <= rms(raw) + 1e-9

@@ -55,7 +55,7 @@ def localize(
     max_iterations = params.usac_max_iterations if method == "usac_magsac" else params.ransac_max_iterations
     result = solve_pnp_ransac(
         object_points, image_points, K, method, params.reprojection_threshold_px, params.ransac_confidence,
-        max_iterations, seed,
+        max_iterations, seed, params.usac_refine_lm,
     )
     status = "no_keypoints" if n_keypoints == 0 else result.status
     artifacts = frame_artifacts(result, object_points, image_points, K, n_keypoints, model_size)
