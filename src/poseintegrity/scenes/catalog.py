@@ -125,8 +125,8 @@ def build_scene(spec: "SceneSpec", index: int, texture_overrides: dict | None = 
     # the ArUco board lies flat on the table beside the target, printed side up (board z points into the table)
     board = tex.BoardSpec()
     bw, bh = board.size_mm
-    # board x points away from the target, so its origin (the model origin, where E_t is measured) is the
-    # corner nearest the target
+    # board x points away from the target, so its origin (the model origin, where E_t is measured) is a corner
+    # of the edge facing the target
     board_yaw = yaw + np.pi + rng.uniform(-0.3, 0.3)
     x_b = np.array([np.cos(board_yaw), np.sin(board_yaw), 0.0])
     R_world_board = np.column_stack([x_b, np.cross([0.0, 0.0, -1.0], x_b), [0.0, 0.0, -1.0]])
