@@ -47,20 +47,24 @@ def test_voting_assigns_only_true_pairs(seed, n_missing, n_phantoms):
     np.testing.assert_array_equal(assignment[found], truth[found])
     assert not outlier[truth[truth >= 0]].any()  # a true marker is never rejected
     if n_missing == 0 and n_phantoms == 0:
-        np.testing.assert_array_equal(assignment, truth)
+        # noise-free, every measured distance matches its own geometry pair, so voting alone assigns all four
+        # (with noise it may leave a marker to brute force: two pair distances differ by only 2.75 mm, and 0.5 mm
+        # noise per coordinate swapped them for seed 1282322)
+        clean, clean_truth, _ = _scene(seed, 0, 0, noise=0.0)
+        np.testing.assert_array_equal(match_voting(clean, G)[0], clean_truth)
 
 
 @settings(deadline=None, max_examples=40)
 @given(seed=st.integers(0, 2**32 - 1), n_missing=st.integers(0, 1), n_phantoms=st.integers(0, 2))
 def test_brute_force_alone_recovers_the_correspondence(seed, n_missing, n_phantoms):
-    points, truth, _ = _scene(seed, n_missing, n_phantoms)
+    points, truth, _ = _scene(seed, n_missing, n_phantoms, noise=0.0002)  # see the noise note above
     np.testing.assert_array_equal(match_brute_force(points, G), truth)
 
 
 @settings(deadline=None, max_examples=50)
 @given(seed=st.integers(0, 2**32 - 1), n_missing=st.integers(0, 1), n_phantoms=st.integers(0, 2))
 def test_frobenius_and_gated_follow_a_small_motion(seed, n_missing, n_phantoms):
-    points, truth, markers = _scene(seed, n_missing, 0)
+    points, truth, markers = _scene(seed, n_missing, 0, noise=0.0002)  # see the noise note above
     rng = np.random.default_rng(seed)
     previous = markers + rng.normal(0, 0.002, (4, 3))  # the last positions, a little off
     np.testing.assert_array_equal(match_frobenius(points, previous), truth)  # Alg. 1 with a missing marker
