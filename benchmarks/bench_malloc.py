@@ -18,6 +18,8 @@ from pathlib import Path
 
 import numpy as np
 
+from poseintegrity.localization.dataset import load_dataset, load_index
+
 TUNED = {"MALLOC_MMAP_THRESHOLD_": "33554432", "MALLOC_TRIM_THRESHOLD_": "1073741824"}  # as in the Makefile
 
 CHILD = """
@@ -38,9 +40,6 @@ print(json.dumps(dict(wall=wall / len(images), sys=(after.ru_stime - before.ru_s
 
 def frame_files(data_dir: Path, n_frames: int) -> list[str]:
     """n_frames images spread over the first arc dataset of data_dir (stage 01 output)."""
-    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
-    from poseintegrity.localization.dataset import load_dataset, load_index  # noqa: PLC0415
-
     index = load_index(data_dir)
     dataset = load_dataset(data_dir, index[index["trajectory"] == "arc"].iloc[0]["path"])
     files = dataset.frames["file"].to_numpy()
