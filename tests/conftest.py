@@ -5,10 +5,9 @@ from pathlib import Path
 import os
 
 import pytest
-import yaml
 from hypothesis import settings
 
-from poseintegrity.config import parse_params
+from poseintegrity.config import parse_params, read_raw
 
 # Property tests explore new random examples on every local run; on CI (CI=true) they replay a fixed set, so a
 # submission never fails on a case nobody has seen. Run locally to find new counterexamples.
@@ -22,10 +21,10 @@ TINY_PARAMS = ROOT / "tests" / "params_tiny.yaml"
 
 @pytest.fixture
 def tiny_raw() -> dict:
-    """tests/params_tiny.yaml as a plain dict, to be altered by a test."""
-    return yaml.safe_load(TINY_PARAMS.read_text())
+    """tests/params_tiny.yaml merged onto params.yaml, as a plain dict to be altered by a test."""
+    return read_raw(TINY_PARAMS)[0]
 
 
 @pytest.fixture
 def tiny_params(tiny_raw):
-    return parse_params(tiny_raw)
+    return parse_params(tiny_raw, base_dir=ROOT)

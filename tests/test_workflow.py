@@ -7,7 +7,7 @@ from pathlib import Path
 import pytest
 import yaml
 
-from poseintegrity.config import Params
+from poseintegrity.config import Params, load_params
 
 ROOT = Path(__file__).resolve().parents[1]
 NOTEBOOKS = sorted((ROOT / "notebooks").glob("*.ipynb"))
@@ -56,9 +56,20 @@ def test_stage_params_are_validated_sections():
             assert section in sections, f"{name} tracks unknown params section {section}"
 
 
-def test_tiny_params_cover_every_section():
+def test_tiny_params_are_an_overlay_that_only_shrinks_params_yaml():
+    """Every key of the overlay exists in params.yaml (a typo would silently add a key) and the merge validates."""
     tiny = yaml.safe_load((ROOT / "tests" / "params_tiny.yaml").read_text())
-    assert set(tiny) == set(Params.model_fields)
+    assert tiny.pop("extends") == "../params.yaml"
+    full = yaml.safe_load((ROOT / "params.yaml").read_text())
+
+    def keys_exist(overlay, base, path=""):
+        for key, value in overlay.items():
+            assert isinstance(base, dict) and key in base, f"tests/params_tiny.yaml: {path}{key} is not in params.yaml"
+            if isinstance(value, dict):
+                keys_exist(value, base[key], f"{path}{key}.")
+
+    keys_exist(tiny, full)
+    load_params(ROOT / "tests" / "params_tiny.yaml")
 
 
 def test_declared_metrics_are_stage_outputs_kept_in_git():

@@ -3,6 +3,11 @@
 Every stage of ``dvc.yaml`` owns one top-level section of ``params.yaml``; the schema of a section lives
 next to the code that uses it (``poseintegrity.<subpackage>.params``) and is collected here. A bad value
 raises :class:`ParamsError` whose message names the offending key, e.g. ``generate.scenes.2.targets.0``.
+
+A params file may start with ``extends: <path>``: it is then an overlay on that file (relative to the overlay),
+merged key by key (mappings recursively, everything else replaced). ``tests/params_tiny.yaml`` is such an overlay
+on ``params.yaml``: tests run the real configuration, shrunk. File paths inside params (:data:`ProjectPath`) are
+relative to the directory of the file at the root of the ``extends`` chain (the repository for ``params.yaml``).
 """
 
 from __future__ import annotations
@@ -44,17 +49,24 @@ def _format_errors(error: ValidationError, prefix: tuple = ()) -> str:
     return "\n".join(lines)
 
 
-def parse_params(raw: dict[str, Any], source: str = "params") -> Params:
+def parse_params(raw: dict[str, Any], source: str = "params", base_dir: Path | None = None) -> Params:
     """Validate a parsed YAML mapping; raise :class:`ParamsError` naming every bad key."""
     if not isinstance(raw, dict):
         raise ParamsError(f"{source}: expected a mapping of sections, got {type(raw).__name__}")
     try:
-        return Params.model_validate(raw)
+        return Params.model_validate(raw, context={"base_dir": base_dir})
     except ValidationError as error:
         raise ParamsError(f"{source} has invalid values:\n{_format_errors(error)}") from None
 
 
-def _read(path: Path) -> Any:
+def merge(base: Any, overlay: Any) -> Any:
+    """``overlay`` on ``base``: mappings merged key by key, recursively; any other overlay value replaces."""
+    if isinstance(base, dict) and isinstance(overlay, dict):
+        return {**base, **{key: merge(base.get(key), value) for key, value in overlay.items()}}
+    return overlay
+
+
+def _read_yaml(path: Path) -> Any:
     try:
         return yaml.safe_load(path.read_text())
     except OSError as error:
@@ -63,9 +75,20 @@ def _read(path: Path) -> Any:
         raise ParamsError(f"{path} is not valid YAML: {error}") from None
 
 
+def read_raw(path: str | Path) -> tuple[Any, Path]:
+    """The parsed params file with its ``extends`` chain merged, and the directory its paths are relative to."""
+    path = Path(path)
+    raw = _read_yaml(path)
+    if not (isinstance(raw, dict) and "extends" in raw):
+        return raw, path.resolve().parent
+    base, base_dir = read_raw(path.parent / str(raw.pop("extends")))
+    return merge(base, raw), base_dir
+
+
 def load_params(path: str | Path = "params.yaml") -> Params:
-    """Read and validate a whole params file (``params.yaml`` or the tiny test variant)."""
-    return parse_params(_read(Path(path)), source=str(path))
+    """Read and validate a whole params file (``params.yaml`` or an overlay on it)."""
+    raw, base_dir = read_raw(path)
+    return parse_params(raw, source=str(path), base_dir=base_dir)
 
 
 def load_section(path: str | Path, section: str) -> BaseModel:
@@ -73,10 +96,10 @@ def load_section(path: str | Path, section: str) -> BaseModel:
     (DVC tracks each stage's own section too)."""
     if section not in Params.model_fields:
         raise ParamsError(f"unknown params section {section!r}; sections: {list(Params.model_fields)}")
-    raw = _read(Path(path))
+    raw, base_dir = read_raw(path)
     if not isinstance(raw, dict) or section not in raw:
         raise ParamsError(f"{path}: section {section!r} is missing")
     try:
-        return Params.model_fields[section].annotation.model_validate(raw[section])
+        return Params.model_fields[section].annotation.model_validate(raw[section], context={"base_dir": base_dir})
     except ValidationError as error:
         raise ParamsError(f"{path} has invalid values:\n{_format_errors(error, (section,))}") from None
