@@ -11,12 +11,13 @@ import pandas as pd
 
 from poseintegrity.artifacts.base_functions import emg, emg_pdf
 
-# The datasets of Windsor et al. IV-D: arcs stop every 2.25 deg up to 45 deg, lines every 10 mm up to 150 mm.
-ARC_THETA_DEG = 2.25 * np.arange(1, 21)
-LINE_X_MM = 10.0 * np.arange(1, 16)
-# Ranges of the true eq. 1 parameters (K, mu in the trajectory's unit) and of the peak count. The EMG's
-# Gaussian has sigma = 1 unit, so for lines (mm) the rise is a 1 mm step: keep it before the first stop.
-TRUTH_RANGES = {"arc": {"K": (6.0, 14.0), "mu": (-4.0, 4.0)}, "line": {"K": (30.0, 60.0), "mu": (-10.0, 5.0)}}
+# The datasets of Windsor et al. IV-D: arcs stop every 2.25 deg from the model view (0 .. 42.75 deg), lines every
+# 10 mm from their start (0 .. 140 mm).
+ARC_THETA_DEG = 2.25 * np.arange(20)
+LINE_X_MM = 10.0 * np.arange(15)
+# Ranges of the true eq. 1 parameters (K, mu in the trajectory's unit) and of the peak count. The counts peak at
+# the trajectory start (the model view, where the images match the model best), so mu lies before the first stop.
+TRUTH_RANGES = {"arc": {"K": (6.0, 14.0), "mu": (-4.0, 0.0)}, "line": {"K": (30.0, 60.0), "mu": (-10.0, 0.0)}}
 PEAK_RANGE = (150.0, 400.0)
 MIN_INLIERS_OK = 6  # below this a frame is reported failed ("too_few_inliers")
 

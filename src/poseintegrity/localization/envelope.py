@@ -8,8 +8,8 @@ Rules (ours, the paper leaves them open):
 - theta_a is the earliest crossing, taking each error linearly interpolated between the last passing stop and
   the first failing one (equivalently: the first crossing of max(E_t / tol_t, E_r / tol_r) along the
   piecewise-linear error curves);
-- the trajectory start (theta = 0, the model view) counts as zero error, so a dataset failing at its first
-  stop gets theta_a inside (0, theta_1];
+- the first stop is the trajectory start (theta = 0, the model view, IV-D; x = 0 on lines): a dataset whose first
+  stop already fails has theta_a = the first stop's position (no safe motion at all);
 - a frame without a pose (failed localization) has infinite error, so its stop fails and theta_a is the
   previous stop;
 - a dataset whose mean errors never exceed the tolerance is censored at its last stop (``censored`` True).
@@ -26,16 +26,18 @@ from poseintegrity.localization.params import tolerance_name
 def actual_envelope(theta: np.ndarray, mean_errors: np.ndarray, tolerance: np.ndarray) -> tuple[float, bool]:
     """theta_a and whether it is censored.
 
-    theta : (m,) increasing stop positions (deg or mm), all > 0
+    theta : (m,) increasing stop positions (deg or mm), the first one the trajectory start
     mean_errors : (m, b) mean error per stop for each of the b bounds (inf: a stop with failed frames)
     tolerance : (b,) the bounds
     """
-    theta = np.concatenate([[0.0], np.asarray(theta, dtype=float)])
-    errors = np.vstack([np.zeros(len(tolerance)), np.asarray(mean_errors, dtype=float)])
+    theta = np.asarray(theta, dtype=float)
+    errors = np.asarray(mean_errors, dtype=float)
     exceeded = np.any(errors > tolerance, axis=1)
     if not exceeded.any():
         return float(theta[-1]), True
-    k = int(np.argmax(exceeded))  # first failing stop (k >= 1: the start never fails)
+    k = int(np.argmax(exceeded))  # first failing stop
+    if k == 0:
+        return float(theta[0]), False
     crossings = []
     for e_prev, e_next, bound in zip(errors[k - 1], errors[k], tolerance):
         if e_next > bound:

@@ -51,23 +51,28 @@ def arc_axis(T_world_cam: np.ndarray, azimuth_deg: float) -> np.ndarray:
 
 
 def arc(T_start: np.ndarray, aim: np.ndarray, azimuth_deg: float, span_deg: float, n_stops: int) -> list[Stop]:
-    """Stops k = 1..n_stops at theta = k * span / n_stops along a circle about ``aim``, camera pointed at ``aim``.
+    """Stops k = 0..n_stops-1 at theta = k * span / n_stops along a circle about ``aim``, camera pointed at ``aim``.
 
+    IV-D: the robot is "re-positioned to its initial pose" (the first model view, ``T_start``) and stops every
+    2.25 deg of a 45 deg arc, so the first stop is the model view itself (theta = 0) and the last is 42.75 deg;
+    theta_i is measured "between the pose where M_t was created and robot pose at position i" (III-D).
     Rotating the camera rigidly about the aim point keeps it pointed at the target, and the change of camera
     orientation from the model view is exactly theta.
     """
     axis = arc_axis(T_start, azimuth_deg)
-    thetas = span_deg * np.arange(1, n_stops + 1) / n_stops
+    thetas = span_deg * np.arange(n_stops) / n_stops
     return [Stop(_rotate_about(T_start, aim, Rotation.from_rotvec(np.deg2rad(t) * axis)), float(t), 0.0)
             for t in thetas]
 
 
 def line(T_model: np.ndarray, aim: np.ndarray, offset_deg: float, step_mm: float, n_stops: int) -> list[Stop]:
     """Straight line along the camera's -z axis from a start view ``offset_deg`` away from the model view
-    (about the aim point, horizontally); stops at x = k * step_mm, k = 1..n_stops."""
+    (about the aim point, horizontally); stops at x = k * step_mm, k = 0..n_stops-1: x_i is "the absolute
+    magnitude of the 3D camera translation between the first position of the trajectory and position i" (V-A),
+    so the first stop is the start view (x = 0)."""
     start = _rotate_about(T_model, aim, Rotation.from_rotvec(np.deg2rad(offset_deg) * arc_axis(T_model, 0.0)))
     stops = []
-    for k in range(1, n_stops + 1):
+    for k in range(n_stops):
         T = start.copy()
         T[:3, 3] -= k * step_mm * start[:3, 2]
         stops.append(Stop(T, float(offset_deg), float(k * step_mm)))
