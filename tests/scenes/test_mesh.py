@@ -21,17 +21,26 @@ def test_box_volume_is_exact_and_outward():
     assert signed_volume(box) == pytest.approx(60000.0, rel=1e-9)  # positive: faces wound outwards
 
 
-def test_bone_plate_is_watertight_and_outward():
-    bone = mesh.bone_plate(np.random.default_rng(3), "bone", hole_uv=(0.6, 0.5))
-    assert (edge_counts(bone) == 2).all()  # every edge shared by exactly two faces: closed surface
-    assert signed_volume(bone) > 0
-    used = np.unique(bone.faces)
-    assert np.allclose(np.linalg.norm(bone.normals[used], axis=1), 1.0)
-    # smooth normals agree with face normals around them
-    v0, v1, v2 = (bone.vertices[bone.faces[:, i]] for i in range(3))
+def test_a_trimesh_becomes_an_untextured_mesh_with_outward_normals_split_at_creases():
+    import trimesh
+
+    box = trimesh.creation.box((20.0, 30.0, 40.0))
+    m = mesh.from_trimesh(box, mesh.BONE_FOAM)
+    assert m.texture is None and m.material.foam_albedo is not None
+    assert signed_volume(m) == pytest.approx(24000.0)
+    # every corner is a crease: its normals follow the faces (a box keeps flat faces), all unit and outward
+    v0, v1, v2 = (m.vertices[m.faces[:, i]] for i in range(3))
     face_n = np.cross(v1 - v0, v2 - v0)
     face_n /= np.linalg.norm(face_n, axis=1, keepdims=True)
-    assert np.median(np.einsum("ij,ij->i", face_n, bone.normals[bone.faces[:, 0]])) > 0.99
+    np.testing.assert_allclose(m.normals[m.faces[:, 0]], face_n, atol=1e-9)
+
+
+def test_transformed_composes_the_object_frame():
+    T1, T2 = np.eye(4), np.eye(4)
+    T1[:3, 3] = [1.0, 2.0, 3.0]
+    T2[:3, :3] = np.array([[0, -1, 0], [1, 0, 0], [0, 0, 1.0]])
+    moved = mesh.box((1.0, 1.0, 1.0), None).transformed(T1).transformed(T2)
+    np.testing.assert_allclose(moved.T_world_obj, T2 @ T1)
 
 
 def test_cylinder_side_faces_point_away_from_axis():

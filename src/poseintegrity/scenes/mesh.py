@@ -1,42 +1,71 @@
-"""Triangle meshes: the primitives our scenes are built from.
+"""Triangle meshes: the primitives our scenes are built from, and meshes read from files (via trimesh).
 
-A mesh lives in its own object frame (millimetres), is wound counter-clockwise seen from outside (so the
-right-hand normal of a face points outwards), carries per-vertex texture coordinates in [0, 1]^2 of one
-named texture and smooth per-vertex normals.
+A mesh is wound counter-clockwise seen from outside (so the right-hand normal of a face points outwards), carries
+smooth per-vertex normals and either per-vertex texture coordinates in [0, 1]^2 of one named texture (printed
+surfaces) or no texture: its albedo and relief then come from its material's solid texture (bone foam,
+:mod:`poseintegrity.scenes.foam`), evaluated in its own object frame (millimetres) wherever it is placed.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from poseintegrity.scenes.camera import rigid
 
+if TYPE_CHECKING:
+    import trimesh
+
 
 @dataclass(frozen=True)
 class Material:
-    """Reflectance of a surface: Lambertian albedo from the texture, Blinn-Phong specular lobe."""
+    """Reflectance of a surface: Lambertian albedo, Blinn-Phong specular lobe, optional bone-foam relief.
+
+    specular, shininess : Blinn-Phong k_s and exponent
+    foam_albedo : None for a textured surface; else the mean albedo of a bone-foam surface, whose albedo and relief
+        are the solid texture of :mod:`poseintegrity.scenes.foam` (the mesh then needs no texture)
+    """
 
     specular: float = 0.05
     shininess: float = 20.0
+    foam_albedo: float | None = None
+
+
+BONE_FOAM = Material(specular=0.06, shininess=25.0, foam_albedo=0.78)  # pale, matte moulded foam, a mild lobe
 
 
 @dataclass(frozen=True)
 class Mesh:
-    """vertices : (n, 3) float mm; faces : (m, 3) int; uv : (n, 2) float in [0, 1]; normals : (n, 3) unit."""
+    """vertices : (n, 3) float mm; faces : (m, 3) int; uv : (n, 2) float in [0, 1]; normals : (n, 3) unit;
+    texture : name of its albedo map, None for a bone-foam material; T_world_obj : (4, 4) where its own frame
+    (the frame of its solid texture) has been placed."""
 
     vertices: np.ndarray
     faces: np.ndarray
     uv: np.ndarray
     normals: np.ndarray
-    texture: str
+    texture: str | None
     material: Material = Material()
+    T_world_obj: np.ndarray = field(default_factory=lambda: np.eye(4))
 
-    def transformed(self, T_world_obj: np.ndarray) -> "Mesh":
-        """The same mesh with vertices and normals mapped by the rigid transform ``T_world_obj``."""
-        R, t = T_world_obj[:3, :3], T_world_obj[:3, 3]
-        return replace(self, vertices=self.vertices @ R.T + t, normals=self.normals @ R.T)
+    def transformed(self, T_new_old: np.ndarray) -> "Mesh":
+        """The same mesh with vertices and normals mapped by the rigid transform ``T_new_old``."""
+        R, t = T_new_old[:3, :3], T_new_old[:3, 3]
+        return replace(self, vertices=self.vertices @ R.T + t, normals=self.normals @ R.T,
+                       T_world_obj=T_new_old @ self.T_world_obj)
+
+
+def from_trimesh(mesh: "trimesh.Trimesh", material: Material, crease_deg: float = 40.0) -> Mesh:
+    """A bone-foam (untextured) mesh from a trimesh mesh: normals smooth except across edges sharper than
+    ``crease_deg`` (e.g. a drill hole's rim), where vertices are split (trimesh.graph.smooth_shade)."""
+    import trimesh
+
+    smooth = trimesh.graph.smooth_shade(mesh, angle=np.radians(crease_deg))
+    vertices = np.asarray(smooth.vertices, dtype=np.float64)
+    return Mesh(vertices, np.asarray(smooth.faces, dtype=np.int32), np.zeros((len(vertices), 2)),
+                np.asarray(smooth.vertex_normals, dtype=np.float64), None, material)
 
 
 def vertex_normals(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
@@ -92,7 +121,7 @@ def merge(meshes: list[Mesh]) -> Mesh:
     )
 
 
-def box(size: tuple[float, float, float], texture: str, n_sub: int = 6, material: Material = Material()) -> Mesh:
+def box(size: tuple[float, float, float], texture: str | None, n_sub: int = 6, material: Material = Material()) -> Mesh:
     """A box centred on the origin with flat-shaded faces; each face shows its own sixth of the texture.
 
     The texture is cut in a 3 x 2 layout: faces +x, -x, +y / -y, +z, -z.
@@ -116,7 +145,7 @@ def box(size: tuple[float, float, float], texture: str, n_sub: int = 6, material
     return merge(faces)
 
 
-def cylinder(radius: float, height: float, texture: str, n_seg: int = 48, n_rings: int = 8,
+def cylinder(radius: float, height: float, texture: str | None, n_seg: int = 48, n_rings: int = 8,
              material: Material = Material()) -> Mesh:
     """An upright cylinder standing on z = 0 with a top cap; the side takes the texture's top 3/4, the cap the rest."""
     phi = np.linspace(0, 2 * np.pi, n_seg + 1)  # the seam vertex is repeated for the texture
@@ -134,64 +163,3 @@ def cylinder(radius: float, height: float, texture: str, n_seg: int = 48, n_ring
     cap_uv = np.column_stack([0.5 + 0.125 * cap_v[:, 0] / radius * 2, 0.875 + 0.125 * cap_v[:, 1] / radius])
     cap = Mesh(cap_v, cap_f, np.clip(cap_uv, 0, 1), np.tile([0.0, 0.0, 1.0], (n_seg + 1, 1)), texture, material)
     return merge([side, cap])
-
-
-def bone_plate(rng: np.random.Generator, texture: str, size_mm: float = 150.0, thickness_mm: float = 14.0,
-               hole_uv: tuple[float, float] | None = None, n_radial: int = 40, n_angular: int = 120,
-               material: Material = Material(specular=0.12, shininess=12.0)) -> Mesh:
-    """A scapula-like bone phantom: a thin, curved, roughly triangular plate with a ridge and a shallow cup.
-
-    Star-shaped outline r(phi) with a dominant 3-fold harmonic (triangular blade); top and bottom surfaces
-    z = +-t(rho)/2 + bend(x, y) meet at the rim, so the surface is closed and smooth. A spine-like ridge runs
-    across the top, a glenoid-like cup sits near one corner, and ``hole_uv`` (texture coordinates) drills a
-    narrow pit (the paper's pre-drilled phantom). Planar texture mapping over the outline's bounding box.
-    """
-    phi = np.linspace(0, 2 * np.pi, n_angular, endpoint=False)
-    harmonics = 1 + 0.28 * np.cos(3 * phi + rng.uniform(0, 0.3)) + 0.06 * np.cos(5 * phi + rng.uniform(0, 6.28))
-    r_outline = 0.5 * size_mm * harmonics / harmonics.max()
-    rho = np.linspace(0, 1, n_radial + 1)[1:]
-    RHO, PHI = np.meshgrid(rho, phi, indexing="ij")
-    x = (RHO * r_outline[None, :] * np.cos(PHI)).ravel()
-    y = (RHO * r_outline[None, :] * np.sin(PHI)).ravel()
-    half_t = 0.5 * thickness_mm * np.sqrt(np.clip(1 - RHO.ravel() ** 4, 0, 1))
-    bend = -(x**2) / (2 * 1.3 * size_mm) + 0.15 * y**2 / (2 * size_mm)  # saddle-like curvature of the blade
-    # the scapular spine: a crest standing ~20 mm proud of the blade, so the phantom is not a plane
-    ridge = 20.0 * np.exp(-(((y - 0.15 * x - 0.1 * size_mm) / (0.08 * size_mm)) ** 2)) * np.clip(
-        (x + 0.4 * size_mm) / (0.15 * size_mm), 0, 1)
-    cup_c = 0.36 * size_mm * np.array([np.cos(0.1), np.sin(0.1)])
-    cup = -5.0 * np.exp(-((x - cup_c[0]) ** 2 + (y - cup_c[1]) ** 2) / (2 * (0.07 * size_mm) ** 2))
-    u = (x - x.min()) / np.ptp(x)
-    v = (y.max() - y) / np.ptp(y)
-    top_z = bend + half_t + ridge + cup
-    if hole_uv is not None:
-        d2 = ((u - hole_uv[0]) * np.ptp(x)) ** 2 + ((v - hole_uv[1]) * np.ptp(y)) ** 2
-        top_z = top_z - 0.8 * thickness_mm * np.exp(-d2 / (2 * 2.5**2))
-    bottom_z = bend - half_t
-    n_ring = n_radial * n_angular
-    top = np.column_stack([x, y, top_z])
-    bottom = np.column_stack([x, y, bottom_z])
-    # rim ring (rho = 1) shared: use the top's last ring for both sides so the surface is watertight
-    # centre vertices of the two fans sit at the mean height of the innermost ring
-    vertices = np.vstack([[0, 0, top_z[:n_angular].mean()], top, [0, 0, bottom_z[:n_angular].mean()], bottom])
-    uv = np.vstack([[(0 - x.min()) / np.ptp(x), y.max() / np.ptp(y)], np.column_stack([u, v])] * 2)
-
-    def cap_faces(centre: int, first: int) -> np.ndarray:
-        j = np.arange(n_angular)
-        fan = np.column_stack([np.full(n_angular, centre), first + j, first + (j + 1) % n_angular])
-        r, c = np.meshgrid(np.arange(n_radial - 1), j, indexing="ij")
-        a = first + r * n_angular + c
-        b = first + r * n_angular + (c + 1) % n_angular
-        a2, b2 = a + n_angular, b + n_angular
-        quads = np.concatenate([np.column_stack([a.ravel(), a2.ravel(), b2.ravel()]),
-                                np.column_stack([a.ravel(), b2.ravel(), b.ravel()])])
-        return np.concatenate([fan, quads])
-
-    top_f = cap_faces(0, 1)
-    bottom_f = cap_faces(n_ring + 1, n_ring + 2)[:, ::-1]
-    # weld: the bottom's rim vertices are replaced by the top's rim vertices
-    rim_bottom = n_ring + 2 + (n_radial - 1) * n_angular + np.arange(n_angular)
-    rim_top = 1 + (n_radial - 1) * n_angular + np.arange(n_angular)
-    remap = np.arange(len(vertices))
-    remap[rim_bottom] = rim_top
-    faces = remap[np.concatenate([top_f, bottom_f])].astype(np.int32)
-    return Mesh(vertices, faces, uv, vertex_normals(vertices, faces), texture, material)
