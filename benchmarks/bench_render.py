@@ -1,8 +1,8 @@
-"""Rendering speed of one frame at the paper-scale resolution, on one core.
+"""Rendering speed of one frame at the paper-scale resolution, on one core, with the bone-foam surfaces.
 
 Prints medians in ms and ratios against two references measured in the same run on the same frame:
-SIFT detectAndCompute (the per-frame work stage 02 does next; ~100 ms here per FACTS.md) and a flat-picture
-perspective warp (cv2.warpPerspective), the cheap thing the renderer replaces. Target: render + sensor <= 100 ms.
+SIFT detectAndCompute (the per-frame work stage 02 does next) and a flat-picture perspective warp
+(cv2.warpPerspective), the cheap thing the renderer replaces. Target: render + sensor <= 100 ms.
 Run: .venv/bin/python benchmarks/bench_render.py
 """
 
@@ -30,7 +30,7 @@ def median_ms(fn, repeats: int) -> float:
     return 1000 * float(np.median(times))
 
 
-for scene_index in (0, 2, 4):  # a bone, a block, a bone + block
+for scene_index in (0, 1, 2, 4):  # a scapula, the drilled scapula, a block, a scapula + block
     world = dataset._world(params, scene_index)
     spec = params.scenes[scene_index]
     T0 = trajectories.model_pair(world.scene.aim, world.scene.view_dir, spec.distance_mm, 20.0)[0]

@@ -1,16 +1,20 @@
-"""The renderer against independent references: OpenCV's perspective warp of a flat texture, analytic depth,
-the z-buffer's order independence, and mip-mapping's anti-aliasing."""
+"""The renderer against independent references: OpenCV's perspective warp of a flat texture, analytic depth and
+Lambert shading, the z-buffer's order independence, mip-mapping's anti-aliasing, and the bone foam's
+viewpoint-dependent appearance."""
 
 import cv2
 import numpy as np
 import pytest
 
-from poseintegrity.scenes import mesh, renderer
+from poseintegrity.scenes import foam, mesh, renderer
 from poseintegrity.scenes.textures import build_atlas
 
 W, H = 320, 240
 K = np.array([[300.0, 0, (W - 1) / 2], [0, 300.0, (H - 1) / 2], [0, 0, 1]])
 NO_SPECULAR = mesh.Material(specular=0.0)
+LIGHTS = (0.2, 0.7, 0.3, 0.05)  # ambient, ring, room, background
+FLAT = foam.ReliefVolume(np.zeros((8, 8, 8), np.float32), 0.125, 0.2, 0.0, 1.0)  # no relief, no mottling
+RELIEF = foam.relief_volume(np.random.default_rng(0), n=64, pore_fraction=0.05, bump_slope=0.1, albedo_std=0.0)
 
 
 def smooth_texture(seed: int, size: int = 256, sigma: float = 3.0) -> np.ndarray:
@@ -25,8 +29,9 @@ def pose(R, t) -> np.ndarray:
     return T
 
 
-def geometry(named_meshes, textures):
-    return renderer.SceneGeometry.from_meshes(named_meshes, build_atlas(textures), np.array([0.0, 0.0, -1.0]))
+def geometry(named_meshes, textures, relief=FLAT, light_dir=(0.0, 0.0, -1.0)):
+    return renderer.SceneGeometry.from_meshes(named_meshes, build_atlas(textures or {"none": np.zeros((8, 8), np.uint8)}),
+                                              np.array(light_dir), LIGHTS, relief)
 
 
 def plane_facing_camera(size_mm, texture, T_cam_plane):
@@ -118,3 +123,56 @@ def test_expose_is_seeded_and_models_noise():
     assert a.dtype == np.uint8 and (a == b).all()
     assert a.mean() == pytest.approx(0.5 * sensor.exposure, abs=0.1)
     assert a.std() == pytest.approx(np.sqrt(4.0 + 1 / 12), rel=0.05)  # read noise + rounding
+
+
+def test_smooth_surfaces_follow_the_lambert_and_blinn_phong_model():
+    """A tilted foam plane without relief: radiance = albedo (ambient + ring n.v + room n.l) + k_s (ring (n.v)^s +
+    room (n.h)^s) per pixel, with v towards the camera (the ring light) and l the room light."""
+    R = cv2.Rodrigues(np.array([0.5, -0.3, 0.0]))[0]
+    material = mesh.Material(specular=0.1, shininess=10.0, foam_albedo=0.7)
+    plane = mesh.plane(400.0, 400.0, 4, 4, None, material=material)
+    placed = plane.transformed(pose(R, [10.0, -5.0, 500.0]) @ pose(np.diag([1.0, -1.0, -1.0]), [0, 0, 0]))
+    light = np.array([0.3, -0.5, -1.0]) / np.linalg.norm([0.3, -0.5, -1.0])
+    out = renderer.render(geometry([("p", placed)], {}, light_dir=light), K, W, H, np.eye(4))
+    n = -R[:, 2]  # the flipped plane faces the camera
+    ys, xs = np.nonzero(out.object_index == 0)
+    rays = np.linalg.inv(K) @ np.vstack([xs, ys, np.ones_like(xs)])
+    v = -(rays / np.linalg.norm(rays, axis=0)).T
+    n_dot_v, n_dot_l = np.clip(v @ n, 0, None), max(n @ light, 0.0)
+    half = (v + light) / np.linalg.norm(v + light, axis=1, keepdims=True)
+    ambient, ring, room, _ = LIGHTS
+    expected = 0.7 * (ambient + ring * n_dot_v + room * n_dot_l) + 0.1 * (
+        ring * n_dot_v**10 + room * np.clip(half @ n, 0, None) ** 10)
+    np.testing.assert_allclose(out.radiance[ys, xs], expected, rtol=1e-5)
+    assert out.radiance[out.object_index < 0] == pytest.approx(LIGHTS[3])
+
+
+def test_bone_foam_changes_with_the_viewpoint_where_print_only_deforms():
+    """Turn the camera 6 deg about a plane's centre and warp the view back onto the first one with the plane's
+    homography: printed albedo comes back (it only deforms), the foam's ring-lit relief does not (its shading
+    depends on the direction it is seen from)."""
+    foam_mat = mesh.Material(specular=0.0, foam_albedo=0.8)
+
+    def similarity(named_mesh, textures, relief):
+        geo = geometry([named_mesh], textures, relief)
+        T_plane = pose(np.eye(3), [0.0, 0.0, 300.0])
+        views = []
+        for angle in (0.0, 6.0):
+            R = cv2.Rodrigues(np.array([0.0, np.radians(angle), 0.0]))[0]
+            T_cam_world = pose(R, T_plane[:3, 3] - R @ T_plane[:3, 3])  # turned about the plane's centre
+            views.append((T_cam_world, renderer.render(geo, K, W, H, T_cam_world).radiance))
+        (_, first), (T1, second) = views  # view 0 is the world frame
+        # plane n.X = d (n = +z, d = 300): pixels of view 0 map to view 1 by H01 = K (R + t n^T / d) K^-1
+        H01 = K @ (T1[:3, :3] + np.outer(T1[:3, 3], [0.0, 0.0, 1.0]) / 300.0) @ np.linalg.inv(K)
+        back = cv2.warpPerspective(second, H01, (W, H), flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP)
+        inner = (slice(60, H - 60), slice(90, W - 90))
+        a, b = first[inner] - first[inner].mean(), back[inner] - back[inner].mean()
+        return float((a * b).sum() / np.sqrt((a * a).sum() * (b * b).sum()))
+
+    flip = pose(np.diag([1.0, -1.0, -1.0]), [0, 0, 300.0])
+    printed = ("p", mesh.plane(300.0, 300.0, 8, 8, "t", material=NO_SPECULAR).transformed(flip))
+    foamed = ("p", mesh.plane(300.0, 300.0, 8, 8, None, material=foam_mat).transformed(flip))
+    print_similarity = similarity(printed, {"t": smooth_texture(9, sigma=2.0)}, FLAT)
+    foam_similarity = similarity(foamed, {}, RELIEF)
+    assert print_similarity > 0.95
+    assert foam_similarity < print_similarity - 0.15
