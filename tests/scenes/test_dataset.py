@@ -20,12 +20,9 @@ def digest(root) -> dict[str, str]:
 def tiny_root(tmp_path_factory):
     from pathlib import Path
 
-    import yaml
+    from poseintegrity.config import load_params
 
-    from poseintegrity.config import parse_params
-
-    raw = yaml.safe_load((Path(__file__).resolve().parents[1] / "params_tiny.yaml").read_text())
-    params = parse_params(raw).generate
+    params = load_params(Path(__file__).resolve().parents[1] / "params_tiny.yaml").generate
     root = tmp_path_factory.mktemp("datasets")
     dataset.generate(params, root, progress=False)
     return params, root

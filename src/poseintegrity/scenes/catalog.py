@@ -1,51 +1,60 @@
-"""The physical world of the experiments: targets, clutter, the ArUco board and the table (Fig. 4).
+"""The physical world of the experiments: targets, clutter, the ArUco board and the table (Fig. 3-4).
 
-Targets are the same physical objects in every scene they appear in (their meshes and textures are seeded by
-name), arranged differently per scene. World frame: table top z = 0, z up, millimetres.
+Targets are the same physical objects in every scene they appear in (their meshes and textures are seeded by name
+from ``generate.seed``), arranged differently per scene:
+
+- ``scapula`` / ``scapula_drilled``: the anatomical scapula phantom of bone foam (:mod:`.scapula`, :mod:`.foam`),
+  the second pre-drilled in the glenoid; held on a rod so that its glenoid faces the model camera tilted by the
+  scene's ``glenoid_tilt_deg`` (a surgeon's camera looks at the glenoid, never quite en face);
+- ``block_print`` / ``block_mosaic``: boxes printed on their sides (faint lids), set corner-on to the model camera.
+
+Clutter mixes printed boxes and cylinders (some printed like the blocks) with bone-foam offcuts (a block and a shaft
+of the phantoms' material): real scenes hold look-alikes that make false matches. World frame: table top z = 0,
+z up, millimetres.
 """
 
 from __future__ import annotations
 
+import zlib
 from dataclasses import dataclass, field
-from functools import lru_cache
 from typing import TYPE_CHECKING
 
 import numpy as np
 from scipy.spatial.transform import Rotation
 
 from poseintegrity.scenes import mesh as meshes
-from poseintegrity.scenes.camera import rigid
 from poseintegrity.scenes import textures as tex
+from poseintegrity.scenes.camera import rigid
+from poseintegrity.scenes.scapula import scapula_mesh
 
 if TYPE_CHECKING:
-    from poseintegrity.scenes.params import SceneSpec
+    from poseintegrity.scenes.params import GenerateParams, SceneSpec
 
-# bone-like phantoms (smooth, curved, low texture; one pre-drilled) and highly textured blocks (Fig. 4)
 TARGET_NAMES = ("scapula", "scapula_drilled", "block_print", "block_mosaic")
-TEXTURE_NAMES = ("scapula", "scapula_drilled", "block_print", "block_mosaic", "table", "clutter_a", "clutter_b",
-                 "clutter_c", "bone_offcut")
-HOLE_UV = (0.62, 0.45)  # where the drill hole of the prepared phantom is, in its texture coordinates
+TEXTURE_NAMES = ("block_print", "block_mosaic", "table", "clutter_a", "clutter_b", "clutter_c", "clutter_print")
+PRINTED_CLUTTER = ("clutter_a", "clutter_b", "clutter_c", "clutter_print")
 BLOCK_SIZE_MM = (72.0, 64.0, 58.0)
+STAND_RADIUS_MM = 8.0
+PHANTOM_CLEARANCE_MM = 20.0  # lowest point of a held phantom above the table
+BOARD_BELOW_AIM_MM = 60.0  # the board's pedestal brings it this far below the aim point (never below the table)
 
 
-def _rng(*key: int) -> np.random.Generator:
-    return np.random.default_rng([20240501, *key])
+def rng_for(seed: int, *key: str | int) -> np.random.Generator:
+    """A Generator keyed by ``generate.seed`` and names/indices: the same draw in every process and run."""
+    return np.random.default_rng([seed, *(zlib.crc32(k.encode()) if isinstance(k, str) else k for k in key)])
 
 
-@lru_cache(maxsize=None)
-def procedural_texture(name: str) -> np.ndarray:
+def procedural_texture(name: str, seed: int) -> np.ndarray:
     """The albedo map of a texture name, the same in every scene and process."""
-    rng = _rng(1, TEXTURE_NAMES.index(name))
-    if name in ("scapula", "scapula_drilled"):
-        return tex.bone_texture(rng, 1024, HOLE_UV if name == "scapula_drilled" else None)
-    if name == "bone_offcut":
-        return tex.bone_texture(rng, 512)
+    rng = rng_for(seed, "texture", name)
     if name == "block_print":
         return _faint_lid(tex.collage_texture(rng, (1024, 1536), density=3.0, contrast=0.45, text=True), rng)
     if name == "block_mosaic":
         return _faint_lid(tex.collage_texture(rng, (1024, 1536), density=5.0, contrast=0.35, text=False), rng)
     if name == "table":
         return tex.wood_texture(rng, 2048)
+    if name == "clutter_print":  # packaging printed like the target blocks
+        return tex.collage_texture(rng, (768, 768), density=3.0, contrast=0.4, text=True)
     return tex.collage_texture(rng, (512, 512), density=0.8, contrast=0.25, text=name == "clutter_a")
 
 
@@ -64,11 +73,12 @@ def _faint_lid(albedo: np.ndarray, rng: np.random.Generator) -> np.ndarray:
     return out
 
 
-def target_mesh(name: str) -> meshes.Mesh:
-    """A target in its own frame: origin at its centre, +z the face shown to the model camera."""
+def target_mesh(name: str, params: "GenerateParams") -> meshes.Mesh:
+    """A target in its own frame: +z the face shown to the model camera (the glenoid for the scapula phantoms,
+    whose origin is the glenoid centre; the lid for a box, whose origin is its centre)."""
     if name.startswith("scapula"):
-        hole = HOLE_UV if name == "scapula_drilled" else None
-        return meshes.bone_plate(_rng(2, TARGET_NAMES.index(name)), name, hole_uv=hole)
+        bone = scapula_mesh(params.scapula, drilled=name == "scapula_drilled")
+        return meshes.from_trimesh(bone, params.bone_foam.material())
     return meshes.box(BLOCK_SIZE_MM, name, material=meshes.Material(specular=0.08, shininess=30.0))
 
 
@@ -76,7 +86,8 @@ def target_mesh(name: str) -> meshes.Mesh:
 class Scene:
     """A laid-out scene: placed meshes, which of them are targets, the board, the model-view direction.
 
-    T_world_target is the frame of the first target (its centre); ``aim`` is the point the camera looks at.
+    T_world_target is the frame of the first target; ``aim`` is the point the camera looks at and the arcs turn
+    about (the glenoid centre of a single scapula: the paper's robot keeps its guide wire in the drill hole).
     """
 
     name: str
@@ -91,9 +102,37 @@ class Scene:
     textures: dict[str, np.ndarray] = field(repr=False, default_factory=dict)
 
 
-def build_scene(spec: "SceneSpec", index: int, texture_overrides: dict | None = None) -> Scene:
-    """Lay out scene ``spec`` (index = its position in params, seeds the arrangement)."""
-    rng = _rng(3, index)
+def _model_view_frame(view_dir: np.ndarray) -> np.ndarray:
+    """(3, 3) columns: the model camera's x (right), y (down) and the direction towards it, world frame."""
+    x = np.cross(-view_dir, [0.0, 0.0, 1.0])
+    x /= np.linalg.norm(x)
+    return np.column_stack([x, np.cross(-view_dir, x), view_dir])
+
+
+def _held_phantom(name: str, params: "GenerateParams", spec: "SceneSpec", view_dir: np.ndarray,
+                  side: np.ndarray) -> tuple[np.ndarray, list[tuple[str, meshes.Mesh]]]:
+    """T_world_phantom and the placed phantom + its stand: the glenoid normal is the direction towards the model
+    camera turned by ``spec.glenoid_tilt_deg`` (about the camera's x, then y axis), the inferior angle as low as
+    that allows (a scapula held upright), the lowest point PHANTOM_CLEARANCE_MM above the table."""
+    C = _model_view_frame(view_dir)
+    tilt_x, tilt_y = np.radians(spec.glenoid_tilt_deg)
+    normal = Rotation.from_rotvec(tilt_y * C[:, 1]).apply(Rotation.from_rotvec(tilt_x * C[:, 0]).apply(view_dir))
+    inferior = np.array([0.0, 0.0, -1.0]) + normal[2] * normal  # world down, orthogonal to the normal
+    inferior /= np.linalg.norm(inferior)
+    R = np.column_stack([inferior, np.cross(normal, inferior), normal])
+    phantom = target_mesh(name, params)
+    lowest = float((phantom.vertices @ R.T)[:, 2].min())
+    T = rigid(R, side + np.array([0.0, 0.0, PHANTOM_CLEARANCE_MM - lowest]))
+    placed = phantom.transformed(T)
+    # the rod holding it: from the table up to its lowest vertex
+    foot = placed.vertices[placed.vertices[:, 2].argmin()]
+    stand = meshes.cylinder(STAND_RADIUS_MM, foot[2] + 2.0, "clutter_c").transformed(rigid(np.eye(3), [*foot[:2], 0]))
+    return T, [(name, placed), (f"{name}_stand", stand)]
+
+
+def build_scene(spec: "SceneSpec", index: int, params: "GenerateParams") -> Scene:
+    """Lay out scene ``spec`` (index = its position in params, seeds the arrangement with ``params.seed``)."""
+    rng = rng_for(params.seed, "scene", index)
     yaw = np.deg2rad(rng.uniform(-20, 20))  # direction of the model camera around the target
     elev = np.deg2rad(spec.elevation_deg)
     view_dir = np.array([np.sin(yaw) * np.cos(elev), -np.cos(yaw) * np.cos(elev), np.sin(elev)])
@@ -101,77 +140,87 @@ def build_scene(spec: "SceneSpec", index: int, texture_overrides: dict | None = 
         ("table", meshes.plane(1400.0, 1400.0, 56, 56, "table", material=meshes.Material(0.03, 8.0)))]
     target_poses = []
     for k, name in enumerate(spec.targets):
-        side = np.array([np.cos(yaw), np.sin(yaw), 0.0]) * 120.0 * k  # further targets stand beside the first
+        side = np.array([np.cos(yaw), np.sin(yaw), 0.0]) * 130.0 * k  # further targets stand beside the first
         if name.startswith("scapula"):
-            # the plate faces the model camera, tilted a little at random, on a stand 95 mm high
-            normal = Rotation.from_rotvec(rng.uniform(-0.25, 0.25, 3)).apply(view_dir)
-            in_plane = Rotation.from_rotvec(normal * rng.uniform(0, 2 * np.pi))
-            z = normal / np.linalg.norm(normal)
-            x = np.cross([0.0, 0.0, 1.0], z)
-            x = in_plane.apply(x / np.linalg.norm(x))
-            R = np.column_stack([x, np.cross(z, x), z])
-            centre = side + np.array([0.0, 0.0, 95.0])
-            placed.append((f"{name}_stand", meshes.cylinder(9.0, 95.0 - 25.0, "clutter_c").transformed(
-                rigid(np.eye(3), side))))
+            T, objects = _held_phantom(name, params, spec, view_dir, side)
+            placed += objects
         else:
             # a corner towards the model camera, so that two printed sides are in view (a 3D point set)
             R = Rotation.from_euler("z", yaw + np.pi / 4 + rng.uniform(-0.25, 0.25)).as_matrix()
-            centre = side + np.array([0.0, 0.0, BLOCK_SIZE_MM[2] / 2])
-        T = rigid(R, centre)
+            T = rigid(R, side + np.array([0.0, 0.0, BLOCK_SIZE_MM[2] / 2]))
+            placed.append((name, target_mesh(name, params).transformed(T)))
         target_poses.append(T)
-        placed.append((name, target_mesh(name).transformed(T)))
     aim = np.mean([T[:3, 3] for T in target_poses], axis=0)
 
-    # the ArUco board lies flat on the table beside the target, printed side up (board z points into the table)
+    # the ArUco board lies flat beside the target, printed side up (board z points down), on the table or, beside a
+    # held phantom, on a pedestal BOARD_BELOW_AIM_MM below the aim point, so that both stay in view along the arcs
     board = tex.BoardSpec()
     bw, bh = board.size_mm
+    m = board.margin_mm
     # board x points away from the target, so its origin (the model origin, where E_t is measured) is a corner
     # of the edge facing the target
     board_yaw = yaw + np.pi + rng.uniform(-0.3, 0.3)
     x_b = np.array([np.cos(board_yaw), np.sin(board_yaw), 0.0])
     R_world_board = np.column_stack([x_b, np.cross([0.0, 0.0, -1.0], x_b), [0.0, 0.0, -1.0]])
-    # beside the first target and in front of it, so that both stay in view along the arcs
-    board_centre = target_poses[0][:2, 3] - 92.0 * np.array([np.cos(yaw), np.sin(yaw)]) + 20.0 * view_dir[
-        :2] / np.linalg.norm(view_dir[:2])
-    origin = np.append(board_centre, 0.4) - R_world_board @ np.array([bw / 2, bh / 2, 0.0])
+    toward_cam = view_dir[:2] / np.linalg.norm(view_dir[:2])
+    board_centre = target_poses[0][:2, 3] - 92.0 * np.array([np.cos(yaw), np.sin(yaw)]) + 20.0 * toward_cam
+    height = max(aim[2] - BOARD_BELOW_AIM_MM, 0.0)
+    if height > 0:
+        pedestal = meshes.box((bw + 2 * m, bh + 2 * m, height), "clutter_b", n_sub=4)
+        placed.append(("board_pedestal", pedestal.transformed(rigid(R_world_board @ np.diag([1.0, -1.0, -1.0]),
+                                                                    [*board_centre, height / 2]))))
+    origin = np.append(board_centre, height + 0.4) - R_world_board @ np.array([bw / 2, bh / 2, 0.0])
     T_world_board = rigid(R_world_board, origin)
-    m = board.margin_mm
     # plane() faces +z with texture v along -y; flip about x so it faces -z (the board's printed side) with v along +y
     board_mesh = meshes.plane(bw + 2 * m, bh + 2 * m, 12, 9, "aruco_board", material=meshes.Material(0.02, 10.0))
     board_mesh = board_mesh.transformed(rigid(np.diag([1.0, -1.0, -1.0]), [bw / 2, bh / 2, 0.0]))
     placed.append(("aruco_board", board_mesh.transformed(T_world_board)))
+    placed += _clutter(spec, params, rng, aim, toward_cam, board_centre)
 
-    # clutter: boxes and cylinders around, off the line of sight of the model view and off the board
-    occupied = [(aim[:2], 110.0 + 120.0 * (len(spec.targets) - 1)), (board_centre, 80.0)]
-    clutter_textures = ["clutter_a", "clutter_b", "clutter_c", "bone_offcut"]
-    n_placed, attempts = 0, 0
-    while n_placed < spec.n_clutter and attempts < 500:
+    light_dir = np.array([rng.uniform(-0.5, 0.5), rng.uniform(-0.5, 0.3), 1.0])
+    used = {m.texture for _, m in placed if m.texture is not None}
+    textures = {name: (tex.load_texture(params.textures[name]) if name in params.textures
+                       else procedural_texture(name, params.seed)) for name in used if name != "aruco_board"}
+    textures["aruco_board"] = board.texture()
+    return Scene(spec.name, placed, tuple(spec.targets), target_poses[0], T_world_board, board, aim, view_dir,
+                 light_dir, textures)
+
+
+def _clutter(spec: "SceneSpec", params: "GenerateParams", rng: np.random.Generator, aim: np.ndarray,
+             toward_cam: np.ndarray, board_centre: np.ndarray) -> list[tuple[str, meshes.Mesh]]:
+    """``spec.n_clutter`` objects around the target, off the line of sight of the model view and off the board:
+    printed boxes and cylinders, and (one in three) bone-foam offcuts, a block or a shaft."""
+    occupied = [(aim[:2], 90.0 + 130.0 * (len(spec.targets) - 1)), (board_centre, 80.0)]
+    foam = params.bone_foam.material()
+    placed, attempts = [], 0
+    while len(placed) < spec.n_clutter and attempts < 500:
         attempts += 1
-        r, a = rng.uniform(150, 420), rng.uniform(0, 2 * np.pi)
+        r, a = rng.uniform(130, 400), rng.uniform(0, 2 * np.pi)
         xy = aim[:2] + r * np.array([np.cos(a), np.sin(a)])
-        radius = rng.uniform(20, 55)
-        towards_cam = np.dot(xy - aim[:2], view_dir[:2] / np.linalg.norm(view_dir[:2]))
-        if towards_cam > 0 and abs(np.cross(view_dir[:2] / np.linalg.norm(view_dir[:2]), xy - aim[:2])) < 130:
+        radius = rng.uniform(20, 50)
+        offset = xy - aim[:2]
+        if offset @ toward_cam > 0 and abs(toward_cam[0] * offset[1] - toward_cam[1] * offset[0]) < 120:
             continue
         if any(np.linalg.norm(xy - c) < radius + rc for c, rc in occupied):
             continue
         occupied.append((xy, radius))
-        texture = clutter_textures[rng.integers(len(clutter_textures))]
-        if rng.random() < 0.5:
+        kind = rng.random()
+        if kind < 1 / 3:  # bone foam: a test block or a long-bone-like shaft of the phantoms' material
+            if rng.random() < 0.5:
+                size = (2 * radius, rng.uniform(0.6, 1.2) * radius, rng.uniform(30, 90))
+                obj = meshes.box(size, None, n_sub=8, material=foam)
+                T = rigid(Rotation.from_euler("z", rng.uniform(0, np.pi)).as_matrix(), [*xy, size[2] / 2])
+            else:
+                obj = meshes.cylinder(0.45 * radius, rng.uniform(80, 160), None, n_seg=48, material=foam)
+                T = rigid(np.eye(3), [*xy, 0.0])
+        elif kind < 2 / 3:
+            texture = PRINTED_CLUTTER[rng.integers(len(PRINTED_CLUTTER))]
             size = (2 * radius, rng.uniform(0.5, 1.5) * radius, rng.uniform(25, 140))
             obj = meshes.box(size, texture, n_sub=4)
             T = rigid(Rotation.from_euler("z", rng.uniform(0, np.pi)).as_matrix(), [*xy, size[2] / 2])
         else:
+            texture = PRINTED_CLUTTER[rng.integers(len(PRINTED_CLUTTER))]
             obj = meshes.cylinder(0.8 * radius, rng.uniform(40, 160), texture, n_seg=40)
             T = rigid(np.eye(3), [*xy, 0.0])
-        placed.append((f"clutter_{n_placed}", obj.transformed(T)))
-        n_placed += 1
-
-    light_dir = np.array([rng.uniform(-0.5, 0.5), rng.uniform(-0.5, 0.3), 1.0])
-    overrides = texture_overrides or {}
-    used = {m.texture for _, m in placed}
-    textures = {name: (tex.load_texture(overrides[name]) if name in overrides else procedural_texture(name))
-                for name in used if name != "aruco_board"}
-    textures["aruco_board"] = board.texture()
-    return Scene(spec.name, placed, tuple(spec.targets), target_poses[0], T_world_board, board, aim, view_dir,
-                 light_dir, textures)
+        placed.append((f"clutter_{len(placed)}", obj.transformed(T)))
+    return placed

@@ -60,6 +60,52 @@ class _World:
 _WORLDS: dict[tuple[str, int], _World] = {}
 
 
+MIN_TARGET_IN_VIEW = 0.5  # share of a target's vertices that must project inside the model images
+MIN_TARGET_AREA = 0.005  # share of the image its projected bounding box must cover (not a speck)
+
+
+class WorldError(ValueError):
+    """A scene cannot give the datasets: its target would leave (or vanish from) the model view."""
+
+
+def check_world(params: GenerateParams) -> None:
+    """Stop before any rendering, naming the key, when a scene cannot be rendered as the protocol needs: every
+    scene is built (an unreadable mesh or a hole outside the bone raises :class:`~.scapula.MeshError` here) and each
+    target must lie mostly inside both model views of its arcs and, for the lines' scene, of the lines' model pair
+    (a mesh scaled far too large or too small, or a distance that puts the target out of the picture)."""
+    cam = Intrinsics.from_params(params.camera)
+    for index, spec in enumerate(params.scenes):
+        scene = catalog.build_scene(spec, index, params)
+        distances = [spec.distance_mm]
+        if params.lines is not None and params.lines.scene == spec.name:
+            distances.append(params.lines.distance_mm)
+        for distance in distances:
+            for T_world_cam in trajectories.model_pair(scene.aim, scene.view_dir, distance, params.model_baseline_mm):
+                T_cam_world = inverse(T_world_cam)
+                for name, mesh in scene.placed:
+                    if name in scene.target_objects:
+                        _check_in_view(mesh.vertices @ T_cam_world[:3, :3].T + T_cam_world[:3, 3], cam, index, name,
+                                       distance)
+
+
+def _check_in_view(points_cam: np.ndarray, cam: Intrinsics, index: int, name: str, distance: float) -> None:
+    """WorldError unless most of points_cam (n, 3, mm) project inside the image and their extent is not a speck."""
+    z = points_cam[:, 2]
+    safe = np.where(z > renderer.NEAR_MM, z, np.nan)
+    u = cam.K[0, 0] * points_cam[:, 0] / safe + cam.K[0, 2]
+    v = cam.K[1, 1] * points_cam[:, 1] / safe + cam.K[1, 2]
+    inside = (u >= 0) & (u <= cam.width - 1) & (v >= 0) & (v <= cam.height - 1)
+    hint = (f"check generate.scenes.{index}.distance_mm ({distance:g} mm)"
+            + (" and generate.scapula.length_mm" if name.startswith("scapula") else ""))
+    if inside.mean() < MIN_TARGET_IN_VIEW:
+        raise WorldError(f"generate.scenes.{index}: only {inside.mean():.0%} of target {name} lies inside the "
+                         f"{cam.width} x {cam.height} model image: it leaves the view; {hint}")
+    area = np.ptp(u[inside]) * np.ptp(v[inside]) / (cam.width * cam.height)
+    if area < MIN_TARGET_AREA:
+        raise WorldError(f"generate.scenes.{index}: target {name} covers {area:.2%} of the model image: too small "
+                         f"to be seen; {hint}")
+
+
 def _world(params: GenerateParams, scene_index: int) -> _World:
     """The scene and its renderable geometry, built once per process and scene."""
     key = (params.model_dump_json(), scene_index)
@@ -70,8 +116,9 @@ def _world(params: GenerateParams, scene_index: int) -> _World:
 
 
 def _build_world(params: GenerateParams, scene_index: int) -> _World:
-    scene = catalog.build_scene(params.scenes[scene_index], scene_index, params.textures)
-    geometry = renderer.SceneGeometry.from_meshes(scene.placed, build_atlas(scene.textures), scene.light_dir)
+    scene = catalog.build_scene(params.scenes[scene_index], scene_index, params)
+    geometry = renderer.SceneGeometry.from_meshes(scene.placed, build_atlas(scene.textures), scene.light_dir,
+                                                  params.lights.intensities(), params.bone_foam.relief(params.seed))
     target_ids = np.array([i for i, name in enumerate(geometry.object_names) if name in scene.target_objects])
     return _World(scene, geometry, target_ids)
 
@@ -153,7 +200,9 @@ def write_dataset(params: GenerateParams, plan: DatasetPlan, root: Path) -> dict
 
 
 def generate(params: GenerateParams, root: Path, progress: bool = True) -> pd.DataFrame:
-    """Render every planned dataset under ``root`` (in parallel, ``params.n_jobs``); returns and writes the index."""
+    """Render every planned dataset under ``root`` (in parallel, ``params.n_jobs``) after :func:`check_world`;
+    returns and writes the index."""
+    check_world(params)
     root = Path(root)
     root.mkdir(parents=True, exist_ok=True)
     (root / "index.parquet").unlink(missing_ok=True)

@@ -2,13 +2,19 @@
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import Annotated
 
 import cv2
+import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
 from poseintegrity.scenes.catalog import TARGET_NAMES, TEXTURE_NAMES
+from poseintegrity.scenes.foam import ReliefVolume, relief_volume
+from poseintegrity.scenes.mesh import Material
+from poseintegrity.scenes.scapula import read_mesh
+from poseintegrity.schema import ProjectPath
 
 _frozen = ConfigDict(extra="forbid", frozen=True)
 PositiveInt = Annotated[int, Field(gt=0)]
@@ -37,6 +43,78 @@ class SensorParams(BaseModel):
     flicker: float = Field(0.006, ge=0, lt=0.5, description="std of the per-image illumination gain")
 
 
+class LightParams(BaseModel):
+    """The lab's light: a ring light on the camera, a room light fixed to the scene, ambient light (radiances of a
+    white surface facing each light); the background is the radiance seen past every object."""
+
+    model_config = _frozen
+    ambient: float = Field(ge=0)
+    ring: float = Field(ge=0, description="on the lens: moves with the camera, lights what the camera sees")
+    room: float = Field(ge=0, description="directional, fixed to the scene (direction drawn per scene)")
+    background: float = Field(ge=0)
+
+    def intensities(self) -> tuple[float, float, float, float]:
+        return self.ambient, self.ring, self.room, self.background
+
+
+class DrillParams(BaseModel):
+    """The prepared phantom's hole: "pre-drilled for implant placement", "oversized" (IV-B, Fig. 3)."""
+
+    model_config = _frozen
+    diameter_mm: float = Field(gt=0, le=20, description="hole diameter (a glenoid baseplate peg hole is 6-8 mm)")
+    depth_mm: float = Field(gt=0, le=40, description="depth below the glenoid centre")
+
+
+class ScapulaParams(BaseModel):
+    """The anatomical scapula phantom (:mod:`poseintegrity.scenes.scapula`)."""
+
+    model_config = _frozen
+    mesh: ProjectPath = Field(description="closed triangle mesh of a left scapula (STL, OBJ, PLY: anything trimesh reads)")
+    length_mm: float = Field(gt=0, description="the mesh is scaled so that its longest extent is this long")
+    glenoid_centre: tuple[float, float, float] = Field(description="glenoid centre in the mesh file's own units")
+    glenoid_normal: tuple[float, float, float] = Field(description="outward normal of the glenoid, mesh frame")
+    drill: DrillParams
+
+    @field_validator("mesh")
+    @classmethod
+    def _closed_mesh(cls, path: Path) -> Path:
+        read_mesh(path, "mesh")  # unreadable or not closed: a MeshError naming the file, before any work
+        return path
+
+    @field_validator("glenoid_normal")
+    @classmethod
+    def _nonzero(cls, normal: tuple[float, float, float]) -> tuple[float, float, float]:
+        if not (all(math.isfinite(c) for c in normal) and math.hypot(*normal) > 1e-6):
+            raise ValueError(f"glenoid_normal must be a finite, non-zero vector, got {normal}")
+        return normal
+
+
+class BoneFoamParams(BaseModel):
+    """The surface of the moulded bone-foam phantoms (:mod:`poseintegrity.scenes.foam`): physical sizes, the same
+    for every phantom and offcut of the material."""
+
+    model_config = _frozen
+    pore_radius_mm: float = Field(gt=0, le=2, description="smallest pore radius r0; octaves add 2 r0 and 4 r0")
+    pore_fraction: float = Field(gt=0, lt=1, description="share of the surface covered by pores (per octave)")
+    pore_depth: float = Field(gt=0, le=3, description="pore depth / pore radius")
+    bump_slope: float = Field(ge=0, le=2, description="RMS slope of the fine bumps between pores")
+    albedo: float = Field(gt=0, le=1, description="mean albedo of the pale foam")
+    albedo_std: float = Field(ge=0, lt=0.5, description="relative std of its albedo mottling")
+    albedo_mottle_mm: float = Field(gt=0, description="size of the mottles")
+    specular: float = Field(ge=0, le=1, description="Blinn-Phong k_s: a mild lobe")
+    shininess: float = Field(gt=0, description="Blinn-Phong exponent")
+
+    def material(self) -> "Material":
+        return Material(specular=self.specular, shininess=self.shininess, foam_albedo=self.albedo)
+
+    def relief(self, seed: int) -> "ReliefVolume":
+        """The foam's height field, seeded by ``generate.seed`` (one material: the same for every object)."""
+        return relief_volume(np.random.default_rng([seed, 7]), pore_radius_mm=self.pore_radius_mm,
+                             pore_fraction=self.pore_fraction, pore_depth=self.pore_depth,
+                             bump_slope=self.bump_slope, albedo_std=self.albedo_std,
+                             albedo_mottle_mm=self.albedo_mottle_mm)
+
+
 class SceneSpec(BaseModel):
     """One physical arrangement on the table (Fig. 4)."""
 
@@ -46,6 +124,8 @@ class SceneSpec(BaseModel):
     distance_mm: float = Field(320.0, gt=50, description="camera to target centre at the model view")
     elevation_deg: float = Field(50.0, gt=5, lt=90, description="of the model view above the table")
     n_clutter: int = Field(4, ge=0, le=20)
+    glenoid_tilt_deg: tuple[float, float] = Field(
+        (0.0, 0.0), description="a scapula's glenoid normal turned from the model camera about its x, then y axis")
 
     @field_validator("targets")
     @classmethod
@@ -97,8 +177,11 @@ class GenerateParams(BaseModel):
     sensor: SensorParams = SensorParams()
     arcs: ArcParams = ArcParams()
     lines: LineParams | None = LineParams()
+    lights: LightParams
+    scapula: ScapulaParams
+    bone_foam: BoneFoamParams
     scenes: list[SceneSpec] = Field(min_length=1)
-    textures: dict[str, Path] = Field(
+    textures: dict[str, ProjectPath] = Field(
         default_factory=dict, description="texture name -> image file replacing the procedural texture"
     )
 
