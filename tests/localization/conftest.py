@@ -12,13 +12,16 @@ import pytest
 sys.path.insert(0, str(Path(__file__).parent))  # --import-mode=importlib: make loc_synthetic importable
 import loc_synthetic as synthetic  # noqa: E402
 
+from poseintegrity.config import load_params  # noqa: E402
 from poseintegrity.localization import ExtractParams  # noqa: E402
+
+TINY_PARAMS = Path(__file__).resolve().parents[1] / "params_tiny.yaml"
 
 
 @pytest.fixture(scope="session")
 def extract_params() -> ExtractParams:
     """The ``extract`` section of the tiny parameters (sequential, so monkeypatching reaches the work)."""
-    return ExtractParams.model_validate(synthetic.TINY_EXTRACT)
+    return load_params(TINY_PARAMS).extract
 
 
 @pytest.fixture(scope="session")

@@ -16,7 +16,6 @@ import numpy as np
 import pandas as pd
 from scipy.spatial.transform import Rotation
 
-TINY_EXTRACT = dict(n_jobs=1, usac_max_iterations=500, ransac_max_iterations=500, pnp_methods=["epnp", "sqpnp"])
 BOARD = dict(dictionary="DICT_4X4_50", markers_x=3, markers_y=2, marker_length_mm=20.0, separation_mm=5.0, first_id=0)
 CANVAS_MM = (-20.0, -30.0, 180.0, 80.0)  # x_min, y_min, x_max, y_max of the scene plane
 TARGET_MM = (85.0, -20.0, 165.0, 65.0)  # textured target rectangle

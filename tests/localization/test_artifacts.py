@@ -2,8 +2,10 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from poseintegrity.artifacts.base_functions import emg
 from poseintegrity.localization.artifacts import frame_artifacts, json_ready, method_summary, realism_metrics
 from poseintegrity.localization.envelope import envelopes
+from poseintegrity.localization.params import RealismParams
 from poseintegrity.localization.pnp import PnPResult, failed
 
 K = np.array([[500.0, 0.0, 0.0], [0.0, 500.0, 0.0], [0.0, 0.0, 1.0]])
@@ -30,46 +32,79 @@ def test_failed_result_has_zero_inliers_and_nan_geometry():
     assert row["n_inliers"] == 0 and row["inlier_ratio"] == 0.0 and np.isnan(row["inlier_spread_px"])
 
 
-def world(decay_by_dataset):
-    """Artifact rows where n_i = 100 - decay * theta and E_t = 50 / n_i (errors blow up with few inliers)."""
+REALISM = RealismParams(fit_stops=4, max_nfev=400)
+
+
+def world(counts_by_dataset, trajectory="arc"):
+    """Artifact rows with n_i = counts(theta) (theta = 0, 2.25, ... 42.75 deg, IV-D) and E_t = 50 / n_i (errors
+    blow up with few inliers); lines use x = 10 mm per stop."""
     rows = []
-    for dataset, decay in decay_by_dataset.items():
-        for stop in range(20):
-            theta = 2.25 * (stop + 1)
-            n_i = max(int(100 - decay * theta), 0)
+    for dataset, counts in counts_by_dataset.items():
+        for stop in range(20 if trajectory == "arc" else 15):
+            theta = 2.25 * stop
+            n_i = max(int(counts(theta)), 0)
             for image in range(2):
-                rows.append(dict(dataset=dataset, trajectory="arc", stop=stop, image=image, theta_deg=theta,
-                                 x_mm=0.0, method="usac_magsac", n_inliers=n_i, status="ok" if n_i else "pnp_failed",
+                rows.append(dict(dataset=dataset, trajectory=trajectory, stop=stop, image=image,
+                                 theta_deg=theta if trajectory == "arc" else 0.0,
+                                 x_mm=10.0 * stop if trajectory == "line" else 0.0, method="usac_magsac",
+                                 n_inliers=n_i, status="ok" if n_i else "pnp_failed",
                                  E_t_mm=50.0 / n_i if n_i else np.nan, E_r_deg=0.0))
     return pd.DataFrame(rows)
 
 
+def linear(decay):
+    return lambda theta: 100 - decay * theta
+
+
 def test_realism_metrics_of_a_world_with_known_answers():
-    table = world({"a": 1.5, "b": 2.0, "c": 0.8})  # strictly decreasing n_i, never 0
-    metrics = realism_metrics(table, envelopes(table, [(2.0, 3.0), (4.0, 10.0)]))
+    table = world({"a": linear(1.5), "b": linear(2.2), "c": linear(0.8)})  # strictly decreasing n_i, never 0
+    metrics = realism_metrics(table, envelopes(table, [(2.0, 3.0), (4.0, 10.0)]), REALISM)
     assert metrics["min_abs_spearman"] == pytest.approx(1.0)
-    assert metrics["min_first_stop_mean_inliers"] == 95  # dataset b: int(100 - 2 * 2.25)
+    assert metrics["min_first_stop_mean_inliers"] == 100  # every dataset starts at the model view
     low = 50.0 / table.loc[table.n_inliers < 15, "n_inliers"]
     high = 50.0 / table.loc[table.n_inliers > 50, "n_inliers"]
     assert metrics["error_ratio_low_vs_high_inliers"] == pytest.approx(low.median() / high.median())
-    # E_t = 50 / n_i exceeds 2 mm once n_i < 25: only b (theta 36 -> 38.25) inside the arc; 4 mm: b only
-    assert 36.0 < metrics["min_theta_a_2mm3deg"] == metrics["theta_a_2mm3deg"]["b"] < 38.25
-    assert metrics["theta_a_2mm3deg"]["a"] == metrics["theta_a_2mm3deg"]["c"] == 45.0
+    # E_t = 50 / n_i exceeds 2 mm once n_i < 25: only b (theta 33.75 -> 36) inside the arc; 4 mm: b only
+    assert 33.75 <= metrics["min_theta_a_2mm3deg"] == metrics["theta_a_2mm3deg"]["b"] < 36.0
+    assert metrics["theta_a_2mm3deg"]["a"] == metrics["theta_a_2mm3deg"]["c"] == 42.75
     assert metrics["n_uncensored_4mm10deg"] == 1
-    # b fails at 4 mm once E_t = 50 / n_i > 4, i.e. between the stops with mean n_i 14 and 10 (theta 42.75, 45)
-    assert 10 < metrics["median_inliers_at_theta_a_4mm10deg"] == metrics["inliers_at_theta_a_4mm10deg"]["b"] <= 14
+    # b fails at 4 mm once E_t = 50 / n_i > 4, i.e. between the stops with n_i 15 and 10 (theta 38.25, 40.5)
+    assert 10 < metrics["median_inliers_at_theta_a_4mm10deg"] == metrics["inliers_at_theta_a_4mm10deg"]["b"] <= 15
     assert set(metrics["inliers_at_theta_a_2mm3deg"]) == {"b"}
     assert metrics["passed"]["inliers_at_failure"]
     assert metrics["passed"]["spearman"] and metrics["passed"]["first_stop_inliers"]
     assert not metrics["passed"]["uncensored"]
+    # R3: only b fails inside the arc at both tolerances; R5: n_i(6.75) / n_i(0) = int(100 - 6.75 d) / 100
+    assert metrics["theta_a_gap"] == {"b": pytest.approx(metrics["theta_a_4mm10deg"]["b"] - metrics["min_theta_a_2mm3deg"])}
+    assert metrics["decay_ratio_arc"] == pytest.approx({"a": 0.89, "b": 0.85, "c": 0.94})
+    assert not metrics["passed"]["r5_early_decay"]  # linear decays keep most inliers over the sampled stops
+
+
+def test_r1_prefers_the_emg_only_on_emg_shaped_decays():
+    emg_world = world({f"d{i}": lambda t, K=K: emg(np.array([t]), 3000.0, K, -1.0)[0] for i, K in enumerate((5, 7, 9))})
+    gauss_world = world({f"d{i}": lambda t, s=s: 300 * np.exp(-0.5 * (t / s) ** 2) for i, s in enumerate((10, 14, 18))})
+    for table, near_best in ((emg_world, True), (gauss_world, False)):
+        metrics = realism_metrics(table, envelopes(table, [(2.0, 3.0), (4.0, 10.0)]), REALISM)
+        assert set(metrics["rmse_by_base_function"]) == {"emg", "exponential", "gaussian", "logistic", "power_law"}
+        assert metrics["passed"]["r1_emg_near_best"] == near_best, metrics["rmse_by_base_function"]
+
+
+def test_r2_flags_envelopes_inside_the_sampled_stops_and_r5_compares_lines():
+    table = pd.concat([world({"early": lambda t: 30 - 3 * t, "late": linear(2.0)}),
+                       world({"line": linear(0.2)}, trajectory="line")], ignore_index=True)
+    metrics = realism_metrics(table, envelopes(table, [(2.0, 3.0), (4.0, 10.0)]), REALISM)
+    # early: E_t = 50 / n_i > 2 once n_i < 25, i.e. at theta 2.25 (n_i 23) -> theta_a <= 6.75, the 4th stop
+    assert metrics["theta_a_2mm3deg_within_sampling"] == ["early"]
+    assert not metrics["passed"]["r2_envelopes_beyond_sampling"]
+    assert metrics["decay_ratio_line"] == {"line": pytest.approx(0.98)}  # int(100 - 0.2 * 6.75) / 100
 
 
 def test_method_summary_and_json_ready():
-    table = pd.concat([world({"a": 2.3}).assign(method=m) for m in ("epnp", "p3p")], ignore_index=True)
+    table = pd.concat([world({"a": linear(2.3)}).assign(method=m) for m in ("epnp", "p3p")], ignore_index=True)
     table.loc[table.method == "p3p", "n_inliers"] += 10
     summary = method_summary(table, envelopes(table, [(2.0, 3.0)])).set_index("method")
     assert summary.loc["p3p", "mean_n_inliers_first_stop"] == summary.loc["epnp", "mean_n_inliers_first_stop"] + 10
     assert summary.loc["epnp", "n_frames"] == 40
-    assert summary.loc["epnp", "failure_rate"] == pytest.approx(2 / 40)  # n_i = 0 at theta 45 only
+    assert summary.loc["epnp", "failure_rate"] == pytest.approx(0.0)  # n_i = 100 - 2.3 theta > 0 up to 42.75
     assert "mean_theta_a_arc_2mm_3deg" in summary.columns
     assert json_ready({"a": np.float64("nan"), "b": [np.int64(3), np.bool_(True)]}) == {"a": None, "b": [3, True]}

@@ -1,5 +1,4 @@
-"""Execute notebooks 02 and 05 with papermill on the tiny synthetic datasets (skipped until config.Params has
-the ``extract`` section)."""
+"""Execute notebooks 02 and 05 with papermill on the tiny synthetic datasets."""
 
 import json
 import os
@@ -8,16 +7,12 @@ from pathlib import Path
 
 import pandas as pd
 import pytest
-import yaml
 
-from loc_synthetic import TINY_EXTRACT
 from poseintegrity import config
 
 ROOT = Path(__file__).resolve().parents[2]
-pytestmark = [
-    pytest.mark.notebook,
-    pytest.mark.skipif("extract" not in config.Params.model_fields, reason="config.Params has no `extract` section yet"),
-]
+PNP_METHODS = config.load_params(ROOT / "tests" / "params_tiny.yaml").extract.pnp_methods
+pytestmark = pytest.mark.notebook
 
 
 @pytest.fixture(scope="module")
@@ -26,14 +21,7 @@ def executed(synthetic_data_dir, tmp_path_factory):
     work = tmp_path_factory.mktemp("notebooks")
     data_dir, reports_dir = work / "data", work / "reports"
     shutil.copytree(synthetic_data_dir / "datasets", data_dir / "datasets")
-    raw = yaml.safe_load((ROOT / "tests" / "params_tiny.yaml").read_text())
-    raw["extract"] = TINY_EXTRACT
-    try:
-        config.parse_params(raw)
-    except config.ParamsError as error:  # another stage's section is still being wired in
-        pytest.skip(f"tests/params_tiny.yaml + extract does not validate yet: {error}")
-    params_path = work / "params.yaml"
-    params_path.write_text(yaml.safe_dump(raw))
+    params_path = ROOT / "tests" / "params_tiny.yaml"
     env_path = os.environ.get("PYTHONPATH", "")
     os.environ["PYTHONPATH"] = os.pathsep.join(filter(None, [env_path, str(ROOT / "src")]))
     try:
@@ -64,10 +52,10 @@ def test_stage_02_writes_tables_metrics_and_figures(executed):
 def test_stage_05_writes_one_row_per_frame_and_method(executed):
     data_dir, reports_dir = executed
     table = pd.read_parquet(data_dir / "artifacts" / "pnp_variants.parquet")
-    assert set(table["method"]) == set(TINY_EXTRACT["pnp_methods"])
+    assert set(table["method"]) == set(PNP_METHODS)
     usac = pd.read_parquet(data_dir / "artifacts" / "artifacts.parquet")
-    assert len(table) == len(usac) * len(TINY_EXTRACT["pnp_methods"])
+    assert len(table) == len(usac) * len(PNP_METHODS)
     assert list(table.columns) == list(usac.columns)
     metrics = json.loads((reports_dir / "metrics" / "pnp.json").read_text())
-    assert set(metrics["methods"]) == {"usac_magsac", *TINY_EXTRACT["pnp_methods"]}
+    assert set(metrics["methods"]) == {"usac_magsac", *PNP_METHODS}
     assert (reports_dir / "figures" / "05_theta_a_by_method.png").stat().st_size > 0

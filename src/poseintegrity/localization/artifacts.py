@@ -22,7 +22,8 @@ import numpy as np
 import pandas as pd
 from scipy.stats import spearmanr
 
-from poseintegrity.localization.params import tolerance_name
+from poseintegrity.artifacts.base_functions import BASE_FUNCTIONS
+from poseintegrity.localization.params import RealismParams, tolerance_name
 from poseintegrity.localization.pnp import PnPResult, reprojection_errors
 
 ARTIFACT_COLUMNS = [
@@ -56,13 +57,17 @@ def frame_artifacts(
     return row
 
 
-def realism_metrics(table: pd.DataFrame, envelope_table: pd.DataFrame, method: str = "usac_magsac") -> dict[str, Any]:
-    """Properties of the rendered world that the paper's real datasets had (issue 3, "Realism").
+def realism_metrics(
+    table: pd.DataFrame, envelope_table: pd.DataFrame, realism: RealismParams, method: str = "usac_magsac"
+) -> dict[str, Any]:
+    """Properties of the rendered world that the paper's real datasets had (issues 3 and 10, "Realism").
 
     table : artifacts rows; envelope_table : :func:`envelope.envelopes` rows. Only ``method`` rows are used.
     Keys (bars in ``passed``):
     - ``min_abs_spearman``: weakest decay of mean n_i with theta over the arc datasets, as min over datasets of
-      -rho (Spearman of stop theta vs mean n_i per stop); equals |rho| when rho < 0 (bar: >= 0.8)
+      -rho (Spearman of stop theta vs mean n_i per stop); equals |rho| when rho < 0 (bar: >= 0.8).
+      ``min_abs_spearman_to_failure`` (no bar, a diagnostic): the same over the stops up to theta_a at
+      4 mm/10 deg, where the noise floor of false matches after failure no longer dilutes rho
     - ``min_first_stop_mean_inliers``: smallest mean n_i at the first stop over all datasets (bar: >= 50)
     - ``error_ratio_low_vs_high_inliers``: median E_t of frames with n_i < 15 over that of frames with n_i > 50,
       frames with a pose only (bar: >= 3)
@@ -73,9 +78,18 @@ def realism_metrics(table: pd.DataFrame, envelope_table: pd.DataFrame, method: s
       4 mm/10 deg for reference
     - ``median_inliers_at_theta_a_4mm10deg``: median over uncensored arc datasets of the mean n_i per stop,
       linearly interpolated at theta_a (bar: <= 30). The paper's thresholds at zero incursion (n_t 12-28,
-      Table III) say that its localization failed once inliers ran short; a world that fails with 100 inliers
-      left fails for reasons n_i cannot see, and no inlier threshold predicts it. The same at 2 mm/3 deg for
-      reference.
+      Table III) say that its localization failed once inliers ran short.
+    - R1 (Fig. 2) ``emg_rmse_ratio``: mean RMSE over the arc datasets of eq. 1 fitted to the first
+      ``realism.fit_stops`` stops and measured over the whole dataset, over the best other least-squares base
+      function's (bar: <= 1.10); ``rmse_by_base_function`` holds every mean
+    - R2 (IV-A) ``n_theta_a_2mm3deg_within_sampling``: arc datasets whose theta_a at 2 mm/3 deg is not beyond the
+      last sampled stop of the long range predictor (the ``fit_stops``-th stop, 6.75 deg) (bar: 0, and the
+      smallest theta_a <= 12 deg)
+    - R3 (Tables I-II) ``median_theta_a_gap``: median over arcs uncensored at both tolerances of
+      theta_a(4 mm/10 deg) - theta_a(2 mm/3 deg) (bar: <= 2 stops = 4.5 deg): failure is abrupt
+    - R4 (Table III) medians of n_i at theta_a in [10, 35] at both tolerances, 90th percentiles <= 50
+    - R5 (V-A) ``median_decay_ratio_arc``: median over arcs of mean n_i at the ``fit_stops``-th stop over the
+      first stop's (bar: <= 0.75); ``median_decay_ratio_line`` the same on lines (bar: larger than on arcs)
     """
     rows = table[table["method"] == method]
     arcs = rows[rows["trajectory"] == "arc"]
@@ -89,10 +103,15 @@ def realism_metrics(table: pd.DataFrame, envelope_table: pd.DataFrame, method: s
     median_high = posed.loc[posed["n_inliers"] > 50, "E_t_mm"].median()
     arc_envelopes = envelope_table[(envelope_table["method"] == method) & (envelope_table["trajectory"] == "arc")]
 
-    def theta_a(tolerance: tuple[float, float]) -> pd.Series:
+    def theta_a(tolerance: tuple[float, float]) -> pd.DataFrame:
         return arc_envelopes.loc[arc_envelopes["tolerance"] == tolerance_name(tolerance)].set_index("dataset")
 
     strict, loose = theta_a((2.0, 3.0)), theta_a((4.0, 10.0))
+    spearman_to_failure = {}
+    for dataset, stops in per_stop.groupby("dataset"):
+        before = stops[stops["theta"] <= loose["theta_a"].get(dataset, np.nan)]
+        if len(before) >= 3:
+            spearman_to_failure[dataset] = float(spearmanr(before["theta"], before["n_i"]).statistic)
 
     def inliers_at_failure(envelope: pd.DataFrame) -> dict[str, float]:
         """Mean n_i per stop interpolated at theta_a, per uncensored dataset."""
@@ -100,6 +119,13 @@ def realism_metrics(table: pd.DataFrame, envelope_table: pd.DataFrame, method: s
                 for dataset, row in envelope[~envelope["censored"]].iterrows()}
 
     at_failure_strict, at_failure_loose = inliers_at_failure(strict), inliers_at_failure(loose)
+    both_uncensored = strict.index[~strict["censored"]].intersection(loose.index[~loose["censored"]])
+    gap = (loose.loc[both_uncensored, "theta_a"] - strict.loc[both_uncensored, "theta_a"]).to_dict()
+    last_sampled = per_stop["theta"].groupby("dataset").nth(realism.fit_stops - 1).droplevel("stop")
+    within_sampling = sorted(d for d, row in strict.iterrows() if d in last_sampled and row["theta_a"] <= last_sampled[d])
+    rmse = base_function_rmse(rows, realism)
+    others = {name: value for name, value in rmse.items() if name != "emg"}
+    decay_arc, decay_line = decay_ratios(rows, "arc", realism.fit_stops), decay_ratios(rows, "line", realism.fit_stops)
     n_arcs = int(arcs["dataset"].nunique())
     metrics = dict(
         method=method,
@@ -107,6 +133,8 @@ def realism_metrics(table: pd.DataFrame, envelope_table: pd.DataFrame, method: s
         n_arc_datasets=n_arcs,
         spearman_theta_vs_mean_inliers=spearman,
         min_abs_spearman=_nanmin([-rho for rho in spearman.values()]),  # a one-stop dataset has no rho
+        spearman_to_failure=spearman_to_failure,
+        min_abs_spearman_to_failure=_nanmin([-rho for rho in spearman_to_failure.values()]),
         first_stop_mean_inliers={k: float(v) for k, v in first_stop.items()},
         min_first_stop_mean_inliers=float(first_stop.min()) if len(first_stop) else float("nan"),
         median_E_t_mm_low_inliers=float(median_low),
@@ -121,9 +149,23 @@ def realism_metrics(table: pd.DataFrame, envelope_table: pd.DataFrame, method: s
         inliers_at_theta_a_4mm10deg=at_failure_loose,
         median_inliers_at_theta_a_2mm3deg=_nanmedian(list(at_failure_strict.values())),
         median_inliers_at_theta_a_4mm10deg=_nanmedian(list(at_failure_loose.values())),
+        p90_inliers_at_theta_a_2mm3deg=_nanquantile(list(at_failure_strict.values()), 0.9),
+        p90_inliers_at_theta_a_4mm10deg=_nanquantile(list(at_failure_loose.values()), 0.9),
         theta_a_2mm3deg={k: float(v) for k, v in strict["theta_a"].items()},
         theta_a_4mm10deg={k: float(v) for k, v in loose["theta_a"].items()},
+        rmse_by_base_function=rmse,
+        emg_rmse_ratio=float(rmse["emg"] / min(others.values())) if others else float("nan"),
+        theta_a_2mm3deg_within_sampling=within_sampling,
+        n_theta_a_2mm3deg_within_sampling=len(within_sampling),
+        theta_a_gap=gap,
+        median_theta_a_gap=_nanmedian(list(gap.values())),
+        decay_ratio_arc=decay_arc,
+        decay_ratio_line=decay_line,
+        median_decay_ratio_arc=_nanmedian(list(decay_arc.values())),
+        median_decay_ratio_line=_nanmedian(list(decay_line.values())),
     )
+    median_at_failure = (metrics["median_inliers_at_theta_a_2mm3deg"], metrics["median_inliers_at_theta_a_4mm10deg"])
+    p90_at_failure = (metrics["p90_inliers_at_theta_a_2mm3deg"], metrics["p90_inliers_at_theta_a_4mm10deg"])
     metrics["passed"] = dict(
         spearman=bool(metrics["min_abs_spearman"] >= 0.8),
         first_stop_inliers=bool(metrics["min_first_stop_mean_inliers"] >= 50),
@@ -132,8 +174,39 @@ def realism_metrics(table: pd.DataFrame, envelope_table: pd.DataFrame, method: s
         min_theta_a=bool(metrics["min_theta_a_2mm3deg"] <= 12),
         cv_theta_a=bool(metrics["cv_theta_a_2mm3deg"] >= 0.25),
         inliers_at_failure=bool(metrics["median_inliers_at_theta_a_4mm10deg"] <= 30),
+        r1_emg_near_best=bool(metrics["emg_rmse_ratio"] <= 1.10),
+        r2_envelopes_beyond_sampling=bool(len(strict) > 0 and not within_sampling
+                                          and metrics["min_theta_a_2mm3deg"] <= 12),
+        r3_abrupt_failure=bool(metrics["median_theta_a_gap"] <= 4.5),
+        r4_inliers_at_failure=bool(all(10 <= m <= 35 for m in median_at_failure) and all(q <= 50 for q in p90_at_failure)),
+        r5_early_decay=bool(metrics["median_decay_ratio_arc"] <= 0.75
+                            and metrics["median_decay_ratio_line"] > metrics["median_decay_ratio_arc"]),
     )
     return metrics
+
+
+def base_function_rmse(rows: pd.DataFrame, realism: RealismParams) -> dict[str, float]:
+    """R1: per least-squares base function (eq. 1 and the other decays of Fig. 2), the mean over arc datasets of
+    the RMSE over every image when fitted to the images of the first ``realism.fit_stops`` stops."""
+    sums: dict[str, list[float]] = {name: [] for name in BASE_FUNCTIONS}
+    for _, frames in rows[rows["trajectory"] == "arc"].groupby("dataset"):
+        theta, n_i = frames["theta_deg"].to_numpy(float), frames["n_inliers"].to_numpy(float)
+        fitted_stops = np.isin(frames["stop"], np.sort(frames["stop"].unique())[: realism.fit_stops])
+        for name, base in BASE_FUNCTIONS.items():
+            model = base.fit(theta[fitted_stops], n_i[fitted_stops], realism.max_nfev)
+            sums[name].append(float(np.sqrt(np.mean((model.predict(theta) - n_i) ** 2))))
+    return {name: _nanmean(values) for name, values in sums.items()}
+
+
+def decay_ratios(rows: pd.DataFrame, trajectory: str, stop: int) -> dict[str, float]:
+    """R5: per dataset of ``trajectory``, mean n_i at its ``stop``-th stop over the mean n_i at its first stop."""
+    means = rows[rows["trajectory"] == trajectory].groupby(["dataset", "stop"])["n_inliers"].mean()
+    ratios = {}
+    for dataset, per_stop in means.groupby("dataset"):
+        values = per_stop.to_numpy()
+        if len(values) >= stop and values[0] > 0:
+            ratios[str(dataset)] = float(values[stop - 1] / values[0])
+    return ratios
 
 
 def _nanmin(values: list[float]) -> float:
@@ -145,6 +218,17 @@ def _nanmin(values: list[float]) -> float:
 def _nanmedian(values: list[float]) -> float:
     """Median of the values; NaN when there are none."""
     return float(np.median(values)) if values else float("nan")
+
+
+def _nanquantile(values: list[float], q: float) -> float:
+    """Quantile q of the values; NaN when there are none."""
+    return float(np.quantile(values, q)) if values else float("nan")
+
+
+def _nanmean(values: list[float]) -> float:
+    """Mean of the finite values; NaN when there are none."""
+    finite = [value for value in values if np.isfinite(value)]
+    return float(np.mean(finite)) if finite else float("nan")
 
 
 def _cv(values: pd.Series) -> float:

@@ -34,6 +34,13 @@ class SiftParams(_Section):
     sigma: float = Field(1.6, gt=0)
 
 
+class RealismParams(_Section):
+    """The realism checks of the rendered world (:func:`poseintegrity.localization.artifacts.realism_metrics`)."""
+
+    fit_stops: int = Field(ge=2, description="stops the R1 fits and the R2 / R5 sampling use (paper: 4)")
+    max_nfev: int = Field(ge=10, description="curve_fit evaluation budget of each R1 fit")
+
+
 class ExtractParams(_Section):
     """Target localization pipeline, artifact extraction and actual envelopes (stages 02 and 05)."""
 
@@ -67,6 +74,7 @@ class ExtractParams(_Section):
     n_jobs: int = Field(2, description="joblib workers over images (-1: all cores)")
     features_dir: str = Field("features", min_length=1, description="SIFT cache, relative to data_dir")
     datasets: list[str] | None = Field(None, description="dataset ids to process; null: every dataset")
+    realism: RealismParams
 
     @field_validator("tolerances")
     @classmethod
