@@ -35,7 +35,7 @@ def scene_tables(seed: int = 0, n_arcs: int = 6, n_lines: int = 2, images_per_st
     rows = []
     for t in truth.itertuples():
         f = lambda theta, t=t: emg(theta, t.alpha, t.K, t.mu)  # noqa: E731
-        first = 2.25 if t.trajectory == "arc" else 10.0
+        first = 0.0  # IV-D: the first stop is the trajectory start
         for tolerance, count in FAILURE_COUNT.items():
             found = envelope_boundary(f, count, first, RANGE_END[t.trajectory])
             theta_a = found.theta_p if found.status == "root" else (first if found.status == "below_at_start"
@@ -50,6 +50,9 @@ TINY_PREDICT = {
     "pnp_method": "usac_magsac",
     "n_t_min": 4,
     "n_t_max": 100,
+    "relative_min": 0.02,
+    "relative_max": 0.5,
+    "relative_step": 0.04,
     "long_range_stops_arc": 4,
     "long_range_stops_line": 5,
     "next_step_first_stops": 4,

@@ -11,7 +11,7 @@ from poseintegrity.artifacts.fig2 import Series
 from poseintegrity.prediction import NextStepSupervisor, long_range, next_step, static_baseline
 
 ALPHA, K, MU = 3000.0, 8.0, -1.0  # exact eq. 1: ~290 inliers at the first stop, 18 at 45 deg
-THETA_STOPS = 2.25 * np.arange(1, 21)
+THETA_STOPS = 2.25 * np.arange(20)  # IV-D: from the model view
 N_T = np.arange(4.0, 101.0)
 
 
@@ -22,7 +22,7 @@ def exact_series(n_inliers=None, n_stops: int = 20, images: int = 3) -> Series:
 
 
 def true_crossing(n_t: float) -> float:
-    return brentq(lambda t: emg(np.array([t]), ALPHA, K, MU)[0] - n_t, 2.25, 45.0)
+    return brentq(lambda t: emg(np.array([t]), ALPHA, K, MU)[0] - n_t, 0.0, 45.0)
 
 
 def test_long_range_on_an_exact_emg_finds_the_true_crossing(tiny_fit):
@@ -68,21 +68,21 @@ def test_next_step_stops_where_the_supervisor_does(tiny_fit):
         for theta in THETA_STOPS:
             decision = supervisor.update(theta, emg(np.full(3, theta), ALPHA, K, MU))
             if not decision.proceed:
-                stopped_at = min(theta, decision.theta_p)  # a boundary behind the robot sends it back
+                stopped_at = theta  # the robot stops where it is (V-B)
                 break
         assert step.prediction.theta_p[index] == stopped_at
-        if step.prediction.status[index] == "stopped":  # the stop is at or before the boundary that caused it
-            assert stopped_at <= step.boundary[index]
+        if step.prediction.status[index] == "stopped":  # stopped because the boundary is within one step
+            assert step.boundary[index] < stopped_at + 2.25
 
 
-def test_next_step_on_exact_data_stops_one_step_before_the_true_crossing(tiny_fit):
+def test_next_step_on_exact_data_stops_at_the_last_stop_before_the_true_crossing(tiny_fit):
     step = next_step(exact_series(), 4, "emg", N_T, tiny_fit, 0, "usac_magsac", 256)
+    assert step.n_failed == 0 and set(step.prediction.theta_p[step.prediction.status == "stopped"]) <= set(THETA_STOPS)
     for n_t, stop, status in zip(N_T, step.prediction.theta_p, step.prediction.status, strict=True):
         crossing = true_crossing(n_t) if emg(np.array([45.0]), ALPHA, K, MU)[0] < n_t else np.inf
-        if status == "stopped":
-            assert stop <= crossing + 1e-3  # never past the true boundary
-            if crossing > THETA_STOPS[3] + 2.25:
-                assert crossing - 2.25 <= stop + 1e-3  # and at most one step before it
+        if status == "stopped" and crossing > THETA_STOPS[3]:
+            # the robot stands at the last stop from which the next step would cross the boundary
+            assert stop <= crossing + 1e-3 and crossing <= stop + 2.25 + 1e-3
 
 
 def test_static_baseline_is_the_size_for_every_dataset():

@@ -8,7 +8,7 @@ import pytest
 from poseintegrity.artifacts.base_functions import emg
 from poseintegrity.prediction import NextStepSupervisor, UncertaintyParams
 
-STOPS = 2.25 * np.arange(1, 21)
+STOPS = 2.25 * np.arange(20)  # IV-D: the first stop is the model view
 
 
 def counts(theta: float, seed: int = 0) -> np.ndarray:

@@ -14,6 +14,7 @@ from poseintegrity.prediction import (
     best_table,
     headline_metrics,
     live_trials,
+    long_range,
     loso,
     operating_curves,
     sweep,
@@ -34,11 +35,31 @@ def test_every_predictor_every_dataset_every_operating_point(swept, tables, tiny
     theta_p, _, _ = swept
     counts = theta_p.groupby(["method", "dataset", "predictor"]).size().unstack("predictor")
     paper = counts.loc["usac_magsac"]
-    assert set(paper.columns) == {"static", "long_range", "long_range_lower", "mlp", "next_step"}
+    assert set(paper.columns) == {"static", "long_range", "long_range_lower", "mlp", "next_step",
+                                  "long_range_relative", "next_step_relative"}
     assert (paper[["long_range", "long_range_lower", "mlp", "next_step"]] == 97).all().all()
+    relative = tiny_predict.relative_thresholds
+    assert relative[0] == 0.02 and relative[-1] == 0.5  # 0.02 .. 0.5 in steps of 0.04: both ends on the grid
+    assert (paper[["long_range_relative", "next_step_relative"]] == relative.size).all().all()
     assert (paper["static"] == tiny_predict.n_static).all()
-    assert counts.loc["epnp"][["mlp", "next_step"]].isna().all().all()  # Fig. 6 runs long range only
+    assert counts.loc["epnp"][["mlp", "next_step", "long_range_relative"]].isna().all().all()  # Fig. 6: long range
     assert len(paper) == tables[0]["dataset"].nunique()
+
+
+def test_relative_thresholds_are_fractions_of_the_first_stop_mean(swept, tables, tiny_predict, tiny_fit):
+    """long_range_relative at fraction r is the long range predictor at n_t = r x (mean n_i of the first stop)."""
+    from poseintegrity.artifacts.fig2 import dataset_series
+    from poseintegrity.prediction.predictors import fit_rng
+
+    theta_p, _, _ = swept
+    series = next(s for s in dataset_series(tables[0], "usac_magsac") if s.dataset == "scene_2_arc01")
+    first_mean = series.n_inliers[series.stop == 0].mean()
+    k = tiny_predict.long_range_stops_arc
+    fractions = tiny_predict.relative_thresholds
+    direct = long_range(series, k, "emg", fractions * first_mean, tiny_fit,
+                        fit_rng(tiny_predict.seed, "usac_magsac", series, k), tiny_predict.n_grid)
+    rows = theta_p[(theta_p.dataset == "scene_2_arc01") & (theta_p.predictor == "long_range_relative")]
+    np.testing.assert_allclose(rows.sort_values("operating_point")["theta_p"], direct.prediction.theta_p)
 
 
 def test_spl_and_incursions_obey_eq_3_and_4(swept):

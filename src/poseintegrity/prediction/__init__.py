@@ -26,11 +26,13 @@ from poseintegrity.prediction.predictors import (
     long_range,
     next_step,
     next_step_stops,
+    relative_thresholds,
     static_baseline,
 )
 from poseintegrity.prediction.supervisor import Decision, NextStepSupervisor
 from poseintegrity.prediction.sweeps import (
     PAPER_PREDICTORS,
+    RELATIVE_PREDICTORS,
     attach_envelopes,
     best_table,
     headline_metrics,
@@ -42,6 +44,7 @@ from poseintegrity.prediction.uncertainty import Interval, bootstrap_interval, c
 
 __all__ = [
     "PAPER_PREDICTORS",
+    "RELATIVE_PREDICTORS",
     "Boundaries",
     "Decision",
     "Interval",
@@ -68,6 +71,7 @@ __all__ = [
     "operating_curves",
     "prediction_interval",
     "predict_dataset",
+    "relative_thresholds",
     "relative_improvement",
     "safe_path_length",
     "scene_of",

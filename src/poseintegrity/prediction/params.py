@@ -48,6 +48,9 @@ class PredictParams(BaseModel):
     pnp_method: str = Field(min_length=1, description="the paper's PnP path (Tables I-III); others only in Fig. 6")
     n_t_min: int = Field(ge=1, description="smallest inlier threshold of the sweep (paper: 4)")
     n_t_max: int = Field(ge=1, description="largest inlier threshold of the sweep (paper: 100)")
+    relative_min: float = Field(gt=0, lt=1, description="beyond the paper: smallest n_t / first-stop mean n_i")
+    relative_max: float = Field(gt=0, lt=1, description="largest n_t / first-stop mean n_i of the sweep")
+    relative_step: float = Field(gt=0, lt=1, description="step of the relative-threshold sweep")
     long_range_stops_arc: int = Field(ge=2, description="stops the long range predictor fits on arcs (paper: 4)")
     long_range_stops_line: int = Field(ge=2, description="the same on straight lines (paper: 5)")
     next_step_first_stops: int = Field(ge=2, description="stops of the next-step predictor's first fit (paper: 4)")
@@ -72,6 +75,8 @@ class PredictParams(BaseModel):
     def _check(self) -> PredictParams:
         if self.n_t_max < self.n_t_min:
             raise ValueError(f"n_t_max ({self.n_t_max}) must be >= n_t_min ({self.n_t_min})")
+        if self.relative_max < self.relative_min:
+            raise ValueError(f"relative_max ({self.relative_max}) must be >= relative_min ({self.relative_min})")
         if self.n_jobs == 0:
             raise ValueError("n_jobs must be a positive count or negative (joblib convention), not 0")
         bad = [r for r in self.loso_target_rates if not 0.0 <= r <= 1.0]
@@ -83,6 +88,13 @@ class PredictParams(BaseModel):
     def thresholds(self) -> np.ndarray:
         """The swept inlier thresholds n_t : (T,) float, n_t_min .. n_t_max in steps of 1."""
         return np.arange(self.n_t_min, self.n_t_max + 1, dtype=float)
+
+    @property
+    def relative_thresholds(self) -> np.ndarray:
+        """The swept relative thresholds n_t / (mean n_i at the first stop) : (R,) float, relative_min ..
+        relative_max in steps of relative_step (rounded to 1e-9 so that the grid is exact)."""
+        n = int(np.floor((self.relative_max - self.relative_min) / self.relative_step + 1e-9)) + 1
+        return np.round(self.relative_min + self.relative_step * np.arange(n), 9)
 
     def long_range_stops(self, trajectory: str) -> int:
         """Stops the long range predictor fits ("arc": 4, "line": 5 in the paper)."""

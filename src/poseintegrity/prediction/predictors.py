@@ -2,8 +2,10 @@
 
     boundaries        theta_p for every inlier threshold n_t at once from one fitted artifact model (III-E)
     long_range        fit the first k stops (4 on arcs, 5 on lines), theta_p per n_t (III-E, V-A)
-    next_step         refit at every stop from the 4th on; stop when theta_p < theta_i + theta_b (III-E, V-B)
+    next_step         refit at every stop from the 4th on; stop where the robot is when theta_p < theta_i + theta_b
+                      (III-E, IV-A, V-B)
     static_baseline   one envelope size for every dataset (IV-A)
+    relative_thresholds  beyond the paper: n_t as a fraction of the first stop's mean n_i
 
 The artifact fit does not depend on n_t, so every predictor fits once per dataset (and stop) and finds the
 crossings of all thresholds on one evaluation of the fitted curve. theta is deg for arcs, mm for lines.
@@ -15,7 +17,8 @@ Statuses of a theta_p (the first four as in :func:`poseintegrity.artifacts.envel
     "non_finite"      the curve is nan/inf before any crossing: theta_p = the last finite point before it
     "bad_threshold"   n_t is not finite: theta_p = NaN (a flagged row)
     "too_few_stops"   fewer stops with a valid inlier count than the predictor needs: theta_p = NaN (flagged)
-    "stopped" / "end_of_path"   next-step only: the robot was stopped (theta_p = its stop) / reached the last stop
+    "stopped" / "end_of_path"   next-step only: the robot was stopped (theta_p = the stop where it stands) / it
+                      reached the last stop (theta_p = the last stop)
 """
 
 from __future__ import annotations
@@ -174,48 +177,64 @@ def sampling_interval(theta_stops: np.ndarray) -> float:
 
 @dataclass(frozen=True)
 class NextStep:
-    """Next-step answer for one dataset: the stop angle per threshold (its theta_p for SPL, V-B), status, fits."""
+    """Next-step answer for one dataset: where the robot stops per threshold (its SPL position, V-B), status, fits."""
 
     prediction: Boundaries  # theta_p = where the robot stops; status "stopped" | "end_of_path" | "too_few_stops"
     boundary: np.ndarray  # (T,) the model's theta_p at the stop that stopped the robot (NaN: never stopped)
     n_fits: int
+    n_failed: int  # fits that did not converge (their theta_p came from the fallback line)
 
 
 def next_step(
     series: Series, k0: int, model: str, thresholds: np.ndarray, fit: FitParams, seed: int, method: str, n_grid: int
 ) -> NextStep:
-    """Next-step predictor (III-E, V-B) run over a recorded dataset for every threshold at once.
+    """Next-step predictor (III-E, IV-A, V-B) run over a recorded dataset for every threshold at once.
 
-    From the k0-th stop on, at every stop i the model is refitted on all stops so far and theta_p(n_t) found;
-    a threshold whose theta_p < theta_i + theta_b stops the robot at min(theta_i, theta_p): the first k0 stops
-    are a sampling phase as for the long range predictor, and a model that puts the boundary behind the robot
-    sends it back there (our reading of V-B, where the SPL of the next-step predictor is "the viewing angle where
-    the predictor would stop the robot" and its zero-incursion SPL, 13.9 deg, needs stops before the 4th stop on
-    datasets whose theta_a is about 7 deg). Thresholds never stopped reach the last stop ("end_of_path"); a
-    non-finite n_t is flagged "bad_threshold". Fits stop once every threshold has stopped.
+    The robot samples the first k0 stops (IV-A: "the first 4 sampling positions ... to generate initial artifact
+    models"); from the k0-th stop on, at every stop i the model is refitted on all stops so far and theta_p(n_t)
+    found; a threshold whose theta_p < theta_i + theta_b (theta_b: the sampling interval, IV-A) stops the robot
+    where it is, so its SPL position is theta_i (V-B: "the viewing angle where the predictor would stop the
+    robot"). Thresholds never stopped reach the last stop ("end_of_path"); a non-finite n_t is flagged
+    "bad_threshold". Fits stop once every threshold has stopped.
     """
     stops, theta_stops = stop_positions(series)
     if stops.size < max(k0, 2):
-        return NextStep(flagged(thresholds, "too_few_stops"), np.full(np.shape(thresholds), np.nan), 0)
+        return NextStep(flagged(thresholds, "too_few_stops"), np.full(np.shape(thresholds), np.nan), 0, 0)
     theta_b, theta_end = sampling_interval(theta_stops), fit.range_end(series.trajectory)
     stop_at = np.full(np.shape(thresholds), theta_stops[-1])
     boundary = np.full(np.shape(thresholds), np.nan)
     moving = np.isfinite(thresholds)
-    n_fits = 0
+    n_fits = n_failed = 0
     for i in range(k0 - 1, stops.size):
         if not moving.any():
             break
         fitted, _, _ = fit_stops(series, stops[: i + 1], model, fit, fit_rng(seed, method, series, i + 1))
-        n_fits += 1
+        n_fits, n_failed = n_fits + 1, n_failed + (not fitted.converged)
         theta_p = envelope_prediction(fitted.predict, thresholds[moving], theta_stops[0], theta_end, n_grid).theta_p
         stop = next_step_stops(theta_p, theta_stops[i], theta_b)
         index = moving.nonzero()[0][stop]
-        stop_at[index], boundary[index] = np.minimum(theta_stops[i], theta_p[stop]), theta_p[stop]
+        stop_at[index], boundary[index] = theta_stops[i], theta_p[stop]
         moving[index] = False
     status = np.where(moving, "end_of_path", "stopped").astype(object)
     bad = ~np.isfinite(thresholds)
     stop_at[bad], status[bad] = np.nan, "bad_threshold"
-    return NextStep(Boundaries(stop_at, status.astype(str)), boundary, n_fits)
+    return NextStep(Boundaries(stop_at, status.astype(str)), boundary, n_fits, n_failed)
+
+
+def first_stop_mean(series: Series) -> float:
+    """Mean n_i over the images of the first stop with a valid count (NaN without one): the reference of the
+    relative thresholds."""
+    stops, _ = stop_positions(series)
+    if stops.size == 0:
+        return float("nan")
+    counts = series.n_inliers[(series.stop == stops[0]) & np.isfinite(series.n_inliers)]
+    return float(counts.mean())
+
+
+def relative_thresholds(series: Series, fractions: np.ndarray) -> np.ndarray:
+    """Beyond the paper: n_t = fraction x mean n_i at the first stop, so that one operating point means the same
+    share of a target's features whatever its texture. fractions : (R,) -> (R,) inlier thresholds."""
+    return np.asarray(fractions, dtype=float) * first_stop_mean(series)
 
 
 def static_baseline(sizes: np.ndarray) -> Boundaries:

@@ -6,12 +6,11 @@
         if not decision.proceed:
             break                                   # failure predicted before the next step: stop here
 
-Until ``first_stops`` stops are seen the supervisor lets the robot move on (it cannot fit yet: the robot
-starts inside the envelope, III-E). From then on it refits the artifact model on every stop so far and stops
-the robot when theta_p < theta_i + theta_b (or, with ``stop_on_lower_bound``, when the lower end of the
-prediction interval on theta_p is). A theta_p below the current theta puts the boundary behind the robot: the
-offline evaluation (:func:`poseintegrity.prediction.next_step`) then counts the stop at theta_p, i.e. the robot
-backs off to it.
+The first stop is the model view (theta = 0, IV-D). Until ``first_stops`` stops are seen the supervisor lets the
+robot move on (it cannot fit yet: the robot starts inside the envelope, III-E). From then on it refits the
+artifact model on every stop so far and stops the robot where it is when theta_p < theta_i + theta_b (or, with
+``stop_on_lower_bound``, when the lower end of the prediction interval on theta_p is): the robot's safe path ends
+at that stop, as in the offline evaluation :func:`poseintegrity.prediction.next_step` (V-B).
 """
 
 from __future__ import annotations

@@ -8,8 +8,10 @@
     headline_metrics  the keys of ``reports/metrics/predictors.json``
 
 Predictors (column ``predictor``): "long_range", "long_range_lower" (stops on the lower bound of the
-prediction interval, :mod:`.uncertainty`), "mlp", "next_step", "static". Only "long_range" and "static" run
-on PnP methods other than ``predict.pnp_method`` (Fig. 6).
+prediction interval, :mod:`.uncertainty`), "mlp", "next_step", "static", and beyond the paper
+"long_range_relative" / "next_step_relative", whose operating point is n_t as a fraction of the dataset's mean n_i
+at the first stop (the same fits as "long_range" / "next_step"). Only "long_range" and "static" run on PnP methods
+other than ``predict.pnp_method`` (Fig. 6).
 """
 
 from __future__ import annotations
@@ -26,10 +28,10 @@ from poseintegrity.prediction.metrics import best_operating_point, relative_impr
 from poseintegrity.prediction.params import PredictParams
 from poseintegrity.prediction.predictors import (
     Boundaries,
-    LongRange,
     fit_rng,
     long_range,
     next_step,
+    relative_thresholds,
     static_baseline,
 )
 from poseintegrity.prediction.uncertainty import prediction_interval
@@ -39,7 +41,10 @@ COLUMNS = [
     "reason",
 ]  # fmt: skip
 PAPER_PREDICTORS = ("static", "long_range", "mlp", "next_step")  # the keys of predictors.json
+RELATIVE_PREDICTORS = ("long_range_relative", "next_step_relative")  # beyond the paper
 CONSERVATIVE_HIGH = {"static": False}  # a larger operating point is more conservative for n_t, not for a size
+OPERATING_POINT_KEY = {"static": "best_size", "long_range_relative": "best_fraction",
+                       "next_step_relative": "best_fraction"}  # predictors.json name of the best operating point
 
 
 def _rows(
@@ -56,37 +61,49 @@ def _rows(
     )  # fmt: skip
 
 
+def _split(found: Boundaries, n: int) -> tuple[Boundaries, Boundaries]:
+    """The answers for the first n thresholds and for the rest."""
+    return (Boundaries(found.theta_p[:n], found.status[:n]), Boundaries(found.theta_p[n:], found.status[n:]))
+
+
 def predict_dataset(series: Series, method: str, predict: PredictParams, fit: FitParams) -> pd.DataFrame:
-    """Every predictor's theta_p over the operating points for one dataset and PnP method (rows of COLUMNS)."""
+    """Every predictor's theta_p over the operating points for one dataset and PnP method (rows of COLUMNS).
+
+    The absolute thresholds n_t and the relative ones (fraction x first-stop mean n_i) go through one fit of each
+    predictor: the fit does not depend on the threshold.
+    """
     n_t, k, models = predict.thresholds, predict.long_range_stops(series.trajectory), predict.models
+    fractions = predict.relative_thresholds
+    both = np.concatenate([n_t, relative_thresholds(series, fractions)])
     sizes = predict.static_sizes(series.trajectory)
     tables = [_rows("static", "", method, series, sizes, static_baseline(sizes), True, "ok")]
-
-    def long_range_rows(predictor: str, model: str) -> tuple[pd.DataFrame, LongRange]:
-        answer = long_range(series, k, model, n_t, fit, fit_rng(predict.seed, method, series, k), predict.n_grid)
-        fitted = answer.fitted
-        converged, reason = (fitted.converged, fitted.reason) if fitted else (False, "too few stops")
-        return _rows(predictor, model, method, series, n_t, answer.prediction, converged, reason), answer
-
-    table, answer = long_range_rows("long_range", models.long_range)
-    tables.append(table)
+    answer = long_range(series, k, models.long_range, both, fit, fit_rng(predict.seed, method, series, k), predict.n_grid)
+    absolute, relative = _split(answer.prediction, n_t.size)
+    converged, reason = (answer.fitted.converged, answer.fitted.reason) if answer.fitted else (False, "too few stops")
+    tables.append(_rows("long_range", models.long_range, method, series, n_t, absolute, converged, reason))
     if method != predict.pnp_method:  # Fig. 6: the long range predictor alone on the other PnP methods
         return pd.concat(tables, ignore_index=True)
+    tables.append(_rows("long_range_relative", models.long_range, method, series, fractions, relative, converged,
+                        reason))  # fmt: skip
 
     interval = prediction_interval(
         models.long_range, answer.fitted, answer.theta, answer.n_inliers, n_t,
         theta_end=fit.range_end(series.trajectory), fit=fit, uncertainty=predict.uncertainty,
         rng=fit_rng(predict.seed + 1, method, series, k), n_grid=predict.n_grid,
     )  # fmt: skip
-    no_interval = np.isnan(interval.lower) & ~np.isnan(answer.prediction.theta_p)
-    lower = Boundaries(interval.lower, np.where(no_interval, "no_interval", answer.prediction.status))
-    converged = bool(answer.fitted is not None and answer.fitted.converged)
+    no_interval = np.isnan(interval.lower) & ~np.isnan(absolute.theta_p)
+    lower = Boundaries(interval.lower, np.where(no_interval, "no_interval", absolute.status))
     tables.append(_rows("long_range_lower", models.long_range, method, series, n_t, lower, converged, interval.reason))
-    tables.append(long_range_rows("mlp", models.mlp)[0])
-    step = next_step(series, predict.next_step_first_stops, models.next_step, n_t, fit, predict.seed, method,
+    mlp = long_range(series, k, models.mlp, n_t, fit, fit_rng(predict.seed, method, series, k), predict.n_grid)
+    mlp_converged, mlp_reason = (mlp.fitted.converged, mlp.fitted.reason) if mlp.fitted else (False, "too few stops")
+    tables.append(_rows("mlp", models.mlp, method, series, n_t, mlp.prediction, mlp_converged, mlp_reason))
+    step = next_step(series, predict.next_step_first_stops, models.next_step, both, fit, predict.seed, method,
                      predict.n_grid)  # fmt: skip
-    tables.append(_rows("next_step", models.next_step, method, series, n_t, step.prediction, True,
-                        f"{step.n_fits} fits"))  # fmt: skip
+    step_absolute, step_relative = _split(step.prediction, n_t.size)
+    step_ok, step_reason = step.n_failed == 0, f"{step.n_fits} fits, {step.n_failed} not converged"
+    tables.append(_rows("next_step", models.next_step, method, series, n_t, step_absolute, step_ok, step_reason))
+    tables.append(_rows("next_step_relative", models.next_step, method, series, fractions, step_relative, step_ok,
+                        step_reason))  # fmt: skip
     return pd.concat(tables, ignore_index=True)
 
 
@@ -157,7 +174,8 @@ def headline_metrics(
     """The content of ``reports/metrics/predictors.json`` (issue 5's keys; NaN written as null).
 
     <predictor>.<tolerance>.{max_mean_spl_zero_incursion, best_n_t} on the arc datasets of the paper's PnP path
-    (best_n_t is null for "static", whose operating point is ``best_size``); <predictor>.relative_improvement
+    (best_n_t is null for "static", whose operating point is ``best_size``, and for the relative-threshold
+    predictors, whose operating point is ``best_fraction``); <predictor>.relative_improvement
     over static on the mean across tolerances (Tables I, II), long_range.relative_improvement_vs_mlp,
     next_step.relative_improvement_vs_long_range; straight_line.relative_improvement (Fig. 7);
     pnp.<method>.{max_mean_spl_zero_incursion, static_max_mean_spl_zero_incursion} (Fig. 6);
@@ -172,17 +190,17 @@ def headline_metrics(
         return (float(row.max_mean_spl.iloc[0]), float(row.best_operating_point.iloc[0])) if len(row) else (np.nan,) * 2
 
     tolerances = sorted(table["tolerance"].unique())
+    static_mean = float(np.mean([get("static", "arc", t)[0] for t in tolerances]))
     metrics: dict = {}
-    for predictor in (*PAPER_PREDICTORS, "long_range_lower"):
+    for predictor in (*PAPER_PREDICTORS, "long_range_lower", *RELATIVE_PREDICTORS):
+        point_key = OPERATING_POINT_KEY.get(predictor, "best_n_t")
         entry: dict = {}
         for tolerance in tolerances:
             spl, point = get(predictor, "arc", tolerance)
-            entry[tolerance] = {"max_mean_spl_zero_incursion": spl,
-                                "best_n_t" if predictor != "static" else "best_size": point}  # fmt: skip
-            if predictor == "static":
+            entry[tolerance] = {"max_mean_spl_zero_incursion": spl, point_key: point}
+            if point_key != "best_n_t":
                 entry[tolerance]["best_n_t"] = None
         mean_spl = float(np.mean([entry[t]["max_mean_spl_zero_incursion"] for t in tolerances]))
-        static_mean = float(np.mean([get("static", "arc", t)[0] for t in tolerances]))
         entry["mean_max_mean_spl_zero_incursion"] = mean_spl
         if predictor != "static":
             entry["relative_improvement"] = relative_improvement(mean_spl, static_mean)
