@@ -1,6 +1,40 @@
-"""The summary report: ours beside the paper's, and an honest word when a figure is missing or null."""
+"""The summary report: ours beside the paper's (per tolerance), and an honest word when a figure is missing or
+null; the table of paper figures against the papers' printed tables."""
 
+import re
+
+import pytest
+
+from poseintegrity.report import paper
 from poseintegrity.report.summary import HEADLINES, SECTIONS, render_summary
+
+# Rows of Windsor et al.'s tables as printed (system, 2mm/3deg, 4mm/10deg, mean, relative improvement)
+TABLE_I = """Static Baseline	7.0	7.0	7.0	84.1%
+MLP	11.5	12.5	12.0	7.4%
+Predictor (Ours)	12.3	13.5	12.9	-"""
+TABLE_II = """Baseline	7.0	7.0	7.0	102.1%
+Predictor (Ours)	13.9	14.4	14.2	-"""
+TABLE_III = """Long Range Predictor	23	28
+Next-Step Predictor	12	15"""
+
+
+def numbers(row: str) -> list[float]:
+    return [float(v) for v in re.findall(r"\d+\.?\d*", row)]
+
+
+def test_paper_table_holds_the_printed_numbers_per_tolerance():
+    static, mlp, ours = (numbers(row) for row in TABLE_I.splitlines())
+    for name, row in (("static", static), ("mlp", mlp), ("long_range", ours)):
+        assert [paper.WINDSOR_SPL_ZERO_INCURSION[name][t] for t in paper.TOLERANCES] == row[:2]
+        assert paper.mean_spl(name) == pytest.approx(row[2], abs=0.05)  # the table's "Mean" column, rounded
+    assert paper.WINDSOR_IMPROVEMENTS["long_range_vs_static"] == pytest.approx(static[3] / 100)
+    assert paper.WINDSOR_IMPROVEMENTS["long_range_vs_mlp"] == pytest.approx(mlp[3] / 100)
+    baseline, next_step = (numbers(row) for row in TABLE_II.splitlines())
+    assert [paper.WINDSOR_SPL_ZERO_INCURSION["next_step"][t] for t in paper.TOLERANCES] == next_step[:2]
+    assert paper.WINDSOR_IMPROVEMENTS["next_step_vs_static"] == pytest.approx(baseline[3] / 100)
+    long_range, step = (numbers(row) for row in TABLE_III.splitlines())
+    assert [paper.WINDSOR_THRESHOLDS["long_range"][t] for t in paper.TOLERANCES] == long_range
+    assert [paper.WINDSOR_THRESHOLDS["next_step"][t] for t in paper.TOLERANCES] == step
 
 
 def test_every_headline_belongs_to_a_section():
@@ -10,10 +44,17 @@ def test_every_headline_belongs_to_a_section():
 def test_values_nulls_and_missing_stages_are_told_apart():
     metrics = {
         "generate": {"n_viewing_angle_datasets": 21, "disk_gb": 1.4731},
-        "predictors": {"long_range": {"2mm_3deg": {"max_mean_spl_zero_incursion": None}}},
+        "predictors": {"long_range": {"2mm_3deg": {"max_mean_spl_zero_incursion": None},
+                                      "4mm_10deg": {"max_mean_spl_zero_incursion": 14.25}}},
     }
     text = render_summary(metrics)
     assert "| viewing-angle datasets | 21 | 21 (7 scenes x 3 azimuths) | - |" in text
     assert "| disk (GB) | 1.473 | - | <= 3 |" in text
-    assert "| long range, 2 mm/3 deg: max mean SPL at zero incursion (deg) | none | 12.9 | - |" in text
+    # each tolerance beside the paper's value for that tolerance (Table I), not the mean of both
+    assert "| long range (EMG, eq. 1), 2 mm/3 deg: max mean SPL at zero incursion (deg) | none | 12.3 | - |" in text
+    assert "| long range (EMG, eq. 1), 4 mm/10 deg: max mean SPL at zero incursion (deg) | 14.25 | 13.5 | - |" in text
     assert "| RMS position error, no filter (mm) | not run | 3.01 | - |" in text
+
+
+def test_the_summary_points_nowhere_outside_the_repository():
+    assert "../shared" not in render_summary({}) and "FACTS.md" not in render_summary({})

@@ -1,7 +1,7 @@
 """``reports/summary.md``: every stage's headline figures beside the papers' numbers.
 
 Each stage writes ``reports/metrics/<stage>.json``; :data:`HEADLINES` says which keys are headline figures,
-what the papers reported for them (``../shared/papers/README.md``) and the project's target where there is one.
+what the papers reported for them (:mod:`poseintegrity.report.paper`) and the project's target where there is one.
 A stage that has not run yet shows "not run" rather than a stale or invented number.
 """
 
@@ -10,6 +10,8 @@ from __future__ import annotations
 import json
 from dataclasses import dataclass
 from pathlib import Path
+
+from poseintegrity.report import paper
 
 
 @dataclass(frozen=True)
@@ -29,8 +31,64 @@ SECTIONS = {
     "pnp": "Stage 05 · PnP variants (Windsor et al. V-A, Fig. 6)",
     "fits": "Stage 03 · artifact models, mean RMSE over the whole dataset from the first 4 stops (Fig. 2)",
     "predictors": "Stage 04 · localization-envelope predictors (Windsor et al. V, Tables I-III)",
-    "tracking": "Stage 06 · marker tracking (Black & Salcudean, section III)",
+    "tracking": "Stage 06 · marker tracking (Black and Salcudean, IEEE TIM 2024, section III)",
 }
+
+def _predictor_rows() -> list[Headline]:
+    """Tables I-III per tolerance, each row beside the paper's own value for that tolerance (report/paper.py)."""
+    names = {"static": "static baseline", "mlp": "MLP", "long_range": "long range (EMG, eq. 1)",
+             "next_step": "next step"}
+    rows = []
+    for tolerance in paper.TOLERANCES:
+        label = paper.TOLERANCE_LABELS[tolerance]
+        for predictor, name in names.items():
+            rows.append(Headline("predictors", f"{predictor}.{tolerance}.max_mean_spl_zero_incursion",
+                                 f"{name}, {label}: max mean SPL at zero incursion (deg)",
+                                 f"{paper.WINDSOR_SPL_ZERO_INCURSION[predictor][tolerance]:g}"))
+        for predictor in paper.WINDSOR_THRESHOLDS:
+            rows.append(Headline("predictors", f"{predictor}.{tolerance}.best_n_t",
+                                 f"{names[predictor]}, {label}: its threshold n_t",
+                                 f"{paper.WINDSOR_THRESHOLDS[predictor][tolerance]}"))
+    improvement = paper.WINDSOR_IMPROVEMENTS
+    rows += [
+        Headline("predictors", "long_range.relative_improvement", "long range over static (mean of both tolerances)",
+                 f"+{improvement['long_range_vs_static']:.1%}"),
+        Headline("predictors", "long_range.relative_improvement_vs_mlp", "long range over MLP",
+                 f"+{improvement['long_range_vs_mlp']:.1%}"),
+        Headline("predictors", "next_step.relative_improvement", "next step over static",
+                 f"+{improvement['next_step_vs_static']:.1%}"),
+        Headline("predictors", "next_step.relative_improvement_vs_long_range", "next step over long range",
+                 f"+{improvement['next_step_vs_long_range']:.1%}"),
+        Headline("predictors", "straight_line.relative_improvement", "straight lines (2 mm/3 deg): long range over static",
+                 f"+{improvement['straight_line_vs_static']:.1%}"),
+        Headline("predictors", "live.incursions", "simulated live trials: incursions (next step, fixed n_t)",
+                 f"{paper.WINDSOR_LIVE['incursions']} of {paper.WINDSOR_LIVE['n_trials']}"),
+        Headline("predictors", "live.envelope_share", "simulated live trials: share of the actual envelope used",
+                 f"{paper.WINDSOR_LIVE['envelope_share']:.1%}"),
+        Headline("predictors", "live.static_envelope_share", "... static baseline",
+                 f"{paper.WINDSOR_LIVE['static_envelope_share']:.1%}"),
+    ]
+    for tolerance in paper.TOLERANCES:
+        label = paper.TOLERANCE_LABELS[tolerance]
+        for predictor, name in (("long_range_relative", "long range"), ("next_step_relative", "next step")):
+            rows += [
+                Headline("predictors", f"{predictor}.{tolerance}.max_mean_spl_zero_incursion",
+                         f"beyond the paper: {name}, n_t relative to the first stop, {label}: max mean SPL at zero "
+                         "incursion (deg)"),
+                Headline("predictors", f"{predictor}.{tolerance}.best_fraction", "... its n_t / first-stop mean n_i"),
+            ]
+        for predictor in ("long_range", "long_range_relative", "next_step", "next_step_relative"):
+            rows += [
+                Headline("predictors", f"loso.{predictor}.{tolerance}.heldout_incursion_rate",
+                         f"beyond the paper, LOSO: {predictor}, {label}, operating point chosen for 0 incursions on "
+                         "the other scenes: held-out R_i"),
+                Headline("predictors", f"loso.{predictor}.{tolerance}.heldout_mean_spl", "... held-out mean SPL (deg)"),
+            ]
+    rows += [Headline("predictors", f"pnp.{method}.max_mean_spl_zero_incursion",
+                      f"long range on {name}, 2 mm/3 deg (deg)", "similar to USAC (Fig. 6)" if method == "epnp" else "-")
+             for method, name in (("epnp", "EPnP"), ("p3p", "P3P"), ("ap3p", "AP3P"), ("sqpnp", "SQPnP"))]
+    return rows
+
 
 HEADLINES: list[Headline] = [
     Headline("generate", "n_viewing_angle_datasets", "viewing-angle datasets", "21 (7 scenes x 3 azimuths)"),
@@ -41,22 +99,38 @@ HEADLINES: list[Headline] = [
     Headline("generate", "clahe_keypoint_gain_bone", "SIFT keypoints on bone targets, CLAHE / raw",
              "CLAHE used 'to improve feature detection on low texture bone phantoms'"),
     Headline("generate", "disk_gb", "disk (GB)", "-", "<= 3"),
-    Headline("generate", "wall_time_s", "stage wall time (s, n_jobs 2)", "-", "<= 480"),
-    Headline("artifacts", "realism.min_abs_spearman", "weakest |Spearman(theta, mean n_i per stop)| over arcs",
+    Headline("generate", "wall_time_s", "stage wall time (s)", "-", "<= 480"),
+    Headline("artifacts", "realism.min_abs_spearman", "weakest decay over arcs: min of -Spearman(theta, mean n_i)",
              "n_i 'decays' with viewing angle", ">= 0.8"),
     Headline("artifacts", "realism.min_first_stop_mean_inliers", "smallest mean n_i at the first stop", "-",
              ">= 50"),
     Headline("artifacts", "realism.error_ratio_low_vs_high_inliers",
              "median E_t: frames with n_i < 15 over frames with n_i > 50", "error blows up at low n_i", ">= 3"),
-    Headline("artifacts", "realism.n_uncensored_4mm10deg", "arcs whose envelope ends inside 45 deg, 4 mm/10 deg",
+    Headline("artifacts", "realism.n_uncensored_4mm10deg", "arcs whose envelope ends inside the arc, 4 mm/10 deg",
              "-", ">= 18 of 21"),
     Headline("artifacts", "realism.min_theta_a_2mm3deg", "smallest theta_a at 2 mm/3 deg (deg)",
-             "~7 (static baseline best)", "<= 12"),
+             "~7 (static baseline at zero incursion)", "<= 12"),
     Headline("artifacts", "realism.cv_theta_a_2mm3deg", "coefficient of variation of theta_a, 2 mm/3 deg", "-",
              ">= 0.25"),
     Headline("artifacts", "realism.median_inliers_at_theta_a_4mm10deg",
              "median mean n_i at theta_a, 4 mm/10 deg (failure by running out of inliers)",
              "12-28 (n_t at zero incursion, Table III)", "<= 30"),
+    Headline("artifacts", "realism.emg_rmse_ratio",
+             "R1: EMG mean RMSE from 4 stops / best other least-squares base function's (arcs)",
+             "EMG lowest (Fig. 2)", "<= 1.10"),
+    Headline("artifacts", "realism.n_theta_a_2mm3deg_within_sampling",
+             "R2: arcs failing at 2 mm/3 deg within the 4 sampled stops (<= 6.75 deg)",
+             "4 stops 'only drawn from within the localization envelope' (IV-A)", "0"),
+    Headline("artifacts", "realism.median_theta_a_gap", "R3: median theta_a(4 mm/10 deg) - theta_a(2 mm/3 deg) (deg)",
+             "static 7.0 at both tolerances", "<= 4.5"),
+    Headline("artifacts", "realism.median_inliers_at_theta_a_2mm3deg", "R4: median mean n_i at theta_a, 2 mm/3 deg",
+             "n_t 12-23 at zero incursion", "10-35"),
+    Headline("artifacts", "realism.p90_inliers_at_theta_a_4mm10deg", "R4: 90th percentile of n_i at theta_a, "
+             "4 mm/10 deg", "-", "<= 50"),
+    Headline("artifacts", "realism.median_decay_ratio_arc", "R5: median mean n_i at the 4th stop / first stop, arcs",
+             "4 stops suffice to fit the decay", "<= 0.75"),
+    Headline("artifacts", "realism.median_decay_ratio_line", "R5: the same on straight lines",
+             "'begins to decay later' (V-A)", "> arcs"),
     Headline("artifacts", "board_vs_exact.median_E_t_mm", "ArUco ground truth vs exact pose, median E_t (mm)",
              "ArUco board used as ground truth"),
     Headline("artifacts", "board_vs_exact.detection_rate", "frames with the board detected"),
@@ -76,37 +150,7 @@ HEADLINES: list[Headline] = [
     Headline("fits", "rmse_k4.mlp_scratch", "MLP, samples only", "'very high RMSE'"),
     Headline("fits", "rmse_k4.mlp_pretrained", "MLP, EMG-pretrained + fine-tuned", "competitive with least squares"),
     Headline("fits", "converged.emg", "share of EMG fits that converged", "-", ">= 0.99"),
-    Headline("predictors", "long_range.2mm_3deg.max_mean_spl_zero_incursion",
-             "long range, 2 mm/3 deg: max mean SPL at zero incursion (deg)", "12.9"),
-    Headline("predictors", "mlp.2mm_3deg.max_mean_spl_zero_incursion", "MLP, 2 mm/3 deg (deg)",
-             "12.0 (long range is +7.4 %)"),
-    Headline("predictors", "static.2mm_3deg.max_mean_spl_zero_incursion", "static baseline, 2 mm/3 deg (deg)", "7.0"),
-    Headline("predictors", "next_step.2mm_3deg.max_mean_spl_zero_incursion", "next step, 2 mm/3 deg (deg)", "14.2"),
-    Headline("predictors", "long_range.2mm_3deg.best_n_t", "long range, 2 mm/3 deg: threshold n_t", "23"),
-    Headline("predictors", "long_range.4mm_10deg.best_n_t", "long range, 4 mm/10 deg: threshold n_t", "28"),
-    Headline("predictors", "next_step.2mm_3deg.best_n_t", "next step, 2 mm/3 deg: threshold n_t", "12"),
-    Headline("predictors", "next_step.4mm_10deg.best_n_t", "next step, 4 mm/10 deg: threshold n_t", "15"),
-    Headline("predictors", "long_range.4mm_10deg.max_mean_spl_zero_incursion",
-             "long range, 4 mm/10 deg: max mean SPL at zero incursion (deg)"),
-    Headline("predictors", "static.4mm_10deg.max_mean_spl_zero_incursion", "static baseline, 4 mm/10 deg (deg)"),
-    Headline("predictors", "straight_line.relative_improvement", "straight lines: long range over static",
-             "+46.2 %"),
-    Headline("predictors", "long_range.relative_improvement", "long range over static (mean of both tolerances)",
-             "+84.1 %"),
-    Headline("predictors", "next_step.relative_improvement", "next step over static", "+102.1 %"),
-    Headline("predictors", "long_range.relative_improvement_vs_mlp", "long range over MLP", "+7.4 %"),
-    Headline("predictors", "live.incursions", "simulated live trials: incursions (next step, fixed n_t)", "0 of 10"),
-    Headline("predictors", "live.envelope_share", "simulated live trials: share of the actual envelope used",
-             "74.7 %"),
-    Headline("predictors", "live.static_envelope_share", "... static baseline", "60.4 %"),
-    Headline("predictors", "loso.long_range.2mm_3deg.heldout_incursion_rate",
-             "beyond the paper: n_t chosen for 0 incursions on the other scenes, held-out R_i (2 mm/3 deg)"),
-    Headline("predictors", "loso.long_range.2mm_3deg.heldout_mean_spl", "... held-out mean SPL (deg)"),
-    Headline("predictors", "loso.next_step.2mm_3deg.heldout_incursion_rate", "... next step, held-out R_i"),
-    Headline("predictors", "pnp.epnp.max_mean_spl_zero_incursion", "long range on EPnP, 2 mm/3 deg (deg)",
-             "similar to USAC (Fig. 6)"),
-    Headline("predictors", "pnp.p3p.max_mean_spl_zero_incursion", "long range on P3P, 2 mm/3 deg (deg)"),
-    Headline("predictors", "pnp.ap3p.max_mean_spl_zero_incursion", "long range on AP3P, 2 mm/3 deg (deg)"),
+    *_predictor_rows(),
     Headline("tracking", "rms_mm.no_filter", "RMS position error, no filter (mm)", "3.01"),
     Headline("tracking", "rms_mm.ukf", "RMS position error, UKF (mm)", "1.77"),
     Headline("tracking", "rms_mm.ukf_gyro", "RMS position error, UKF + gyro (mm)"),
@@ -153,9 +197,10 @@ def _fmt(value) -> str:
 def render_summary(metrics: dict[str, dict]) -> str:
     """Markdown: one table per stage, ours beside the paper's and the target."""
     lines = ["# Summary of the latest run", "",
-             "Generated by stage 07 from `reports/metrics/*.json`. Paper figures: Windsor et al. (RA-L 2024) and",
-             "Black & Salcudean (2023), see `../shared/papers/README.md`. \"none\": the stage ran and found no such",
-             "value (e.g. no threshold n_t <= 100 reaches zero incursions); \"not run\": no metrics yet.", ""]
+             "Generated by stage 07 from `reports/metrics/*.json`. Paper figures (per tolerance where the paper gives",
+             "them): Windsor et al., IEEE RA-L 9(5), 2024; Black and Salcudean, IEEE Transactions on Instrumentation and",
+             "Measurement, 2024, DOI 10.1109/TIM.2024.3398108 (see `docs/references.md`). \"none\": the stage ran and",
+             "found no such value (e.g. no threshold n_t <= 100 reaches zero incursions); \"not run\": no metrics yet.", ""]
     for stage, title in SECTIONS.items():
         lines += [f"## {title}", "", "| figure | ours | paper | target |", "| --- | --- | --- | --- |"]
         for h in (h for h in HEADLINES if h.stage == stage):
