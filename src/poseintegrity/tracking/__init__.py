@@ -1,4 +1,4 @@
-"""Marker tracking after Black and Salcudean (2023): IR marker detection, point correspondence, Kabsch,
+"""Marker tracking after Black and Salcudean (IEEE TIM 2024): IR marker detection, point correspondence, Kabsch,
 square-root UKF with gyro fusion, and the simulation study of their sections II-F and III.
 
 Module map (paper section -> module):

@@ -1,10 +1,23 @@
-"""IR marker detection (section II-B): threshold, contours, circularity filter, centroid, depth, unprojection.
+"""IR marker detection (section II-B): threshold, contours, shape tests, centroid, depth, unprojection.
 
 Usable on real HoloLens 2 AHAT frames: ``unproject`` is either a 3x3 pinhole K or the per-pixel unit-plane
-lookup table (H, W, 2) of the Research Mode API; IR may be uint8 (already 8-bit) or uint16 (raw).
-Constants are those of their public code (FACTS.md): IR clipped at 1000 and scaled to 8 bit, threshold 222,
-contour area 2-1000 px, circularity >= 0.6 (area over the area of the minimum enclosing circle), convexity
->= 0.75, depth window 100-900 mm.
+lookup table (H, W, 2) of the Research Mode API; IR may be uint8 (already 8-bit) or uint16 (raw); depth is
+millimetres along each pixel's ray.  The constants of their public code (docs/references.md, "Marker
+tracking"): IR clipped at 1000 and scaled to 8 bit, threshold 222, contour area 2-1000 px, circularity >= 0.6
+(area over the area of the minimum enclosing circle), convexity >= 0.75, depth window 100-900 mm.
+
+Two additions of ours, both switchable in :class:`~poseintegrity.tracking.params.DetectionParams`:
+
+- ``shape_measure: pixel`` measures a blob by its pixels instead of by the polygon through its boundary
+  pixel centres.  A blob of 8-20 px (an 11 mm sphere at 0.6-0.9 m, focal ~250 px) has a contour polygon
+  whose area is about half its pixel count (a 3 x 3 square: polygon area 4, 9 pixels), so the published
+  ratio is dominated by pixelisation and genuine markers fall below 0.6.  The pixel forms count each pixel
+  as a unit square: area = polygon area + boundary length / 2 + 1 (Pick's theorem), circle radius
+  = enclosing radius of the pixel centres + 0.5, hull area likewise.  For large blobs both forms agree.
+- ``split_touching``: a blob that fails the shape tests is tried as the union of two discs (two markers whose
+  images touch or overlap): its boundary points are split between two circles fitted by least squares; the
+  split is kept if both circles fit the boundary within ``split_max_residual_px`` and their union covers the
+  blob.  Elongated reflections are not two circles and stay rejected.
 """
 
 from __future__ import annotations
@@ -15,76 +28,154 @@ import cv2
 import numpy as np
 
 from poseintegrity.tracking.geometry import transform_points
+from poseintegrity.tracking.params import DetectionParams
+
+MIN_METRES_DEPTH_MM = 10.0  # a median depth below this is metres, not millimetres (AHAT depth is 100-1000 mm)
+
+
+class FrameError(ValueError):
+    """A recorded frame cannot be used as given (wrong shape, dtype, units or lookup table)."""
 
 
 def validate_frame(ir: np.ndarray, depth_mm: np.ndarray, unproject: np.ndarray) -> str:
     """Why a frame cannot be used, or "" if it can.
 
-    ir : (H, W) uint8/uint16/float; depth_mm : (H, W) numeric; unproject : (3, 3) K or (H, W, 2) LUT.
+    ir : (H, W) uint8/uint16/float; depth_mm : (H, W) numeric, millimetres; unproject : (3, 3) K or (H, W, 2) LUT.
+    Depth whose valid (positive, finite) median is below 10 is taken to be in metres; an all-zero or
+    non-finite lookup table cannot unproject anything.
     """
     ir, depth_mm, unproject = np.asarray(ir), np.asarray(depth_mm), np.asarray(unproject)
     if ir.ndim != 2 or ir.size == 0:
         return f"IR image must be 2-D and non-empty, got shape {ir.shape}"
     if depth_mm.shape != ir.shape:
         return f"depth shape {depth_mm.shape} differs from IR shape {ir.shape}"
-    if not (np.issubdtype(ir.dtype, np.number) and np.issubdtype(depth_mm.dtype, np.number)):
-        return "IR and depth must be numeric"
+    if not (np.issubdtype(ir.dtype, np.number) and np.issubdtype(depth_mm.dtype, np.number)) or ir.dtype == np.bool_:
+        return f"IR and depth must be numeric arrays, got dtypes {ir.dtype} and {depth_mm.dtype}"
     if unproject.shape != (3, 3) and unproject.shape != ir.shape + (2,):
         return f"unproject must be a 3x3 K or an (H, W, 2) = {ir.shape + (2,)} lookup table, got {unproject.shape}"
+    if unproject.shape != (3, 3) and (not np.all(np.isfinite(unproject)) or not np.any(unproject)):
+        return "unit-plane lookup table is all zero or not finite: it cannot unproject pixels"
+    valid = depth_mm[np.isfinite(depth_mm) & (depth_mm > 0)] if np.issubdtype(depth_mm.dtype, np.floating) else depth_mm[depth_mm > 0]
+    if valid.size and np.median(valid) < MIN_METRES_DEPTH_MM:
+        return f"depth looks like metres, not millimetres (median of valid depth {np.median(valid):.3g} < {MIN_METRES_DEPTH_MM:g})"
     return ""
 
 
-def detect_blobs(
-    ir: np.ndarray,
-    *,
-    threshold: int = 222,
-    ir_clip: float = 1000.0,
-    min_area: float = 2.0,
-    max_area: float = 1000.0,
-    min_circularity: float = 0.6,
-    min_convexity: float = 0.75,
-) -> np.ndarray:
+def blob_shape(contour: np.ndarray, measure: str) -> tuple[float, float, float]:
+    """(area px^2, circularity, convexity) of one external contour (k, 1, 2) int.
+
+    measure "contour": the polygon through the boundary pixel centres (their public code);
+    "pixel": each pixel a unit square (module docstring).  Circularity is area over the area of the
+    minimum enclosing circle, convexity area over the convex hull's area.
+    """
+    area = cv2.contourArea(contour)
+    _, radius = cv2.minEnclosingCircle(contour)
+    hull = cv2.convexHull(contour)
+    hull_area = cv2.contourArea(hull)
+    if measure == "pixel":
+        area += len(contour) / 2.0 + 1.0  # Pick: pixels = interior + boundary = A + B/2 + 1
+        radius += 0.5
+        hull_area += cv2.arcLength(hull, True) / 2.0 + 1.0
+    circularity = area / (np.pi * radius * radius) if radius > 0 else 0.0
+    convexity = area / hull_area if hull_area > 0 else 0.0
+    return area, circularity, convexity
+
+
+def fit_circle(points: np.ndarray) -> tuple[np.ndarray, float, float]:
+    """Least-squares circle (Kasa) through points (k, 2): (centre (2,), radius, RMS radial residual), px."""
+    A = np.column_stack([2.0 * points, np.ones(len(points))])
+    b = (points**2).sum(axis=1)
+    (cx, cy, c), *_ = np.linalg.lstsq(A, b, rcond=None)
+    centre = np.array([cx, cy])
+    radius = float(np.sqrt(max(c + cx * cx + cy * cy, 0.0)))
+    residual = float(np.sqrt(np.mean((np.linalg.norm(points - centre, axis=1) - radius) ** 2)))
+    return centre, radius, residual
+
+
+def split_two_discs(contour: np.ndarray, detection: DetectionParams) -> np.ndarray:
+    """Centres (2, 2) px of two touching discs whose union is this blob, or (0, 2) if it is not such a union.
+
+    Boundary points start split along the blob's principal axis and are then reassigned to the circle whose
+    radius they fit better until the split settles (k-means with circles as centres).  Accepted when both
+    circles fit within split_max_residual_px, their radii agree within a factor 2, their centres are apart by
+    more than half the smaller radius, and the union of the two discs covers the blob (pixel area within 30 %).
+    """
+    points = contour.reshape(-1, 2).astype(float)
+    if len(points) < 8:
+        return np.zeros((0, 2))
+    mean = points.mean(axis=0)
+    _, _, Vt = np.linalg.svd(points - mean, full_matrices=False)
+    side = (points - mean) @ Vt[0] > 0
+    for _ in range(10):
+        if side.sum() < 4 or (~side).sum() < 4:
+            return np.zeros((0, 2))
+        fits = [fit_circle(points[s]) for s in (side, ~side)]
+        gaps = np.stack([np.abs(np.linalg.norm(points - c, axis=1) - r) for c, r, _ in fits], axis=1)
+        new_side = gaps[:, 0] < gaps[:, 1]
+        if np.array_equal(new_side, side):
+            break
+        side = new_side
+    (c1, r1, e1), (c2, r2, e2) = fits
+    d = float(np.linalg.norm(c1 - c2))
+    if max(e1, e2) > detection.split_max_residual_px or not (0.5 < r1 / max(r2, 1e-9) < 2.0) or d < 0.5 * min(r1, r2):
+        return np.zeros((0, 2))
+    pixel_area, _, _ = blob_shape(contour, "pixel")
+    R1, R2 = r1 + 0.5, r2 + 0.5  # boundary pixel centres lie half a pixel inside the disc edge
+    lens = 0.0
+    if d < R1 + R2:  # area of the overlap of the two discs
+        a1 = R1 * R1 * np.arccos(np.clip((d * d + R1 * R1 - R2 * R2) / (2 * d * R1), -1, 1))
+        a2 = R2 * R2 * np.arccos(np.clip((d * d + R2 * R2 - R1 * R1) / (2 * d * R2), -1, 1))
+        lens = a1 + a2 - 0.5 * np.sqrt(max((-d + R1 + R2) * (d + R1 - R2) * (d - R1 + R2) * (d + R1 + R2), 0.0))
+    union = np.pi * (R1 * R1 + R2 * R2) - lens
+    if abs(union - pixel_area) > 0.3 * pixel_area:
+        return np.zeros((0, 2))
+    return np.stack([c1, c2])
+
+
+def detect_blobs(ir: np.ndarray, detection: DetectionParams) -> np.ndarray:
     """Centroids (k, 2) float (u, v), pixels, of the bright round blobs of an IR image (II-B).
 
     uint8 input is compared with ``threshold`` directly; other types are raw reflectivity, clipped at
     ir_clip and scaled to 8 bit, which is the comparison ``ir > threshold * ir_clip / 255``.
+    A blob that fails the shape tests may be split into two touching markers (``split_touching``).
     """
-    raw_threshold = threshold if ir.dtype == np.uint8 else threshold * ir_clip / 255.0
+    d = detection
+    raw_threshold = d.threshold if ir.dtype == np.uint8 else d.threshold * d.ir_clip / 255.0
     if ir.dtype not in (np.uint8, np.uint16, np.float32, np.float64):
         ir = ir.astype(np.float64)
     mask = cv2.compare(ir, float(raw_threshold), cv2.CMP_GT)  # 255 where brighter
     contours, _ = cv2.findContours(mask, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
     centroids = []
     for contour in contours:
-        area = cv2.contourArea(contour)
-        if not (min_area <= area <= max_area):
+        area, circularity, convexity = blob_shape(contour, d.shape_measure)
+        if not (d.min_area <= area <= 2.0 * d.max_area):
             continue
-        _, radius = cv2.minEnclosingCircle(contour)
-        if area / (np.pi * radius * radius) < min_circularity:  # circularity (FACTS.md form of 4 pi a / c^2)
-            continue
-        hull_area = cv2.contourArea(cv2.convexHull(contour))
-        if hull_area <= 0 or area / hull_area < min_convexity:
-            continue
-        m = cv2.moments(contour)
-        centroids.append((m["m10"] / m["m00"], m["m01"] / m["m00"]))  # m00 = area > 0 here
+        if area <= d.max_area and circularity >= d.min_circularity and convexity >= d.min_convexity:
+            m = cv2.moments(contour)
+            if m["m00"] > 0:
+                centroids.append((m["m10"] / m["m00"], m["m01"] / m["m00"]))
+            else:  # a blob one pixel wide: its polygon has no area
+                centroids.append(tuple(contour.reshape(-1, 2).mean(axis=0)))
+        elif d.split_touching:
+            centroids.extend(map(tuple, split_two_discs(contour, d)))
     return np.array(centroids, dtype=float).reshape(-1, 2)
 
 
-def lookup_depth(
-    depth_mm: np.ndarray, uv: np.ndarray, *, window: int = 1, depth_min_mm: float = 100.0, depth_max_mm: float = 900.0
-) -> np.ndarray:
-    """Depth (k,) mm at the centroids: median of the valid pixels in a (2w+1)^2 window, NaN if none.
+def lookup_depth(depth_mm: np.ndarray, uv: np.ndarray, detection: DetectionParams) -> np.ndarray:
+    """Depth (k,) mm at the centroids uv (k, 2): median of the valid pixels in a (2w+1)^2 window, NaN if none.
 
     Valid means finite and inside [depth_min_mm, depth_max_mm] (zero, NaN and far readings are rejected).
     """
+    w = detection.depth_window
     H, W = depth_mm.shape
     out = np.full(len(uv), np.nan)
     for k, (u, v) in enumerate(np.rint(uv).astype(int)):
-        patch = np.asarray(depth_mm[max(v - window, 0) : v + window + 1, max(u - window, 0) : u + window + 1], dtype=float)
-        valid = patch[np.isfinite(patch) & (patch >= depth_min_mm) & (patch <= depth_max_mm)]
+        if not (0 <= u < W and 0 <= v < H):
+            continue
+        patch = np.asarray(depth_mm[max(v - w, 0) : v + w + 1, max(u - w, 0) : u + w + 1], dtype=float)
+        valid = patch[np.isfinite(patch) & (patch >= detection.depth_min_mm) & (patch <= detection.depth_max_mm)]
         if valid.size:
-            valid = np.sort(valid)
-            out[k] = 0.5 * (valid[(valid.size - 1) // 2] + valid[valid.size // 2])  # median
+            out[k] = np.median(valid)
     return out
 
 
@@ -107,25 +198,15 @@ def detect_markers(
     ir: np.ndarray,
     depth_mm: np.ndarray,
     unproject: np.ndarray,
-    *,
+    detection: DetectionParams,
     T_world_cam: np.ndarray | None = None,
-    threshold: int = 222,
-    ir_clip: float = 1000.0,
-    min_area: float = 2.0,
-    max_area: float = 1000.0,
-    min_circularity: float = 0.6,
-    min_convexity: float = 0.75,
-    depth_min_mm: float = 100.0,
-    depth_max_mm: float = 900.0,
-    depth_window: int = 1,
-    depth_offset_mm: float = 0.0,
 ) -> np.ndarray:
     """Marker centres (n, 3), metres, in the world frame, from one IR + depth frame (section II-B).
 
     ir : (H, W) uint8 or uint16 reflectivity; depth_mm : (H, W) millimetres along each pixel's ray
     (0 or NaN = invalid); unproject : (3, 3) pinhole K or (H, W, 2) unit-plane LUT, lut[v, u] = (x, y);
-    T_world_cam : (4, 4) extrinsics, identity if None; depth_offset_mm : added along the ray (the sphere
-    radius, to go from the reflecting surface to the marker centre).
+    detection : the detector's constants (``track.detection``); T_world_cam : (4, 4) extrinsics, identity if
+    None.  depth_offset_mm is added along the ray (the sphere radius: from the reflecting surface to the centre).
     Blobs without a valid depth are dropped.  An unusable frame (see :func:`validate_frame`) gives an
     empty (0, 3) array and a ``RuntimeWarning`` naming the reason; it never raises.
     """
@@ -134,14 +215,11 @@ def detect_markers(
         warnings.warn(f"detect_markers: {reason}", RuntimeWarning, stacklevel=2)
         return np.zeros((0, 3))
     ir, depth_mm, unproject = np.asarray(ir), np.asarray(depth_mm), np.asarray(unproject, dtype=float)
-    uv = detect_blobs(
-        ir, threshold=threshold, ir_clip=ir_clip, min_area=min_area, max_area=max_area,
-        min_circularity=min_circularity, min_convexity=min_convexity,
-    )
-    d_mm = lookup_depth(depth_mm, uv, window=depth_window, depth_min_mm=depth_min_mm, depth_max_mm=depth_max_mm)
+    uv = detect_blobs(ir, detection)
+    d_mm = lookup_depth(depth_mm, uv, detection)
     keep = np.isfinite(d_mm)
     xy = unit_plane_coordinates(uv[keep], unproject)
     rays = np.column_stack([xy, np.ones(len(xy))])
     rays /= np.linalg.norm(rays, axis=1, keepdims=True)
-    points_cam = rays * ((d_mm[keep] + depth_offset_mm) / 1000.0)[:, None]  # depth is measured along the ray
+    points_cam = rays * ((d_mm[keep] + detection.depth_offset_mm) / 1000.0)[:, None]  # depth is along the ray
     return points_cam if T_world_cam is None else transform_points(T_world_cam, points_cam)

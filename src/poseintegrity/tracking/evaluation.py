@@ -23,7 +23,7 @@ from poseintegrity.tracking.srukf import SquareRootUKF
 from poseintegrity.tracking.tracker import MarkerTracker
 from poseintegrity.tracking.unscented import UnscentedMarkerFilter
 
-# Black and Salcudean (2023), section III and Table I: the numbers ours are reported beside.
+# Black and Salcudean (IEEE TIM 2024), section III and Table I: the numbers ours are reported beside.
 PAPER = {
     "rms_mm": {"no_filter": 3.01, "ukf": 1.77},
     "rms_deg": {"no_filter": 1.75, "ukf": 1.51},
