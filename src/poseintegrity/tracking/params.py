@@ -58,7 +58,7 @@ class DetectionParams(_Section):
     min_circularity: float = Field(0.6, ge=0, le=1)
     min_convexity: float = Field(0.75, ge=0, le=1)
     depth_min_mm: float = Field(100.0, ge=0)
-    depth_max_mm: float = Field(900.0, gt=0)
+    depth_max_mm: float = Field(1000.0, gt=0)  # published 900; AHAT reaches ~1 m and markers at 0.9 m read up to 0.9 m + noise
     depth_window: int = Field(1, ge=0, le=5)  # median over a (2w+1)^2 window at the centroid
     depth_offset_mm: float = Field(5.5, ge=0)  # sphere radius: the depth hits the surface, we want the centre
     shape_measure: Literal["pixel", "contour"] = "pixel"  # "contour": the published polygon form
@@ -160,6 +160,7 @@ class EvaluationParams(_Section):
     sweep_focal_px: float = Field(250.0, gt=0)
     sweep_poses: int = Field(50, ge=1)  # random tool orientations per distance
     sweep_phantoms: int = Field(400, ge=1)  # elongated phantoms rendered for the rejection rate
+    replay_s: float = Field(5.0, gt=0)  # seconds of recording written as PNG frames and replayed from disk
     multi_tool_frames: int = Field(500, ge=1)  # frames of the two-tool and phantom-rich runs
     phantom_rich_max: int = Field(6, ge=0)  # phantoms per frame (binomial, p_phantom) in the phantom-rich scene
     second_tool: list[tuple[float, float, float]] = [

@@ -121,16 +121,16 @@ def track_recording(recording: Recording, tools: dict[str, np.ndarray], params: 
 
     Columns: t_s, frame, tool, flag, n_points, n_matched, x_mm / y_mm / z_mm and qx / qy / qz / qw (filtered
     T_world_body, NaN while the filter is not running).  Gyro samples are fused by gyro_tool's filter between
-    the frames (events in time order; a gyro sample at the time of a frame comes first).
+    the frames (events in time order; a gyro sample at the time of a frame comes after it).
     """
     tracker = MultiToolTracker(tools, params.filter, params.matching, gyro_tool if recording.gyro is not None else None)
-    events = [(t, 1, k) for k, t in enumerate(recording.frames.t_s)]
+    events = [(t, 0, k) for k, t in enumerate(recording.frames.t_s)]
     if recording.gyro is not None:
-        events += [(t, 0, k) for k, t in enumerate(recording.gyro.t_s)]
+        events += [(t, 1, k) for k, t in enumerate(recording.gyro.t_s)]
     rows, warned = [], set()
     gyro = recording.gyro[["wx", "wy", "wz"]].to_numpy(float) if recording.gyro is not None else None
-    for t, is_frame, k in sorted(events):
-        if not is_frame:
+    for t, is_gyro, k in sorted(events):
+        if is_gyro:
             tracker.gyro(t, gyro[k])
             continue
         row = recording.frames.iloc[k]
