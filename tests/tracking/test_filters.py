@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from poseintegrity.tracking.evaluation import filterpy_filter
+from poseintegrity.tracking.peers import filterpy_filter
 from poseintegrity.tracking.geometry import MARKERS_BODY
 from poseintegrity.tracking.params import FilterParams
 from poseintegrity.tracking.srukf import SquareRootUKF

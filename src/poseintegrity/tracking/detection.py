@@ -92,13 +92,26 @@ def fit_circle(points: np.ndarray) -> tuple[np.ndarray, float, float]:
     return centre, radius, residual
 
 
+def lens_area(d: float, R1: float, R2: float) -> float:
+    """Area of the overlap of two discs of radii R1, R2 whose centres are d apart (px^2)."""
+    if d >= R1 + R2:
+        return 0.0
+    if d <= abs(R1 - R2):
+        return float(np.pi * min(R1, R2) ** 2)
+    a1 = R1 * R1 * np.arccos((d * d + R1 * R1 - R2 * R2) / (2 * d * R1))
+    a2 = R2 * R2 * np.arccos((d * d + R2 * R2 - R1 * R1) / (2 * d * R2))
+    return float(a1 + a2 - 0.5 * np.sqrt(max((-d + R1 + R2) * (d + R1 - R2) * (d - R1 + R2) * (d + R1 + R2), 0.0)))
+
+
 def split_two_discs(contour: np.ndarray, detection: DetectionParams) -> np.ndarray:
     """Centres (2, 2) px of two touching discs whose union is this blob, or (0, 2) if it is not such a union.
 
     Boundary points start split along the blob's principal axis and are then reassigned to the circle whose
     radius they fit better until the split settles (k-means with circles as centres).  Accepted when both
     circles fit within split_max_residual_px, their radii agree within a factor 2, their centres are apart by
-    more than half the smaller radius, and the union of the two discs covers the blob (pixel area within 30 %).
+    more than half the smaller radius, the discs touch, 97 % of the blob's pixels lie in one of them, the
+    area of their union is the blob's within 30 %, and the blob narrows between the centres (a neck at most
+    0.85 times as wide as the blob through either centre: an elongated reflection is a bar, not two discs).
     """
     points = contour.reshape(-1, 2).astype(float)
     if len(points) < 8:
@@ -119,15 +132,26 @@ def split_two_discs(contour: np.ndarray, detection: DetectionParams) -> np.ndarr
     d = float(np.linalg.norm(c1 - c2))
     if max(e1, e2) > detection.split_max_residual_px or not (0.5 < r1 / max(r2, 1e-9) < 2.0) or d < 0.5 * min(r1, r2):
         return np.zeros((0, 2))
-    pixel_area, _, _ = blob_shape(contour, "pixel")
     R1, R2 = r1 + 0.5, r2 + 0.5  # boundary pixel centres lie half a pixel inside the disc edge
-    lens = 0.0
-    if d < R1 + R2:  # area of the overlap of the two discs
-        a1 = R1 * R1 * np.arccos(np.clip((d * d + R1 * R1 - R2 * R2) / (2 * d * R1), -1, 1))
-        a2 = R2 * R2 * np.arccos(np.clip((d * d + R2 * R2 - R1 * R1) / (2 * d * R2), -1, 1))
-        lens = a1 + a2 - 0.5 * np.sqrt(max((-d + R1 + R2) * (d + R1 - R2) * (d - R1 + R2) * (d + R1 + R2), 0.0))
-    union = np.pi * (R1 * R1 + R2 * R2) - lens
-    if abs(union - pixel_area) > 0.3 * pixel_area:
+    if d > R1 + R2 + 0.5:  # the images of two markers touch or overlap; separate blobs would not be one contour
+        return np.zeros((0, 2))
+    x0, y0, w, h = cv2.boundingRect(contour)
+    mask = np.zeros((h, w), np.uint8)
+    cv2.drawContours(mask, [contour - [x0, y0]], -1, 1, thickness=cv2.FILLED)
+    v, u = np.nonzero(mask)
+    pixels = np.column_stack([u + x0, v + y0]).astype(float)
+    inside = (np.linalg.norm(pixels - c1, axis=1) <= R1 + 0.5) | (np.linalg.norm(pixels - c2, axis=1) <= R2 + 0.5)
+    union = np.pi * (R1 * R1 + R2 * R2) - lens_area(d, R1, R2)
+    if inside.mean() < 0.97 or abs(union - len(pixels)) > 0.3 * len(pixels):  # the blob is the union of the discs
+        return np.zeros((0, 2))
+    axis = (c2 - c1) / max(d, 1e-9)
+    along, across = (pixels - c1) @ axis, (pixels - c1) @ np.array([-axis[1], axis[0]])
+
+    def width(at: float) -> float:  # extent of the blob across the axis, in a one-pixel slab
+        slab = np.abs(along - at) <= 0.5
+        return float(np.ptp(across[slab]) + 1.0) if slab.any() else 0.0
+
+    if width(d / 2) > 0.85 * min(width(0.0), width(d)):  # two discs have a neck between them; a bar does not
         return np.zeros((0, 2))
     return np.stack([c1, c2])
 
