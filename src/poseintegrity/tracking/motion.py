@@ -2,8 +2,10 @@
 
 Random linear and angular accelerations are integrated into motion: the linear acceleration is an
 Ornstein-Uhlenbeck (OU) process pulled back to a home position by a spring and damped, so the tool stays in
-front of the camera; the body angular velocity is an OU process whose spread gives full turns about every
-axis.  Marker frames arrive every ``frame_interval_s`` (+- jitter, the paper measured 45.98 +- 7.67 ms), and
+front of the camera; the body angular velocity is an OU process (the accuracy recording, and motion (b), the
+stress test, with a large spread), or, for motion (a), the paper-like one of section III, a sequence of full
+turns about the body x, y, z axes at hand speeds plus an OU wobble (:func:`simulate_hand_motion`) with brief
+per-marker occlusions (:func:`brief_occlusions`).  Marker frames arrive every ``frame_interval_s`` (+- jitter, the paper measured 45.98 +- 7.67 ms), and
 between two frames the gyro delivers 2 samples with probability P_2, else 3 (P_3 = 1 - P_2).
 Each frame gets per-marker occlusions (probability P_o), phantom reflections (P_p per slot) and the
 deliberate extended occlusions of the params (all markers hidden).

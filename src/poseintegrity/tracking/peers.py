@@ -141,7 +141,12 @@ def filter_speed(markers_body: np.ndarray, fp: FilterParams, repeats: int, rng: 
     _, Q, R = additive_model(markers_body, fp, 1e-3)
     pk = pykalman_step(markers_body, fp.dt, Q, R)
     start = correlated_state(markers_body, fp, rng)  # every repeat from the same state: pykalman's update is unstable
-    times["pykalman"] = _mean_time_ms(lambda: pk(start.x, start.covariance(), z), max(repeats // 5, 1))
+
+    def pykalman_once():
+        with np.errstate(all="ignore"):  # its downdate fails on this model (see the module docstring); same work
+            pk(start.x, start.covariance(), z)
+
+    times["pykalman"] = _mean_time_ms(pykalman_once, max(repeats // 5, 1))
     times["speedup_vs_filterpy"] = times["filterpy"] / times["srukf"]
     times["speedup_vs_pykalman"] = times["pykalman"] / times["srukf"]
     return times
