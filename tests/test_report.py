@@ -16,4 +16,4 @@ def test_values_nulls_and_missing_stages_are_told_apart():
     assert "| viewing-angle datasets | 21 | 21 (7 scenes x 3 azimuths) | - |" in text
     assert "| disk (GB) | 1.473 | - | <= 3 |" in text
     assert "| long range, 2 mm/3 deg: max mean SPL at zero incursion (deg) | none | 12.9 | - |" in text
-    assert "| RMS position error, no filter (mm) | not run | 3.01 | - |" in text
+    assert "| RMS position error per axis, no filter (mm; paper's metric) | not run | 3.01 | - |" in text
