@@ -45,7 +45,8 @@ def test_simulation_is_bit_identical_for_a_seed_and_the_filter_beats_no_filter_o
 
 def test_success_rates_cover_both_motions_and_the_split_variant():
     table, sims, frames = success_rates(TINY)
-    assert len(table) == 6 and set(table.motion) == {"a", "b"}
+    assert len(table) == 9 and set(table.motion) == {"a", "b"}  # (a): 4 markers, 3 with each marker dropped; (b): 4, 3, split or not
+    assert set(table.dropped[table.motion == "a"]) == {0, 1, 2, 3, 4}
     assert (table.frames == TINY.evaluation.success_frames).all()
     assert ((table.rate >= 0) & (table.rate <= table.possible)).all()  # a hidden marker cannot be found
     again, _, _ = success_rates(TINY)

@@ -14,10 +14,12 @@ Two additions of ours, both switchable in :class:`~poseintegrity.tracking.params
   ratio is dominated by pixelisation and genuine markers fall below 0.6.  The pixel forms count each pixel
   as a unit square: area = polygon area + boundary length / 2 + 1 (Pick's theorem), circle radius
   = enclosing radius of the pixel centres + 0.5, hull area likewise.  For large blobs both forms agree.
-- ``split_touching``: a blob that fails the shape tests is tried as the union of two discs (two markers whose
-  images touch or overlap): its boundary points are split between two circles fitted by least squares; the
-  split is kept if both circles fit the boundary within ``split_max_residual_px`` and their union covers the
-  blob.  Elongated reflections are not two circles and stay rejected.
+- ``split_touching``: two markers whose images touch or overlap make one blob.  If the depth inside a blob
+  jumps by depth_split_mm or more, it is two markers one behind the other, cut at the jump
+  (:func:`split_by_depth`); otherwise a blob that fails the shape tests is tried as the union of two discs:
+  its boundary points are split between two circles fitted by least squares, kept if both fit within
+  ``split_max_residual_px``, their union covers the blob and it narrows between them
+  (:func:`split_two_discs`).  Elongated reflections are not two discs and stay rejected.
 """
 
 from __future__ import annotations
@@ -135,11 +137,7 @@ def split_two_discs(contour: np.ndarray, detection: DetectionParams) -> np.ndarr
     R1, R2 = r1 + 0.5, r2 + 0.5  # boundary pixel centres lie half a pixel inside the disc edge
     if d > R1 + R2 + 0.5:  # the images of two markers touch or overlap; separate blobs would not be one contour
         return np.zeros((0, 2))
-    x0, y0, w, h = cv2.boundingRect(contour)
-    mask = np.zeros((h, w), np.uint8)
-    cv2.drawContours(mask, [contour - [x0, y0]], -1, 1, thickness=cv2.FILLED)
-    v, u = np.nonzero(mask)
-    pixels = np.column_stack([u + x0, v + y0]).astype(float)
+    pixels = blob_pixels(contour).astype(float)
     inside = (np.linalg.norm(pixels - c1, axis=1) <= R1 + 0.5) | (np.linalg.norm(pixels - c2, axis=1) <= R2 + 0.5)
     union = np.pi * (R1 * R1 + R2 * R2) - lens_area(d, R1, R2)
     if inside.mean() < 0.97 or abs(union - len(pixels)) > 0.3 * len(pixels):  # the blob is the union of the discs
@@ -156,12 +154,67 @@ def split_two_discs(contour: np.ndarray, detection: DetectionParams) -> np.ndarr
     return np.stack([c1, c2])
 
 
-def detect_blobs(ir: np.ndarray, detection: DetectionParams) -> np.ndarray:
-    """Centroids (k, 2) float (u, v), pixels, of the bright round blobs of an IR image (II-B).
+def blob_pixels(contour: np.ndarray) -> np.ndarray:
+    """Pixel coordinates (k, 2) int (u, v) inside an external contour (k, 1, 2), its boundary included."""
+    x0, y0, w, h = cv2.boundingRect(contour)
+    mask = np.zeros((h, w), np.uint8)
+    cv2.drawContours(mask, [contour - [x0, y0]], -1, 1, thickness=cv2.FILLED)
+    v, u = np.nonzero(mask)
+    return np.column_stack([u + x0, v + y0])
+
+
+def split_by_depth(pixels: np.ndarray, depth_mm: np.ndarray, detection: DetectionParams) -> tuple[np.ndarray, np.ndarray]:
+    """Markers one partly in front of the other: (centres (m, 2) px, depths (m,) mm), m = 0, 1 or 2.
+
+    pixels : (k, 2) int (u, v) of one blob.  Two markers whose images overlap lie nearly on one ray, so their
+    depths differ by a good part of their distance (tens of mm) while one sphere's visible surface spans at most
+    its radius (5.5 mm) plus noise.  If the sorted valid depths of the blob have a gap of at least
+    depth_split_mm, the blob is cut there: the front set is a whole disc (its pixel centroid is its centre); the
+    back set is a crescent whose outline away from the front set is fitted by a circle (its centre is the hidden
+    marker's centre).  Depths are the medians of each set.  A set smaller than min_area, or a crescent whose
+    outline does not fit a circle within split_max_residual_px, is left out.  m = 0: no depth gap.
+    """
+    d_all = np.asarray(depth_mm[pixels[:, 1], pixels[:, 0]], dtype=float)
+    valid = np.isfinite(d_all) & (d_all >= detection.depth_min_mm) & (d_all <= detection.depth_max_mm)
+    if valid.sum() < 2:
+        return np.zeros((0, 2)), np.zeros(0)
+    ordered = np.sort(d_all[valid])
+    gaps = np.diff(ordered)
+    i = int(np.argmax(gaps))
+    if gaps[i] < detection.depth_split_mm:
+        return np.zeros((0, 2)), np.zeros(0)
+    cut = 0.5 * (ordered[i] + ordered[i + 1])
+    front, back = valid & (d_all <= cut), valid & (d_all > cut)
+    centres, depths = [], []
+    if front.sum() >= detection.min_area:
+        centres.append(pixels[front].mean(axis=0))
+        depths.append(float(np.median(d_all[front])))
+    if back.sum() >= detection.min_area:
+        x0, y0 = pixels.min(axis=0)
+        shape = tuple(pixels.max(axis=0) - [x0, y0] + 3)[::-1]
+        back_mask, front_mask = np.zeros(shape, np.uint8), np.zeros(shape, np.uint8)
+        back_mask[pixels[back, 1] - y0 + 1, pixels[back, 0] - x0 + 1] = 1
+        front_mask[pixels[front, 1] - y0 + 1, pixels[front, 0] - x0 + 1] = 1
+        outline = back_mask & ~cv2.erode(back_mask, np.ones((3, 3), np.uint8)) & 1
+        away = cv2.distanceTransform((1 - front_mask).astype(np.uint8), cv2.DIST_L2, 3) > 1.5
+        v, u = np.nonzero(outline.astype(bool) & away)
+        if len(u) >= 5:
+            centre, _, residual = fit_circle(np.column_stack([u + x0 - 1, v + y0 - 1]).astype(float))
+            if residual <= detection.split_max_residual_px:
+                centres.append(centre)
+                depths.append(float(np.median(d_all[back])))
+    return np.array(centres, dtype=float).reshape(-1, 2), np.array(depths)
+
+
+def detect_blobs(ir: np.ndarray, detection: DetectionParams, depth_mm: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Centres (k, 2) float (u, v), pixels, of the bright round blobs of an IR image (II-B), and their depth
+    (k,) mm where a depth split measured it (NaN elsewhere: :func:`lookup_depth` reads it at the centre).
 
     uint8 input is compared with ``threshold`` directly; other types are raw reflectivity, clipped at
     ir_clip and scaled to 8 bit, which is the comparison ``ir > threshold * ir_clip / 255``.
-    A blob that fails the shape tests may be split into two touching markers (``split_touching``).
+    With ``split_touching`` a blob is first tried as two markers one in front of the other (a depth gap inside
+    it, :func:`split_by_depth`, when depth_mm (H, W) is given), and a blob that fails the shape tests as two
+    touching discs (:func:`split_two_discs`).
     """
     d = detection
     raw_threshold = d.threshold if ir.dtype == np.uint8 else d.threshold * d.ir_clip / 255.0
@@ -169,20 +222,29 @@ def detect_blobs(ir: np.ndarray, detection: DetectionParams) -> np.ndarray:
         ir = ir.astype(np.float64)
     mask = cv2.compare(ir, float(raw_threshold), cv2.CMP_GT)  # 255 where brighter
     contours, _ = cv2.findContours(mask, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
-    centroids = []
+    centres, depths = [], []
     for contour in contours:
         area, circularity, convexity = blob_shape(contour, d.shape_measure)
         if not (d.min_area <= area <= 2.0 * d.max_area):
             continue
+        if d.split_touching and depth_mm is not None:
+            uv, dd = split_by_depth(blob_pixels(contour), depth_mm, d)
+            if len(uv):
+                centres.extend(map(tuple, uv))
+                depths.extend(dd)
+                continue
         if area <= d.max_area and circularity >= d.min_circularity and convexity >= d.min_convexity:
             m = cv2.moments(contour)
             if m["m00"] > 0:
-                centroids.append((m["m10"] / m["m00"], m["m01"] / m["m00"]))
+                centres.append((m["m10"] / m["m00"], m["m01"] / m["m00"]))
             else:  # a blob one pixel wide: its polygon has no area
-                centroids.append(tuple(contour.reshape(-1, 2).mean(axis=0)))
+                centres.append(tuple(contour.reshape(-1, 2).mean(axis=0)))
+            depths.append(np.nan)
         elif d.split_touching:
-            centroids.extend(map(tuple, split_two_discs(contour, d)))
-    return np.array(centroids, dtype=float).reshape(-1, 2)
+            uv = split_two_discs(contour, d)
+            centres.extend(map(tuple, uv))
+            depths.extend([np.nan] * len(uv))
+    return np.array(centres, dtype=float).reshape(-1, 2), np.array(depths, dtype=float)
 
 
 def lookup_depth(depth_mm: np.ndarray, uv: np.ndarray, detection: DetectionParams) -> np.ndarray:
@@ -239,8 +301,8 @@ def detect_markers(
         warnings.warn(f"detect_markers: {reason}", RuntimeWarning, stacklevel=2)
         return np.zeros((0, 3))
     ir, depth_mm, unproject = np.asarray(ir), np.asarray(depth_mm), np.asarray(unproject, dtype=float)
-    uv = detect_blobs(ir, detection)
-    d_mm = lookup_depth(depth_mm, uv, detection)
+    uv, d_split = detect_blobs(ir, detection, depth_mm)
+    d_mm = np.where(np.isnan(d_split), lookup_depth(depth_mm, uv, detection), d_split)
     keep = np.isfinite(d_mm)
     xy = unit_plane_coordinates(uv[keep], unproject)
     rays = np.column_stack([xy, np.ones(len(xy))])

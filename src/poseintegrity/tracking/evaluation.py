@@ -169,29 +169,31 @@ def success_frames_duration(params: TrackParams) -> float:
 
 def success_rates(params: TrackParams) -> tuple[pd.DataFrame, dict[str, Simulation], dict[str, pd.DataFrame]]:
     """Share of evaluation.success_frames frames with a correct pose (section III) on motion (a), paper-like, and
-    motion (b), the stress test, with 4 and with 3 markers; on (b) also without splitting touching blobs (the
-    same frames: same generator).  Returns (table motion/markers/split/rate/possible, the motion (a) recordings,
-    per-frame tables).  ``possible``: share of frames with >= 3 markers in view (not hidden by an occlusion)."""
+    motion (b), the stress test, with 4 and with 3 markers (params.drop_marker removed; the paper does not say
+    which one it removed, so on (a) every other choice is run too, ``markers3_drop<k>``); on (b) also without
+    splitting touching blobs (the same frames: same generator).  Returns (table motion/markers/dropped/split/
+    rate/possible, the motion (a) recordings by label, per-frame tables).  ``possible``: share of frames with
+    >= 3 markers not hidden by an occlusion (a marker hidden behind another still counts as possible)."""
     geometry = np.array(params.markers_body)
-    bodies = {"markers4": geometry, "markers3": np.delete(geometry, params.drop_marker, axis=0)}
     duration, n = success_frames_duration(params), params.evaluation.success_frames
     no_split = params.detection.model_copy(update={"split_touching": False})
+    stress = params.evaluation.success_omega_std
+    three = {"markers3" if i == params.drop_marker else f"markers3_drop{i + 1}": i for i in range(len(geometry))}
+    runs = [("a", "markers4", -1, True)] + [("a", label, i, True) for label, i in three.items()]
+    runs += [("b", label, i, split) for label, i in [("markers4", -1), ("markers3", params.drop_marker)] for split in (True, False)]
     rows, sims, tables = [], {}, {}
-    for markers, body in bodies.items():
-        runs = {
-            ("a", True): lambda: simulate_hand(params, experiment_rng(params, f"hand_{markers}"), body, duration),
-            ("b", True): lambda: simulate(params, experiment_rng(params, f"stress_{markers}"), body, params.evaluation.success_omega_std, duration),
-            ("b", False): lambda: simulate(params, experiment_rng(params, f"stress_{markers}"), body, params.evaluation.success_omega_std, duration, no_split),
-        }
-        for (motion, split), run in runs.items():
-            sim = run()
-            df = run_no_filter(sim, params).iloc[:n]
-            name = f"{motion}_{markers}" + ("" if split else "_no_split")
-            tables[f"success_{name}"] = df
-            if motion == "a" and split:
-                sims[markers] = sim
-            rows.append({"motion": motion, "markers": markers, "split_touching": split, "rate": float(df.correct.mean()),
-                         "possible": float((df.n_visible >= 3).mean()), "frames": len(df)})
+    for motion, label, dropped, split in runs:
+        body = geometry if dropped < 0 else np.delete(geometry, dropped, axis=0)
+        if motion == "a":
+            sim = simulate_hand(params, experiment_rng(params, f"hand_{label}"), body, duration)
+            sims[label] = sim
+        else:
+            sim = simulate(params, experiment_rng(params, f"stress_{label}"), body, stress, duration, None if split else no_split)
+        df = run_no_filter(sim, params).iloc[:n]
+        name = f"{motion}_{label}" + ("" if split else "_no_split")
+        tables[f"success_{name}"] = df
+        rows.append({"run": name, "motion": motion, "markers": label, "dropped": dropped + 1, "split_touching": split,
+                     "rate": float(df.correct.mean()), "possible": float((df.n_visible >= 3).mean()), "frames": len(df)})
     return pd.DataFrame(rows), sims, tables
 
 
@@ -376,7 +378,7 @@ def run_study(params: TrackParams, recording_folder: Path) -> Study:
     replay, replay_metrics = recording_replay(params, recording_folder)
     geometry = np.array(params.markers_body)
     speed = filter_speed(geometry, params.filter, params.evaluation.timing_repeats, experiment_rng(params, "speed"))
-    rate = {f"{r.motion}_{r.markers}" + ("" if r.split_touching else "_no_split"): r.rate for r in success.itertuples()}
+    rate = dict(zip(success.run, success.rate))
     metrics = {
         **accuracy,
         "rms_mm": {run: v["norm_mm"] for run, v in accuracy["rms"].items()},
@@ -386,7 +388,7 @@ def run_study(params: TrackParams, recording_folder: Path) -> Study:
         "euler_convention": "Unity: R = R_y R_x R_z (scipy intrinsic 'YXZ'); mean over the three angles of the RMS wrapped difference",
         "success_rate": {"markers4": rate["a_markers4"], "markers3": rate["a_markers3"]},
         "success_rates": rate,
-        "success_possible": {f"{r.motion}_{r.markers}": r.possible for r in success.itertuples() if r.split_touching},
+        "success_possible": dict(zip(success.run, success.possible)),
         "sigmas_motion_a": sigma_metrics,
         "small_blobs": sweep_summary(blobs),
         "multi_tool_success": tools.groupby(["scene", "tool"]).correct.mean().unstack().to_dict(orient="index"),

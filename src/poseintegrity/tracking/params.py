@@ -64,6 +64,7 @@ class DetectionParams(_Section):
     shape_measure: Literal["pixel", "contour"] = "pixel"  # "contour": the published polygon form
     split_touching: bool = True  # split a blob made of two touching marker images
     split_max_residual_px: float = Field(0.6, gt=0)  # RMS boundary residual of each of the two circles
+    depth_split_mm: float = Field(12.0, gt=0)  # a depth jump inside a blob this large: two markers, one behind
 
     @model_validator(mode="after")
     def _ranges(self):
@@ -143,7 +144,7 @@ class HandMotionParams(_Section):
     pause_s: tuple[float, float] = (0.3, 1.5)  # between turns, s (uniform)
     wobble_std: float = Field(0.3, ge=0)  # rad/s, OU angular velocity added throughout (hand tremor, re-grip)
     accel_std: float = Field(1.5, ge=0)  # m/s^2, the OU linear acceleration of the large motions
-    occlusion_rate_hz: float = Field(0.05, ge=0)  # per marker
+    occlusion_rate_hz: float = Field(0.045, ge=0)  # per marker
     occlusion_s: tuple[float, float] = (0.1, 0.3)  # duration of a brief occlusion, s (uniform)
 
 
@@ -173,7 +174,7 @@ class TrackParams(_Section):
 
     seed: int = 6
     markers_body: list[tuple[float, float, float]] = [tuple(m) for m in MARKERS_BODY.tolist()]
-    drop_marker: int = Field(3, ge=0)  # the marker removed for the 3-marker variant
+    drop_marker: int = Field(1, ge=0)  # the marker removed for the 3-marker variant (params.yaml says why)
     camera: CameraParams = CameraParams()
     frames: FrameParams = FrameParams()
     detection: DetectionParams = DetectionParams()
