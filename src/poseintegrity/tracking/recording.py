@@ -12,6 +12,16 @@ Folder layout:
 - optional ``gyro.csv``: columns ``t_s, wx, wy, wz`` (rad/s, body frame of the tool carrying the gyro).
 Points are expressed in the camera frame (T_world_cam = identity).
 
+Usage, e.g. on a HoloLens 2 recording with the probe of the paper::
+
+    from poseintegrity.config import load_section
+    from poseintegrity.tracking import MARKERS_BODY, read_recording, read_tools, track_recording
+
+    params = load_section("params.yaml", "track")
+    tools = {"probe": MARKERS_BODY}  # or read_tools("tools.json", params.matching.distinct_m)
+    poses = track_recording(read_recording("my_recording"), tools, params, gyro_tool="probe")
+    poses.to_csv("poses.csv", index=False)
+
 Bad input: a missing file, a non-finite or decreasing timestamp, or an all-zero lookup table raises
 :class:`RecordingError` naming it; a frame of the wrong shape, dtype or units (depth in metres) gives a row
 flagged ``bad_frame`` and a RuntimeWarning naming the file and the reason; no NaN point is ever produced.
