@@ -173,9 +173,9 @@ def split_by_depth(pixels: np.ndarray, depth_mm: np.ndarray, detection: Detectio
     depths differ by a good part of their distance (tens of mm) while one sphere's visible surface spans at most
     its radius (5.5 mm) plus noise.  If the sorted valid depths of the blob have a gap of at least
     depth_split_mm, the blob is cut there: the front set is a whole disc (its pixel centroid is its centre); the
-    back set is a crescent whose outline away from the front set is fitted by a circle (its centre is the hidden
-    marker's centre).  Depths are the medians of each set.  A set smaller than min_area, or a crescent whose
-    outline does not fit a circle within split_max_residual_px, is left out.  m = 0: no depth gap.
+    back set is the visible crescent of the hidden marker, whose disc has the front disc's radius scaled by the
+    depth ratio and reaches to the crescent's farthest pixel, which places its centre even when only a sliver
+    shows.  Depths are the medians of each set.  A set smaller than min_area is left out.  m = 0: no depth gap.
     """
     d_all = np.asarray(depth_mm[pixels[:, 1], pixels[:, 0]], dtype=float)
     valid = np.isfinite(d_all) & (d_all >= detection.depth_min_mm) & (d_all <= detection.depth_max_mm)
@@ -190,22 +190,22 @@ def split_by_depth(pixels: np.ndarray, depth_mm: np.ndarray, detection: Detectio
     front, back = valid & (d_all <= cut), valid & (d_all > cut)
     centres, depths = [], []
     if front.sum() >= detection.min_area:
-        centres.append(pixels[front].mean(axis=0))
-        depths.append(float(np.median(d_all[front])))
-    if back.sum() >= detection.min_area:
-        x0, y0 = pixels.min(axis=0)
-        shape = tuple(pixels.max(axis=0) - [x0, y0] + 3)[::-1]
-        back_mask, front_mask = np.zeros(shape, np.uint8), np.zeros(shape, np.uint8)
-        back_mask[pixels[back, 1] - y0 + 1, pixels[back, 0] - x0 + 1] = 1
-        front_mask[pixels[front, 1] - y0 + 1, pixels[front, 0] - x0 + 1] = 1
-        outline = back_mask & ~cv2.erode(back_mask, np.ones((3, 3), np.uint8)) & 1
-        away = cv2.distanceTransform((1 - front_mask).astype(np.uint8), cv2.DIST_L2, 3) > 1.5
-        v, u = np.nonzero(outline.astype(bool) & away)
-        if len(u) >= 5:
-            centre, _, residual = fit_circle(np.column_stack([u + x0 - 1, v + y0 - 1]).astype(float))
-            if residual <= detection.split_max_residual_px:
-                centres.append(centre)
-                depths.append(float(np.median(d_all[back])))
+        c_front = pixels[front].mean(axis=0)
+        d_front, d_back = float(np.median(d_all[front])), float(np.median(d_all[back]))
+        centres.append(c_front)
+        depths.append(d_front)
+        if back.sum() >= detection.min_area:
+            # the hidden marker's disc: radius from the front disc's (pixel count = pi r^2) scaled by the depth
+            # ratio of the sphere centres; it reaches exactly to the farthest visible pixel of the crescent
+            r_back = np.sqrt(front.sum() / np.pi) * (d_front + detection.depth_offset_mm) / (d_back + detection.depth_offset_mm)
+            offset = pixels[back].mean(axis=0) - c_front
+            u = offset / max(np.linalg.norm(offset), 1e-9)
+            reach = float(((pixels[back] - c_front) @ u).max()) + 0.5  # edge of the farthest pixel
+            centres.append(c_front + u * max(reach - r_back, 0.0))
+            depths.append(d_back)
+    elif back.sum() >= detection.min_area:
+        centres.append(pixels[back].mean(axis=0))
+        depths.append(float(np.median(d_all[back])))
     return np.array(centres, dtype=float).reshape(-1, 2), np.array(depths)
 
 
