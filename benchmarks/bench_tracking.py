@@ -1,11 +1,12 @@
 """Speed of the marker-tracking library, as ratios against references measured in the same run.
 
 1. One SR-UKF predict + update (4 markers + gyro) against filterpy's UnscentedKalmanFilter on the same
-   model (eq. 10 per sigma point with the SVD Kabsch of Alg. 4).  Target: >= 10x.
+   model (eq. 10 per sigma point with the SVD Kabsch of Alg. 4), target >= 10x, and against pykalman's
+   square-root UKF (pykalman.sqrt.AdditiveUnscentedKalmanFilter.filter_update) on the additive-noise model.
 2. Detection + correspondence + Kabsch on one 512 x 512 frame (4 markers, one round phantom), in frames
    per second on one core, beside a bare OpenCV threshold + findContours on the same frame.  Target: >= 300.
 
-Run: cd /work/main && PYTHONPATH=src .venv/bin/python benchmarks/bench_tracking.py
+Run: .venv/bin/python benchmarks/bench_tracking.py (from the repository root)
 """
 
 import os
@@ -14,14 +15,16 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")  # one core, and no thread st
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 
 import time  # noqa: E402
+from pathlib import Path  # noqa: E402
 
 import cv2  # noqa: E402
 import numpy as np  # noqa: E402
 
-from poseintegrity.tracking.evaluation import detect_match_kabsch, filter_speed  # noqa: E402
+from poseintegrity.config import load_section  # noqa: E402
+from poseintegrity.tracking.evaluation import detect_match_kabsch  # noqa: E402
 from poseintegrity.tracking.frames import draw_phantoms, intrinsics, render_frame  # noqa: E402
 from poseintegrity.tracking.geometry import MARKER_DIAMETER_M, MARKERS_BODY  # noqa: E402
-from poseintegrity.tracking.params import FilterParams, TrackParams  # noqa: E402
+from poseintegrity.tracking.peers import filter_speed  # noqa: E402
 
 
 def per_call_ms(fn, repeats):
@@ -35,19 +38,21 @@ def per_call_ms(fn, repeats):
 def main():
     cv2.setNumThreads(1)
     rng = np.random.default_rng(0)
-    speed = filter_speed(MARKERS_BODY, FilterParams(), 400, rng)
-    print("filter predict + update (4 markers + gyro, paper constants)")
-    for name in ("srukf", "ukf", "filterpy"):
+    params = load_section(Path(__file__).resolve().parents[1] / "params.yaml", "track")
+    speed = filter_speed(MARKERS_BODY, params.filter, 400, rng)
+    print("filter predict + update (4 markers + gyro, params.yaml constants)")
+    for name in ("srukf", "ukf", "filterpy", "pykalman"):
         print(f"  {name:9s} {speed[name]:8.3f} ms")
     print(f"  SR-UKF speed-up over filterpy: {speed['speedup_vs_filterpy']:.1f}x (target >= 10x)")
+    print(f"  SR-UKF speed-up over pykalman: {speed['speedup_vs_pykalman']:.1f}x")
 
-    params = TrackParams()
     K = intrinsics(params.camera)
     markers = MARKERS_BODY + [0.02, -0.01, 0.45]
     ir, depth = render_frame(markers, draw_phantoms(1, params.camera, params.frames, 1.0, rng), params.camera, params.frames, MARKER_DIAMETER_M / 2, rng)
     assert np.isfinite(detect_match_kabsch(ir, depth, K, params, MARKERS_BODY)).all()
     chain = per_call_ms(lambda: detect_match_kabsch(ir, depth, K, params, MARKERS_BODY), 500)
-    bare = per_call_ms(lambda: cv2.findContours(cv2.compare(ir, 871.0, cv2.CMP_GT), cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE), 500)
+    raw_threshold = params.detection.threshold * params.detection.ir_clip / 255.0
+    bare = per_call_ms(lambda: cv2.findContours(cv2.compare(ir, raw_threshold, cv2.CMP_GT), cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE), 500)
     print("detection + correspondence + Kabsch, one 512 x 512 frame")
     print(f"  full chain        {chain:8.3f} ms = {1000 / chain:7.0f} frames/s (target >= 300)")
     print(f"  threshold+contours{bare:8.3f} ms = {1000 / bare:7.0f} frames/s (reference); chain / reference = {chain / bare:.1f}")

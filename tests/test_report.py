@@ -53,7 +53,7 @@ def test_values_nulls_and_missing_stages_are_told_apart():
     # each tolerance beside the paper's value for that tolerance (Table I), not the mean of both
     assert "| long range (EMG, eq. 1), 2 mm/3 deg: max mean SPL at zero incursion (deg) | none | 12.3 | - |" in text
     assert "| long range (EMG, eq. 1), 4 mm/10 deg: max mean SPL at zero incursion (deg) | 14.25 | 13.5 | - |" in text
-    assert "| RMS position error, no filter (mm) | not run | 3.01 | - |" in text
+    assert "| RMS position error per axis, no filter (mm; paper's metric) | not run | 3.01 | - |" in text
 
 
 def test_the_summary_points_nowhere_outside_the_repository():

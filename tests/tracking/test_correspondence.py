@@ -11,8 +11,11 @@ from poseintegrity.tracking.correspondence import (
     match_voting,
 )
 from poseintegrity.tracking.geometry import MARKERS_BODY
+from poseintegrity.tracking.params import MatchingParams
 
 G = MARKERS_BODY
+MATCHING = MatchingParams()
+TOL = MATCHING.tolerance_m
 
 
 def _scene(seed, n_missing, n_phantoms, noise=0.0005):
@@ -35,14 +38,14 @@ def test_match_markers_finds_the_true_correspondence(seed, n_missing, n_phantoms
     # 0.2 mm noise: with one marker missing, the swapped triangle 3-2-1 fits the true 1-2-3 to ~1 mm RMS
     # (sides 35.8 / 38.5 mm), so at 0.5 mm noise a swap is a legitimate best fit (seed 1018941 found one)
     points, truth, _ = _scene(seed, n_missing, n_phantoms, noise=0.0002)
-    np.testing.assert_array_equal(match_markers(points, G), truth)
+    np.testing.assert_array_equal(match_markers(points, G, None, MATCHING), truth)
 
 
 @settings(deadline=None, max_examples=50)
 @given(seed=st.integers(0, 2**32 - 1), n_missing=st.integers(0, 1), n_phantoms=st.integers(0, 3))
 def test_voting_assigns_only_true_pairs(seed, n_missing, n_phantoms):
     points, truth, _ = _scene(seed, n_missing, n_phantoms)
-    assignment, outlier = match_voting(points, G)
+    assignment, outlier = match_voting(points, G, tolerance_m=TOL)
     found = assignment >= 0
     np.testing.assert_array_equal(assignment[found], truth[found])
     assert not outlier[truth[truth >= 0]].any()  # a true marker is never rejected
@@ -51,14 +54,14 @@ def test_voting_assigns_only_true_pairs(seed, n_missing, n_phantoms):
         # (with noise it may leave a marker to brute force: two pair distances differ by only 2.75 mm, and 0.5 mm
         # noise per coordinate swapped them for seed 1282322)
         clean, clean_truth, _ = _scene(seed, 0, 0, noise=0.0)
-        np.testing.assert_array_equal(match_voting(clean, G)[0], clean_truth)
+        np.testing.assert_array_equal(match_voting(clean, G, tolerance_m=TOL)[0], clean_truth)
 
 
 @settings(deadline=None, max_examples=40)
 @given(seed=st.integers(0, 2**32 - 1), n_missing=st.integers(0, 1), n_phantoms=st.integers(0, 2))
 def test_brute_force_alone_recovers_the_correspondence(seed, n_missing, n_phantoms):
     points, truth, _ = _scene(seed, n_missing, n_phantoms, noise=0.0002)  # see the noise note above
-    np.testing.assert_array_equal(match_brute_force(points, G), truth)
+    np.testing.assert_array_equal(match_brute_force(points, G, tolerance_m=TOL, min_markers=3), truth)
 
 
 @settings(deadline=None, max_examples=50)
@@ -71,7 +74,7 @@ def test_frobenius_and_gated_follow_a_small_motion(seed, n_missing, n_phantoms):
     phantoms = markers.mean(0) + rng.choice([-1, 1], (n_phantoms, 3)) * rng.uniform(0.12, 0.3, (n_phantoms, 3))
     with_phantoms = np.vstack([points, phantoms])
     np.testing.assert_array_equal(match_gated(with_phantoms, previous, gate_m=0.02), truth)
-    np.testing.assert_array_equal(match_markers(with_phantoms, G, previous), truth)
+    np.testing.assert_array_equal(match_markers(with_phantoms, G, previous, MATCHING), truth)
 
 
 @settings(deadline=None, max_examples=30)
@@ -82,12 +85,12 @@ def test_every_matcher_survives_arbitrary_points(points, seed):
         points[np.random.default_rng(seed).random(len(points)) < 0.2] = np.nan
     previous = G + [0.0, 0.0, 0.5]
     for assignment in [
-        match_markers(points, G),
-        match_markers(points, G, previous),
-        match_voting(points, G)[0],
-        match_brute_force(points, G),
+        match_markers(points, G, None, MATCHING),
+        match_markers(points, G, previous, MATCHING),
+        match_voting(points, G, tolerance_m=TOL)[0],
+        match_brute_force(points, G, tolerance_m=TOL, min_markers=3),
         match_frobenius(points, previous),
-        match_gated(points, previous),
+        match_gated(points, previous, gate_m=MATCHING.gate_m),
     ]:
         assert assignment.shape == (4,) and assignment.dtype.kind == "i"
         used = assignment[assignment >= 0]
@@ -96,9 +99,9 @@ def test_every_matcher_survives_arbitrary_points(points, seed):
 
 
 def test_too_few_points_only_phantoms_and_duplicates():
-    assert (match_markers(np.zeros((0, 3)), G) == -1).all()
-    assert (match_markers(G[:2] + 0.5, G) == -1).all()  # two points: no unique match without a prediction
-    assert (match_markers(np.random.default_rng(0).uniform(-1, 1, (5, 3)), G) == -1).all()  # only phantoms
+    assert (match_markers(np.zeros((0, 3)), G, None, MATCHING) == -1).all()
+    assert (match_markers(G[:2] + 0.5, G, None, MATCHING) == -1).all()  # two points: no unique match without a prediction
+    assert (match_markers(np.random.default_rng(0).uniform(-1, 1, (5, 3)), G, None, MATCHING) == -1).all()  # only phantoms
     duplicated = np.vstack([G, G[:1]]) + [0, 0, 0.5]
-    assignment = match_markers(duplicated, G)
+    assignment = match_markers(duplicated, G, None, MATCHING)
     assert assignment[0] in (0, 4) and list(assignment[1:]) == [1, 2, 3]

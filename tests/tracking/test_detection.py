@@ -27,25 +27,25 @@ def _nearest(points, markers):
 def test_detects_every_marker_within_a_few_millimetres():
     markers, ir, depth = _frame()
     assert ir.dtype == np.uint16 and depth.dtype == np.uint16 and ir.shape == (512, 512)
-    points = detect_markers(ir, depth, K, **DETECTION.model_dump())
+    points = detect_markers(ir, depth, K, DETECTION)
     assert len(points) == 4
     assert _nearest(points, markers).max() < 0.012  # frame-level depth bias (3 mm std) included
 
 
 def test_lut_and_pinhole_give_the_same_points_and_extrinsics_apply():
     markers, ir, depth = _frame(1)
-    by_k = detect_markers(ir, depth, K, **DETECTION.model_dump())
-    by_lut = detect_markers(ir, depth, unit_plane_lut(K, 512, 512), **DETECTION.model_dump())
+    by_k = detect_markers(ir, depth, K, DETECTION)
+    by_lut = detect_markers(ir, depth, unit_plane_lut(K, 512, 512), DETECTION)
     np.testing.assert_allclose(by_lut, by_k, atol=1e-9)
     T = np.eye(4)
     T[:3, 3] = [1.0, 2.0, 3.0]
-    np.testing.assert_allclose(detect_markers(ir, depth, K, T_world_cam=T, **DETECTION.model_dump()), by_k + [1.0, 2.0, 3.0])
+    np.testing.assert_allclose(detect_markers(ir, depth, K, DETECTION, T_world_cam=T), by_k + [1.0, 2.0, 3.0])
 
 
 def test_uint8_input_is_thresholded_directly():
     markers, ir, depth = _frame(2)
     ir8 = (np.clip(ir, 0, 1000) * 255.0 / 1000.0).astype(np.uint8)
-    points = detect_markers(ir8, depth, K, **DETECTION.model_dump())
+    points = detect_markers(ir8, depth, K, DETECTION)
     assert len(points) == 4 and _nearest(points, markers).max() < 0.012
 
 
@@ -53,7 +53,7 @@ def test_round_phantoms_pass_and_elongated_ones_are_rejected():
     round_ph = Phantom(u=60, v=60, radius_px=3.0, elongation=1.0, angle=0.0, depth_mm=500.0)
     long_ph = Phantom(u=450, v=450, radius_px=2.0, elongation=6.0, angle=0.7, depth_mm=500.0)
     _, ir, depth = _frame(3, [round_ph, long_ph])
-    points = detect_markers(ir, depth, K, **DETECTION.model_dump())
+    points = detect_markers(ir, depth, K, DETECTION)
     assert len(points) == 5  # the 4 markers and the round phantom
 
 
@@ -61,15 +61,83 @@ def test_invalid_depth_drops_the_blob_and_bad_frames_do_not_crash():
     markers, ir, depth = _frame(4)
     zeroed = depth.copy()
     zeroed[:, :] = 0
-    assert detect_markers(ir, zeroed, K).shape == (0, 3)
+    assert detect_markers(ir, zeroed, K, DETECTION).shape == (0, 3)
     nan_depth = depth.astype(float)
     nan_depth[:] = np.nan
-    assert detect_markers(ir, nan_depth, K).shape == (0, 3)
+    assert detect_markers(ir, nan_depth, K, DETECTION).shape == (0, 3)
     with pytest.warns(RuntimeWarning, match="lookup table"):
-        assert detect_markers(ir, depth, np.zeros((10, 10, 2))).shape == (0, 3)
+        assert detect_markers(ir, depth, np.zeros((10, 10, 2)), DETECTION).shape == (0, 3)
     with pytest.warns(RuntimeWarning, match="differs"):
-        assert detect_markers(ir, depth[:10], K).shape == (0, 3)
+        assert detect_markers(ir, depth[:10], K, DETECTION).shape == (0, 3)
     assert validate_frame(ir, depth, K) == ""
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        assert detect_markers(np.zeros((512, 512), np.uint16), depth, K).shape == (0, 3)
+        assert detect_markers(np.zeros((512, 512), np.uint16), depth, K, DETECTION).shape == (0, 3)
+
+
+def test_bad_units_lut_and_dtype_are_named_not_turned_into_points():
+    markers, ir, depth = _frame(5)
+    cases = {
+        "metres": (ir, depth / 1000.0, K),
+        "all zero": (ir, depth, np.zeros((512, 512, 2))),
+        "numeric": (ir.astype(bool), depth, K),
+    }
+    for words, (a, b, c) in cases.items():
+        with pytest.warns(RuntimeWarning, match=words):
+            assert detect_markers(a, b, c, DETECTION).shape == (0, 3)
+
+
+def _small_marker_frame(distance_m, seed):
+    """One marker at distance_m seen with a focal length of 250 px: a blob of about 8-20 px."""
+    camera = CAMERA.model_copy(update={"focal_px": 250.0})
+    rng = np.random.default_rng(seed)
+    centre = np.array([[rng.uniform(-0.1, 0.1), rng.uniform(-0.1, 0.1), distance_m]])
+    ir, depth = render_frame(centre, [], camera, FRAMES, MARKER_DIAMETER_M / 2, rng)
+    return centre, ir, depth, intrinsics(camera)
+
+
+def test_pixel_shape_measure_keeps_small_blobs_the_contour_form_drops():
+    kept = {"contour": 0, "pixel": 0}
+    for seed in range(40):
+        centre, ir, depth, K250 = _small_marker_frame(0.85, seed)
+        for measure in kept:
+            points = detect_markers(ir, depth, K250, DETECTION.model_copy(update={"shape_measure": measure}))
+            kept[measure] += int(len(points) == 1 and np.linalg.norm(points[0] - centre[0]) < 0.015)
+    assert kept["pixel"] == 40  # every blob of 8-10 px area
+    assert kept["contour"] < 35  # the published polygon form loses a share of them to pixelisation
+
+
+def test_touching_markers_are_split_into_two_points_near_their_centres():
+    rng = np.random.default_rng(7)
+    # two markers 9 mm apart side by side at 0.45 m: blobs of radius ~2.9 px whose centres are 4.8 px apart
+    markers = np.array([[0.0, 0.0, 0.45], [0.009, 0.0, 0.452]])
+    ir, depth = render_frame(markers, [], CAMERA, FRAMES, MARKER_DIAMETER_M / 2, rng)
+    merged = detect_markers(ir, depth, K, DETECTION.model_copy(update={"split_touching": False}))
+    split = detect_markers(ir, depth, K, DETECTION)
+    assert len(merged) == 0  # one non-round blob: dropped by the published tests
+    assert len(split) == 2
+    assert _nearest(split, markers).max() < 0.006
+
+
+def test_elongated_reflections_are_not_split_into_markers():
+    rng = np.random.default_rng(8)
+    found = 0
+    for _ in range(30):
+        phantom = Phantom(u=rng.uniform(60, 450), v=rng.uniform(60, 450), radius_px=rng.uniform(1.5, 4.0),
+                          elongation=rng.uniform(3.0, 8.0), angle=rng.uniform(0, np.pi), depth_mm=500.0)
+        ir, depth = render_frame(np.zeros((0, 3)), [phantom], CAMERA, FRAMES, MARKER_DIAMETER_M / 2, rng)
+        found += len(detect_markers(ir, depth, K, DETECTION))
+    assert found <= 1
+
+
+def test_a_marker_partly_behind_another_is_found_at_the_depth_jump():
+    rng = np.random.default_rng(9)
+    # the second marker 40 mm further along nearly the same ray: its image is half hidden by the first, or all
+    # but a sliver (centres 1.6 px apart)
+    for lateral in ([0.006, 0.002], [0.0035, 0.0]):
+        markers = np.array([[0.0, 0.0, 0.45], [*lateral, 0.49]])
+        ir, depth = render_frame(markers, [], CAMERA, FRAMES, MARKER_DIAMETER_M / 2, rng)
+        merged = detect_markers(ir, depth, K, DETECTION.model_copy(update={"split_touching": False}))
+        split = detect_markers(ir, depth, K, DETECTION)
+        assert len(merged) == 1 and _nearest(merged, markers).max() > 0.02  # one blob read as one marker: one is lost
+        assert len(split) == 2 and _nearest(split, markers).max() < 0.008

@@ -1,10 +1,11 @@
 import numpy as np
 import pytest
+from pykalman.sqrt.unscented import Moments, moments2points, unscented_filter_correct
 from scipy.spatial.transform import Rotation
 
-from poseintegrity.tracking.evaluation import filterpy_filter
 from poseintegrity.tracking.geometry import MARKERS_BODY
 from poseintegrity.tracking.params import FilterParams
+from poseintegrity.tracking.peers import additive_model, correlated_state, filterpy_filter, pykalman_time_update
 from poseintegrity.tracking.srukf import SquareRootUKF
 from poseintegrity.tracking.ukf import UnscentedKalmanFilter
 from poseintegrity.tracking.unscented import unscented_weights
@@ -92,10 +93,35 @@ def test_filter_tracks_and_counts_failed_downdates_without_crashing():
 
 
 def test_divergence_is_detected_and_the_filter_stops():
-    f = SquareRootUKF(MARKERS_BODY)
+    f = SquareRootUKF(MARKERS_BODY, FilterParams())
     f.initialize(MARKERS_BODY + [0, 0, 0.5])
     assert not f.update(np.full(12, np.nan), np.ones(4, bool), gyro=False)
     assert not f.initialized and f.n_divergences == 1 and f.last_reason == "non-finite state or covariance"
     f.initialize(MARKERS_BODY + [0, 0, 0.5])
     f.S = f.S * 1e4  # runaway covariance
     assert not f.predict(0.0025) and f.last_reason == "runaway covariance"
+
+
+def test_time_update_agrees_with_pykalman_square_root_ukf():
+    # pykalman's SR-UKF on the additive model, given the lower factor of Q: same mean and covariance; the
+    # residual covariance difference is its |Wc[0]| centre term, 2 |Wc[0]| d d^T, and nothing else
+    diff = pykalman_time_update(MARKERS_BODY, FilterParams(), np.random.default_rng(3))
+    assert diff["mean"] < 1e-8
+    assert diff["covariance"] < 1e-8
+    assert diff["covariance_after_centre_term"] < 1e-13
+
+
+def test_our_update_is_the_kalman_update_and_pykalmans_is_not():
+    # h is linear (rows of the state), so the exact update is x + K (z - x[rows]) with K = P H^T (H P H^T + R)^-1;
+    # pykalman solves its gain with the transposed triangular factor (poseintegrity.tracking.peers), so it is not
+    settings, _, R = additive_model(MARKERS_BODY, FilterParams(), 1e-3)
+    prior = correlated_state(MARKERS_BODY, settings, np.random.default_rng(4))
+    x0, P = prior.x.copy(), prior.covariance()
+    z = x0[:15] + 0.002
+    expected = x0 + P[:, :15] @ np.linalg.solve(P[:15, :15] + R, z - x0[:15])
+    with np.errstate(all="ignore"):
+        theirs = unscented_filter_correct(lambda x: x[:15], Moments(x0, prior.S.T), moments2points(Moments(x0, prior.S.T)), z,
+                                          sigma2_observation=np.sqrt(R))
+    prior.update(z, np.ones(4, bool), gyro=True)
+    np.testing.assert_allclose(prior.x, expected, rtol=0, atol=1e-10)
+    assert np.abs(theirs.mean - expected).max() > 1e-4

@@ -1,15 +1,22 @@
-"""Marker tracking after Black and Salcudean (2023): IR marker detection, point correspondence, Kabsch,
-square-root UKF with gyro fusion, and the simulation study of their sections II-F and III.
+"""Marker tracking after Black and Salcudean, "Robust Object Pose Tracking for Augmented Reality Guidance and
+Teleoperation", IEEE Transactions on Instrumentation and Measurement, 2024, DOI 10.1109/TIM.2024.3398108: IR marker
+detection, point correspondence, Kabsch, square-root UKF with gyro fusion, and the simulation study of their
+sections II-F and III.  Recorded frames (a HoloLens 2 recording) go through :func:`read_recording` and
+:func:`track_recording`; several tools through :class:`MultiToolTracker`.
 
 Module map (paper section -> module):
-    II-B  detection      :mod:`detection`       (threshold, contours, circularity, centroid, depth, unprojection)
+    II-B  detection      :mod:`detection`       (threshold, contours, shape tests, touching-blob split, depth, unprojection)
+          small blobs    :mod:`detection_sweep` (ours: keep rate of 8-20 px markers, phantom rejection)
     II-B  sensor frames  :mod:`frames`          (AHAT-like IR + depth synthesis, ours)
     II-D  Alg. 1, 2, 3   :mod:`correspondence`  (+ gated optimal assignment)
     Alg. 4               :mod:`kabsch`
     II-E  eqs. 3-30      :mod:`model`           (state, process model, P_proc, P_mes)
     Alg. 5               :mod:`srukf`, :mod:`cholesky`, :mod:`unscented`; reference :mod:`ukf`
-    II-F  simulation     :mod:`motion`
-    loop                 :mod:`tracker`
+    II-F  simulation     :mod:`motion` (motion (a) paper-like and (b) stress), :mod:`simulation`
+    II-F  errors         :mod:`errors`          (the paper's per-axis / Euler RMS beside norm / geodesic)
+    loop                 :mod:`tracker`         (+ innovation gate, ours), :mod:`tools` (several tools, ours)
+    input                :mod:`recording`       (a folder of recorded frames -> pose table)
+    peers                :mod:`peers`           (filterpy, pykalman)
     III   results        :mod:`evaluation`
 """
 
@@ -18,14 +25,21 @@ from poseintegrity.tracking.detection import detect_markers, validate_frame
 from poseintegrity.tracking.geometry import MARKERS_BODY
 from poseintegrity.tracking.kabsch import kabsch, pose_from_points
 from poseintegrity.tracking.params import TrackParams
+from poseintegrity.tracking.recording import Recording, RecordingError, RecordingWriter, read_recording, track_recording
 from poseintegrity.tracking.srukf import SquareRootUKF
+from poseintegrity.tracking.tools import MultiToolTracker, ToolError, read_tools, write_tools
 from poseintegrity.tracking.tracker import MarkerTracker
 from poseintegrity.tracking.ukf import UnscentedKalmanFilter
 
 __all__ = [
     "MARKERS_BODY",
     "MarkerTracker",
+    "MultiToolTracker",
+    "Recording",
+    "RecordingError",
+    "RecordingWriter",
     "SquareRootUKF",
+    "ToolError",
     "TrackParams",
     "UnscentedKalmanFilter",
     "detect_markers",
@@ -36,5 +50,9 @@ __all__ = [
     "match_markers",
     "match_voting",
     "pose_from_points",
+    "read_recording",
+    "read_tools",
+    "track_recording",
     "validate_frame",
+    "write_tools",
 ]

@@ -1,7 +1,7 @@
 """Triangular square roots for the SR-UKF: QR-based factor and rank-1 Cholesky update / downdate.
 
 Convention: ``S`` is lower triangular with ``P = S @ S.T`` (van der Merwe and Wan 2001 write the upper
-factor; the algebra is the same).  There is no rank-1 update in numpy/scipy (FACTS.md), so it is written
+factor; the algebra is the same).  There is no rank-1 update in numpy/scipy (docs/references.md), so it is written
 here after Stewart, *Matrix Algorithms I* (1998), sec. 4.3, the reference [61] of the paper.
 """
 

@@ -22,6 +22,7 @@ from scipy.optimize import linear_sum_assignment
 
 from poseintegrity.tracking.geometry import pairwise_distances
 from poseintegrity.tracking.kabsch import kabsch_residuals
+from poseintegrity.tracking.params import MatchingParams
 
 
 def _finite_rows(points: np.ndarray) -> np.ndarray:
@@ -75,7 +76,7 @@ def match_frobenius(points: np.ndarray, previous: np.ndarray, *, max_distance_m:
     return assignment
 
 
-def match_voting(points: np.ndarray, geometry: np.ndarray, *, tolerance_m: float = 0.008) -> tuple[np.ndarray, np.ndarray]:
+def match_voting(points: np.ndarray, geometry: np.ndarray, *, tolerance_m: float) -> tuple[np.ndarray, np.ndarray]:
     """Alg. 2: Euclidean-distance voting.  Returns (assignment (m,) int, outlier (n,) bool).
 
     For every geometry pair (i, j), the measured pair (k, l) whose distance is closest to |y^i - y^j| gets
@@ -125,8 +126,8 @@ def match_brute_force(
     *,
     fixed: np.ndarray | None = None,
     candidates: np.ndarray | None = None,
-    tolerance_m: float = 0.008,
-    min_markers: int = 3,
+    tolerance_m: float,
+    min_markers: int,
 ) -> np.ndarray:
     """Alg. 3 generalised: try every injective map of geometry markers to points, Kabsch each, keep the best.
 
@@ -172,7 +173,7 @@ def match_brute_force(
     return np.full(m, -1)
 
 
-def match_gated(points: np.ndarray, predicted: np.ndarray, *, gate_m: float = 0.03) -> np.ndarray:
+def match_gated(points: np.ndarray, predicted: np.ndarray, *, gate_m: float) -> np.ndarray:
     """Optimal assignment (scipy.optimize.linear_sum_assignment) to predicted marker positions.
 
     predicted : (m, 3) metres, e.g. the filter's prior markers.  Minimises the summed distance; pairs
@@ -195,15 +196,12 @@ def match_gated(points: np.ndarray, predicted: np.ndarray, *, gate_m: float = 0.
 def match_markers(
     points: np.ndarray,
     geometry: np.ndarray,
-    previous: np.ndarray | None = None,
-    *,
-    tolerance_m: float = 0.008,
-    gate_m: float = 0.03,
-    min_markers: int = 3,
+    previous: np.ndarray | None,
+    matching: MatchingParams,
 ) -> np.ndarray:
     """For each geometry marker (m, 3) the index of its measured point among points (n, 3), or -1.
 
-    previous : (m, 3) predicted marker positions (metres, world) or None.  With a prediction the gated
+    previous : (m, 3) predicted marker positions (metres, world) or None; matching : ``track.matching``.  With a prediction the gated
     optimal assignment is tried first and kept if it rigidly matches at least min_markers markers and no
     other permutation of the same points fits the geometry better (Alg. 3 on those points).
     Otherwise voting (Alg. 2) fixes the confident matches and brute force (Alg. 3) fills the rest from the
@@ -211,17 +209,18 @@ def match_markers(
     points and wins if it matches more.  If all of that finds nothing, a consistent
     gated match of one or two markers is returned (the filter can use a partial update); else all -1.
     """
+    tolerance_m, min_markers = matching.tolerance_m, matching.min_markers
     geometry = np.asarray(geometry, dtype=float)
     points = np.asarray(points, dtype=float).reshape(-1, 3)
     gated = np.full(geometry.shape[0], -1)
     if previous is not None:
-        gated = match_gated(points, previous, gate_m=gate_m)
+        gated = match_gated(points, previous, gate_m=matching.gate_m)
         if not is_consistent(points, geometry, gated, tolerance_m):
             gated[:] = -1
         used = np.zeros(len(points), dtype=bool)
         used[gated[gated >= 0]] = True
         if used.sum() >= min_markers:
-            # the marker body is nearly symmetric under some permutations (FACTS geometry: (4, 3, 2, 1) fits
+            # the marker body is nearly symmetric under some permutations (the published geometry: (4, 3, 2, 1) fits
             # within 3.7 mm), so keep the gated match only if it is also the best rigid fit of its points
             best = match_brute_force(points, geometry, candidates=used, tolerance_m=tolerance_m, min_markers=int(used.sum()))
             if np.array_equal(best, gated):

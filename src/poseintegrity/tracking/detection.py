@@ -1,10 +1,25 @@
-"""IR marker detection (section II-B): threshold, contours, circularity filter, centroid, depth, unprojection.
+"""IR marker detection (section II-B): threshold, contours, shape tests, centroid, depth, unprojection.
 
 Usable on real HoloLens 2 AHAT frames: ``unproject`` is either a 3x3 pinhole K or the per-pixel unit-plane
-lookup table (H, W, 2) of the Research Mode API; IR may be uint8 (already 8-bit) or uint16 (raw).
-Constants are those of their public code (FACTS.md): IR clipped at 1000 and scaled to 8 bit, threshold 222,
-contour area 2-1000 px, circularity >= 0.6 (area over the area of the minimum enclosing circle), convexity
->= 0.75, depth window 100-900 mm.
+lookup table (H, W, 2) of the Research Mode API; IR may be uint8 (already 8-bit) or uint16 (raw); depth is
+millimetres along each pixel's ray.  The constants of their public code (docs/references.md, "Marker
+tracking"): IR clipped at 1000 and scaled to 8 bit, threshold 222, contour area 2-1000 px, circularity >= 0.6
+(area over the area of the minimum enclosing circle), convexity >= 0.75, depth window 100-900 mm.
+
+Two additions of ours, both switchable in :class:`~poseintegrity.tracking.params.DetectionParams`:
+
+- ``shape_measure: pixel`` measures a blob by its pixels instead of by the polygon through its boundary
+  pixel centres.  A blob of 8-20 px (an 11 mm sphere at 0.6-0.9 m, focal ~250 px) has a contour polygon
+  whose area is about half its pixel count (a 3 x 3 square: polygon area 4, 9 pixels), so the published
+  ratio is dominated by pixelisation and genuine markers fall below 0.6.  The pixel forms count each pixel
+  as a unit square: area = polygon area + boundary length / 2 + 1 (Pick's theorem), circle radius
+  = enclosing radius of the pixel centres + 0.5, hull area likewise.  For large blobs both forms agree.
+- ``split_touching``: two markers whose images touch or overlap make one blob.  If the depth inside a blob
+  jumps by depth_split_mm or more, it is two markers one behind the other, cut at the jump
+  (:func:`split_by_depth`); otherwise a blob that fails the shape tests is tried as the union of two discs:
+  its boundary points are split between two circles fitted by least squares, kept if both fit within
+  ``split_max_residual_px``, their union covers the blob and it narrows between them
+  (:func:`split_two_discs`).  Elongated reflections are not two discs and stay rejected.
 """
 
 from __future__ import annotations
@@ -15,76 +30,241 @@ import cv2
 import numpy as np
 
 from poseintegrity.tracking.geometry import transform_points
+from poseintegrity.tracking.params import DetectionParams
+
+MIN_METRES_DEPTH_MM = 10.0  # a median depth below this is metres, not millimetres (AHAT depth is 100-1000 mm)
+
+
+class FrameError(ValueError):
+    """A recorded frame cannot be used as given (wrong shape, dtype, units or lookup table)."""
 
 
 def validate_frame(ir: np.ndarray, depth_mm: np.ndarray, unproject: np.ndarray) -> str:
     """Why a frame cannot be used, or "" if it can.
 
-    ir : (H, W) uint8/uint16/float; depth_mm : (H, W) numeric; unproject : (3, 3) K or (H, W, 2) LUT.
+    ir : (H, W) uint8/uint16/float; depth_mm : (H, W) numeric, millimetres; unproject : (3, 3) K or (H, W, 2) LUT.
+    Depth whose valid (positive, finite) median is below 10 is taken to be in metres; an all-zero or
+    non-finite lookup table cannot unproject anything (both read on every 8th row and column).
     """
     ir, depth_mm, unproject = np.asarray(ir), np.asarray(depth_mm), np.asarray(unproject)
     if ir.ndim != 2 or ir.size == 0:
         return f"IR image must be 2-D and non-empty, got shape {ir.shape}"
     if depth_mm.shape != ir.shape:
         return f"depth shape {depth_mm.shape} differs from IR shape {ir.shape}"
-    if not (np.issubdtype(ir.dtype, np.number) and np.issubdtype(depth_mm.dtype, np.number)):
-        return "IR and depth must be numeric"
+    if not (np.issubdtype(ir.dtype, np.number) and np.issubdtype(depth_mm.dtype, np.number)) or ir.dtype == np.bool_:
+        return f"IR and depth must be numeric arrays, got dtypes {ir.dtype} and {depth_mm.dtype}"
     if unproject.shape != (3, 3) and unproject.shape != ir.shape + (2,):
         return f"unproject must be a 3x3 K or an (H, W, 2) = {ir.shape + (2,)} lookup table, got {unproject.shape}"
+    grid = (slice(None, None, 8), slice(None, None, 8))  # the unit checks read every 8th row and column (fast)
+    lut = unproject[grid] if unproject.shape != (3, 3) else None
+    if lut is not None and (not np.all(np.isfinite(lut)) or not np.any(lut)):
+        return "unit-plane lookup table is all zero or not finite: it cannot unproject pixels"
+    sample = np.asarray(depth_mm[grid], dtype=float)
+    valid = sample[np.isfinite(sample) & (sample > 0)]
+    if valid.size and np.median(valid) < MIN_METRES_DEPTH_MM:
+        return f"depth looks like metres, not millimetres (median of valid depth {np.median(valid):.3g} < {MIN_METRES_DEPTH_MM:g})"
     return ""
 
 
-def detect_blobs(
-    ir: np.ndarray,
-    *,
-    threshold: int = 222,
-    ir_clip: float = 1000.0,
-    min_area: float = 2.0,
-    max_area: float = 1000.0,
-    min_circularity: float = 0.6,
-    min_convexity: float = 0.75,
-) -> np.ndarray:
-    """Centroids (k, 2) float (u, v), pixels, of the bright round blobs of an IR image (II-B).
+def blob_shape(contour: np.ndarray, measure: str) -> tuple[float, float, float]:
+    """(area px^2, circularity, convexity) of one external contour (k, 1, 2) int.
+
+    measure "contour": the polygon through the boundary pixel centres (their public code);
+    "pixel": each pixel a unit square (module docstring).  Circularity is area over the area of the
+    minimum enclosing circle, convexity area over the convex hull's area.
+    """
+    area = cv2.contourArea(contour)
+    _, radius = cv2.minEnclosingCircle(contour)
+    hull = cv2.convexHull(contour)
+    hull_area = cv2.contourArea(hull)
+    if measure == "pixel":
+        area += len(contour) / 2.0 + 1.0  # Pick: pixels = interior + boundary = A + B/2 + 1
+        radius += 0.5
+        hull_area += cv2.arcLength(hull, True) / 2.0 + 1.0
+    circularity = area / (np.pi * radius * radius) if radius > 0 else 0.0
+    convexity = area / hull_area if hull_area > 0 else 0.0
+    return area, circularity, convexity
+
+
+def blob_pixels(contour: np.ndarray) -> np.ndarray:
+    """Pixel coordinates (k, 2) int (u, v) inside an external contour (k, 1, 2), its boundary included."""
+    x0, y0, w, h = cv2.boundingRect(contour)
+    mask = np.zeros((h, w), np.uint8)
+    cv2.drawContours(mask, [contour - [x0, y0]], -1, 1, thickness=cv2.FILLED)
+    v, u = np.nonzero(mask)
+    return np.column_stack([u + x0, v + y0])
+
+
+def fit_circle(points: np.ndarray) -> tuple[np.ndarray, float, float]:
+    """Least-squares circle (Kasa) through points (k, 2): (centre (2,), radius, RMS radial residual), px."""
+    A = np.column_stack([2.0 * points, np.ones(len(points))])
+    b = (points**2).sum(axis=1)
+    (cx, cy, c), *_ = np.linalg.lstsq(A, b, rcond=None)
+    centre = np.array([cx, cy])
+    radius = float(np.sqrt(max(c + cx * cx + cy * cy, 0.0)))
+    residual = float(np.sqrt(np.mean((np.linalg.norm(points - centre, axis=1) - radius) ** 2)))
+    return centre, radius, residual
+
+
+def lens_area(d: float, R1: float, R2: float) -> float:
+    """Area of the overlap of two discs of radii R1, R2 whose centres are d apart (px^2)."""
+    if d >= R1 + R2:
+        return 0.0
+    if d <= abs(R1 - R2):
+        return float(np.pi * min(R1, R2) ** 2)
+    a1 = R1 * R1 * np.arccos((d * d + R1 * R1 - R2 * R2) / (2 * d * R1))
+    a2 = R2 * R2 * np.arccos((d * d + R2 * R2 - R1 * R1) / (2 * d * R2))
+    return float(a1 + a2 - 0.5 * np.sqrt(max((-d + R1 + R2) * (d + R1 - R2) * (d - R1 + R2) * (d + R1 + R2), 0.0)))
+
+
+def split_two_discs(contour: np.ndarray, detection: DetectionParams) -> np.ndarray:
+    """Centres (2, 2) px of two touching discs whose union is this blob, or (0, 2) if it is not such a union.
+
+    Boundary points start split along the blob's principal axis and are then reassigned to the circle whose
+    radius they fit better until the split settles (k-means with circles as centres).  Accepted when both
+    circles fit within split_max_residual_px, their radii agree within a factor 2, their centres are apart by
+    more than half the smaller radius, the discs touch, 97 % of the blob's pixels lie in one of them, the
+    area of their union is the blob's within 30 %, and the blob narrows between the centres (a neck at most
+    0.85 times as wide as the blob through either centre: an elongated reflection is a bar, not two discs).
+    """
+    points = contour.reshape(-1, 2).astype(float)
+    if len(points) < 8:
+        return np.zeros((0, 2))
+    mean = points.mean(axis=0)
+    _, _, Vt = np.linalg.svd(points - mean, full_matrices=False)
+    side = (points - mean) @ Vt[0] > 0
+    for _ in range(10):
+        if side.sum() < 4 or (~side).sum() < 4:
+            return np.zeros((0, 2))
+        fits = [fit_circle(points[s]) for s in (side, ~side)]
+        gaps = np.stack([np.abs(np.linalg.norm(points - c, axis=1) - r) for c, r, _ in fits], axis=1)
+        new_side = gaps[:, 0] < gaps[:, 1]
+        if np.array_equal(new_side, side):
+            break
+        side = new_side
+    (c1, r1, e1), (c2, r2, e2) = fits
+    d = float(np.linalg.norm(c1 - c2))
+    if max(e1, e2) > detection.split_max_residual_px or not (0.5 < r1 / max(r2, 1e-9) < 2.0) or d < 0.5 * min(r1, r2):
+        return np.zeros((0, 2))
+    R1, R2 = r1 + 0.5, r2 + 0.5  # boundary pixel centres lie half a pixel inside the disc edge
+    if d > R1 + R2 + 0.5:  # the images of two markers touch or overlap; separate blobs would not be one contour
+        return np.zeros((0, 2))
+    pixels = blob_pixels(contour).astype(float)
+    inside = (np.linalg.norm(pixels - c1, axis=1) <= R1 + 0.5) | (np.linalg.norm(pixels - c2, axis=1) <= R2 + 0.5)
+    union = np.pi * (R1 * R1 + R2 * R2) - lens_area(d, R1, R2)
+    if inside.mean() < 0.97 or abs(union - len(pixels)) > 0.3 * len(pixels):  # the blob is the union of the discs
+        return np.zeros((0, 2))
+    axis = (c2 - c1) / max(d, 1e-9)
+    along, across = (pixels - c1) @ axis, (pixels - c1) @ np.array([-axis[1], axis[0]])
+
+    def width(at: float) -> float:  # extent of the blob across the axis, in a one-pixel slab
+        slab = np.abs(along - at) <= 0.5
+        return float(np.ptp(across[slab]) + 1.0) if slab.any() else 0.0
+
+    if width(d / 2) > 0.85 * min(width(0.0), width(d)):  # two discs have a neck between them; a bar does not
+        return np.zeros((0, 2))
+    return np.stack([c1, c2])
+
+
+def split_by_depth(pixels: np.ndarray, depth_mm: np.ndarray, detection: DetectionParams) -> tuple[np.ndarray, np.ndarray]:
+    """Markers one partly in front of the other: (centres (m, 2) px, depths (m,) mm), m = 0, 1 or 2.
+
+    pixels : (k, 2) int (u, v) of one blob.  Two markers whose images overlap lie nearly on one ray, so their
+    depths differ by a good part of their distance (tens of mm) while one sphere's visible surface spans at most
+    its radius (5.5 mm) plus noise.  If the sorted valid depths of the blob have a gap of at least
+    depth_split_mm, the blob is cut there: the front set is a whole disc (its pixel centroid is its centre); the
+    back set is the visible crescent of the hidden marker, whose disc has the front disc's radius scaled by the
+    depth ratio and reaches to the crescent's farthest pixel, which places its centre even when only a sliver
+    shows.  Depths are the medians of each set.  A set smaller than min_area is left out.  m = 0: no depth gap.
+    """
+    d_all = np.asarray(depth_mm[pixels[:, 1], pixels[:, 0]], dtype=float)
+    valid = np.isfinite(d_all) & (d_all >= detection.depth_min_mm) & (d_all <= detection.depth_max_mm)
+    if valid.sum() < 2:
+        return np.zeros((0, 2)), np.zeros(0)
+    ordered = np.sort(d_all[valid])
+    gaps = np.diff(ordered)
+    i = int(np.argmax(gaps))
+    if gaps[i] < detection.depth_split_mm:
+        return np.zeros((0, 2)), np.zeros(0)
+    cut = 0.5 * (ordered[i] + ordered[i + 1])
+    front, back = valid & (d_all <= cut), valid & (d_all > cut)
+    centres, depths = [], []
+    if front.sum() >= detection.min_area:
+        c_front = pixels[front].mean(axis=0)
+        d_front, d_back = float(np.median(d_all[front])), float(np.median(d_all[back]))
+        centres.append(c_front)
+        depths.append(d_front)
+        if back.sum() >= detection.min_area:
+            # the hidden marker's disc: radius from the front disc's (pixel count = pi r^2) scaled by the depth
+            # ratio of the sphere centres; it reaches exactly to the farthest visible pixel of the crescent
+            r_back = np.sqrt(front.sum() / np.pi) * (d_front + detection.depth_offset_mm) / (d_back + detection.depth_offset_mm)
+            offset = pixels[back].mean(axis=0) - c_front
+            u = offset / max(np.linalg.norm(offset), 1e-9)
+            reach = float(((pixels[back] - c_front) @ u).max()) + 0.5  # edge of the farthest pixel
+            centres.append(c_front + u * max(reach - r_back, 0.0))
+            depths.append(d_back)
+    elif back.sum() >= detection.min_area:
+        centres.append(pixels[back].mean(axis=0))
+        depths.append(float(np.median(d_all[back])))
+    return np.array(centres, dtype=float).reshape(-1, 2), np.array(depths)
+
+
+def detect_blobs(ir: np.ndarray, detection: DetectionParams, depth_mm: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Centres (k, 2) float (u, v), pixels, of the bright round blobs of an IR image (II-B), and their depth
+    (k,) mm where a depth split measured it (NaN elsewhere: :func:`lookup_depth` reads it at the centre).
 
     uint8 input is compared with ``threshold`` directly; other types are raw reflectivity, clipped at
     ir_clip and scaled to 8 bit, which is the comparison ``ir > threshold * ir_clip / 255``.
+    With ``split_touching`` a blob is first tried as two markers one in front of the other (a depth gap inside
+    it, :func:`split_by_depth`, when depth_mm (H, W) is given), and a blob that fails the shape tests as two
+    touching discs (:func:`split_two_discs`).
     """
-    raw_threshold = threshold if ir.dtype == np.uint8 else threshold * ir_clip / 255.0
+    d = detection
+    raw_threshold = d.threshold if ir.dtype == np.uint8 else d.threshold * d.ir_clip / 255.0
     if ir.dtype not in (np.uint8, np.uint16, np.float32, np.float64):
         ir = ir.astype(np.float64)
     mask = cv2.compare(ir, float(raw_threshold), cv2.CMP_GT)  # 255 where brighter
     contours, _ = cv2.findContours(mask, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
-    centroids = []
+    centres, depths = [], []
     for contour in contours:
-        area = cv2.contourArea(contour)
-        if not (min_area <= area <= max_area):
+        area, circularity, convexity = blob_shape(contour, d.shape_measure)
+        if not (d.min_area <= area <= 2.0 * d.max_area):
             continue
-        _, radius = cv2.minEnclosingCircle(contour)
-        if area / (np.pi * radius * radius) < min_circularity:  # circularity (FACTS.md form of 4 pi a / c^2)
-            continue
-        hull_area = cv2.contourArea(cv2.convexHull(contour))
-        if hull_area <= 0 or area / hull_area < min_convexity:
-            continue
-        m = cv2.moments(contour)
-        centroids.append((m["m10"] / m["m00"], m["m01"] / m["m00"]))  # m00 = area > 0 here
-    return np.array(centroids, dtype=float).reshape(-1, 2)
+        if d.split_touching and depth_mm is not None:
+            uv, dd = split_by_depth(blob_pixels(contour), depth_mm, d)
+            if len(uv):
+                centres.extend(map(tuple, uv))
+                depths.extend(dd)
+                continue
+        if area <= d.max_area and circularity >= d.min_circularity and convexity >= d.min_convexity:
+            m = cv2.moments(contour)
+            if m["m00"] > 0:
+                centres.append((m["m10"] / m["m00"], m["m01"] / m["m00"]))
+            else:  # a blob one pixel wide: its polygon has no area
+                centres.append(tuple(contour.reshape(-1, 2).mean(axis=0)))
+            depths.append(np.nan)
+        elif d.split_touching:
+            uv = split_two_discs(contour, d)
+            centres.extend(map(tuple, uv))
+            depths.extend([np.nan] * len(uv))
+    return np.array(centres, dtype=float).reshape(-1, 2), np.array(depths, dtype=float)
 
 
-def lookup_depth(
-    depth_mm: np.ndarray, uv: np.ndarray, *, window: int = 1, depth_min_mm: float = 100.0, depth_max_mm: float = 900.0
-) -> np.ndarray:
-    """Depth (k,) mm at the centroids: median of the valid pixels in a (2w+1)^2 window, NaN if none.
+def lookup_depth(depth_mm: np.ndarray, uv: np.ndarray, detection: DetectionParams) -> np.ndarray:
+    """Depth (k,) mm at the centroids uv (k, 2): median of the valid pixels in a (2w+1)^2 window, NaN if none.
 
     Valid means finite and inside [depth_min_mm, depth_max_mm] (zero, NaN and far readings are rejected).
     """
+    w = detection.depth_window
     H, W = depth_mm.shape
     out = np.full(len(uv), np.nan)
     for k, (u, v) in enumerate(np.rint(uv).astype(int)):
-        patch = np.asarray(depth_mm[max(v - window, 0) : v + window + 1, max(u - window, 0) : u + window + 1], dtype=float)
-        valid = patch[np.isfinite(patch) & (patch >= depth_min_mm) & (patch <= depth_max_mm)]
+        if not (0 <= u < W and 0 <= v < H):
+            continue
+        patch = np.asarray(depth_mm[max(v - w, 0) : v + w + 1, max(u - w, 0) : u + w + 1], dtype=float)
+        valid = patch[np.isfinite(patch) & (patch >= detection.depth_min_mm) & (patch <= detection.depth_max_mm)]
         if valid.size:
-            valid = np.sort(valid)
-            out[k] = 0.5 * (valid[(valid.size - 1) // 2] + valid[valid.size // 2])  # median
+            out[k] = np.median(valid)
     return out
 
 
@@ -107,25 +287,15 @@ def detect_markers(
     ir: np.ndarray,
     depth_mm: np.ndarray,
     unproject: np.ndarray,
-    *,
+    detection: DetectionParams,
     T_world_cam: np.ndarray | None = None,
-    threshold: int = 222,
-    ir_clip: float = 1000.0,
-    min_area: float = 2.0,
-    max_area: float = 1000.0,
-    min_circularity: float = 0.6,
-    min_convexity: float = 0.75,
-    depth_min_mm: float = 100.0,
-    depth_max_mm: float = 900.0,
-    depth_window: int = 1,
-    depth_offset_mm: float = 0.0,
 ) -> np.ndarray:
     """Marker centres (n, 3), metres, in the world frame, from one IR + depth frame (section II-B).
 
     ir : (H, W) uint8 or uint16 reflectivity; depth_mm : (H, W) millimetres along each pixel's ray
     (0 or NaN = invalid); unproject : (3, 3) pinhole K or (H, W, 2) unit-plane LUT, lut[v, u] = (x, y);
-    T_world_cam : (4, 4) extrinsics, identity if None; depth_offset_mm : added along the ray (the sphere
-    radius, to go from the reflecting surface to the marker centre).
+    detection : the detector's constants (``track.detection``); T_world_cam : (4, 4) extrinsics, identity if
+    None.  depth_offset_mm is added along the ray (the sphere radius: from the reflecting surface to the centre).
     Blobs without a valid depth are dropped.  An unusable frame (see :func:`validate_frame`) gives an
     empty (0, 3) array and a ``RuntimeWarning`` naming the reason; it never raises.
     """
@@ -134,14 +304,11 @@ def detect_markers(
         warnings.warn(f"detect_markers: {reason}", RuntimeWarning, stacklevel=2)
         return np.zeros((0, 3))
     ir, depth_mm, unproject = np.asarray(ir), np.asarray(depth_mm), np.asarray(unproject, dtype=float)
-    uv = detect_blobs(
-        ir, threshold=threshold, ir_clip=ir_clip, min_area=min_area, max_area=max_area,
-        min_circularity=min_circularity, min_convexity=min_convexity,
-    )
-    d_mm = lookup_depth(depth_mm, uv, window=depth_window, depth_min_mm=depth_min_mm, depth_max_mm=depth_max_mm)
+    uv, d_split = detect_blobs(ir, detection, depth_mm)
+    d_mm = np.where(np.isnan(d_split), lookup_depth(depth_mm, uv, detection), d_split)
     keep = np.isfinite(d_mm)
     xy = unit_plane_coordinates(uv[keep], unproject)
     rays = np.column_stack([xy, np.ones(len(xy))])
     rays /= np.linalg.norm(rays, axis=1, keepdims=True)
-    points_cam = rays * ((d_mm[keep] + depth_offset_mm) / 1000.0)[:, None]  # depth is measured along the ray
+    points_cam = rays * ((d_mm[keep] + detection.depth_offset_mm) / 1000.0)[:, None]  # depth is along the ray
     return points_cam if T_world_cam is None else transform_points(T_world_cam, points_cam)

@@ -1,29 +1,40 @@
-"""Section III on our simulation: frames, runs, errors, success rate, lag, sigma sweep, timing.
+"""Section III on our simulation: one small function per experiment, each named after what it measures, and
+:func:`run_study` that runs them all.
 
-Every function takes its randomness from a ``numpy.random.Generator``; the per-frame tables are
-bit-identical for the same seed (timings are the only non-deterministic outputs and are kept apart).
+Each experiment draws from its own generator, ``numpy.random.default_rng([params.seed, crc32(name)])``, so the
+experiments do not depend on each other's order and the per-frame tables are bit-identical for one seed
+(timings are the only non-deterministic outputs and are kept apart).
 """
 
 from __future__ import annotations
 
 import time
+import zlib
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
 from poseintegrity.tracking.correspondence import match_brute_force, match_markers, match_voting
 from poseintegrity.tracking.detection import detect_markers
-from poseintegrity.tracking.frames import draw_phantoms, intrinsics, render_frame
-from poseintegrity.tracking.geometry import MARKER_DIAMETER_M, pose_matrix, rotation_angle_deg, transform_points
+from poseintegrity.tracking.detection_sweep import small_blob_sweep, sweep_summary
+from poseintegrity.tracking.errors import rms, rms_summary
+from poseintegrity.tracking.frames import draw_phantoms, intrinsics, render_frame, unit_plane_lut
+from poseintegrity.tracking.geometry import MARKER_DIAMETER_M, pose_matrix, transform_points
 from poseintegrity.tracking.kabsch import kabsch, pose_from_points
-from poseintegrity.tracking.motion import SensorTimeline, Trajectory, sample_sensors, simulate_trajectory
-from poseintegrity.tracking.params import FilterParams, TrackParams
-from poseintegrity.tracking.srukf import SquareRootUKF
+from poseintegrity.tracking.motion import sample_sensors, simulate_trajectory
+from poseintegrity.tracking.params import PAPER_SIGMAS, TrackParams
+from poseintegrity.tracking.peers import filter_speed, pykalman_time_update
+from poseintegrity.tracking.recording import RecordingWriter, read_recording, track_recording
+from poseintegrity.tracking.simulation import Simulation, T_world_cam, run_filter, run_no_filter, simulate, simulate_hand
+from poseintegrity.tracking.tools import MultiToolTracker
 from poseintegrity.tracking.tracker import MarkerTracker
+from poseintegrity.tracking.ukf import UnscentedKalmanFilter
 from poseintegrity.tracking.unscented import UnscentedMarkerFilter
 
-# Black and Salcudean (2023), section III and Table I: the numbers ours are reported beside.
+# Black and Salcudean (IEEE TIM 2024), section III and Table I: the numbers ours are reported beside.
+# rms_mm / rms_deg are their metric: mean over axes of the RMS element-wise difference (position, Euler angles).
 PAPER = {
     "rms_mm": {"no_filter": 3.01, "ukf": 1.77},
     "rms_deg": {"no_filter": 1.75, "ukf": 1.51},
@@ -33,128 +44,9 @@ PAPER = {
 }
 
 
-@dataclass(frozen=True)
-class Simulation:
-    """One simulated recording: ground truth, sensor timeline, and the detected points of every frame.
-
-    t : (F,) s frame times; T_true : (F, 4, 4) T_world_body; points : list of (n_f, 3) detections, metres;
-    in_occlusion : (F,) bool, inside a deliberate extended occlusion.
-    """
-
-    trajectory: Trajectory
-    timeline: SensorTimeline
-    markers_body: np.ndarray
-    t: np.ndarray
-    T_true: np.ndarray
-    points: list[np.ndarray]
-    in_occlusion: np.ndarray
-
-
-def T_world_cam(params: TrackParams) -> np.ndarray:
-    """Camera extrinsics (4, 4): the camera looks along world +z from params.camera.origin_m."""
-    return pose_matrix(np.eye(3), np.array(params.camera.origin_m))
-
-
-def simulate(params: TrackParams, rng: np.random.Generator, markers_body: np.ndarray | None = None,
-             omega_std: float | None = None, duration_s: float | None = None) -> Simulation:
-    """Simulate motion (II-F), render every marker frame (AHAT-like) and run the detector on it.
-
-    markers_body : (m, 3) geometry (default params.markers_body); omega_std, duration_s override motion.
-    The points of a frame come from detection on the rendered images, so their error is the detector's.
-    """
-    markers_body = np.array(params.markers_body) if markers_body is None else markers_body
-    motion = params.motion if duration_s is None else params.motion.model_copy(update={"duration_s": duration_s})
-    trajectory = simulate_trajectory(motion, rng, omega_std=omega_std)
-    timeline = sample_sensors(trajectory, len(markers_body), motion, rng)
-    idx = timeline.frame_index
-    T_true = pose_matrix(trajectory.rotation(idx), trajectory.position[idx])
-    T_wc = T_world_cam(params)
-    T_cw = np.linalg.inv(T_wc)
-    K = intrinsics(params.camera)
-    detection = params.detection.model_dump()
-    points = []
-    for f in range(len(idx)):
-        markers_cam = transform_points(T_cw, transform_points(T_true[f], markers_body))[~timeline.occluded[f]]
-        phantoms = draw_phantoms(int(timeline.n_phantoms[f]), params.camera, params.frames, motion.phantom_round_fraction, rng)
-        ir, depth_mm = render_frame(markers_cam, phantoms, params.camera, params.frames, MARKER_DIAMETER_M / 2, rng)
-        points.append(detect_markers(ir, depth_mm, K, T_world_cam=T_wc, **detection))
-    t = trajectory.t[idx]
-    in_occlusion = np.zeros(len(idx), dtype=bool)
-    for start, duration in motion.occlusions:
-        in_occlusion |= (t >= start) & (t < start + duration)
-    return Simulation(trajectory, timeline, markers_body, t, T_true, points, in_occlusion)
-
-
-def pose_errors(T_est: np.ndarray, T_true: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Position error (k,) mm and rotation error (k,) deg (geodesic) of poses (k, 4, 4); NaN where T_est is NaN."""
-    pos = np.linalg.norm(T_est[:, :3, 3] - T_true[:, :3, 3], axis=1) * 1000.0
-    rot = rotation_angle_deg(np.nan_to_num(T_est[:, :3, :3]), T_true[:, :3, :3])
-    return pos, np.where(np.isnan(pos), np.nan, rot)
-
-
-def run_no_filter(sim: Simulation, params: TrackParams) -> pd.DataFrame:
-    """Kabsch per frame on the matched detections (no filter, no prediction): one row per frame.
-
-    correct: at least min_markers markers matched and every matched point within correct_tolerance_m of
-    its true marker (correspondence right and pose usable).
-    """
-    m, rows = params.matching, []
-    for f, points in enumerate(sim.points):
-        assignment = match_markers(points, sim.markers_body, None, tolerance_m=m.tolerance_m, gate_m=m.gate_m, min_markers=m.min_markers)
-        matched = assignment >= 0
-        true_markers = transform_points(sim.T_true[f], sim.markers_body)
-        T = pose_from_points(points[assignment[matched]], sim.markers_body[matched]) if matched.sum() >= 3 else np.full((4, 4), np.nan)
-        err = np.linalg.norm(points[assignment[matched]] - true_markers[matched], axis=1) if matched.any() else np.zeros(0)
-        correct = matched.sum() >= m.min_markers and bool(np.all(err <= params.evaluation.correct_tolerance_m))
-        rows.append({"frame": f, "t": sim.t[f], "n_detected": len(points), "n_matched": int(matched.sum()), "correct": correct, "T": T})
-    df = pd.DataFrame(rows)
-    poses = np.stack(df.pop("T").to_list())
-    df["pos_err_mm"], df["rot_err_deg"] = pose_errors(poses, sim.T_true)
-    df[["x_mm", "y_mm", "z_mm"]] = poses[:, :3, 3] * 1000.0
-    df["in_occlusion"] = sim.in_occlusion
-    return df
-
-
-def run_filter(
-    sim: Simulation,
-    params: TrackParams,
-    use_gyro: bool,
-    filter_params: FilterParams | None = None,
-    filter_cls: type[UnscentedMarkerFilter] = SquareRootUKF,
-) -> tuple[pd.DataFrame, MarkerTracker]:
-    """Run the tracker over the recording: one row per event (marker frame or gyro sample), in time order.
-
-    Columns: t, kind ("frame"/"gyro"), frame (index or -1), flag, n_matched, pos_err_mm, rot_err_deg,
-    x_mm / y_mm / z_mm (filtered position of the body origin), in_occlusion.
-    """
-    tracker = MarkerTracker(sim.markers_body, filter_params or params.filter, params.matching, use_gyro, filter_cls)
-    tl, traj = sim.timeline, sim.trajectory
-    events = sorted([(i, 1, g) for g, i in enumerate(tl.gyro_index)] + [(i, 0, f) for f, i in enumerate(tl.frame_index)])
-    occlusion_t = [(s, s + d) for s, d in params.motion.occlusions]
-    rows, poses, truth = [], [], []
-    for grid_index, is_gyro, k in events:
-        t = traj.t[grid_index]
-        if is_gyro:
-            flag, n_matched, T = tracker.gyro(t, tl.gyro[k]), -1, tracker.pose()
-        else:
-            result = tracker.frame(t, sim.points[k])
-            flag, n_matched, T = result.flag, int((result.assignment >= 0).sum()), result.T_filtered
-        rows.append({"t": t, "kind": "gyro" if is_gyro else "frame", "frame": -1 if is_gyro else k, "flag": flag, "n_matched": n_matched,
-                     "in_occlusion": any(a <= t < b for a, b in occlusion_t)})
-        poses.append(T)
-        truth.append(pose_matrix(traj.rotation(np.array([grid_index]))[0], traj.position[grid_index]))
-    df = pd.DataFrame(rows)
-    poses = np.stack(poses)
-    df["pos_err_mm"], df["rot_err_deg"] = pose_errors(poses, np.stack(truth))
-    df[["x_mm", "y_mm", "z_mm"]] = poses[:, :3, 3] * 1000.0
-    return df, tracker
-
-
-def rms(values: np.ndarray) -> float:
-    """Root mean square over the finite values (NaN if none)."""
-    values = np.asarray(values, dtype=float)
-    values = values[np.isfinite(values)]
-    return float(np.sqrt(np.mean(values**2))) if values.size else float("nan")
+def experiment_rng(params: TrackParams, name: str) -> np.random.Generator:
+    """The generator of one experiment: default_rng([params.seed, crc32(name)])."""
+    return np.random.default_rng([params.seed, zlib.crc32(name.encode())])
 
 
 def normalized_lag_ms(t_ref: np.ndarray, ref: np.ndarray, t_sig: np.ndarray, sig: np.ndarray, lag_max_ms: float) -> float:
@@ -191,35 +83,19 @@ def filter_lag_ms(no_filter: pd.DataFrame, filtered: pd.DataFrame, lag_max_ms: f
     return float(np.mean(lags))
 
 
-def success_rate(params: TrackParams, rng: np.random.Generator, markers_body: np.ndarray) -> tuple[float, pd.DataFrame]:
-    """Share of ``evaluation.success_frames`` frames of large motion with a correct pose (section III).
-
-    Large motion: angular velocity spread evaluation.success_omega_std (full turns about every axis);
-    random occlusions (P_o) and phantoms (P_p) as in the params, no deliberate extended occlusion.
-    Returns (share, per-frame table of :func:`run_no_filter`).
-    """
-    duration = params.evaluation.success_frames * params.motion.frame_interval_s * 1.2 + 1.0
-    no_deliberate = params.model_copy(update={"motion": params.motion.model_copy(update={"occlusions": []})})
-    sim = simulate(no_deliberate, rng, markers_body=markers_body, omega_std=params.evaluation.success_omega_std, duration_s=duration)
-    df = run_no_filter(sim, params).iloc[: params.evaluation.success_frames]
-    return float(df.correct.mean()), df
-
-
 def accuracy_frames(no_filter: pd.DataFrame) -> np.ndarray:
     """Frames on which accuracy is compared: correct unfiltered pose, outside deliberate occlusions."""
     return no_filter.frame[no_filter.correct & ~no_filter.in_occlusion].to_numpy()
 
 
 def summarize_accuracy(no_filter: pd.DataFrame, runs: dict[str, pd.DataFrame]) -> dict[str, dict[str, float]]:
-    """RMS position (mm) and rotation (deg) error of the no-filter poses and of every filter run,
+    """Per run (no_filter and every filter run) the RMS errors of :func:`~poseintegrity.tracking.errors.rms_summary`
     on the frames of :func:`accuracy_frames` (the filter rows of those marker frames)."""
     frames = accuracy_frames(no_filter)
-    rms_mm = {"no_filter": rms(no_filter.pos_err_mm[frames])}
-    rms_deg = {"no_filter": rms(no_filter.rot_err_deg[frames])}
+    out = {"no_filter": rms_summary(no_filter[no_filter.frame.isin(frames)])}
     for name, df in runs.items():
-        rows = df[(df.kind == "frame") & df.frame.isin(frames)]
-        rms_mm[name], rms_deg[name] = rms(rows.pos_err_mm), rms(rows.rot_err_deg)
-    return {"rms_mm": rms_mm, "rms_deg": rms_deg}
+        out[name] = rms_summary(df[(df.kind == "frame") & df.frame.isin(frames)])
+    return out
 
 
 def occlusion_summary(runs: dict[str, pd.DataFrame]) -> pd.DataFrame:
@@ -230,21 +106,6 @@ def occlusion_summary(runs: dict[str, pd.DataFrame]) -> pd.DataFrame:
         inside = df[df.in_occlusion]
         share = float(np.isfinite(inside.rot_err_deg).mean()) if len(inside) else float("nan")
         rows.append({"run": name, "rms_deg": rms(inside.rot_err_deg), "share_tracked": share})
-    return pd.DataFrame(rows)
-
-
-def sigma_sweep(sim: Simulation, params: TrackParams, no_filter: pd.DataFrame) -> pd.DataFrame:
-    """Noise-vs-lag trade-off (Figs. 6, 9): sigma_c and sigma_alpha scaled by evaluation.sigma_scales.
-
-    One row per scale: RMS position (mm) and rotation (deg) error and lag (ms) of the UKF without gyro.
-    """
-    rows, frames = [], accuracy_frames(no_filter)
-    for scale in params.evaluation.sigma_scales:
-        fp = params.filter.model_copy(update={"sigma_c": params.filter.sigma_c * scale, "sigma_alpha": params.filter.sigma_alpha * scale})
-        df, _ = run_filter(sim, params, use_gyro=False, filter_params=fp)
-        at_frames = df[(df.kind == "frame") & df.frame.isin(frames)]
-        rows.append({"scale": scale, "rms_mm": rms(at_frames.pos_err_mm), "rms_deg": rms(at_frames.rot_err_deg),
-                     "lag_ms": filter_lag_ms(no_filter, df, params.evaluation.lag_max_ms)})
     return pd.DataFrame(rows)
 
 
@@ -259,84 +120,218 @@ def filter_agreement(sim: Simulation, params: TrackParams, alpha: float, other_c
     return float(np.abs(xa[both] - xb[both]).max() / np.abs(xb[both]).max())
 
 
+# -- experiments ---------------------------------------------------------------------------------------------
+
+
+def accuracy_and_occlusion(params: TrackParams) -> tuple[Simulation, dict[str, pd.DataFrame], dict]:
+    """The accuracy recording (params.motion, with its deliberate occlusion): no filter, UKF, UKF + gyro; RMS
+    errors both ways, lag, orientation through the occlusion, restarts, failed downdates, SR-UKF vs plain UKF."""
+    sim = simulate(params, experiment_rng(params, "accuracy"))
+    no_filter = run_no_filter(sim, params)
+    (ukf, t_ukf), (gyro, t_gyro) = run_filter(sim, params, use_gyro=False), run_filter(sim, params, use_gyro=True)
+    runs, trackers = {"ukf": ukf, "ukf_gyro": gyro}, {"ukf": t_ukf, "ukf_gyro": t_gyro}
+    occlusion = occlusion_summary(runs)
+    metrics = {
+        "rms": summarize_accuracy(no_filter, runs),
+        "lag_ms": {name: filter_lag_ms(no_filter, df, params.evaluation.lag_max_ms) for name, df in runs.items()},
+        "occlusion_rms_deg": dict(zip(occlusion.run, occlusion.rms_deg)),
+        "occlusion_share_tracked": dict(zip(occlusion.run, occlusion.share_tracked)),
+        "failed_downdates": int(sum(t.filter.failed_downdates for t in trackers.values())),
+        "filter_steps": {name: int((df.flag == "ok").sum()) for name, df in runs.items()},
+        "divergences": {name: t.filter.n_divergences for name, t in trackers.items()},
+        "restarts": {name: t.n_restarts for name, t in trackers.items()},
+        "gated_markers": {name: t.n_gated for name, t in trackers.items()},
+        "srukf_vs_ukf_max_rel_diff": {f"alpha_{a:g}": filter_agreement(sim, params, a, UnscentedKalmanFilter) for a in (1.0, params.filter.alpha)},
+        "n_frames": int(len(sim.t)),
+    }
+    return sim, {"no_filter": no_filter, **runs, "occlusion": occlusion}, metrics
+
+
+def noise_against_lag(sim: Simulation, params: TrackParams, no_filter: pd.DataFrame) -> pd.DataFrame:
+    """Noise-vs-lag trade-off (Figs. 6, 9): sigma_c and sigma_alpha scaled by evaluation.sigma_scales.
+
+    One row per scale: RMS position (mm) and rotation (deg) error and lag (ms) of the UKF without gyro.
+    """
+    rows, frames = [], accuracy_frames(no_filter)
+    for scale in params.evaluation.sigma_scales:
+        fp = params.filter.model_copy(update={"sigma_c": params.filter.sigma_c * scale, "sigma_alpha": params.filter.sigma_alpha * scale})
+        df, _ = run_filter(sim, params, use_gyro=False, filter_params=fp)
+        at_frames = df[(df.kind == "frame") & df.frame.isin(frames)]
+        rows.append({"scale": scale, "rms_mm": rms(at_frames.pos_err_mm), "rms_deg": rms(at_frames.rot_err_deg),
+                     "lag_ms": filter_lag_ms(no_filter, df, params.evaluation.lag_max_ms)})
+    return pd.DataFrame(rows)
+
+
+def success_frames_duration(params: TrackParams) -> float:
+    """Seconds of recording that give at least evaluation.success_frames marker frames."""
+    return params.evaluation.success_frames * params.motion.frame_interval_s * 1.2 + 1.0
+
+
+def success_rates(params: TrackParams) -> tuple[pd.DataFrame, dict[str, Simulation], dict[str, pd.DataFrame]]:
+    """Share of evaluation.success_frames frames with a correct pose (section III) on motion (a), paper-like, and
+    motion (b), the stress test, with 4 and with 3 markers (params.drop_marker removed; the paper does not say
+    which one it removed, so on (a) every other choice is run too, ``markers3_drop<k>``); on (b) also without
+    splitting touching blobs (the same frames: same generator).  Returns (table motion/markers/dropped/split/
+    rate/possible, the motion (a) recordings by label, per-frame tables).  ``possible``: share of frames with
+    >= 3 markers not hidden by an occlusion (a marker hidden behind another still counts as possible)."""
+    geometry = np.array(params.markers_body)
+    duration, n = success_frames_duration(params), params.evaluation.success_frames
+    no_split = params.detection.model_copy(update={"split_touching": False})
+    stress = params.evaluation.success_omega_std
+    three = {"markers3" if i == params.drop_marker else f"markers3_drop{i + 1}": i for i in range(len(geometry))}
+    runs = [("a", "markers4", -1, True)] + [("a", label, i, True) for label, i in three.items()]
+    runs += [("b", label, i, split) for label, i in [("markers4", -1), ("markers3", params.drop_marker)] for split in (True, False)]
+    rows, sims, tables = [], {}, {}
+    for motion, label, dropped, split in runs:
+        body = geometry if dropped < 0 else np.delete(geometry, dropped, axis=0)
+        if motion == "a":
+            sim = simulate_hand(params, experiment_rng(params, f"hand_{label}"), body, duration)
+            sims[label] = sim
+        else:
+            sim = simulate(params, experiment_rng(params, f"stress_{label}"), body, stress, duration, None if split else no_split)
+        df = run_no_filter(sim, params).iloc[:n]
+        name = f"{motion}_{label}" + ("" if split else "_no_split")
+        tables[f"success_{name}"] = df
+        rows.append({"run": name, "motion": motion, "markers": label, "dropped": dropped + 1, "split_touching": split,
+                     "rate": float(df.correct.mean()), "possible": float((df.n_visible >= 3).mean()), "frames": len(df)})
+    return pd.DataFrame(rows), sims, tables
+
+
+def published_against_our_sigmas(sim: Simulation, params: TrackParams) -> tuple[pd.DataFrame, dict]:
+    """On motion (a) (4 markers): the UKF with the published sigmas and with ours, no gyro; the two halves
+    swapped (published measurement sigma_r with our process sigmas, and the reverse) to see which half makes
+    the difference; and the published process sigmas read as per-second intensities.  Eq. 30 adds
+    dt^2 sigma^2 to omega's variance at every filter step, so over one second the variance grows by
+    dt sigma^2: the published sigma_alpha = 0.71 rad/s^2 at the 400 Hz clock lets omega drift 0.035 rad/s in
+    a second.  Read as a per-second intensity (variance sigma^2 per second, clock-independent) it is
+    sigma / sqrt(dt / 1 s) per step.  RMS both ways on the correct no-filter frames, lag behind the no-filter
+    signal, and how often the filter was gated or restarted."""
+    no_filter = run_no_filter(sim, params)
+    frames = accuracy_frames(no_filter)
+    process = ("sigma_c", "sigma_alpha")
+    variants = {
+        "published": params.filter.model_copy(update=PAPER_SIGMAS),
+        "ours": params.filter,
+        "published_measurement_our_process": params.filter.model_copy(update={k: v for k, v in PAPER_SIGMAS.items() if k not in process}),
+        "our_measurement_published_process": params.filter.model_copy(update={k: v for k, v in PAPER_SIGMAS.items() if k in process}),
+        "published_per_second": params.filter.model_copy(
+            update={**PAPER_SIGMAS, **{k: PAPER_SIGMAS[k] / np.sqrt(params.filter.dt) for k in process}}
+        ),
+    }
+    rows, metrics = [], {}
+    for name, fp in variants.items():
+        df, tracker = run_filter(sim, params, use_gyro=False, filter_params=fp)
+        summary = rms_summary(df[(df.kind == "frame") & df.frame.isin(frames)])
+        lag = filter_lag_ms(no_filter, df, params.evaluation.lag_max_ms)
+        frames_df = df[df.kind == "frame"]
+        metrics[name] = {**summary, "lag_ms": lag, "restarts": tracker.n_restarts, "gated_markers": tracker.n_gated,
+                         "share_ok": float((frames_df.flag == "ok").mean()), **{k: getattr(fp, k) for k in PAPER_SIGMAS}}
+        rows.append({"sigmas": name, **metrics[name]})
+    metrics["no_filter"] = rms_summary(no_filter[no_filter.frame.isin(frames)])
+    return pd.DataFrame(rows), metrics
+
+
+def two_tools_success(params: TrackParams, phantom_max: int, name: str) -> pd.DataFrame:
+    """Two tools in view (params.markers_body and evaluation.second_tool), each on its own hand-like trajectory
+    (the second 0.12 m to the side), one filter per tool (:class:`MultiToolTracker`), no gyro; phantoms
+    binomial(phantom_max, p_phantom) per frame.  One row per frame and tool: correct (>= 3 markers matched and
+    every matched point within correct_tolerance_m of its own marker)."""
+    rng = experiment_rng(params, name)
+    tools = {"tool1": np.array(params.markers_body), "tool2": np.array(params.evaluation.second_tool)}
+    duration = params.evaluation.multi_tool_frames * params.motion.frame_interval_s * 1.2 + 1.0
+    motion = params.motion.model_copy(update={"duration_s": duration, "occlusions": [], "max_phantoms": phantom_max})
+    homes = {"tool1": np.array(motion.home_m) + [-0.06, 0.0, 0.0], "tool2": np.array(motion.home_m) + [0.06, 0.0, 0.0]}
+    trajectories = {k: simulate_trajectory(motion.model_copy(update={"home_m": tuple(homes[k])}), rng) for k in tools}
+    timeline = sample_sensors(trajectories["tool1"], 8, motion, rng)
+    idx = timeline.frame_index[: params.evaluation.multi_tool_frames]
+    K, T_wc = intrinsics(params.camera), T_world_cam(params)
+    tracker = MultiToolTracker(tools, params.filter, params.matching)
+    rows = []
+    for f, i in enumerate(idx):
+        T = {k: pose_matrix(tr.rotation(np.array([i]))[0], tr.position[i]) for k, tr in trajectories.items()}
+        true = {k: transform_points(T[k], tools[k]) for k in tools}
+        markers = np.vstack([true["tool1"], true["tool2"]])[~timeline.occluded[f]]
+        phantoms = draw_phantoms(int(timeline.n_phantoms[f]), params.camera, params.frames, motion.phantom_round_fraction, rng)
+        ir, depth = render_frame(transform_points(np.linalg.inv(T_wc), markers), phantoms, params.camera, params.frames, MARKER_DIAMETER_M / 2, rng)
+        points = detect_markers(ir, depth, K, params.detection, T_world_cam=T_wc)
+        for tool, result in tracker.frame(trajectories["tool1"].t[i], points).items():
+            matched = result.assignment >= 0
+            err = np.linalg.norm(points[result.assignment[matched]] - true[tool][matched], axis=1)
+            rows.append({"scene": name, "frame": f, "tool": tool, "flag": result.flag, "n_points": len(points), "n_matched": int(matched.sum()),
+                         "correct": bool(matched.sum() >= 3 and np.all(err <= params.evaluation.correct_tolerance_m))})
+    return pd.DataFrame(rows)
+
+
+def ten_metre_jump(sim: Simulation, params: TrackParams, jump_at_s: float = 2.0, jump_m: float = 10.0) -> dict:
+    """The innovation gate on a persistent jump of every measured point by jump_m (m) along x at jump_at_s:
+    the true markers of the accuracy recording (2 mm noise) are fed to the tracker, the jump persists.
+    Returns how many frames after the jump were reported "ok" while more than 0.1 m off (must be 0), the flags
+    seen, the frames until the restart, and the error after it."""
+    rng = experiment_rng(params, "jump")
+    tracker = MarkerTracker(sim.markers_body, params.filter, params.matching, use_gyro=False)
+    flags, errors = [], []
+    for f in range(len(sim.t)):
+        t = sim.t[f]
+        if t > jump_at_s + 2.0:
+            break
+        shift = np.array([jump_m, 0.0, 0.0]) if t >= jump_at_s else np.zeros(3)
+        points = transform_points(sim.T_true[f], sim.markers_body) + rng.normal(0.0, 0.002, (len(sim.markers_body), 3))
+        result = tracker.frame(t, points + shift)
+        if t >= jump_at_s:
+            flags.append(result.flag)
+            errors.append(float(np.linalg.norm(result.T_filtered[:3, 3] - sim.T_true[f, :3, 3] - shift)))
+    errors = np.array(errors)
+    restart = flags.index("restart") if "restart" in flags else -1
+    return {"frames_after_jump": len(flags), "ok_while_off": int(sum(fl == "ok" and e > 0.1 for fl, e in zip(flags, errors))),
+            "flags": {fl: flags.count(fl) for fl in sorted(set(flags))}, "frames_to_restart": restart,
+            "error_after_restart_mm": float(np.nanmax(errors[restart + 1 :]) * 1000) if restart >= 0 else float("nan")}
+
+
+def recording_replay(params: TrackParams, folder: Path) -> tuple[pd.DataFrame, dict]:
+    """Write evaluation.replay_s seconds of a simulated recording as a recording folder (16-bit PNG frames,
+    gyro.csv, the unit-plane LUT) and replay it from disk with :func:`track_recording`; the in-memory run of the
+    same recording (:func:`run_filter`, gyro fused) must give the same poses.  Returns (pose table, agreement)."""
+    writer = RecordingWriter(folder, unit_plane_lut(intrinsics(params.camera), params.camera.width, params.camera.height))
+    sim = simulate(params, experiment_rng(params, "replay"), duration_s=params.evaluation.replay_s, sink=writer.add_frame)
+    writer.close(sim.trajectory.t[sim.timeline.gyro_index], sim.timeline.gyro)
+    table = track_recording(read_recording(folder), {"tool": sim.markers_body}, params, gyro_tool="tool")
+    direct, _ = run_filter(sim, params, use_gyro=True)
+    direct = direct[direct.kind == "frame"]
+    diff = np.abs(table[["x_mm", "y_mm", "z_mm"]].to_numpy() - direct[["x_mm", "y_mm", "z_mm"]].to_numpy())
+    same_nan = np.array_equal(np.isnan(diff), np.isnan(direct[["x_mm", "y_mm", "z_mm"]].to_numpy()))
+    return table, {"frames": len(table), "max_position_diff_mm": float(np.nanmax(diff)) if np.isfinite(diff).any() else float("nan"),
+                   "same_flags": bool((table.flag.to_numpy() == direct.flag.to_numpy()).all()) and same_nan}
+
+
 def _mean_time_ms(fn, repeats: int) -> float:
+    fn()
     start = time.perf_counter()
     for _ in range(repeats):
         fn()
     return (time.perf_counter() - start) / repeats * 1000.0
 
 
-def filterpy_filter(markers_body: np.ndarray, fp: FilterParams):
-    """filterpy's UnscentedKalmanFilter on the same model: eq. 10 per sigma point with the SVD Kabsch of
-    Alg. 4, P_proc of eq. 30 set before every predict, all markers and the gyro measured.
-
-    Returns (ukf, step) where step(z, dt) runs one predict + update.
-    """
-    from filterpy.kalman import MerweScaledSigmaPoints
-    from filterpy.kalman import UnscentedKalmanFilter as FilterpyUKF
-
-    from poseintegrity.tracking.model import centred, process_model_reference, process_noise_sqrt, state_dim
-
-    n = len(markers_body)
-    N = state_dim(n)
-    kappa = 3.0 - N if fp.kappa is None else fp.kappa
-    points = MerweScaledSigmaPoints(N, fp.alpha, fp.beta, kappa)
-    ukf = FilterpyUKF(N, 3 * n + 3, fp.dt, lambda x: x[: 3 * n + 3], lambda x, dt: process_model_reference(x, dt, markers_body), points)
-    ukf.R = np.diag(np.r_[np.full(3 * n, fp.sigma_r**2), np.full(3, fp.sigma_omega**2)])
-    ell = centred(markers_body)
-
-    def step(z: np.ndarray, dt: float) -> None:
-        B = process_noise_sqrt(ukf.x, dt, ell, fp.sigma_c, fp.sigma_alpha)
-        ukf.Q = B @ B.T
-        ukf.predict(dt=dt)
-        ukf.update(z)
-
-    return ukf, step
-
-
-def filter_speed(markers_body: np.ndarray, fp: FilterParams, repeats: int, rng: np.random.Generator) -> dict[str, float]:
-    """Mean time (ms) of one predict + update (all markers + gyro) of the SR-UKF, the plain UKF and
-    filterpy on the same model, measured in the same run, and the SR-UKF's speed-up over filterpy."""
-    from poseintegrity.tracking.ukf import UnscentedKalmanFilter
-
-    n = len(markers_body)
-    markers = markers_body + np.array([0.0, 0.0, 0.45])
-    z = np.r_[(markers + rng.normal(0, 0.001, markers.shape)).ravel(), rng.normal(0, 0.5, 3)]
-    observed = np.ones(n, dtype=bool)
-    times = {}
-    for name, cls in [("srukf", SquareRootUKF), ("ukf", UnscentedKalmanFilter)]:
-        f = cls(markers_body, fp)
-        f.initialize(markers)
-        f.predict(fp.dt)  # warm-up (numba compilation)
-        times[name] = _mean_time_ms(lambda f=f: (f.predict(fp.dt), f.update(z, observed, True)), repeats)
-    ukf, step = filterpy_filter(markers_body, fp)
-    ukf.x = np.r_[markers.ravel(), np.zeros(6)]
-    ukf.P = np.diag(np.r_[np.full(3 * n, fp.sigma_r**2), np.full(3, fp.init_std_omega**2), np.full(3, fp.init_std_velocity**2)])
-    times["filterpy"] = _mean_time_ms(lambda: step(z, fp.dt), max(repeats // 5, 1))
-    times["speedup_vs_filterpy"] = times["filterpy"] / times["srukf"]
-    return times
-
-
 def detect_match_kabsch(ir: np.ndarray, depth_mm: np.ndarray, K: np.ndarray, params: TrackParams, geometry: np.ndarray) -> np.ndarray:
     """The no-filter chain on one frame: detection, correspondence, Kabsch.  Returns T_world_body (4, 4),
     NaN if fewer than 3 markers were matched."""
-    points = detect_markers(ir, depth_mm, K, **params.detection.model_dump())
-    assignment = match_markers(points, geometry, tolerance_m=params.matching.tolerance_m, min_markers=params.matching.min_markers)
+    points = detect_markers(ir, depth_mm, K, params.detection)
+    assignment = match_markers(points, geometry, None, params.matching)
     matched = assignment >= 0
     if matched.sum() < 3:
         return np.full((4, 4), np.nan)
     return pose_from_points(points[assignment[matched]], geometry[matched])
 
 
-def timing_table(sim: Simulation, params: TrackParams, rng: np.random.Generator) -> pd.DataFrame:
+def timing_table(sim: Simulation, params: TrackParams) -> pd.DataFrame:
     """Mean time (ms) of the subroutines, like Table I, on one frame of the recording with a round phantom."""
+    rng = experiment_rng(params, "timing")
     K = intrinsics(params.camera)
     T_cw = np.linalg.inv(T_world_cam(params))
     geometry = sim.markers_body
     markers_cam = transform_points(T_cw, transform_points(sim.T_true[0], geometry))
     phantoms = draw_phantoms(1, params.camera, params.frames, 1.0, rng)
     ir, depth_mm = render_frame(markers_cam, phantoms, params.camera, params.frames, MARKER_DIAMETER_M / 2, rng)
-    points = detect_markers(ir, depth_mm, K, **params.detection.model_dump())
+    points = detect_markers(ir, depth_mm, K, params.detection)
     tol, repeats = params.matching.tolerance_m, params.evaluation.timing_repeats
     tracker = MarkerTracker(geometry, params.filter, params.matching)
     tracker.frame(0.0, points)
@@ -345,9 +340,9 @@ def timing_table(sim: Simulation, params: TrackParams, rng: np.random.Generator)
     observed = np.ones(len(geometry), dtype=bool)
     rows = {
         "Frame synthesis (ours)": lambda: render_frame(markers_cam, phantoms, params.camera, params.frames, MARKER_DIAMETER_M / 2, rng),
-        "Contour detection": lambda: detect_markers(ir, depth_mm, K, **params.detection.model_dump()),
+        "Contour detection": lambda: detect_markers(ir, depth_mm, K, params.detection),
         "Euclidean matching": lambda: match_voting(points, geometry, tolerance_m=tol),
-        "Brute force matching": lambda: match_brute_force(points, geometry, tolerance_m=tol),
+        "Brute force matching": lambda: match_brute_force(points, geometry, tolerance_m=tol, min_markers=params.matching.min_markers),
         "Kabsch algorithm": lambda: kabsch(z.reshape(-1, 3), geometry),
         "Detection + correspondence + Kabsch": lambda: detect_match_kabsch(ir, depth_mm, K, params, geometry),
         "UKF state update (one dt step)": lambda: filt.predict(params.filter.dt),
@@ -369,61 +364,42 @@ class Study:
     metrics: dict
 
 
-def run_study(params: TrackParams) -> Study:
-    """Section III on our simulation, all randomness from ``numpy.random.default_rng(params.seed)``.
+def run_study(params: TrackParams, recording_folder: Path) -> Study:
+    """Section III on our simulation: every experiment above, their tables and the metrics of tracking.json.
 
-    Runs: no filter, UKF, UKF + gyro (and the UKF with the paper's sigmas) on one recording with a
-    deliberate extended occlusion; success rate on large-motion recordings with 4 and with 3 markers;
-    lag by normalized cross-correlation and the sigma sweep; SR-UKF vs plain UKF agreement at alpha 1 and
-    at params.filter.alpha; failed downdates; timings and the speed-up over filterpy.
-    """
-    from poseintegrity.tracking.ukf import UnscentedKalmanFilter
-
-    rng = np.random.default_rng(params.seed)
+    recording_folder : where :func:`recording_replay` writes the replayed recording."""
+    sim, tables, accuracy = accuracy_and_occlusion(params)
+    sweep = noise_against_lag(sim, params, tables["no_filter"])
+    success, hand_sims, success_tables = success_rates(params)
+    sigmas, sigma_metrics = published_against_our_sigmas(hand_sims["markers4"], params)
+    blobs = small_blob_sweep(params, experiment_rng(params, "small_blobs"))
+    tools = pd.concat([two_tools_success(params, params.motion.max_phantoms, "two_tools"),
+                       two_tools_success(params, params.evaluation.phantom_rich_max, "two_tools_phantom_rich")], ignore_index=True)
+    replay, replay_metrics = recording_replay(params, recording_folder)
     geometry = np.array(params.markers_body)
-    sim = simulate(params, rng)
-    no_filter = run_no_filter(sim, params)
-    ukf, t_ukf = run_filter(sim, params, use_gyro=False)
-    ukf_gyro, t_gyro = run_filter(sim, params, use_gyro=True)
-    paper_sigmas = FilterParams(alpha=params.filter.alpha, dt=params.filter.dt, restart_after_s=params.filter.restart_after_s)
-    ukf_paper, t_paper = run_filter(sim, params, use_gyro=False, filter_params=paper_sigmas)
-    runs = {"ukf": ukf, "ukf_gyro": ukf_gyro, "ukf_paper_sigmas": ukf_paper}
-    accuracy = summarize_accuracy(no_filter, runs)
-    occlusion = occlusion_summary({"ukf": ukf, "ukf_gyro": ukf_gyro})
-    sweep = sigma_sweep(sim, params, no_filter)
-    rate4, success4 = success_rate(params, rng, geometry)
-    rate3, success3 = success_rate(params, rng, np.delete(geometry, params.drop_marker, axis=0))
-    lag = {name: filter_lag_ms(no_filter, df, params.evaluation.lag_max_ms) for name, df in runs.items()}
-    agreement = {f"alpha_{a:g}": filter_agreement(sim, params, a, UnscentedKalmanFilter) for a in (1.0, params.filter.alpha)}
-    trackers = {"ukf": t_ukf, "ukf_gyro": t_gyro, "ukf_paper_sigmas": t_paper}
-    n_updates = {name: int((df.flag == "ok").sum()) for name, df in runs.items()}
-    speed = filter_speed(geometry, params.filter, params.evaluation.timing_repeats, rng)
-    timing = timing_table(sim, params, rng)
+    speed = filter_speed(geometry, params.filter, params.evaluation.timing_repeats, experiment_rng(params, "speed"))
+    rate = dict(zip(success.run, success.rate))
     metrics = {
         **accuracy,
-        "success_rate": {"markers4": rate4, "markers3": rate3},
-        "lag_ms": lag["ukf"],
-        "lag_ms_all": lag,
-        "failed_downdates": int(sum(t.filter.failed_downdates for t in trackers.values())),
-        "filter_steps": n_updates,
-        "divergences": {name: t.filter.n_divergences for name, t in trackers.items()},
-        "restarts": {name: t.n_restarts for name, t in trackers.items()},
-        "occlusion_rms_deg": dict(zip(occlusion.run, occlusion.rms_deg)),
-        "occlusion_share_tracked": dict(zip(occlusion.run, occlusion.share_tracked)),
-        "srukf_vs_ukf_max_rel_diff": agreement,
+        "rms_mm": {run: v["norm_mm"] for run, v in accuracy["rms"].items()},
+        "rms_deg": {run: v["geodesic_deg"] for run, v in accuracy["rms"].items()},
+        "rms_axis_mm": {run: v["axis_mm"] for run, v in accuracy["rms"].items()},
+        "rms_euler_deg": {run: v["euler_deg"] for run, v in accuracy["rms"].items()},
+        "euler_convention": "Unity: R = R_y R_x R_z (scipy intrinsic 'YXZ'); mean over the three angles of the RMS wrapped difference",
+        "success_rate": {"markers4": rate["a_markers4"], "markers3": rate["a_markers3"]},
+        "success_rates": rate,
+        "success_possible": dict(zip(success.run, success.possible)),
+        "sigmas_motion_a": sigma_metrics,
+        "small_blobs": sweep_summary(blobs),
+        "multi_tool_success": tools.groupby(["scene", "tool"]).correct.mean().unstack().to_dict(orient="index"),
+        "ten_metre_jump": ten_metre_jump(sim, params),
+        "recording_replay": replay_metrics,
+        "pykalman_time_update_max_diff": pykalman_time_update(geometry, params.filter, experiment_rng(params, "pykalman")),
         "speedup_vs_filterpy": speed["speedup_vs_filterpy"],
-        "filter_step_ms": {k: v for k, v in speed.items() if k != "speedup_vs_filterpy"},
-        "n_frames": int(len(sim.t)),
+        "speedup_vs_pykalman": speed["speedup_vs_pykalman"],
+        "filter_step_ms": {k: v for k, v in speed.items() if not k.startswith("speedup")},
         "paper": PAPER,
     }
-    tables = {
-        "no_filter": no_filter,
-        "ukf": ukf,
-        "ukf_gyro": ukf_gyro,
-        "ukf_paper_sigmas": ukf_paper,
-        "sigma_sweep": sweep,
-        "success_markers4": success4,
-        "success_markers3": success3,
-        "occlusion": occlusion,
-    }
-    return Study(tables=tables, timing=timing, metrics=metrics)
+    tables = {**tables, "sigma_sweep": sweep, "success": success, **success_tables, "sigmas_motion_a": sigmas,
+              "small_blobs": blobs, "multi_tool": tools, "replay_poses": replay}
+    return Study(tables=tables, timing=timing_table(sim, params), metrics=metrics)

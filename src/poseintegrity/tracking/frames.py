@@ -1,6 +1,6 @@
 """AHAT-like IR reflectivity and depth frames with marker blobs, phantom reflections and noise.
 
-A pinhole camera stands in for the HoloLens 2 AHAT camera (512 x 512, FACTS.md).  Markers are spheres
+A pinhole camera stands in for the HoloLens 2 AHAT camera (512 x 512, docs/references.md).  Markers are spheres
 rendered by ray casting with ``supersampling**2`` rays per pixel: IR is proportional to the covered
 fraction of the pixel, depth is the distance in millimetres *along the ray* to the first hit (as AHAT
 reports it), so the detector's depth lookup lands on the sphere surface, not its centre.
@@ -41,7 +41,7 @@ def intrinsics(camera: CameraParams) -> np.ndarray:
 def unit_plane_lut(K: np.ndarray, width: int, height: int) -> np.ndarray:
     """Per-pixel unit-plane lookup table of a pinhole camera, (H, W, 2): ``lut[v, u] = (x, y)`` at z = 1.
 
-    This is the form the HoloLens Research Mode API gives (FACTS.md).
+    This is the form the HoloLens Research Mode API gives (docs/references.md).
     """
     u, v = np.meshgrid(np.arange(width, dtype=float), np.arange(height, dtype=float))
     return np.stack([(u - K[0, 2]) / K[0, 0], (v - K[1, 2]) / K[1, 1]], axis=-1)

@@ -1,4 +1,4 @@
-"""The rigid marker body and small frame helpers (section II-B of Black and Salcudean 2023).
+"""The rigid marker body and small frame helpers (section II-B of Black and Salcudean, IEEE TIM 2024).
 
 Poses are 4x4 homogeneous matrices named ``T_a_b``: they map b coordinates into frame a.
 """
@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-# Marker centres in the body frame, metres (FACTS.md, "The marker rigid body of Black and Salcudean").
+# Marker centres in the body frame, metres (docs/references.md, "Marker tracking").
 MARKERS_BODY = np.array(
     [
         [0.03455, 0.01295, 0.01797],
@@ -16,7 +16,7 @@ MARKERS_BODY = np.array(
         [-0.02375, 0.03040, -0.01573],
     ]
 )
-MARKER_DIAMETER_M = 0.011  # FACTS.md: 11 mm spheres
+MARKER_DIAMETER_M = 0.011  # docs/references.md: 11 mm spheres
 
 
 def pairwise_distances(points: np.ndarray) -> np.ndarray:

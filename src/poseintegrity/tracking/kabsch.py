@@ -1,4 +1,4 @@
-"""Kabsch-Umeyama pose from corresponding points (Algorithm 4 of Black and Salcudean 2023).
+"""Kabsch-Umeyama pose from corresponding points (Algorithm 4 of Black and Salcudean, IEEE TIM 2024).
 
 The paper returns the translation as ``r_bar - y_bar``; the least-squares translation is ``r_bar - R y_bar``
 (the two agree only when the body points are centred), so we return the latter.

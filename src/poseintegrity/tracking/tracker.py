@@ -5,12 +5,19 @@ measurement update with the markers that were matched; gyro samples (body frame)
 world frame with the current estimate and update omega only.  Between measurements the filter predicts in
 steps of at most ``dt`` (the paper's 400 Hz filter clock).
 
-Failure handling (every step returns a flag, nothing raises):
+Failure handling (every step returns a flag; only a non-finite timestamp raises, a ValueError saying so):
 - "no_points" / "no_markers": nothing detected / nothing matched; the filter keeps predicting;
+- "gated" (ours): every matched marker lies outside the innovation gate, i.e. its squared Mahalanobis distance
+  to the predicted marker, under the predicted covariance plus sigma_r^2 I, exceeds innovation_gate_chi2
+  (3 dof); the measurement is not fused and the filter keeps predicting.  Markers outside the gate in a frame
+  whose other markers pass are left out of the update ("ok" then; ``n_gated`` counts them).
 - "restart": no marker for ``restart_after_s`` and no gyro fused (their code restarts after 1 s): the
-  filter waits for the next frame with >= min_markers matched markers;
+  filter waits for the next frame with >= min_markers matched markers; or (ours) ``restart_after_rejections``
+  frames in a row were gated although they had >= min_markers rigidly matched markers: the object really
+  moved (or the filter is lost), so the filter restarts from that measurement;
 - "diverged": NaN or runaway covariance (see :class:`UnscentedMarkerFilter`); re-initialised from the next
-  good frame.
+  good frame;
+- "stale": a measurement older than the filter's time; ignored; "bad_gyro": a non-finite gyro sample; ignored.
 """
 
 from __future__ import annotations
@@ -20,13 +27,21 @@ from dataclasses import dataclass
 import numpy as np
 
 from poseintegrity.tracking.correspondence import match_markers
+from poseintegrity.tracking.errors import NAN_POSE
 from poseintegrity.tracking.geometry import transform_points
 from poseintegrity.tracking.kabsch import pose_from_points
 from poseintegrity.tracking.params import FilterParams, MatchingParams
 from poseintegrity.tracking.srukf import SquareRootUKF
 from poseintegrity.tracking.unscented import UnscentedMarkerFilter
 
-NAN_POSE = np.full((4, 4), np.nan)
+
+
+def check_timestamp(t: float) -> float:
+    """t as a float; a ValueError naming the problem if it is not a finite number of seconds."""
+    t = float(t)
+    if not np.isfinite(t):
+        raise ValueError(f"timestamp must be a finite number of seconds, got {t}")
+    return t
 
 
 @dataclass(frozen=True)
@@ -53,8 +68,8 @@ class MarkerTracker:
     def __init__(
         self,
         markers_body: np.ndarray,
-        filter_params: FilterParams = FilterParams(),
-        matching: MatchingParams = MatchingParams(),
+        filter_params: FilterParams,
+        matching: MatchingParams,
         use_gyro: bool = True,
         filter_cls: type[UnscentedMarkerFilter] = SquareRootUKF,
     ):
@@ -66,6 +81,8 @@ class MarkerTracker:
         self.t = 0.0
         self.last_marker_t = -np.inf
         self.n_restarts = 0
+        self.n_rejected = 0  # consecutive gated frames
+        self.n_gated = 0  # markers left out of an update by the innovation gate
 
     def pose(self) -> np.ndarray:
         """T_world_body (4, 4) of the filter, NaN while it is not running."""
@@ -91,6 +108,11 @@ class MarkerTracker:
 
     def gyro(self, t: float, omega_body: np.ndarray) -> str:
         """A gyro sample at t: omega_body (3,) rad/s in the body frame.  Returns "ok" or a flag."""
+        t = check_timestamp(t)
+        if t < self.t - 1e-9:
+            return "stale"
+        if not np.all(np.isfinite(omega_body)):
+            return "bad_gyro"
         flag = self.advance(t)
         if flag or not self.use_gyro or not self.filter.initialized:
             return flag or ("ok" if self.filter.initialized else "not_running")
@@ -98,25 +120,53 @@ class MarkerTracker:
         ok = self.filter.update(omega_world, np.zeros(self.filter.n, dtype=bool), gyro=True)
         return "ok" if ok else "diverged"
 
+    def innovation_ok(self, points: np.ndarray, observed: np.ndarray) -> np.ndarray:
+        """(n,) bool: observed markers whose point (n, 3 rows in geometry order) passes the innovation gate."""
+        S = self.filter.sqrt_covariance()
+        ok = np.zeros(self.filter.n, dtype=bool)
+        predicted = self.filter.markers()
+        for i in np.flatnonzero(observed):
+            rows = S[3 * i : 3 * i + 3]
+            cov = rows @ rows.T + self.params.sigma_r**2 * np.eye(3)  # predicted marker + measurement noise (eq. 16)
+            nu = points[i] - predicted[i]
+            ok[i] = nu @ np.linalg.solve(cov, nu) <= self.params.innovation_gate_chi2
+        return ok
+
     def frame(self, t: float, points: np.ndarray) -> FrameResult:
         """A marker frame at t: measured points (n, 3), metres, world frame (may be empty, NaN rows ignored)."""
-        flag = self.advance(t)
+        t = check_timestamp(t)
         points = np.asarray(points, dtype=float).reshape(-1, 3)
+        if t < self.t - 1e-9:
+            return FrameResult(np.full(self.filter.n, -1), NAN_POSE, self.pose(), "stale")
+        flag = self.advance(t)
         predicted = self.filter.markers() if self.filter.initialized else None
-        assignment = match_markers(
-            points, self.markers_body, predicted, tolerance_m=self.matching.tolerance_m,
-            gate_m=self.matching.gate_m, min_markers=self.matching.min_markers,
-        )
+        assignment = match_markers(points, self.markers_body, predicted, self.matching)
         matched = assignment >= 0
         T_measured = pose_from_points(points[assignment[matched]], self.markers_body[matched]) if matched.sum() >= 3 else NAN_POSE
         if not matched.any():
             return FrameResult(assignment, T_measured, self.pose(), flag or ("no_markers" if len(points) else "no_points"))
         if not self.filter.initialized:  # without a prediction a match has >= min_markers markers
-            self.filter.initialize(transform_points(T_measured, self.markers_body))  # start from a good measurement
-            self.last_marker_t = t
-            return FrameResult(assignment, T_measured, self.pose(), flag or "initialized")
-        ok = self.filter.update(points[assignment[matched]].ravel(), matched, gyro=False)
+            return self._restart(assignment, T_measured, t, flag or "initialized")
+        measured = np.zeros((self.filter.n, 3))
+        measured[matched] = points[assignment[matched]]
+        accepted = matched & self.innovation_ok(measured, matched)
+        self.n_gated += int(matched.sum() - accepted.sum())
+        if not accepted.any():
+            self.n_rejected += 1
+            if self.n_rejected >= self.params.restart_after_rejections and matched.sum() >= self.matching.min_markers:
+                self.n_restarts += 1
+                return self._restart(assignment, T_measured, t, "restart")
+            return FrameResult(assignment, T_measured, self.pose(), flag or "gated")
+        self.n_rejected = 0
+        ok = self.filter.update(measured[accepted].ravel(), accepted, gyro=False)
         self.last_marker_t = t
         if not ok:
             return FrameResult(assignment, T_measured, NAN_POSE, "diverged")
         return FrameResult(assignment, T_measured, self.pose(), flag or "ok")
+
+    def _restart(self, assignment: np.ndarray, T_measured: np.ndarray, t: float, flag: str) -> FrameResult:
+        """Start the filter from a good measurement (>= min_markers matched, so T_measured is finite)."""
+        self.filter.initialize(transform_points(T_measured, self.markers_body))
+        self.last_marker_t = t
+        self.n_rejected = 0
+        return FrameResult(assignment, T_measured, self.pose(), flag)

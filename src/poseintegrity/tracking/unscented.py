@@ -43,7 +43,7 @@ class UnscentedMarkerFilter:
     downdates, see the subclass for the recovery); n_divergences; last_reason (why the last step failed).
     """
 
-    def __init__(self, markers_body: np.ndarray, settings: FilterParams = FilterParams()):
+    def __init__(self, markers_body: np.ndarray, settings: FilterParams):
         self.markers_body = np.asarray(markers_body, dtype=float)
         self.ell = centred(self.markers_body)
         self.n = self.ell.shape[0]
@@ -94,10 +94,15 @@ class UnscentedMarkerFilter:
         S = self.sqrt_covariance()
         return self.x[:, None] + self.gamma * np.hstack([np.zeros((self.N, 1)), S, -S])
 
-    def predict(self, dt: float) -> bool:
-        """Time update over dt seconds (Alg. 5, "State Update").  Returns False if the filter diverged."""
+    def predict(self, dt: float, noise_sqrt: np.ndarray | None = None) -> bool:
+        """Time update over dt seconds (Alg. 5, "State Update").  Returns False if the filter diverged.
+
+        noise_sqrt : (N, p) a square root B of the process covariance, P_proc = B B^T; None: eq. 30 at the
+        current state (:func:`~poseintegrity.tracking.model.process_noise_sqrt`).  A fixed B is how the filter
+        runs an additive-noise model for the comparison with pykalman.
+        """
         X_f = process_model(self.sigma_points(), dt, self.ell)  # X_{k|k-1} = f(X_{k-1})
-        B = process_noise_sqrt(self.x, dt, self.ell, self.settings.sigma_c, self.settings.sigma_alpha)
+        B = process_noise_sqrt(self.x, dt, self.ell, self.settings.sigma_c, self.settings.sigma_alpha) if noise_sqrt is None else noise_sqrt
         self.x = X_f @ self.Wm  # x_k^- = X_{k|k-1} w_m
         self._time_update(X_f, self.x, B)
         return self._check_health()

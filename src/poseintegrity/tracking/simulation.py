@@ -1,0 +1,182 @@
+"""Simulated recordings (section II-F) and the two ways of running them: no filter and the tracker.
+
+A recording is a trajectory, its sensor timeline, and the rendered AHAT-like frames run through the detector;
+frames are not kept (a ``sink`` may receive them, e.g. a :class:`~poseintegrity.tracking.recording.RecordingWriter`).
+Every random draw comes from the generator passed in; the same generator state gives bit-identical tables.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, replace
+
+import numpy as np
+import pandas as pd
+from tqdm.auto import tqdm
+
+from poseintegrity.tracking.correspondence import match_markers
+from poseintegrity.tracking.detection import detect_markers
+from poseintegrity.tracking.errors import NAN_POSE, error_columns
+from poseintegrity.tracking.frames import draw_phantoms, intrinsics, render_frame
+from poseintegrity.tracking.geometry import MARKER_DIAMETER_M, pose_matrix, transform_points
+from poseintegrity.tracking.kabsch import pose_from_points
+from poseintegrity.tracking.motion import (
+    SensorTimeline,
+    Trajectory,
+    brief_occlusions,
+    sample_sensors,
+    simulate_hand_motion,
+    simulate_trajectory,
+)
+from poseintegrity.tracking.params import DetectionParams, FilterParams, TrackParams
+from poseintegrity.tracking.srukf import SquareRootUKF
+from poseintegrity.tracking.tracker import MarkerTracker
+from poseintegrity.tracking.unscented import UnscentedMarkerFilter
+
+
+@dataclass(frozen=True)
+class Simulation:
+    """One simulated recording: ground truth, sensor timeline, and the detected points of every frame.
+
+    t : (F,) s frame times; T_true : (F, 4, 4) T_world_body; points : list of (n_f, 3) detections, metres;
+    in_occlusion : (F,) bool, inside a deliberate extended occlusion; occlusions : (start_s, duration_s) of those.
+    """
+
+    trajectory: Trajectory
+    timeline: SensorTimeline
+    markers_body: np.ndarray
+    t: np.ndarray
+    T_true: np.ndarray
+    points: list[np.ndarray]
+    in_occlusion: np.ndarray
+    occlusions: list[tuple[float, float]]
+
+
+def T_world_cam(params: TrackParams) -> np.ndarray:
+    """Camera extrinsics (4, 4): the camera looks along world +z from params.camera.origin_m."""
+    return pose_matrix(np.eye(3), np.array(params.camera.origin_m))
+
+
+def record(
+    params: TrackParams,
+    trajectory: Trajectory,
+    timeline: SensorTimeline,
+    markers_body: np.ndarray,
+    rng: np.random.Generator,
+    detection: DetectionParams | None = None,
+    sink: Callable[[float, np.ndarray, np.ndarray], None] | None = None,
+    label: str = "frames",
+) -> Simulation:
+    """Render every marker frame of a timeline (AHAT-like, with phantoms) and run the detector on it.
+
+    detection : overrides params.detection; sink(t, ir, depth_mm) receives each rendered frame.
+    The points of a frame come from detection on the rendered images, so their error is the detector's.
+    """
+    idx = timeline.frame_index
+    T_true = pose_matrix(trajectory.rotation(idx), trajectory.position[idx])
+    T_wc = T_world_cam(params)
+    T_cw = np.linalg.inv(T_wc)
+    K = intrinsics(params.camera)
+    detection = detection or params.detection
+    t = trajectory.t[idx]
+    points = []
+    for f in tqdm(range(len(idx)), desc=label, leave=False, mininterval=5):
+        markers_cam = transform_points(T_cw, transform_points(T_true[f], markers_body))[~timeline.occluded[f]]
+        phantoms = draw_phantoms(int(timeline.n_phantoms[f]), params.camera, params.frames, params.motion.phantom_round_fraction, rng)
+        ir, depth_mm = render_frame(markers_cam, phantoms, params.camera, params.frames, MARKER_DIAMETER_M / 2, rng)
+        if sink is not None:
+            sink(float(t[f]), ir, depth_mm)
+        points.append(detect_markers(ir, depth_mm, K, detection, T_world_cam=T_wc))
+    occlusions = [tuple(o) for o in params.motion.occlusions]
+    in_occlusion = np.zeros(len(idx), dtype=bool)
+    for start, duration in occlusions:
+        in_occlusion |= (t >= start) & (t < start + duration)
+    return Simulation(trajectory, timeline, markers_body, t, T_true, points, in_occlusion, occlusions)
+
+
+def simulate(params: TrackParams, rng: np.random.Generator, markers_body: np.ndarray | None = None, omega_std: float | None = None,
+             duration_s: float | None = None, detection: DetectionParams | None = None, sink=None) -> Simulation:
+    """The accuracy recording (params.motion), or motion (b), the stress test, with omega_std and no deliberate
+    occlusion when omega_std is given.  markers_body : (m, 3) geometry (default params.markers_body)."""
+    markers_body = np.array(params.markers_body) if markers_body is None else markers_body
+    update = {} if duration_s is None else {"duration_s": duration_s}
+    if omega_std is not None:
+        update["occlusions"] = []
+    params = params.model_copy(update={"motion": params.motion.model_copy(update=update)})
+    trajectory = simulate_trajectory(params.motion, rng, omega_std=omega_std)
+    timeline = sample_sensors(trajectory, len(markers_body), params.motion, rng)
+    return record(params, trajectory, timeline, markers_body, rng, detection, sink, label="stress" if omega_std else "recording")
+
+
+def simulate_hand(params: TrackParams, rng: np.random.Generator, markers_body: np.ndarray, duration_s: float,
+                  detection: DetectionParams | None = None) -> Simulation:
+    """Motion (a), paper-like (:class:`~poseintegrity.tracking.params.HandMotionParams`): full turns about every
+    axis, large translations, brief per-marker occlusions in place of the i.i.d. P_o and the deliberate occlusion."""
+    motion = params.motion.model_copy(update={"duration_s": duration_s, "p_occlusion": 0.0, "occlusions": []})
+    params = params.model_copy(update={"motion": motion})
+    trajectory = simulate_hand_motion(motion, params.hand, rng)
+    timeline = sample_sensors(trajectory, len(markers_body), motion, rng)
+    hidden = brief_occlusions(trajectory.t[timeline.frame_index], len(markers_body), params.hand, rng)
+    timeline = replace(timeline, occluded=timeline.occluded | hidden)
+    return record(params, trajectory, timeline, markers_body, rng, detection, label="hand motion")
+
+
+def run_no_filter(sim: Simulation, params: TrackParams) -> pd.DataFrame:
+    """Kabsch per frame on the matched detections (no filter, no prediction): one row per frame.
+
+    correct: at least min_markers markers matched and every matched point within correct_tolerance_m of
+    its true marker (correspondence right and pose usable).  Error columns: :func:`~poseintegrity.tracking.errors.error_columns`.
+    """
+    m, rows, poses = params.matching, [], []
+    for f, points in enumerate(sim.points):
+        assignment = match_markers(points, sim.markers_body, None, m)
+        matched = assignment >= 0
+        true_markers = transform_points(sim.T_true[f], sim.markers_body)
+        poses.append(pose_from_points(points[assignment[matched]], sim.markers_body[matched]) if matched.sum() >= 3 else NAN_POSE)
+        err = np.linalg.norm(points[assignment[matched]] - true_markers[matched], axis=1) if matched.any() else np.zeros(0)
+        correct = matched.sum() >= m.min_markers and bool(np.all(err <= params.evaluation.correct_tolerance_m))
+        visible = int((~sim.timeline.occluded[f]).sum())
+        rows.append({"frame": f, "t": sim.t[f], "n_visible": visible, "n_detected": len(points), "n_matched": int(matched.sum()), "correct": correct})
+    df = pd.DataFrame(rows)
+    poses = np.stack(poses)
+    for name, column in error_columns(poses, sim.T_true).items():
+        df[name] = column
+    df[["x_mm", "y_mm", "z_mm"]] = poses[:, :3, 3] * 1000.0
+    df["in_occlusion"] = sim.in_occlusion
+    return df
+
+
+def run_filter(
+    sim: Simulation,
+    params: TrackParams,
+    use_gyro: bool,
+    filter_params: FilterParams | None = None,
+    filter_cls: type[UnscentedMarkerFilter] = SquareRootUKF,
+) -> tuple[pd.DataFrame, MarkerTracker]:
+    """Run the tracker over the recording: one row per event (marker frame or gyro sample), in time order.
+
+    Columns: t, kind ("frame"/"gyro"), frame (index or -1), flag, n_matched, the error columns, x_mm / y_mm /
+    z_mm (filtered position of the body origin), in_occlusion.
+    """
+    tracker = MarkerTracker(sim.markers_body, filter_params or params.filter, params.matching, use_gyro, filter_cls)
+    tl, traj = sim.timeline, sim.trajectory
+    events = sorted([(i, 1, g) for g, i in enumerate(tl.gyro_index)] + [(i, 0, f) for f, i in enumerate(tl.frame_index)])
+    rows, poses, grid = [], [], []
+    for grid_index, is_gyro, k in events:
+        t = traj.t[grid_index]
+        if is_gyro:
+            flag, n_matched, T = tracker.gyro(t, tl.gyro[k]), -1, tracker.pose()
+        else:
+            result = tracker.frame(t, sim.points[k])
+            flag, n_matched, T = result.flag, int((result.assignment >= 0).sum()), result.T_filtered
+        rows.append({"t": t, "kind": "gyro" if is_gyro else "frame", "frame": -1 if is_gyro else k, "flag": flag, "n_matched": n_matched,
+                     "in_occlusion": any(a <= t < a + d for a, d in sim.occlusions)})
+        poses.append(T)
+        grid.append(grid_index)
+    df = pd.DataFrame(rows)
+    poses, grid = np.stack(poses), np.array(grid)
+    truth = pose_matrix(traj.rotation(grid), traj.position[grid])
+    for name, column in error_columns(poses, truth).items():
+        df[name] = column
+    df[["x_mm", "y_mm", "z_mm"]] = poses[:, :3, 3] * 1000.0
+    return df, tracker

@@ -1,0 +1,68 @@
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from poseintegrity.config import load_section
+from poseintegrity.tracking.evaluation import recording_replay
+from poseintegrity.tracking.frames import intrinsics, render_frame, unit_plane_lut
+from poseintegrity.tracking.geometry import MARKER_DIAMETER_M, MARKERS_BODY
+from poseintegrity.tracking.recording import RecordingError, RecordingWriter, read_recording, track_recording
+
+PARAMS = load_section(Path(__file__).resolve().parents[1] / "params_tiny.yaml", "track")
+
+
+def test_replay_from_disk_gives_the_in_memory_poses(tmp_path):
+    table, agreement = recording_replay(PARAMS, tmp_path / "rec")
+    assert agreement["same_flags"] and agreement["max_position_diff_mm"] < 1e-4
+    assert (table.flag == "ok").mean() > 0.8
+    assert {"t_s", "tool", "flag", "x_mm", "qw"} <= set(table.columns)
+
+
+def _write(folder, n=4, depth_scale=1.0, npy=False):
+    camera = PARAMS.camera
+    writer = RecordingWriter(folder, unit_plane_lut(intrinsics(camera), camera.width, camera.height))
+    rng = np.random.default_rng(0)
+    for k in range(n):
+        ir, depth = render_frame(MARKERS_BODY + [0.0, 0.0, 0.45], [], camera, PARAMS.frames, MARKER_DIAMETER_M / 2, rng)
+        writer.add_frame(0.046 * k, ir, depth)
+    writer.close()
+    if npy or depth_scale != 1.0:  # replace the last frame's depth by a .npy in other units
+        frames = pd.read_csv(folder / "frames.csv")
+        np.save(folder / "depth" / "last.npy", depth.astype(float) * depth_scale)
+        frames.loc[len(frames) - 1, "depth"] = "depth/last.npy"
+        frames.to_csv(folder / "frames.csv", index=False)
+
+
+def test_depth_in_metres_and_wrong_shapes_are_flagged_rows_with_a_warning(tmp_path):
+    _write(tmp_path, depth_scale=0.001)
+    with pytest.warns(RuntimeWarning, match="last.npy|metres"):
+        table = track_recording(read_recording(tmp_path), {"tool": MARKERS_BODY}, PARAMS)
+    assert list(table.flag) == ["initialized", "ok", "ok", "bad_frame"]
+    np.save(tmp_path / "depth" / "last.npy", np.zeros((10, 10)))
+    with pytest.warns(RuntimeWarning, match="differs from IR shape"):
+        table = track_recording(read_recording(tmp_path), {"tool": MARKERS_BODY}, PARAMS)
+    assert table.flag.iloc[-1] == "bad_frame" and np.isfinite(table.x_mm.iloc[-1])  # the filter's pose, not NaN points
+
+
+def test_bad_recordings_are_refused_naming_the_problem(tmp_path):
+    _write(tmp_path)
+    frames = pd.read_csv(tmp_path / "frames.csv")
+    frames.loc[2, "t_s"] = np.nan
+    frames.to_csv(tmp_path / "frames.csv", index=False)
+    with pytest.raises(RecordingError, match="row 2 is not a finite number"):
+        read_recording(tmp_path)
+    frames.loc[2, "t_s"] = 0.0
+    frames.to_csv(tmp_path / "frames.csv", index=False)
+    with pytest.raises(RecordingError, match="decrease at row 2"):
+        read_recording(tmp_path)
+    frames.loc[2, "t_s"] = 0.1
+    frames.to_csv(tmp_path / "frames.csv", index=False)
+    np.save(tmp_path / "lut_x.npy", np.zeros((512, 512)))
+    np.save(tmp_path / "lut_y.npy", np.zeros((512, 512)))
+    with pytest.raises(RecordingError, match="all zero"):
+        read_recording(tmp_path)
+    (tmp_path / "frames.csv").unlink()
+    with pytest.raises(RecordingError, match="frames.csv is missing"):
+        read_recording(tmp_path)
