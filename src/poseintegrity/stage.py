@@ -118,14 +118,17 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--data", type=Path, default=Path("data"), help="data_dir of the notebook")
     parser.add_argument("--reports", type=Path, default=Path("reports"), help="reports_dir of the notebook")
     args = parser.parse_args(argv)
+    name = args.notebook.stem
+    partial = StageOutputs(args.reports, name).partial_notebook
     try:
         record = run_stage(args.notebook, args.params, args.data, args.reports,
                            started=psutil.Process().create_time())
     except (ParamsError, ConnectionError) as error:
-        sys.exit(f"{args.notebook.stem}: {error}")
+        sys.exit(f"{name}: {error}")
     except papermill.PapermillExecutionError as error:
-        partial = StageOutputs(args.reports, args.notebook.stem).partial_notebook
-        sys.exit(f"{error}\n{args.notebook.stem} failed; the notebook as far as it ran: {partial}")
+        sys.exit(f"{error}\n{name} failed; the notebook as far as it ran: {partial}")
+    except KeyboardInterrupt:
+        sys.exit(f"{name} interrupted; the notebook as far as it ran: {partial}")
     print(record.line(), flush=True)
 
 
