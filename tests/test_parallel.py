@@ -3,15 +3,21 @@ Dask cluster; bad settings fail naming their key before any work; progress lines
 
 import hashlib
 import socket
+import sys
 from pathlib import Path
 
+import cloudpickle
+import distributed
 import numpy as np
 import pytest
 
+from poseintegrity import parallel
 from poseintegrity.config import ParamsError, parse_params
 from poseintegrity.parallel import ParallelParams, Progress, Workers, worker_count
 
-distributed = pytest.importorskip("distributed")
+# Worker processes cannot import this test module (pytest imports it from a path): send its functions by value,
+# as for functions defined in a notebook. The pipeline's functions live in poseintegrity, which workers import.
+cloudpickle.register_pickle_by_value(sys.modules[__name__])
 
 
 @pytest.fixture(scope="module")
@@ -91,6 +97,14 @@ def test_unreachable_scheduler_fails_naming_the_key_before_any_work():
     for connect in (lambda: Workers(params, connect_timeout_s=1), lambda: worker_count(params, 1)):
         with pytest.raises(ConnectionError, match=f"parallel.address: no Dask scheduler answers at {address}"):
             connect()
+
+
+def test_workers_running_other_code_are_refused_naming_the_key(cluster):
+    """A worker from another checkout would compute other results, or hang a stage that it cannot unpickle."""
+    with Workers(ParallelParams(backend="dask", address=cluster.scheduler_address)) as workers:
+        parallel._check_workers(workers._client, cluster.scheduler_address, parallel.source_digest())  # same code
+        with pytest.raises(ConnectionError, match=r"parallel.address: workers \['tcp://127.0.0.1:\d+', 'tcp://"):
+            parallel._check_workers(workers._client, cluster.scheduler_address, "0" * 64)
 
 
 @pytest.mark.parametrize("section, key", [

@@ -19,13 +19,15 @@ float reductions run in the same order whichever backend runs them. (The local b
 the tasks one after the other in the calling process, where tracebacks and debuggers work as usual.)
 
 Dask workers on other machines must see the same files at the same paths and run the same environment (README,
-"Running on a Dask cluster").
+"Running on a Dask cluster"); connecting checks that every worker runs the same poseintegrity source.
 """
 
 from __future__ import annotations
 
+import hashlib
 import time
 from collections.abc import Callable, Sequence
+from pathlib import Path
 from typing import Literal, TypeVar
 from urllib.parse import urlsplit
 
@@ -98,15 +100,45 @@ def describe_backend(backend: str, address: str | None, n_jobs: int) -> str:
     return f"dask {f'at {address}' if address else 'LocalCluster'}, n_jobs {n_jobs}"
 
 
+def source_digest() -> str:
+    """SHA-256 of poseintegrity's source files: the same on two machines exactly when they run the same code."""
+    package = Path(__file__).parent
+    digest = hashlib.sha256()
+    for path in sorted(package.rglob("*.py")):
+        digest.update(path.relative_to(package).as_posix().encode() + b"\0" + path.read_bytes())
+    return digest.hexdigest()
+
+
 def _connect(address: str, timeout_s: float):
+    """A client of the scheduler at ``address`` whose connected workers run this machine's poseintegrity code
+    (a worker that cannot even load a task's function would otherwise leave the stage waiting forever)."""
     from distributed import Client  # imported on use: a second to import, and the local backend never needs it
 
     try:
-        return Client(address, timeout=timeout_s, set_as_default=False)
+        client = Client(address, timeout=timeout_s, set_as_default=False)
     except OSError as error:  # refused, unresolvable, or timed out (TimeoutError is an OSError)
         raise ConnectionError(
             f"parallel.address: no Dask scheduler answers at {address} within {timeout_s:g} s ({error}); start one "
             f"with `dask scheduler`, or set parallel.address: null to start a LocalCluster") from None
+    try:
+        _check_workers(client, address, source_digest())
+    except ConnectionError:
+        client.close()
+        raise
+    return client
+
+
+def _check_workers(client, address: str, expected_digest: str) -> None:
+    """ConnectionError naming ``parallel.address`` unless every connected worker has ``expected_digest``."""
+    try:
+        digests = client.run(source_digest)
+    except Exception as error:  # a worker without poseintegrity cannot even unpickle source_digest
+        raise ConnectionError(f"parallel.address: the workers of {address} cannot run poseintegrity ({error!r}); "
+                              f"start them with the project's .venv") from None
+    others = sorted(worker for worker, digest in digests.items() if digest != expected_digest)
+    if others:
+        raise ConnectionError(f"parallel.address: workers {others} of {address} run other poseintegrity code than "
+                              f"this machine; start every worker from the same checkout")
 
 
 class Workers:

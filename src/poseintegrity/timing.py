@@ -44,7 +44,8 @@ class StageTiming:
     def line(self) -> str:
         """``"02_extract_artifacts        612 s   local, n_jobs 2              finished 2025-11-23 14:12"``"""
         where = describe_backend(self.backend, self.address, self.n_jobs)
-        return f"{self.stage:<24} {self.wall_time_s:6.0f} s   {where:<28} finished {self.finished_at.replace('T', ' ')[:16]}"
+        finished = self.finished_at.replace("T", " ")[:16]
+        return f"{self.stage:<24} {self.wall_time_s:6.0f} s   {where:<28} finished {finished}"
 
 
 def summary(folder: Path) -> list[str]:
