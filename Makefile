@@ -27,8 +27,9 @@ $(VENV)/.installed: requirements.lock pyproject.toml
 
 install: $(VENV)/.installed ## create .venv and install the pinned dependencies
 
-repro: $(VENV)/.installed ## run the paper-scale pipeline (dvc repro)
+repro: $(VENV)/.installed ## run the paper-scale pipeline (dvc repro), then print each stage's wall time
 	$(BIN)/dvc repro
+	@$(BIN)/python -m poseintegrity.timing reports/metrics/timing
 
 test: $(VENV)/.installed ## run the pytest suite (notebooks executed with tiny parameters)
 	$(BIN)/python -m pytest -n 2

@@ -1,5 +1,6 @@
-"""The workflow's contracts: output-free notebooks with stable ids and a parameters cell, dvc stages that
-depend on data (never on executed notebooks), params sections validated by config, the two README commands."""
+"""The workflow's contracts: output-free notebooks with stable ids and a parameters cell, dvc stages run by the
+stage runner that depend on data (never on executed notebooks), params sections validated by config, the two
+README commands."""
 
 import json
 from pathlib import Path
@@ -32,14 +33,17 @@ def test_source_notebook_is_output_free_with_parameters_cell(notebook):
     assert nb["metadata"]["kernelspec"]["name"] == "python3"
 
 
-def test_every_notebook_has_a_stage_running_it_with_papermill():
+def test_every_notebook_has_a_stage_running_it_through_the_stage_runner():
+    """poseintegrity.stage writes the executed notebook, its HTML and a timing file, and reads `parallel`."""
     stages = DVC["stages"]
     for notebook in NOTEBOOKS:
         stage = stages[notebook.stem]
-        assert f"papermill -k python3 --log-level WARNING notebooks/{notebook.name}" in stage["cmd"]
-        assert f"reports/notebooks/{notebook.name}" in stage["cmd"]
-        assert "nbconvert" in stage["cmd"] and "mkdir -p reports/notebooks" in stage["cmd"]
+        assert stage["cmd"].endswith(f"python -m poseintegrity.stage notebooks/{notebook.name}")
         assert f"notebooks/{notebook.name}" in stage["deps"]
+        assert "parallel" in stage["params"]
+        outs = [next(iter(out)) if isinstance(out, dict) else out for out in stage["outs"]]
+        assert f"reports/notebooks/{notebook.name}" in outs and f"reports/notebooks/{notebook.stem}.html" in outs
+        assert {f"reports/metrics/timing/{notebook.stem}.json": {"cache": False}} in stage["outs"]
 
 
 def test_no_stage_depends_on_an_executed_notebook():

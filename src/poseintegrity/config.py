@@ -20,6 +20,7 @@ from pydantic import BaseModel, ConfigDict, ValidationError
 
 from poseintegrity.artifacts.params import FitParams
 from poseintegrity.localization.params import ExtractParams
+from poseintegrity.parallel import ParallelParams
 from poseintegrity.prediction.params import PredictParams
 from poseintegrity.scenes.params import GenerateParams
 from poseintegrity.tracking.params import TrackParams
@@ -39,6 +40,7 @@ class Params(BaseModel):
     fit: FitParams  # stage 03
     predict: PredictParams  # stage 04
     track: TrackParams  # stage 06
+    parallel: ParallelParams  # every stage: where the per-frame and per-dataset tasks run
 
 
 def _format_errors(error: ValidationError, prefix: tuple = ()) -> str:

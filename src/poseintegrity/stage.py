@@ -1,0 +1,136 @@
+"""Run one pipeline stage (a ``dvc.yaml`` cmd): execute its notebook with papermill, export it to HTML, and
+record its wall time::
+
+    python -m poseintegrity.stage notebooks/02_extract_artifacts.ipynb [--params params.yaml] [--data data]
+                                  [--reports reports]
+
+writes ``<reports>/notebooks/<name>.ipynb`` and ``.html`` and ``<reports>/metrics/timing/<name>.json``
+(:class:`poseintegrity.timing.StageTiming`). While the notebook runs, everything it prints (the progress lines of
+:mod:`poseintegrity.parallel`, tqdm bars) reaches this terminal as it comes, with one line per cell.
+
+Before any work, the ``parallel`` section is validated and a Dask scheduler at ``parallel.address`` must answer:
+both fail naming the key. The stage's previous outputs are deleted first and the notebook executes into
+``<name>.partial.ipynb``, renamed when the HTML is written; the timing file comes last. So an interrupted or
+failed stage leaves nothing that looks complete (the partial notebook shows how far it got).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from dataclasses import dataclass
+from datetime import datetime
+from pathlib import Path
+
+import papermill
+import psutil
+from nbconvert import HTMLExporter
+from tqdm import tqdm
+from traitlets.config import Config
+
+from poseintegrity.config import ParamsError, load_section
+from poseintegrity.parallel import worker_count
+from poseintegrity.timing import StageTiming
+
+KERNEL = "python3"  # the kernelspec `make install` writes into .venv (the Makefile points JUPYTER_PATH there)
+
+
+def kernel_config() -> Config:
+    """jupyter_client's KernelManager by default starts the kernel over TCP without CurveZMQ keys, and the
+    kernel (ipykernel's IPKernelApp.init_sockets) then warns "Kernel is running over TCP without encryption" on
+    every start. Our kernelspec declares ``supported_encryption: [curve]`` (ipykernel >= 7), so asking the manager
+    to provision keys when the kernel supports them encrypts the sockets, and the warning has no cause left."""
+    config = Config()
+    config.KernelManager.transport_encryption = "auto"
+    return config
+
+
+@dataclass(frozen=True)
+class StageOutputs:
+    """The files the runner writes for notebook ``name`` under ``reports_dir``."""
+
+    reports_dir: Path
+    name: str
+
+    @property
+    def notebook(self) -> Path:
+        return self.reports_dir / "notebooks" / f"{self.name}.ipynb"
+
+    @property
+    def partial_notebook(self) -> Path:
+        return self.reports_dir / "notebooks" / f"{self.name}.partial.ipynb"
+
+    @property
+    def html(self) -> Path:
+        return self.reports_dir / "notebooks" / f"{self.name}.html"
+
+    @property
+    def timing(self) -> Path:
+        return self.reports_dir / "metrics" / "timing" / f"{self.name}.json"
+
+
+def run_stage(notebook: Path, params_path: Path, data_dir: Path, reports_dir: Path,
+              started: float | None = None) -> StageTiming:
+    """Execute ``notebook`` with the three pipeline parameters (passed as given; relative paths resolve against
+    the current directory, as in the kernel), export HTML, write the timing file; return its record.
+
+    The wall time runs from ``started`` (epoch s; default: now; the command line passes its process's start, so
+    that its own imports count) to the written HTML. Raises ParamsError or ConnectionError before any work, and
+    papermill.PapermillExecutionError when a cell fails."""
+    start = time.time() if started is None else started
+    name = notebook.stem
+    parallel = load_section(params_path, "parallel")
+    n_jobs = worker_count(parallel)
+    outputs = StageOutputs(reports_dir, name)
+    for path in (outputs.notebook, outputs.html, outputs.timing):
+        path.unlink(missing_ok=True)
+    for path in (outputs.notebook, outputs.timing):
+        path.parent.mkdir(parents=True, exist_ok=True)
+
+    def announce_cell(cell, cell_index) -> None:
+        if not {"parameters", "injected-parameters"} & set(cell.metadata.get("tags", [])):
+            print(f"[{name} {tqdm.format_interval(time.time() - start)}] cell {cell.id}", flush=True)
+
+    nb = papermill.execute_notebook(
+        str(notebook), str(outputs.partial_notebook), kernel_name=KERNEL, progress_bar=False,
+        parameters={"params_path": str(params_path), "data_dir": str(data_dir), "reports_dir": str(reports_dir)},
+        stdout_file=sys.stdout, stderr_file=sys.stderr,  # the kernel's output, forwarded as it arrives
+        config=kernel_config(), on_cell_execute=announce_cell,
+        coalesce_streams=True,  # the saved notebook keeps a tqdm bar's last state, not every redraw
+    )
+    body, _ = HTMLExporter().from_notebook_node(nb, resources={"metadata": {"name": name}})
+    partial_html = outputs.html.with_name(f"{name}.partial.html")
+    partial_html.write_text(body, encoding="utf-8")
+    partial_html.replace(outputs.html)
+    outputs.partial_notebook.replace(outputs.notebook)
+    record = StageTiming(stage=name, wall_time_s=round(time.time() - start, 1), backend=parallel.backend,
+                         n_jobs=n_jobs, address=parallel.address,
+                         finished_at=datetime.now().isoformat(timespec="seconds"))
+    record.write(outputs.timing)
+    return record
+
+
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("notebook", type=Path, help="source notebook, e.g. notebooks/02_extract_artifacts.ipynb")
+    parser.add_argument("--params", type=Path, default=Path("params.yaml"), help="params_path of the notebook")
+    parser.add_argument("--data", type=Path, default=Path("data"), help="data_dir of the notebook")
+    parser.add_argument("--reports", type=Path, default=Path("reports"), help="reports_dir of the notebook")
+    args = parser.parse_args(argv)
+    name = args.notebook.stem
+    partial = StageOutputs(args.reports, name).partial_notebook
+    try:
+        record = run_stage(args.notebook, args.params, args.data, args.reports,
+                           started=psutil.Process().create_time())
+    except (ParamsError, ConnectionError) as error:
+        sys.exit(f"{name}: {error}")
+    except papermill.PapermillExecutionError as error:
+        sys.exit(f"{error}\n{name} failed; the notebook as far as it ran: {partial}")
+    except KeyboardInterrupt:
+        sys.exit(f"{name} interrupted; the notebook as far as it ran: {partial}")
+    print(record.line(), flush=True)
+
+
+if __name__ == "__main__":
+    main()

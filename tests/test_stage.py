@@ -1,0 +1,125 @@
+"""The stage runner (`python -m poseintegrity.stage`, every dvc.yaml cmd) on a tiny notebook of its own: output
+reaches the terminal while the notebook runs, no kernel warning, HTML and a timing file; a failed or refused stage
+leaves nothing that looks complete."""
+
+import json
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import nbformat
+import pytest
+
+from poseintegrity.timing import StageTiming, summary
+
+PARAMETERS = 'params_path = "params.yaml"\ndata_dir = "data"\nreports_dir = "reports"'
+WORK = """\
+import time
+from pathlib import Path
+from tqdm import tqdm
+from poseintegrity.config import load_section
+from poseintegrity.parallel import Workers
+
+with Workers(load_section(params_path, "parallel")) as workers:
+    values = workers.map(abs, [-1, -2, -3], desc="values")"""
+HANDSHAKE = """\
+print("waiting for the test", flush=True)
+deadline = time.monotonic() + 60
+while not (Path(data_dir) / "go").exists():  # the test creates it once it has read the line above
+    assert time.monotonic() < deadline, "the runner did not pass the first line on while the notebook ran"
+    time.sleep(0.05)"""
+BAR = 'for _ in tqdm(range(50), desc="bar", mininterval=0):\n    time.sleep(0.002)'
+WRITE = '(Path(data_dir) / "values.txt").write_text(str(values))'
+
+
+def make_notebook(path: Path, cells: dict[str, str]) -> Path:
+    """An output-free notebook like the pipeline's: first cell tagged `parameters`, readable cell ids."""
+    nb = nbformat.v4.new_notebook(metadata={"kernelspec": {"name": "python3", "display_name": "Python 3",
+                                                           "language": "python"}})
+    nb.cells = [nbformat.v4.new_code_cell(PARAMETERS, id="parameters", metadata={"tags": ["parameters"]})]
+    nb.cells += [nbformat.v4.new_code_cell(source, id=cell_id) for cell_id, source in cells.items()]
+    nbformat.write(nb, path)
+    return path
+
+
+def runner(notebook: Path, root: Path, parallel: str) -> list[str]:
+    """The command line of a dvc.yaml stage, for a project in ``root`` whose params.yaml holds ``parallel``."""
+    (root / "params.yaml").write_text(f"parallel: {parallel}\n")
+    (root / "data").mkdir(exist_ok=True)
+    return [sys.executable, "-m", "poseintegrity.stage", str(notebook), "--params", str(root / "params.yaml"),
+            "--data", str(root / "data"), "--reports", str(root / "reports")]
+
+
+@pytest.mark.notebook
+def test_runner_streams_output_while_running_and_writes_notebook_html_and_timing(tmp_path):
+    notebook = make_notebook(tmp_path / "demo.ipynb", {"work": WORK, "handshake": HANDSHAKE, "bar": BAR,
+                                                        "write": WRITE})
+    command = runner(notebook, tmp_path, "{backend: local, n_jobs: 1}")
+    start = time.time()
+    with open(tmp_path / "stderr.txt", "w") as stderr:
+        process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=stderr, text=True)
+        stdout = []
+        for line in process.stdout:
+            stdout.append(line)
+            if line.startswith("waiting for the test"):
+                (tmp_path / "data" / "go").touch()
+        process.wait(timeout=120)
+    elapsed = time.time() - start
+    stdout, stderr = "".join(stdout), (tmp_path / "stderr.txt").read_text()
+    assert process.returncode == 0, stderr
+    assert (tmp_path / "data" / "values.txt").read_text() == "[1, 2, 3]"
+
+    # the terminal: one line per cell, the parallel layer's progress line, the tqdm bar, no kernel warning
+    assert "[demo " in stdout and "] cell handshake\n" in stdout and "cell parameters" not in stdout
+    assert "values (local, n_jobs 1): 3/3 (100 %) in " in stdout
+    assert "bar: 100%" in stderr and "50/50" in stderr
+    assert "without encryption" not in stderr + stdout
+
+    reports = tmp_path / "reports"
+    executed = nbformat.read(reports / "notebooks" / "demo.ipynb", as_version=4)
+    bar_output = next(cell for cell in executed.cells if cell.get("id") == "bar").outputs[0]["text"]
+    assert "50/50" in bar_output and "\r" not in bar_output  # the saved notebook keeps the bar's last state
+    assert "waiting for the test" in (reports / "notebooks" / "demo.html").read_text()
+    timing = json.loads((reports / "metrics" / "timing" / "demo.json").read_text())
+    assert timing["stage"] == "demo" and timing["backend"] == "local" and timing["n_jobs"] == 1
+    assert 0 < timing["wall_time_s"] <= elapsed + 0.1
+    assert stdout.splitlines()[-1] == StageTiming(**timing).line()
+    assert not list(reports.rglob("*partial*"))
+
+
+@pytest.mark.notebook
+def test_failed_stage_leaves_nothing_that_looks_complete(tmp_path):
+    notebook = make_notebook(tmp_path / "demo.ipynb", {"fail": 'raise RuntimeError("boom")'})
+    reports = tmp_path / "reports"
+    stale = [reports / "notebooks" / "demo.ipynb", reports / "notebooks" / "demo.html",
+             reports / "metrics" / "timing" / "demo.json"]  # outputs of an earlier run
+    for path in stale:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text("earlier run")
+    result = subprocess.run(runner(notebook, tmp_path, "{backend: local, n_jobs: 1}"), capture_output=True,
+                            text=True, timeout=120)
+    assert result.returncode != 0
+    assert "boom" in result.stderr and "demo.partial.ipynb" in result.stderr
+    assert not any(path.exists() for path in stale)
+    assert (reports / "notebooks" / "demo.partial.ipynb").is_file()  # how far it got, named as such
+
+
+def test_bad_parallel_value_stops_before_any_work_naming_the_key(tmp_path):
+    notebook = make_notebook(tmp_path / "demo.ipynb", {"work": WORK})
+    result = subprocess.run(runner(notebook, tmp_path, "{backend: local, n_jobs: 0}"), capture_output=True,
+                            text=True, timeout=120)
+    assert result.returncode != 0 and "parallel.n_jobs" in result.stderr
+    assert "Traceback" not in result.stderr
+    assert not (tmp_path / "reports").exists()  # no kernel started, no folder made
+
+
+def test_summary_lists_stages_in_name_order_with_their_total(tmp_path):
+    for stage, seconds, backend, address in [("02_b", 30.4, "dask", "tcp://10.0.0.5:8786"),
+                                             ("01_a", 12.0, "local", None)]:
+        StageTiming(stage, seconds, backend, 4, address, "2025-11-23T14:02:07").write(tmp_path / f"{stage}.json")
+    lines = summary(tmp_path)
+    assert [line.split()[0] for line in lines] == ["01_a", "02_b", "total"]
+    assert "dask at tcp://10.0.0.5:8786, n_jobs 4" in lines[1] and "finished 2025-11-23 14:02" in lines[1]
+    assert lines[2].split()[1] == "42"
+    assert summary(tmp_path / "missing") == []
