@@ -12,7 +12,7 @@ from pred_synthetic import TINY_FIT, TINY_PREDICT, scene_tables
 ROOT = Path(__file__).resolve().parents[2]
 NOTEBOOK = ROOT / "notebooks" / "04_predictor_sweeps.ipynb"
 FIGURES = ["04_fig5_long_range.png", "04_fig6_pnp.png", "04_fig7_straight_line.png", "04_fig8_next_step.png",
-           "04_uncertainty.png"]  # fmt: skip
+           "04_loso.png", "04_relative_thresholds.png", "04_uncertainty.png"]  # fmt: skip
 
 
 @pytest.mark.notebook
