@@ -23,6 +23,7 @@ class Headline:
     label: str
     paper: str = "-"
     target: str = "-"
+    fmt: str = "{:.4g}"  # how a float is shown, e.g. "{:+.1%}" for a relative improvement
 
 
 SECTIONS = {
@@ -52,21 +53,21 @@ def _predictor_rows() -> list[Headline]:
     improvement = paper.WINDSOR_IMPROVEMENTS
     rows += [
         Headline("predictors", "long_range.relative_improvement", "long range over static (mean of both tolerances)",
-                 f"+{improvement['long_range_vs_static']:.1%}"),
+                 f"+{improvement['long_range_vs_static']:.1%}", fmt="{:+.1%}"),
         Headline("predictors", "long_range.relative_improvement_vs_mlp", "long range over MLP",
-                 f"+{improvement['long_range_vs_mlp']:.1%}"),
+                 f"+{improvement['long_range_vs_mlp']:.1%}", fmt="{:+.1%}"),
         Headline("predictors", "next_step.relative_improvement", "next step over static",
-                 f"+{improvement['next_step_vs_static']:.1%}"),
+                 f"+{improvement['next_step_vs_static']:.1%}", fmt="{:+.1%}"),
         Headline("predictors", "next_step.relative_improvement_vs_long_range", "next step over long range",
-                 f"+{improvement['next_step_vs_long_range']:.1%}"),
+                 f"+{improvement['next_step_vs_long_range']:.1%}", fmt="{:+.1%}"),
         Headline("predictors", "straight_line.relative_improvement", "straight lines (2 mm/3 deg): long range over static",
-                 f"+{improvement['straight_line_vs_static']:.1%}"),
+                 f"+{improvement['straight_line_vs_static']:.1%}", fmt="{:+.1%}"),
         Headline("predictors", "live.incursions", "simulated live trials: incursions (next step, fixed n_t)",
                  f"{paper.WINDSOR_LIVE['incursions']} of {paper.WINDSOR_LIVE['n_trials']}"),
         Headline("predictors", "live.envelope_share", "simulated live trials: share of the actual envelope used",
-                 f"{paper.WINDSOR_LIVE['envelope_share']:.1%}"),
+                 f"{paper.WINDSOR_LIVE['envelope_share']:.1%}", fmt="{:.1%}"),
         Headline("predictors", "live.static_envelope_share", "... static baseline",
-                 f"{paper.WINDSOR_LIVE['static_envelope_share']:.1%}"),
+                 f"{paper.WINDSOR_LIVE['static_envelope_share']:.1%}", fmt="{:.1%}"),
     ]
     for tolerance in paper.TOLERANCES:
         label = paper.TOLERANCE_LABELS[tolerance]
@@ -102,6 +103,8 @@ HEADLINES: list[Headline] = [
     Headline("generate", "wall_time_s", "stage wall time (s)", "-", "<= 480"),
     Headline("artifacts", "realism.min_abs_spearman", "weakest decay over arcs: min of -Spearman(theta, mean n_i)",
              "n_i 'decays' with viewing angle", ">= 0.8"),
+    Headline("artifacts", "realism.min_abs_spearman_to_failure",
+             "... over the stops up to theta_a (4 mm/10 deg) only, a diagnostic: the floor after failure is noise"),
     Headline("artifacts", "realism.min_first_stop_mean_inliers", "smallest mean n_i at the first stop", "-",
              ">= 50"),
     Headline("artifacts", "realism.error_ratio_low_vs_high_inliers",
@@ -114,7 +117,7 @@ HEADLINES: list[Headline] = [
              ">= 0.25"),
     Headline("artifacts", "realism.median_inliers_at_theta_a_4mm10deg",
              "median mean n_i at theta_a, 4 mm/10 deg (failure by running out of inliers)",
-             "12-28 (n_t at zero incursion, Table III)", "<= 30"),
+             "12-28 (n_t at zero incursion, Table III)", "<= 30; R4: 10-35"),
     Headline("artifacts", "realism.emg_rmse_ratio",
              "R1: EMG mean RMSE from 4 stops / best other least-squares base function's (arcs)",
              "EMG lowest (Fig. 2)", "<= 1.10"),
@@ -125,6 +128,8 @@ HEADLINES: list[Headline] = [
              "static 7.0 at both tolerances", "<= 4.5"),
     Headline("artifacts", "realism.median_inliers_at_theta_a_2mm3deg", "R4: median mean n_i at theta_a, 2 mm/3 deg",
              "n_t 12-23 at zero incursion", "10-35"),
+    Headline("artifacts", "realism.p90_inliers_at_theta_a_2mm3deg", "R4: 90th percentile of n_i at theta_a, "
+             "2 mm/3 deg", "-", "<= 50"),
     Headline("artifacts", "realism.p90_inliers_at_theta_a_4mm10deg", "R4: 90th percentile of n_i at theta_a, "
              "4 mm/10 deg", "-", "<= 50"),
     Headline("artifacts", "realism.median_decay_ratio_arc", "R5: median mean n_i at the 4th stop / first stop, arcs",
@@ -163,11 +168,11 @@ HEADLINES: list[Headline] = [
     Headline("tracking", "rms_deg.no_filter", "RMS geodesic rotation error, no filter (deg; ours)"),
     Headline("tracking", "rms_deg.ukf", "RMS geodesic rotation error, UKF (deg; ours)"),
     Headline("tracking", "rms_deg.ukf_gyro", "RMS geodesic rotation error, UKF + gyro (deg; ours)"),
-    Headline("tracking", "success_rates.a_markers4", "correct pose, 4 markers, motion (a) paper-like", "98.63 %"),
-    Headline("tracking", "success_rates.a_markers3", "correct pose, 3 markers, motion (a) paper-like", "96.04 %"),
-    Headline("tracking", "success_rates.b_markers4", "correct pose, 4 markers, motion (b) stress test"),
-    Headline("tracking", "success_rates.b_markers3", "correct pose, 3 markers, motion (b) stress test"),
-    Headline("tracking", "success_rates.b_markers4_no_split", "correct pose, 4 markers, motion (b), touching blobs not split"),
+    Headline("tracking", "success_rates.a_markers4", "correct pose, 4 markers, motion (a) paper-like", "98.63 %", fmt="{:.2%}"),
+    Headline("tracking", "success_rates.a_markers3", "correct pose, 3 markers, motion (a) paper-like", "96.04 %", fmt="{:.2%}"),
+    Headline("tracking", "success_rates.b_markers4", "correct pose, 4 markers, motion (b) stress test", fmt="{:.2%}"),
+    Headline("tracking", "success_rates.b_markers3", "correct pose, 3 markers, motion (b) stress test", fmt="{:.2%}"),
+    Headline("tracking", "success_rates.b_markers4_no_split", "correct pose, 4 markers, motion (b), touching blobs not split", fmt="{:.2%}"),
     Headline("tracking", "lag_ms.ukf", "lag of the filtered signal, our sigmas (ms)", "199.5"),
     Headline("tracking", "sigmas_motion_a.published.lag_ms", "lag on motion (a), published sigmas (ms)", "199.5"),
     Headline("tracking", "sigmas_motion_a.published.axis_mm", "RMS position error per axis on motion (a), published sigmas (mm)", "1.77"),
@@ -200,13 +205,13 @@ def lookup(metrics: dict[str, dict], stage: str, key: str):
     return value
 
 
-def _fmt(value) -> str:
+def _fmt(value, fmt: str = "{:.4g}") -> str:
     if value is MISSING:
         return "not run"
     if value is None:
         return "none"
     if isinstance(value, float):
-        return f"{value:.4g}"
+        return fmt.format(value)
     return str(value)
 
 
@@ -220,6 +225,6 @@ def render_summary(metrics: dict[str, dict]) -> str:
     for stage, title in SECTIONS.items():
         lines += [f"## {title}", "", "| figure | ours | paper | target |", "| --- | --- | --- | --- |"]
         for h in (h for h in HEADLINES if h.stage == stage):
-            lines.append(f"| {h.label} | {_fmt(lookup(metrics, stage, h.key))} | {h.paper} | {h.target} |")
+            lines.append(f"| {h.label} | {_fmt(lookup(metrics, stage, h.key), h.fmt)} | {h.paper} | {h.target} |")
         lines.append("")
     return "\n".join(lines)
