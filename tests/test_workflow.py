@@ -110,3 +110,18 @@ def test_dvc_lock_matches_committed_notebooks_and_params():
                 assert digest == dep["md5"], f"{dep['path']} differs from the one {name} ran (re-run the stage)"
         for section, value in stage.get("params", {}).get("params.yaml", {}).items():
             assert params[section] == value, f"params.yaml section {section} changed since {name} ran"
+
+
+SHIPPED = ["src", "notebooks", "benchmarks", "docs", "assets/README.md", "README.md", "params.yaml", "dvc.yaml",
+           "Makefile"]
+
+
+@pytest.mark.parametrize("outside", ["FACTS.md", "../shared", "/work/"])
+def test_the_repository_points_nowhere_outside_itself(outside):
+    """A user's clone has no ../shared: facts the code relies on are cited from docs/references.md."""
+    files = [p for entry in SHIPPED for p in ([ROOT / entry] if (ROOT / entry).is_file()
+                                               else sorted((ROOT / entry).rglob("*"))) if p.is_file()]
+    text_files = [p for p in files if p.suffix in {".py", ".ipynb", ".md", ".yaml", ""}]
+    assert len(text_files) > 50
+    offenders = [str(p.relative_to(ROOT)) for p in text_files if outside in p.read_text(errors="ignore")]
+    assert not offenders, f"{outside} named in {offenders}"

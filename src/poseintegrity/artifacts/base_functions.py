@@ -34,7 +34,7 @@ from poseintegrity.artifacts.fitted import (
     valid_samples,
 )
 
-K_MIN = 0.05  # lower bound of the EMG shape K: exponnorm misbehaves as K -> 0 (FACTS.md, scipy)
+K_MIN = 0.05  # lower bound of the EMG shape K: exponnorm misbehaves as K -> 0 (docs/references.md, "SciPy")
 LONGEST_DECAY = 20.0  # longest decay length (K, tau, s) a fit may choose, in sampled spans
 LARGEST_LEVEL = 10.0  # largest amplitude (a level, in counts) a fit may choose, in largest mean counts
 
@@ -155,7 +155,7 @@ StartRule = Callable[[DecaySummary], tuple[list[float], list[float], list[float]
 
 def _start_emg(s: DecaySummary) -> tuple[list[float], list[float], list[float]]:
     # K ~ decay length; Gaussian centre 2 sigma (2 theta units) before the first sample, so the samples
-    # start on the decaying side of the peak. K >= K_MIN (FACTS.md: exponnorm trouble at small K).
+    # start on the decaying side of the peak. K >= K_MIN (docs/references.md, "SciPy": exponnorm trouble at small K).
     (_, k_hi), (m_lo, m_hi) = s.scale_bounds, s.location_bounds
     return [s.tau0, s.t0 - 2.0], [0.0, K_MIN, m_lo], [np.inf, k_hi, m_hi]
 

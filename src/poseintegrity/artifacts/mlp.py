@@ -5,7 +5,7 @@
                 of :data:`poseintegrity.artifacts.base_functions.EMG`), then fine-tuned on the samples
                 plus artificial points (theta_max, 0), e.g. (45 deg, 0) for arcs
 
-The paper publishes no training details (FACTS.md); ours, all in params.yaml ``fit.mlp``: inputs scaled to
+The paper publishes no training details (docs/references.md, "Camera of the Windsor et al. experiments"); ours, all in params.yaml ``fit.mlp``: inputs scaled to
 u = 2 theta / theta_max - 1 in [-1, 1], outputs to y = n / max(n); float64; full batch; L-BFGS with a strong
 Wolfe line search, stopped early when the loss changes by less than ``tolerance_change``; the fine-tune
 after pretraining is deliberately short (``max_iter_finetune``, e.g. 20 iterations) because a full

@@ -1,7 +1,7 @@
 """Schema of the ``fit`` section of ``params.yaml`` (stage 03, artifact models).
 
 Every value is explicit in ``params.yaml``: none of these choices were published by Windsor et al.
-(see /work/shared/reference/FACTS.md), so each is ours and documented here.
+(docs/references.md, "Camera of the Windsor et al. experiments"), so each is ours and documented here.
 """
 
 from __future__ import annotations

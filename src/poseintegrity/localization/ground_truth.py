@@ -1,6 +1,6 @@
 """Board-based ground truth (IV-C): ArUco GridBoard detection -> board.matchImagePoints -> cv2.solvePnP.
 
-OpenCV 5 API (FACTS.md): ``cv2.aruco.ArucoDetector(...).detectMarkers`` replaces the removed free functions.
+OpenCV 5 API (docs/references.md, "OpenCV 5"): ``cv2.aruco.ArucoDetector(...).detectMarkers`` replaces the removed free functions.
 The estimated pose maps board coordinates (the frame of ``board.getObjPoints()``, mm) into the camera frame.
 """
 

@@ -1,6 +1,6 @@
 """Schema of the ``extract`` section of ``params.yaml`` (stages 02 and 05).
 
-Windsor et al. published no SIFT, CLAHE or RANSAC settings (FACTS.md, "Camera of the Windsor et al.
+Windsor et al. published no SIFT, CLAHE or RANSAC settings (docs/references.md, "Camera of the Windsor et al.
 experiments"): every value here is our choice and is documented next to its field.
 """
 
@@ -59,8 +59,8 @@ class ExtractParams(_Section):
         True, description="polish the USAC pose by Levenberg-Marquardt on its inliers (pnp.solve_pnp_ransac)")
     ransac_max_iterations: int = Field(
         100, ge=1,
-        description="classic RANSAC iteration cap (stage 05); 100 is OpenCV's default iterationsCount. FACTS.md:"
-        " EPnP needed ~10 000 at 80 % outliers, so the classic solvers give up earlier than USAC on low-inlier"
+        description="classic RANSAC iteration cap (stage 05); 100 is OpenCV's default iterationsCount."
+        " docs/references.md, 'OpenCV 5': EPnP needed ~10 000 at 80 % outliers, so the classic solvers give up earlier than USAC on low-inlier"
         " frames (where each 5-point EPnP iteration costs ~0.1-0.2 ms)",
     )
     pnp_method: PnPMethod = Field("usac_magsac", description="stage 02: the paper's PnP-RANSAC (OpenCV USAC)")

@@ -3,7 +3,7 @@
 Two paths, both through ``cv2.solvePnPRansac``:
 
 - ``usac_magsac``: the paper's path, OpenCV USAC with MAGSAC++ scoring, sigma-consensus local optimisation and a
-  MAGSAC final polish; USAC always uses a P3P minimal solver (FACTS.md, OpenCV 5.0).
+  MAGSAC final polish; USAC always uses a P3P minimal solver (docs/references.md, "OpenCV 5").
 - ``epnp``, ``p3p``, ``ap3p``, ``sqpnp``, ``iterative``: classic RANSAC with that ``SOLVEPNP_*`` flag. In
   OpenCV the minimal samples are solved with P3P/AP3P for those flags and with EPnP otherwise, and the final
   refit on the inliers uses the flag (EPnP for P3P/AP3P).
@@ -14,7 +14,7 @@ to them). With ``refine_lm`` the USAC pose is therefore polished by Levenberg-Ma
 (``cv2.solvePnPRefineLM``), the step classic ``solvePnPRansac`` takes itself with its final refit.
 
 n_i: classic RANSAC reports the inliers of the best *hypothesis*, not of the refined pose it returns (OpenCV
-issue 29573, FACTS.md). For every method the inliers are therefore recounted on the returned pose with
+issue 29573; docs/references.md, "OpenCV 5"). For every method the inliers are therefore recounted on the returned pose with
 ``cv2.projectPoints`` and the same threshold; OpenCV's own count is kept as ``n_inliers_reported``.
 """
 
@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-# names of FACTS.md (OpenCV 5 renumbered the flags: never use the integers)
+# names of docs/references.md, "OpenCV 5" (OpenCV 5 renumbered the flags: never use the integers)
 CLASSIC_FLAGS = {
     "epnp": cv2.SOLVEPNP_EPNP,
     "p3p": cv2.SOLVEPNP_P3P,

@@ -28,7 +28,7 @@ class Intrinsics:
 
     @classmethod
     def from_params(cls, camera: "CameraParams") -> "Intrinsics":
-        """IDS U3-3060CP: f_px = f_mm / pixel pitch (FACTS.md), principal point at the centre, downscaled."""
+        """IDS U3-3060CP: f_px = f_mm / pixel pitch (docs/references.md, "Camera of the Windsor et al. experiments"), principal point at the centre, downscaled."""
         scale = 1.0 / camera.downscale
         f_px = camera.lens_mm / (camera.pixel_um * 1e-3) * scale
         width = camera.sensor_width_px // camera.downscale

@@ -21,7 +21,7 @@ PositiveInt = Annotated[int, Field(gt=0)]
 
 
 class CameraParams(BaseModel):
-    """IDS U3-3060CP-M (Sony IMX174, mono) with a fixed-focal lens (FACTS.md)."""
+    """IDS U3-3060CP-M (Sony IMX174, mono) with a fixed-focal lens (docs/references.md, "Camera of the Windsor et al. experiments")."""
 
     model_config = _frozen
     sensor_width_px: PositiveInt = 1936
