@@ -35,6 +35,8 @@ import joblib
 from pydantic import BaseModel, ConfigDict, Field, ValidationInfo, field_validator
 from tqdm import tqdm
 
+from poseintegrity.schema import WorkerCount
+
 Task = TypeVar("Task")
 Result = TypeVar("Result")
 
@@ -51,16 +53,9 @@ class ParallelParams(BaseModel):
     address: str | None = Field(
         None, description="dask only: a scheduler address such as tcp://host:8786; null starts a LocalCluster "
                           "of n_jobs single-threaded worker processes on this machine")
-    n_jobs: int = Field(
+    n_jobs: WorkerCount = Field(
         2, description="worker processes of the local backend and of a LocalCluster (-1: all cores); "
                        "a scheduler at `address` has the workers that joined it")
-
-    @field_validator("n_jobs")
-    @classmethod
-    def _valid_n_jobs(cls, n_jobs: int) -> int:
-        if n_jobs == 0 or n_jobs < -1:
-            raise ValueError("n_jobs must be a positive number of worker processes or -1 (all cores)")
-        return n_jobs
 
     @field_validator("address")
     @classmethod

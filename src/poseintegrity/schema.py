@@ -16,3 +16,12 @@ def _resolve(path: Path, info: ValidationInfo) -> Path:
 
 
 ProjectPath = Annotated[Path, AfterValidator(_resolve)]  # a file named in params.yaml, relative to its directory
+
+
+def _worker_count(n_jobs: int) -> int:
+    if n_jobs == 0 or n_jobs < -1:
+        raise ValueError("n_jobs must be a positive number of worker processes or -1 (all cores)")
+    return n_jobs
+
+
+WorkerCount = Annotated[int, AfterValidator(_worker_count)]  # n_jobs: processes, or -1 for all cores

@@ -10,6 +10,8 @@ from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator
 
+from poseintegrity.schema import WorkerCount
+
 PnPMethod = Literal["usac_magsac", "epnp", "p3p", "ap3p", "sqpnp", "iterative"]
 
 
@@ -71,7 +73,7 @@ class ExtractParams(_Section):
         [(2.0, 3.0), (4.0, 10.0)], min_length=1, description="(E_t mm, E_r deg) error tolerances of IV-E"
     )
     seed: int = Field(0, ge=0, description="seeds every RANSAC run (one derived seed per frame)")
-    n_jobs: int = Field(2, description="joblib workers over images (-1: all cores)")
+    n_jobs: WorkerCount = Field(2, description="joblib workers over images (-1: all cores)")
     features_dir: str = Field("features", min_length=1, description="SIFT cache, relative to data_dir")
     datasets: list[str] | None = Field(None, description="dataset ids to process; null: every dataset")
     realism: RealismParams
@@ -83,13 +85,6 @@ class ExtractParams(_Section):
             if E_t_mm <= 0 or E_r_deg <= 0:
                 raise ValueError(f"tolerances must be positive (mm, deg), got ({E_t_mm}, {E_r_deg})")
         return tolerances
-
-    @field_validator("n_jobs")
-    @classmethod
-    def _valid_n_jobs(cls, n_jobs: int) -> int:
-        if n_jobs == 0 or n_jobs < -1:
-            raise ValueError("n_jobs must be a positive number of workers or -1 (all cores)")
-        return n_jobs
 
 
 def tolerance_name(tolerance: tuple[float, float]) -> str:
