@@ -7,6 +7,7 @@ import pytest
 
 from poseintegrity.report import paper
 from poseintegrity.report.summary import HEADLINES, SECTIONS, render_summary
+from repository import ROOT, outside_references
 
 # Rows of Windsor et al.'s tables as printed (system, 2mm/3deg, 4mm/10deg, mean, relative improvement)
 TABLE_I = """Static Baseline	7.0	7.0	7.0	84.1%
@@ -57,4 +58,6 @@ def test_values_nulls_and_missing_stages_are_told_apart():
 
 
 def test_the_summary_points_nowhere_outside_the_repository():
-    assert "../shared" not in render_summary({}) and "FACTS.md" not in render_summary({})
+    summary = ROOT / "reports" / "summary.md"
+    assert "docs/references.md" in render_summary({})
+    assert outside_references(render_summary({}), summary.parent) == []
