@@ -34,6 +34,16 @@ WINDSOR_IMPROVEMENTS = {
 # V-C live trials: n_t = 15 (Table III, 4 mm/10 deg), 10 trials
 WINDSOR_LIVE = {"n_t": 15, "n_trials": 10, "incursions": 0, "envelope_share": 0.747, "static_envelope_share": 0.604}
 
+# Black and Salcudean, section III and Table I. rms_mm / rms_deg are their metric: the mean over the three axes of
+# the RMS element-wise difference (position; Euler angles); success rates as fractions of 10 000 frames
+BLACK_RESULTS = {
+    "rms_mm": {"no_filter": 3.01, "ukf": 1.77},
+    "rms_deg": {"no_filter": 1.75, "ukf": 1.51},
+    "success_rate": {"markers4": 0.9863, "markers3": 0.9604},
+    "lag_ms": 199.5,
+    "failed_downdate_share": 16 / 25000,
+}
+
 
 def mean_spl(predictor: str) -> float:
     """The paper's "Mean" column of Tables I-II: the mean over both tolerances."""

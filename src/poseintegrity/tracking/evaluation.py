@@ -24,6 +24,7 @@ from poseintegrity.tracking.frames import draw_phantoms, intrinsics, render_fram
 from poseintegrity.tracking.geometry import MARKER_DIAMETER_M, pose_matrix, transform_points
 from poseintegrity.tracking.kabsch import kabsch, pose_from_points
 from poseintegrity.tracking.motion import sample_sensors, simulate_trajectory
+from poseintegrity.report.paper import BLACK_RESULTS
 from poseintegrity.tracking.params import PAPER_SIGMAS, TrackParams
 from poseintegrity.tracking.peers import filter_speed, pykalman_time_update
 from poseintegrity.tracking.recording import RecordingWriter, read_recording, track_recording
@@ -32,17 +33,6 @@ from poseintegrity.tracking.tools import MultiToolTracker
 from poseintegrity.tracking.tracker import MarkerTracker
 from poseintegrity.tracking.ukf import UnscentedKalmanFilter
 from poseintegrity.tracking.unscented import UnscentedMarkerFilter
-
-# Black and Salcudean (IEEE TIM 2024), section III and Table I: the numbers ours are reported beside.
-# rms_mm / rms_deg are their metric: mean over axes of the RMS element-wise difference (position, Euler angles).
-PAPER = {
-    "rms_mm": {"no_filter": 3.01, "ukf": 1.77},
-    "rms_deg": {"no_filter": 1.75, "ukf": 1.51},
-    "success_rate": {"markers4": 0.9863, "markers3": 0.9604},
-    "lag_ms": 199.5,
-    "failed_downdate_share": 16 / 25000,
-}
-
 
 def experiment_rng(params: TrackParams, name: str) -> np.random.Generator:
     """The generator of one experiment: default_rng([params.seed, crc32(name)])."""
@@ -398,7 +388,7 @@ def run_study(params: TrackParams, recording_folder: Path) -> Study:
         "speedup_vs_filterpy": speed["speedup_vs_filterpy"],
         "speedup_vs_pykalman": speed["speedup_vs_pykalman"],
         "filter_step_ms": {k: v for k, v in speed.items() if not k.startswith("speedup")},
-        "paper": PAPER,
+        "paper": BLACK_RESULTS,
     }
     tables = {**tables, "sigma_sweep": sweep, "success": success, **success_tables, "sigmas_motion_a": sigmas,
               "small_blobs": blobs, "multi_tool": tools, "replay_poses": replay}
