@@ -23,6 +23,7 @@ from poseintegrity.localization.params import ExtractParams
 from poseintegrity.parallel import ParallelParams
 from poseintegrity.prediction.params import PredictParams
 from poseintegrity.scenes.params import GenerateParams
+from poseintegrity.schema import KeyRule
 from poseintegrity.tracking.params import TrackParams
 
 
@@ -44,10 +45,17 @@ class Params(BaseModel):
 
 
 def _format_errors(error: ValidationError, prefix: tuple = ()) -> str:
+    """One line per bad key: ``  <dotted key>: <why> (got <value>)``. A rule between keys (:class:`KeyRule`) names
+    the key it carries; the whole section it was checked on is not repeated."""
     lines = []
     for item in error.errors():
-        key = ".".join(str(part) for part in (*prefix, *item["loc"])) or "<root>"
-        lines.append(f"  {key}: {item['msg']} (got {item.get('input')!r:.80})")
+        rule = item.get("ctx", {}).get("error")
+        loc = (*prefix, *item["loc"], *(rule.key.split(".") if isinstance(rule, KeyRule) else ()))
+        key = ".".join(str(part) for part in loc) or "<root>"
+        value = item.get("input")
+        got = "" if isinstance(value, dict) else f" (got {value!r:.80})"
+        message = str(rule) if isinstance(rule, KeyRule) else item["msg"]
+        lines.append(f"  {key}: {message}{got}")
     return "\n".join(lines)
 
 

@@ -32,10 +32,10 @@ from typing import Literal, TypeVar
 from urllib.parse import urlsplit
 
 import joblib
-from pydantic import BaseModel, ConfigDict, Field, ValidationInfo, field_validator
+from pydantic import Field, ValidationInfo, field_validator
 from tqdm import tqdm
 
-from poseintegrity.schema import WorkerCount
+from poseintegrity.schema import Section, WorkerCount
 
 Task = TypeVar("Task")
 Result = TypeVar("Result")
@@ -43,10 +43,8 @@ Result = TypeVar("Result")
 DASK_SCHEMES = ("tcp", "tls", "ws", "wss")
 
 
-class ParallelParams(BaseModel):
+class ParallelParams(Section):
     """The ``parallel`` section of ``params.yaml``: where the per-frame and per-dataset tasks run."""
-
-    model_config = ConfigDict(extra="forbid", frozen=True)
 
     backend: Literal["local", "dask"] = Field(
         "local", description="local: joblib (loky) worker processes on this machine; dask: a Dask cluster")

@@ -1,11 +1,36 @@
-"""Building blocks shared by the params schemas of every section (``poseintegrity.<subpackage>.params``)."""
+"""Building blocks shared by the params schemas of every section (``poseintegrity.<subpackage>.params``).
+
+Every section model derives from :class:`Section`: unknown keys are refused, values are frozen, and every float
+must be finite (NaN and inf are refused wherever a number is expected). Field types here carry the rules that
+recur across sections (seeds, worker counts, ordered ranges, distinct entries), so that a bad value is refused
+by the field itself and the error names its key. A rule between several keys of one model raises
+:class:`KeyRule` from a ``model_validator``; :mod:`poseintegrity.config` then names the key it carries.
+"""
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, TypeVar
 
-from pydantic import AfterValidator, ValidationInfo
+from pydantic import AfterValidator, BaseModel, ConfigDict, Field, ValidationInfo
+
+T = TypeVar("T")
+
+
+class Section(BaseModel):
+    """Base of every params.yaml (sub)section: extra keys refused, frozen, floats finite."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+
+
+class KeyRule(ValueError):
+    """A rule between keys of one section failed; ``key`` (dotted, relative to the model that raised it) is the
+    key the error message names, e.g. ``KeyRule("k_report_arc", "must be <= k_max (5), got 30")``."""
+
+    def __init__(self, key: str, message: str):
+        super().__init__(message)
+        self.key = key
 
 
 def _resolve(path: Path, info: ValidationInfo) -> Path:
@@ -25,3 +50,25 @@ def _worker_count(n_jobs: int) -> int:
 
 
 WorkerCount = Annotated[int, AfterValidator(_worker_count)]  # n_jobs: processes, or -1 for all cores
+Seed = Annotated[int, Field(ge=0, lt=2**63)]  # a numpy SeedSequence entropy: a non-negative integer
+
+
+def _ordered(bounds: tuple[float, float]) -> tuple[float, float]:
+    if not bounds[0] <= bounds[1]:
+        raise ValueError(f"a range [low, high] needs low <= high, got {list(bounds)}")
+    return bounds
+
+
+OrderedRange = Annotated[tuple[float, float], AfterValidator(_ordered)]  # [low, high], low <= high
+
+
+def _distinct(values: Sequence[T]) -> Sequence[T]:
+    repeated = sorted({str(v) for v in values if list(values).count(v) > 1})
+    if repeated:
+        raise ValueError(f"entries must be distinct, repeated: {', '.join(repeated)}")
+    return values
+
+
+def distinct(item_type: type) -> type:
+    """``list[item_type]`` whose entries must all differ, e.g. ``distinct(float)`` for azimuths."""
+    return Annotated[list[item_type], AfterValidator(_distinct)]

@@ -8,17 +8,17 @@ from __future__ import annotations
 
 from typing import Literal
 
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import Field, model_validator
+
+from poseintegrity.schema import Section
 
 ModelName = Literal[
     "emg", "exponential", "gaussian", "logistic", "power_law", "mlp_scratch", "mlp_pretrained"
 ]
 
 
-class MLPParams(BaseModel):
+class MLPParams(Section):
     """The MLP of Windsor et al. IV-E and its training (full batch, L-BFGS with strong Wolfe line search)."""
-
-    model_config = ConfigDict(extra="forbid", frozen=True)
 
     hidden_layers: int = Field(ge=1, le=10, description="hidden layers (paper: 3)")
     hidden_units: int = Field(ge=1, le=1000, description="neurons per hidden layer (paper: 10)")
@@ -35,10 +35,8 @@ class MLPParams(BaseModel):
     n_artificial: int = Field(ge=1, description="copies of the artificial sample (range end, 0)")
 
 
-class FitParams(BaseModel):
+class FitParams(Section):
     """Stage 03: fit artifact models f: theta -> n_inliers and run the Fig. 2 experiment."""
-
-    model_config = ConfigDict(extra="forbid", frozen=True)
 
     pnp_method: str = Field(min_length=1, description="PnP method whose n_inliers are modelled")
     models: tuple[ModelName, ...] = Field(min_length=1, description="artifact models compared in Fig. 2")

@@ -8,25 +8,22 @@ from __future__ import annotations
 
 from typing import Literal
 
-from pydantic import BaseModel, ConfigDict, Field, field_validator
+from pydantic import Field, field_validator
 
-from poseintegrity.schema import WorkerCount
+from poseintegrity.schema import Section, WorkerCount
 
 PnPMethod = Literal["usac_magsac", "epnp", "p3p", "ap3p", "sqpnp", "iterative"]
 
 
-class _Section(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
 
-
-class ClaheParams(_Section):
+class ClaheParams(Section):
     """Contrast limited adaptive histogram equalization before SIFT (paper IV-C)."""
 
     clip_limit: float = Field(2.0, gt=0, description="cv2.createCLAHE clipLimit")
     tile_grid: int = Field(8, ge=1, le=64, description="tiles per image side (tileGridSize = (n, n))")
 
 
-class SiftParams(_Section):
+class SiftParams(Section):
     """cv2.SIFT_create arguments (Lowe 2004 defaults unless changed)."""
 
     n_features: int = Field(0, ge=0, description="keep the n strongest keypoints; 0 keeps all")
@@ -36,14 +33,14 @@ class SiftParams(_Section):
     sigma: float = Field(1.6, gt=0)
 
 
-class RealismParams(_Section):
+class RealismParams(Section):
     """The realism checks of the rendered world (:func:`poseintegrity.localization.artifacts.realism_metrics`)."""
 
     fit_stops: int = Field(ge=2, description="stops the R1 fits and the R2 / R5 sampling use (paper: 4)")
     max_nfev: int = Field(ge=10, description="curve_fit evaluation budget of each R1 fit")
 
 
-class ExtractParams(_Section):
+class ExtractParams(Section):
     """Target localization pipeline, artifact extraction and actual envelopes (stages 02 and 05)."""
 
     clahe: ClaheParams = ClaheParams()

@@ -10,27 +10,24 @@ from __future__ import annotations
 from typing import Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import Field, model_validator
 
 from poseintegrity.artifacts.params import ModelName
+from poseintegrity.schema import Section
 
 IntervalMethod = Literal["covariance", "bootstrap"]
 
 
-class PredictorModels(BaseModel):
+class PredictorModels(Section):
     """Artifact model behind each predictor (a name of :data:`poseintegrity.artifacts.MODEL_NAMES`)."""
-
-    model_config = ConfigDict(extra="forbid", frozen=True)
 
     long_range: ModelName = Field(description="long range predictor (paper: eq. 1, the EMG)")
     next_step: ModelName = Field(description="next-step predictor (paper: the EMG)")
     mlp: ModelName = Field(description="the MLP baseline of IV-A (paper: the EMG-pretrained, fine-tuned MLP)")
 
 
-class UncertaintyParams(BaseModel):
+class UncertaintyParams(Section):
     """Prediction interval on theta_p (beyond the paper)."""
-
-    model_config = ConfigDict(extra="forbid", frozen=True)
 
     method: IntervalMethod = Field(
         description="covariance: delta method from the EMG fit's parameter covariance; bootstrap: refits on images"
@@ -40,10 +37,8 @@ class UncertaintyParams(BaseModel):
     n_bootstrap: int = Field(ge=2, description="bootstrap refits per dataset (method bootstrap)")
 
 
-class PredictParams(BaseModel):
+class PredictParams(Section):
     """Stage 04: predictors, the n_t sweep, the static baseline, LOSO threshold choice, live-trial simulation."""
-
-    model_config = ConfigDict(extra="forbid", frozen=True)
 
     pnp_method: str = Field(min_length=1, description="the paper's PnP path (Tables I-III); others only in Fig. 6")
     n_t_min: int = Field(ge=1, description="smallest inlier threshold of the sweep (paper: 4)")

@@ -8,22 +8,20 @@ from typing import Annotated
 
 import cv2
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
+from pydantic import Field, field_validator, model_validator
 
 from poseintegrity.scenes.catalog import TARGET_NAMES, TEXTURE_NAMES
 from poseintegrity.scenes.foam import ReliefVolume, relief_volume
 from poseintegrity.scenes.mesh import Material
 from poseintegrity.scenes.scapula import read_mesh
-from poseintegrity.schema import ProjectPath
+from poseintegrity.schema import ProjectPath, Section
 
-_frozen = ConfigDict(extra="forbid", frozen=True)
 PositiveInt = Annotated[int, Field(gt=0)]
 
 
-class CameraParams(BaseModel):
+class CameraParams(Section):
     """IDS U3-3060CP-M (Sony IMX174, mono) with a fixed-focal lens (docs/references.md, "Camera of the Windsor et al. experiments")."""
 
-    model_config = _frozen
     sensor_width_px: PositiveInt = 1936
     sensor_height_px: PositiveInt = 1216
     pixel_um: float = Field(5.86, gt=0)
@@ -32,10 +30,9 @@ class CameraParams(BaseModel):
     f_number: float = Field(4.0, gt=0, description="aperture; sets the depth of field (focus at the model view)")
 
 
-class SensorParams(BaseModel):
+class SensorParams(Section):
     """Image formation after the optics: exposure, noise, blur, flicker (8-bit output)."""
 
-    model_config = _frozen
     exposure: float = Field(215.0, gt=0, description="DN for a white Lambertian surface facing the ring light")
     read_noise_dn: float = Field(1.2, ge=0)
     shot_noise_dn_per_dn: float = Field(0.02, ge=0, description="variance of shot noise per DN of signal")
@@ -43,11 +40,10 @@ class SensorParams(BaseModel):
     flicker: float = Field(0.006, ge=0, lt=0.5, description="std of the per-image illumination gain")
 
 
-class LightParams(BaseModel):
+class LightParams(Section):
     """The lab's light: a ring light on the camera, a room light fixed to the scene, ambient light (radiances of a
     white surface facing each light); the background is the radiance seen past every object."""
 
-    model_config = _frozen
     ambient: float = Field(ge=0)
     ring: float = Field(ge=0, description="on the lens: moves with the camera, lights what the camera sees")
     room: float = Field(ge=0, description="directional, fixed to the scene (direction drawn per scene)")
@@ -57,18 +53,16 @@ class LightParams(BaseModel):
         return self.ambient, self.ring, self.room, self.background
 
 
-class DrillParams(BaseModel):
+class DrillParams(Section):
     """The prepared phantom's hole: "pre-drilled for implant placement", "oversized" (IV-B, Fig. 3)."""
 
-    model_config = _frozen
     diameter_mm: float = Field(gt=0, le=20, description="hole diameter (a glenoid baseplate peg hole is 6-8 mm)")
     depth_mm: float = Field(gt=0, le=40, description="depth below the glenoid centre")
 
 
-class ScapulaParams(BaseModel):
+class ScapulaParams(Section):
     """The anatomical scapula phantom (:mod:`poseintegrity.scenes.scapula`)."""
 
-    model_config = _frozen
     mesh: ProjectPath = Field(description="closed triangle mesh of a left scapula (STL, OBJ, PLY: anything trimesh reads)")
     length_mm: float = Field(gt=0, description="the mesh is scaled so that its longest extent is this long")
     glenoid_centre: tuple[float, float, float] = Field(description="glenoid centre in the mesh file's own units")
@@ -89,11 +83,10 @@ class ScapulaParams(BaseModel):
         return normal
 
 
-class BoneFoamParams(BaseModel):
+class BoneFoamParams(Section):
     """The surface of the moulded bone-foam phantoms (:mod:`poseintegrity.scenes.foam`): physical sizes, the same
     for every phantom and offcut of the material."""
 
-    model_config = _frozen
     pore_radius_mm: float = Field(gt=0, le=2, description="smallest pore radius r0; octaves add 2 r0 and 4 r0")
     pore_fraction: float = Field(gt=0, lt=1, description="share of the surface covered by pores (per octave)")
     pore_depth: float = Field(gt=0, le=3, description="pore depth / pore radius")
@@ -115,10 +108,9 @@ class BoneFoamParams(BaseModel):
                              albedo_mottle_mm=self.albedo_mottle_mm)
 
 
-class SceneSpec(BaseModel):
+class SceneSpec(Section):
     """One physical arrangement on the table (Fig. 4)."""
 
-    model_config = _frozen
     name: str = Field(min_length=1)
     targets: list[str] = Field(min_length=1)
     distance_mm: float = Field(320.0, gt=50, description="camera to target centre at the model view")
@@ -138,19 +130,17 @@ class SceneSpec(BaseModel):
         return names
 
 
-class ArcParams(BaseModel):
+class ArcParams(Section):
     """Viewing-angle datasets: arcs about the target (IV-D)."""
 
-    model_config = _frozen
     azimuths_deg: list[float] = Field(default=[0.0, 90.0, 270.0], min_length=1)
     span_deg: float = Field(45.0, gt=0, le=90, description="arc length; stops at span/n_stops * (1..n_stops)")
     n_stops: PositiveInt = 20
 
 
-class LineParams(BaseModel):
+class LineParams(Section):
     """Straight-line datasets: the camera moves along its -z axis (IV-D)."""
 
-    model_config = _frozen
     scene: str = Field("scene_2", description="scene holding the drilled bone-like target")
     distance_mm: float = Field(220.0, gt=50, description="camera to target centre at the lines' own model pair")
     offsets_deg: list[float] = Field(default=[0.0, 5.0, 10.0, 15.0])
@@ -165,10 +155,9 @@ class LineParams(BaseModel):
         return offsets
 
 
-class GenerateParams(BaseModel):
+class GenerateParams(Section):
     """Stage 01: render the robot datasets."""
 
-    model_config = _frozen
     seed: int = Field(20240501, ge=0)
     n_jobs: int = Field(2, ge=1)
     images_per_stop: PositiveInt = 10

@@ -9,19 +9,15 @@ P_p, P_o, the gyro rate split, the retuned filter sigmas).
 from __future__ import annotations
 
 import math
-
 from typing import Literal
 
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import Field, model_validator
 
+from poseintegrity.schema import Section
 from poseintegrity.tracking.geometry import MARKERS_BODY
 
 
-class _Section(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
-
-
-class CameraParams(_Section):
+class CameraParams(Section):
     """AHAT-like pinhole camera (docs/references.md: 512 x 512); the world frame is the camera frame shifted by origin_m."""
 
     width: int = Field(512, ge=16)
@@ -30,7 +26,7 @@ class CameraParams(_Section):
     origin_m: tuple[float, float, float] = (0.0, 0.0, 0.0)  # camera centre in the world frame (T_world_cam)
 
 
-class FrameParams(_Section):
+class FrameParams(Section):
     """IR reflectivity and depth synthesis (our choices; docs/references.md: IR raw 0-1000, depth in mm along the ray)."""
 
     ir_background: float = Field(80.0, ge=0)
@@ -47,7 +43,7 @@ class FrameParams(_Section):
     phantom_elongation: tuple[float, float] = (3.0, 8.0)  # axis ratio of non-round reflections
 
 
-class DetectionParams(_Section):
+class DetectionParams(Section):
     """Detector of section II-B; constants of their public code (docs/references.md) and our two additions
     (shape_measure "pixel", split_touching; see :mod:`poseintegrity.tracking.detection`)."""
 
@@ -75,7 +71,7 @@ class DetectionParams(_Section):
         return self
 
 
-class MatchingParams(_Section):
+class MatchingParams(Section):
     """Correspondence (Alg. 1-3 and the gated assignment).  docs/references.md: matching threshold 8 mm."""
 
     tolerance_m: float = Field(0.008, gt=0)
@@ -84,7 +80,7 @@ class MatchingParams(_Section):
     distinct_m: float = Field(0.001, gt=0)  # inter-marker distances of all tools must differ by more than this
 
 
-class FilterParams(_Section):
+class FilterParams(Section):
     """SR-UKF constants.  Published (docs/references.md): alpha 1e-3, beta 2, kappa 3 - N, dt 0.0025 s, restart
     after 1 s, and the sigmas of :data:`PAPER_SIGMAS`; the sigmas used here are ours (params.yaml says why).
     The innovation gate and the restart after repeated rejections are ours too."""
@@ -110,7 +106,7 @@ class FilterParams(_Section):
 PAPER_SIGMAS = {"sigma_r": math.sqrt(0.00025), "sigma_omega": math.sqrt(0.1), "sigma_c": math.sqrt(0.5), "sigma_alpha": math.sqrt(0.5)}
 
 
-class MotionParams(_Section):
+class MotionParams(Section):
     """Simulation of section II-F (all our choices; the paper published none of them)."""
 
     duration_s: float = Field(60.0, gt=0)
@@ -133,7 +129,7 @@ class MotionParams(_Section):
     occlusions: list[tuple[float, float]] = [(20.0, 2.0)]  # (start_s, duration_s): all markers hidden
 
 
-class HandMotionParams(_Section):
+class HandMotionParams(Section):
     """Motion (a), paper-like (section III: "a series of large motions and many full 360 deg rotations in all
     axes ... with markers periodically occluded briefly"): full turns about the body x, y, z axes in turn, each
     with a smooth sin^2 speed profile lasting turn_s (peak speed 4 pi / turn_s), separated by pauses; the
@@ -148,7 +144,7 @@ class HandMotionParams(_Section):
     occlusion_s: tuple[float, float] = (0.1, 0.3)  # duration of a brief occlusion, s (uniform)
 
 
-class EvaluationParams(_Section):
+class EvaluationParams(Section):
     """Section III on our simulation."""
 
     success_frames: int = Field(10_000, ge=1)  # paper: 10 000 frames of large motion
@@ -169,7 +165,7 @@ class EvaluationParams(_Section):
     ]  # m; distances 81-146 mm, 10 mm apart and away from the first tool's 36-70 mm
 
 
-class TrackParams(_Section):
+class TrackParams(Section):
     """The ``track`` section of params.yaml."""
 
     seed: int = 6
