@@ -1,7 +1,7 @@
 """Speed of stage 04 (predictor sweeps), as ratios against references measured in the same run.
 
     1. theta_p for all 97 thresholds from one fitted EMG             (vectorized scan + bisection)
-       reference: artifacts.envelope_boundary called once per threshold (scan + brentq each)
+       reference: tests/scalar_boundary.py: envelope_boundary called once per threshold (scan + brentq each)
     2. the whole n_t sweep at paper scale                             target: <= 60 s on this machine
        (21 arcs + 4 lines of synthetic eq. 1 data x 10 images per stop, 6 PnP methods; long range,
        its lower-bound variant, MLP and next-step on the paper's path, long range + static on the others)
@@ -14,17 +14,21 @@ Usage: PYTHONPATH=src .venv/bin/python benchmarks/bench_prediction.py [--params 
 from __future__ import annotations
 
 import argparse
+import sys
 import time
 from pathlib import Path
 
 import numpy as np
 
-from poseintegrity.artifacts import emg, envelope_boundary, fit_model
-from poseintegrity.artifacts.fig2 import dataset_series
-from poseintegrity.artifacts.synthetic import synthetic_artifacts
+from poseintegrity.artifact_models import emg, fit_model
+from poseintegrity.artifact_models.series import dataset_series
+from poseintegrity.artifact_models.synthetic import synthetic_artifacts
 from poseintegrity.config import load_section
 from poseintegrity.prediction import boundaries, sweep
 from timing import paired_medians  # benchmarks/timing.py
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+from scalar_boundary import envelope_boundary  # noqa: E402 (the scalar reference of the tests)
 
 METHODS = ("usac_magsac", "epnp", "p3p", "ap3p", "sqpnp", "iterative")
 

@@ -61,3 +61,17 @@ def test_the_summary_points_nowhere_outside_the_repository():
     summary = ROOT / "reports" / "summary.md"
     assert "docs/references.md" in render_summary({})
     assert outside_references(render_summary({}), summary.parent) == []
+
+
+def test_metrics_file_is_valid_json_with_null_for_nan(tmp_path):
+    """json.dumps alone writes NaN / Infinity, which no JSON reader (dvc metrics) accepts."""
+    import json
+
+    import numpy as np
+
+    from poseintegrity.report.metrics import write_metrics
+
+    path = tmp_path / "stage.json"
+    write_metrics(path, {"a": np.float64("nan"), "b": [np.int64(3), np.bool_(True), np.inf], "c": {"d": np.float32(0.5)}})
+    assert json.loads(path.read_text()) == {"a": None, "b": [3, True, None], "c": {"d": 0.5}}
+    assert [p.name for p in tmp_path.iterdir()] == ["stage.json"]  # the partial file was renamed

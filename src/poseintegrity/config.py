@@ -18,7 +18,7 @@ from typing import Any
 import yaml
 from pydantic import BaseModel, ConfigDict, ValidationError
 
-from poseintegrity.artifacts.params import FitParams
+from poseintegrity.artifact_models.params import FitParams
 from poseintegrity.localization.params import ExtractParams
 from poseintegrity.parallel import ParallelParams
 from poseintegrity.prediction.params import PredictParams

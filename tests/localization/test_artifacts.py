@@ -2,8 +2,10 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from poseintegrity.artifacts.base_functions import emg
-from poseintegrity.localization.artifacts import frame_artifacts, json_ready, method_summary, realism_metrics
+from poseintegrity.artifact_models.base_functions import emg
+from poseintegrity.localization.frame_artifacts import frame_artifacts
+from poseintegrity.localization.realism import realism_metrics
+from poseintegrity.localization.summaries import method_summary
 from poseintegrity.localization.envelope import envelopes
 from poseintegrity.localization.params import RealismParams
 from poseintegrity.localization.pnp import PnPResult, failed
@@ -99,7 +101,7 @@ def test_r2_flags_envelopes_inside_the_sampled_stops_and_r5_compares_lines():
     assert metrics["decay_ratio_line"] == {"line": pytest.approx(0.98)}  # int(100 - 0.2 * 6.75) / 100
 
 
-def test_method_summary_and_json_ready():
+def test_method_summary():
     table = pd.concat([world({"a": linear(2.3)}).assign(method=m) for m in ("epnp", "p3p")], ignore_index=True)
     table.loc[table.method == "p3p", "n_inliers"] += 10
     summary = method_summary(table, envelopes(table, [(2.0, 3.0)])).set_index("method")
@@ -107,4 +109,3 @@ def test_method_summary_and_json_ready():
     assert summary.loc["epnp", "n_frames"] == 40
     assert summary.loc["epnp", "failure_rate"] == pytest.approx(0.0)  # n_i = 100 - 2.3 theta > 0 up to 42.75
     assert "mean_theta_a_arc_2mm_3deg" in summary.columns
-    assert json_ready({"a": np.float64("nan"), "b": [np.int64(3), np.bool_(True)]}) == {"a": None, "b": [3, True]}

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from poseintegrity.artifacts import FitParams
+from poseintegrity.artifact_models import FitParams
 from poseintegrity.prediction import PredictParams
 
 sys.path.insert(0, str(Path(__file__).parent))

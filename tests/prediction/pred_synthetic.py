@@ -11,9 +11,9 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from poseintegrity.artifacts import envelope_boundary
-from poseintegrity.artifacts.base_functions import emg
-from poseintegrity.artifacts.synthetic import synthetic_artifacts
+from scalar_boundary import envelope_boundary
+from poseintegrity.artifact_models.base_functions import emg
+from poseintegrity.artifact_models.synthetic import synthetic_artifacts
 
 FAILURE_COUNT = {"2mm_3deg": 60.0, "4mm_10deg": 40.0}  # true inlier count at which localization fails
 RANGE_END = {"arc": 45.0, "line": 150.0}

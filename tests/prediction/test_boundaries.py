@@ -1,4 +1,4 @@
-"""theta_p for all thresholds at once (predictors.boundaries) against envelope_boundary and analytic crossings."""
+"""theta_p for all thresholds at once (predictors.boundaries) against the scalar reference envelope_boundary and analytic crossings."""
 
 from __future__ import annotations
 
@@ -8,8 +8,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.optimize import brentq
 
-from poseintegrity.artifacts import envelope_boundary
-from poseintegrity.artifacts.base_functions import emg
+from scalar_boundary import envelope_boundary
+from poseintegrity.artifact_models.base_functions import emg
 from poseintegrity.prediction import boundaries
 
 THRESHOLDS = np.arange(4.0, 101.0)

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from poseintegrity.artifacts.base_functions import emg
-from poseintegrity.artifacts.fig2 import Series
+from poseintegrity.artifact_models.base_functions import emg
+from poseintegrity.artifact_models.series import Series
 from poseintegrity.prediction import NextStepSupervisor, long_range, next_step, static_baseline
 
 ALPHA, K, MU = 3000.0, 8.0, -1.0  # exact eq. 1: ~290 inliers at the first stop, 18 at 45 deg

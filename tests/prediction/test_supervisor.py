@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from poseintegrity.artifacts.base_functions import emg
+from poseintegrity.artifact_models.base_functions import emg
 from poseintegrity.prediction import NextStepSupervisor, UncertaintyParams
 
 STOPS = 2.25 * np.arange(20)  # IV-D: the first stop is the model view

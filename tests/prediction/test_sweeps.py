@@ -8,6 +8,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from poseintegrity.report.metrics import json_ready
 from poseintegrity.prediction import (
     PAPER_PREDICTORS,
     attach_envelopes,
@@ -48,7 +49,7 @@ def test_every_predictor_every_dataset_every_operating_point(swept, tables, tiny
 
 def test_relative_thresholds_are_fractions_of_the_first_stop_mean(swept, tables, tiny_predict, tiny_fit):
     """long_range_relative at fraction r is the long range predictor at n_t = r x (mean n_i of the first stop)."""
-    from poseintegrity.artifacts.fig2 import dataset_series
+    from poseintegrity.artifact_models.series import dataset_series
     from poseintegrity.prediction.predictors import fit_rng
 
     theta_p, _, _ = swept
@@ -84,7 +85,7 @@ def test_headline_metrics_have_the_issue_keys_and_are_json(swept, tiny_predict):
     static = best[(best.predictor == "static") & (best.trajectory == "arc") & (best.method == "usac_magsac")
                   & (best.tolerance == tiny_predict.live_tolerance)].best_operating_point.iloc[0]  # fmt: skip
     live = live_trials(table, tiny_predict, static)
-    metrics = json.loads(json.dumps(headline_metrics(table, curves, folds, live, tiny_predict), allow_nan=False))
+    metrics = json.loads(json.dumps(json_ready(headline_metrics(table, curves, folds, live, tiny_predict)), allow_nan=False))
     for predictor in PAPER_PREDICTORS:
         for tolerance in TOLERANCES:
             assert {"max_mean_spl_zero_incursion", "best_n_t"} <= set(metrics[predictor][tolerance])

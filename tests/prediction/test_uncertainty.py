@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from poseintegrity.artifacts import fit_model
-from poseintegrity.artifacts.base_functions import emg, emg_jacobian
+from poseintegrity.artifact_models import fit_model
+from poseintegrity.artifact_models.base_functions import emg, emg_jacobian
 from poseintegrity.prediction import bootstrap_interval, covariance_interval, envelope_prediction
 from poseintegrity.prediction.uncertainty import parameter_covariance
 

@@ -16,7 +16,7 @@ import pandas as pd
 from joblib import Parallel, delayed
 from tqdm.auto import tqdm
 
-from poseintegrity.localization.artifacts import frame_artifacts
+from poseintegrity.localization.frame_artifacts import frame_artifacts
 from poseintegrity.localization.dataset import Dataset, load_dataset, load_index
 from poseintegrity.localization.errors import pose_errors
 from poseintegrity.localization.features import Features, cached_features, read_gray

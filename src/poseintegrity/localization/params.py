@@ -34,7 +34,7 @@ class SiftParams(Section):
 
 
 class RealismParams(Section):
-    """The realism checks of the rendered world (:func:`poseintegrity.localization.artifacts.realism_metrics`)."""
+    """The realism checks of the rendered world (:func:`poseintegrity.localization.realism.realism_metrics`)."""
 
     fit_stops: int = Field(ge=2, description="stops the R1 fits and the R2 / R5 sampling use (paper: 4)")
     max_nfev: int = Field(ge=10, description="curve_fit evaluation budget of each R1 fit")

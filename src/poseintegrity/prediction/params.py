@@ -1,6 +1,6 @@
 """Schema of the ``predict`` section of ``params.yaml`` (stage 04, localization-envelope predictors).
 
-The artifact models themselves are configured by the ``fit`` section (:class:`poseintegrity.artifacts.FitParams`:
+The artifact models themselves are configured by the ``fit`` section (:class:`poseintegrity.artifact_models.FitParams`:
 curve_fit budget, MLP recipe, range ends theta_max / x_max); this section says how the predictors of
 Windsor et al. III-E use them and how the operating points are swept (IV-A, V). Lengths in mm, angles in deg.
 """
@@ -12,14 +12,14 @@ from typing import Literal
 import numpy as np
 from pydantic import Field, model_validator
 
-from poseintegrity.artifacts.params import ModelName
+from poseintegrity.artifact_models.params import ModelName
 from poseintegrity.schema import Section
 
 IntervalMethod = Literal["covariance", "bootstrap"]
 
 
 class PredictorModels(Section):
-    """Artifact model behind each predictor (a name of :data:`poseintegrity.artifacts.MODEL_NAMES`)."""
+    """Artifact model behind each predictor (a name of :data:`poseintegrity.artifact_models.MODEL_NAMES`)."""
 
     long_range: ModelName = Field(description="long range predictor (paper: eq. 1, the EMG)")
     next_step: ModelName = Field(description="next-step predictor (paper: the EMG)")

@@ -10,7 +10,7 @@
 The artifact fit does not depend on n_t, so every predictor fits once per dataset (and stop) and finds the
 crossings of all thresholds on one evaluation of the fitted curve. theta is deg for arcs, mm for lines.
 
-Statuses of a theta_p (the first four as in :func:`poseintegrity.artifacts.envelope_boundary`):
+Statuses of a theta_p (the first four as in the scalar reference ``envelope_boundary`` of tests/scalar_boundary.py):
     "root"            the fitted curve falls to n_t inside [theta_1, theta_end]
     "censored"        it stays above n_t up to the range end: theta_p = theta_end
     "below_at_start"  it is at or below n_t already at the first stop: theta_p = 0 (no safe motion predicted)
@@ -29,8 +29,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from poseintegrity.artifacts import FitParams, FittedModel, fit_model
-from poseintegrity.artifacts.fig2 import Series
+from poseintegrity.artifact_models import FitParams, FittedModel, fit_model
+from poseintegrity.artifact_models.series import Series
 
 BISECTION_XTOL = 1e-9  # theta units; the root refinement of :func:`boundaries`
 
@@ -52,7 +52,7 @@ def boundaries(
 ) -> Boundaries:
     """theta_p in [theta_start, theta_end] where predict first falls to each threshold n_t (III-E, vectorized).
 
-    The same answers as :func:`poseintegrity.artifacts.envelope_boundary` with ``n_scan = n_grid`` (checked in
+    The same answers as the scalar reference ``envelope_boundary`` of tests/scalar_boundary.py with ``n_scan = n_grid`` (checked in
     the tests): f is evaluated once on the grid; the first grid point at or below n_t is found for every
     threshold through the running minimum of f; each bracketing interval is then refined by a bisection run on
     all brackets at once (one call of ``predict`` per halving) down to BISECTION_XTOL.

@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from poseintegrity.artifacts import FitParams, fit_model
+from poseintegrity.artifact_models import FitParams, fit_model
 from poseintegrity.prediction.params import UncertaintyParams
 from poseintegrity.prediction.predictors import envelope_prediction, next_step_stops
 from poseintegrity.prediction.uncertainty import prediction_interval

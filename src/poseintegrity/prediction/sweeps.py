@@ -21,8 +21,8 @@ import pandas as pd
 from joblib import Parallel, delayed
 from tqdm import tqdm
 
-from poseintegrity.artifacts import FitParams
-from poseintegrity.artifacts.fig2 import Series, dataset_series
+from poseintegrity.artifact_models import FitParams
+from poseintegrity.artifact_models.series import Series, dataset_series
 from poseintegrity.prediction.loso import loso_summary
 from poseintegrity.prediction.metrics import best_operating_point, relative_improvement, with_metrics
 from poseintegrity.prediction.params import PredictParams
@@ -171,7 +171,7 @@ def live_trials(table: pd.DataFrame, predict: PredictParams, static_size: float)
 def headline_metrics(
     table: pd.DataFrame, curves: pd.DataFrame, loso: pd.DataFrame, live: pd.DataFrame, predict: PredictParams
 ) -> dict:
-    """The content of ``reports/metrics/predictors.json`` (issue 5's keys; NaN written as null).
+    """The content of ``reports/metrics/predictors.json``.
 
     <predictor>.<tolerance>.{max_mean_spl_zero_incursion, best_n_t} on the arc datasets of the paper's PnP path
     (best_n_t is null for "static", whose operating point is ``best_size``, and for the relative-threshold
@@ -180,7 +180,8 @@ def headline_metrics(
     next_step.relative_improvement_vs_long_range; straight_line.relative_improvement (Fig. 7);
     pnp.<method>.{max_mean_spl_zero_incursion, static_max_mean_spl_zero_incursion} (Fig. 6);
     loso.<predictor>.<tolerance>.{heldout_incursion_rate, heldout_mean_spl, ...} at the first target rate;
-    live.{n_t, incursions, n_trials, envelope_share, static_*} (V-C).
+    live.{n_t, incursions, n_trials, envelope_share, static_*} (V-C). NaN where there is no value
+    (:func:`poseintegrity.report.metrics.write_metrics` writes it as null).
     """
     best = best_table(curves)
 
@@ -234,13 +235,5 @@ def headline_metrics(
         "static_incursions": float(live["static_incursion"].sum()),
         "static_envelope_share": float(live["static_share"].mean()),
     }  # fmt: skip
-    return _nan_to_none(metrics)
+    return metrics
 
-
-def _nan_to_none(value):
-    """NaN -> None throughout a nested dict (JSON null); numpy scalars -> Python numbers."""
-    if isinstance(value, dict):
-        return {k: _nan_to_none(v) for k, v in value.items()}
-    if isinstance(value, (float, np.floating)):
-        return None if np.isnan(value) else float(value)
-    return value

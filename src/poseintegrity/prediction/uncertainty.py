@@ -22,8 +22,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.stats import norm
 
-from poseintegrity.artifacts import FitParams, FittedModel, fit_model
-from poseintegrity.artifacts.base_functions import BaseCurve
+from poseintegrity.artifact_models import FitParams, FittedModel, fit_model
+from poseintegrity.artifact_models.base_functions import BaseCurve
 from poseintegrity.prediction.params import UncertaintyParams
 from poseintegrity.prediction.predictors import envelope_prediction
 

@@ -7,8 +7,8 @@ import pytest
 import torch
 from torch import nn
 
-from poseintegrity.artifacts import EMG, emg, fit_mlp
-from poseintegrity.artifacts.mlp import mlp_network
+from poseintegrity.artifact_models import EMG, emg, fit_mlp
+from poseintegrity.artifact_models.mlp import mlp_network
 
 THETA4 = np.repeat(2.25 * np.arange(1, 5), 10)  # first 4 stops of an arc, deg
 N4 = np.maximum(np.round(emg(THETA4, 3000.0, 9.0, 1.0) + np.random.default_rng(5).normal(0, 4, THETA4.size)), 0)

@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from poseintegrity.artifacts.base_functions import emg, emg_pdf
+from poseintegrity.artifact_models.base_functions import emg, emg_pdf
 
 # The datasets of Windsor et al. IV-D: arcs stop every 2.25 deg from the model view (0 .. 42.75 deg), lines every
 # 10 mm from their start (0 .. 140 mm).

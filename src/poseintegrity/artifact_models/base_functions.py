@@ -25,7 +25,7 @@ import numpy as np
 from scipy.optimize import OptimizeWarning, curve_fit
 from scipy.special import erfc, erfcx
 
-from poseintegrity.artifacts.fitted import (
+from poseintegrity.artifact_models.fitted import (
     OK,
     FallbackLine,
     FittedModel,

@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 from scipy.stats import exponnorm
 
-from poseintegrity.artifacts import BASE_FUNCTIONS, EMG, FallbackLine, emg, emg_pdf
-from poseintegrity.artifacts.base_functions import emg_jacobian
-from poseintegrity.artifacts.fig2 import dataset_series
+from poseintegrity.artifact_models import BASE_FUNCTIONS, EMG, FallbackLine, emg, emg_pdf
+from poseintegrity.artifact_models.base_functions import emg_jacobian
+from poseintegrity.artifact_models.series import dataset_series
 
 THETA = np.repeat(2.25 * np.arange(1, 21), 10)  # an arc dataset: 20 stops x 10 images, deg
 

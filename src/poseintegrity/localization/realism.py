@@ -1,60 +1,20 @@
-"""Pose estimation artifacts per frame (paper III-C) and the realism checks of the rendered world.
+"""The realism bars of the rendered world: properties the paper's real datasets had, checked on ours (stage 02).
 
-Artifacts of one PnP-RANSAC run (columns of ``artifacts.parquet``):
-
-- ``n_inliers``: n_i, inliers of the returned pose (recounted, see :mod:`pnp`); 0 on failure
-- ``n_inliers_reported``: OpenCV's own inlier count
-- ``n_keypoints``, ``n_matches``: SIFT keypoints in the frame, ratio-test matches to M_t
-- ``inlier_ratio``: n_i / n_matches (0 without matches)
-- ``reproj_error_px``: mean reprojection error of the inliers
-- ``inlier_spread_px``: RMS distance of the inlier keypoints from their centroid (image-space spread)
-- ``inlier_hull_area_px2``: area of the convex hull of the inlier keypoints (coverage; Windsor et al. [4]
-  studied keypoint distribution artifacts)
-- ``model_coverage``: n_i / |M_t|, the fraction of the target model seen
+Windsor et al. published no data; :func:`realism_metrics` measures on the stage-02 tables what their results
+imply about real data (the inlier count decays with viewing angle, failure comes when inliers run short, eq. 1
+extrapolates best from 4 stops, ...), so that a rendered world that does not behave like theirs is seen.
 """
 
 from __future__ import annotations
 
 from typing import Any
 
-import cv2
 import numpy as np
 import pandas as pd
 from scipy.stats import spearmanr
 
-from poseintegrity.artifacts.base_functions import BASE_FUNCTIONS
+from poseintegrity.artifact_models.base_functions import BASE_FUNCTIONS
 from poseintegrity.localization.params import RealismParams, tolerance_name
-from poseintegrity.localization.pnp import PnPResult, reprojection_errors
-
-ARTIFACT_COLUMNS = [
-    "n_inliers", "n_inliers_reported", "n_keypoints", "n_matches", "inlier_ratio", "reproj_error_px",
-    "inlier_spread_px", "inlier_hull_area_px2", "model_coverage",
-]
-
-
-def frame_artifacts(
-    result: PnPResult, object_points: np.ndarray, image_points: np.ndarray, K: np.ndarray, n_keypoints: int, model_size: int
-) -> dict[str, Any]:
-    """Artifact values of one PnP result.
-
-    object_points : (n, 3) mm and image_points : (n, 2) px are the n ratio-test matches given to PnP.
-    A failed result has n_i = 0 and NaN for the inlier geometry.
-    """
-    n_matches = len(image_points)
-    row = dict(
-        n_inliers=result.n_inliers, n_inliers_reported=result.n_inliers_reported, n_keypoints=n_keypoints,
-        n_matches=n_matches, inlier_ratio=result.n_inliers / n_matches if n_matches else 0.0,
-        reproj_error_px=np.nan, inlier_spread_px=np.nan, inlier_hull_area_px2=np.nan,
-        model_coverage=result.n_inliers / model_size if model_size else 0.0,
-    )
-    if result.status != "ok":
-        return row
-    x = image_points[result.inliers].astype(np.float64)
-    errors = reprojection_errors(object_points[result.inliers], x, K, result.T_cam_model)
-    row["reproj_error_px"] = float(errors.mean())
-    row["inlier_spread_px"] = float(np.sqrt(np.mean(np.sum((x - x.mean(axis=0)) ** 2, axis=1))))
-    row["inlier_hull_area_px2"] = float(cv2.contourArea(cv2.convexHull(x.astype(np.float32))))
-    return row
 
 
 def realism_metrics(
@@ -234,51 +194,3 @@ def _nanmean(values: list[float]) -> float:
 def _cv(values: pd.Series) -> float:
     """Coefficient of variation std / mean (ddof 0); NaN for an empty series."""
     return float(values.std(ddof=0) / values.mean()) if len(values) else float("nan")
-
-
-def method_summary(table: pd.DataFrame, envelope_table: pd.DataFrame) -> pd.DataFrame:
-    """One row per PnP method: frames, failure rate, n_i at the first stop, median errors, mean theta_a per
-    tolerance and trajectory type, and how many envelopes are censored (stage 05, paper Fig. 6)."""
-    first_stop = table[table["stop"] == 0]
-    summary = table.groupby("method").agg(
-        n_frames=("status", "size"),
-        failure_rate=("status", lambda status: float((status != "ok").mean())),
-        median_n_inliers=("n_inliers", "median"),
-        median_E_t_mm=("E_t_mm", "median"),
-        median_E_r_deg=("E_r_deg", "median"),
-    )
-    summary["mean_n_inliers_first_stop"] = first_stop.groupby("method")["n_inliers"].mean()
-    theta_a = envelope_table.pivot_table(
-        index="method", columns=["trajectory", "tolerance"], values="theta_a", aggfunc="mean"
-    )
-    theta_a.columns = [f"mean_theta_a_{trajectory}_{tolerance}" for trajectory, tolerance in theta_a.columns]
-    censored = envelope_table.groupby("method")["censored"].sum().rename("n_censored")
-    return summary.join(theta_a).join(censored).reset_index()
-
-
-def board_summary(table: pd.DataFrame) -> dict[str, float]:
-    """How far the ArUco ground truth is from the exact renderer pose (one row per frame is enough)."""
-    frames = table.drop_duplicates(["dataset", "stop", "image"])
-    detected = frames[frames["board_status"] == "ok"]
-    return dict(
-        detection_rate=float(len(detected) / len(frames)) if len(frames) else float("nan"),
-        median_E_t_mm=float(detected["E_t_board_exact_mm"].median()),
-        p95_E_t_mm=float(detected["E_t_board_exact_mm"].quantile(0.95)),
-        median_E_r_deg=float(detected["E_r_board_exact_deg"].median()),
-        p95_E_r_deg=float(detected["E_r_board_exact_deg"].quantile(0.95)),
-    )
-
-
-def json_ready(value: Any) -> Any:
-    """Nested dicts/lists with numpy scalars and NaN/inf turned into plain JSON values (NaN -> null)."""
-    if isinstance(value, dict):
-        return {str(key): json_ready(item) for key, item in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [json_ready(item) for item in value]
-    if isinstance(value, (bool, np.bool_)):
-        return bool(value)
-    if isinstance(value, (int, np.integer)):
-        return int(value)
-    if isinstance(value, (float, np.floating)):
-        return float(value) if np.isfinite(value) else None
-    return value

@@ -2,7 +2,7 @@
 
     scratch     trained on the samples only (the paper: "failed to generalize beyond the training range")
     pretrained  first trained on the EMG curve of the least squares starting values (eq. 1 with the p0
-                of :data:`poseintegrity.artifacts.base_functions.EMG`), then fine-tuned on the samples
+                of :data:`poseintegrity.artifact_models.base_functions.EMG`), then fine-tuned on the samples
                 plus artificial points (theta_max, 0), e.g. (45 deg, 0) for arcs
 
 The paper publishes no training details (docs/references.md, "Camera of the Windsor et al. experiments"); ours, all in params.yaml ``fit.mlp``: inputs scaled to
@@ -22,9 +22,9 @@ import torch
 from torch import nn
 from torch.nn.utils import skip_init
 
-from poseintegrity.artifacts.base_functions import EMG
-from poseintegrity.artifacts.fitted import OK, FallbackLine, FittedModel, too_few_samples, valid_samples
-from poseintegrity.artifacts.params import MLPParams
+from poseintegrity.artifact_models.base_functions import EMG
+from poseintegrity.artifact_models.fitted import OK, FallbackLine, FittedModel, too_few_samples, valid_samples
+from poseintegrity.artifact_models.params import MLPParams
 
 PARAM_NAMES = ("loss", "evaluations")  # FittedModel.params of an MLP: final scaled MSE, loss evaluations
 

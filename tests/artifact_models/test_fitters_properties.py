@@ -11,8 +11,8 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from poseintegrity.artifacts import BASE_FUNCTIONS, MODEL_NAMES, fit_model
-from poseintegrity.artifacts.fitted import valid_samples
+from poseintegrity.artifact_models import BASE_FUNCTIONS, MODEL_NAMES, fit_model
+from poseintegrity.artifact_models.fitted import valid_samples
 
 GRID = np.linspace(0.0, 45.0, 91)
 

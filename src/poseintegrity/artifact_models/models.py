@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from poseintegrity.artifacts.base_functions import BASE_FUNCTIONS
-from poseintegrity.artifacts.fitted import FittedModel
-from poseintegrity.artifacts.mlp import fit_mlp
-from poseintegrity.artifacts.params import FitParams
+from poseintegrity.artifact_models.base_functions import BASE_FUNCTIONS
+from poseintegrity.artifact_models.fitted import FittedModel
+from poseintegrity.artifact_models.mlp import fit_mlp
+from poseintegrity.artifact_models.params import FitParams
 
 MLP_RECIPES = {"mlp_scratch": False, "mlp_pretrained": True}  # name -> pretrain on the EMG curve?
 MODEL_NAMES: tuple[str, ...] = (*BASE_FUNCTIONS, *MLP_RECIPES)

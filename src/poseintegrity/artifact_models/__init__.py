@@ -1,36 +1,35 @@
-"""Artifact models f: theta -> n_inliers (Windsor et al. III-D, Fig. 2) and the envelope boundary theta_p (III-E).
+"""Artifact models f: theta -> n_inliers (Windsor et al. III-D, Fig. 2), fitted to the first stops of a dataset.
 
     params.py          the ``fit`` section of params.yaml (FitParams)
     fitted.py          FittedModel: what every fitter returns (converged flag, reason, fallback line)
     base_functions.py  eq. 1 (scaled EMG) and four other decays, fitted by bounded curve_fit
     mlp.py             the 3 x 10 tanh MLP (IV-E), from scratch or EMG-pretrained + fine-tuned (III-D)
     models.py          fit_model(name, ...): one entry point for all of them
-    roots.py           theta_p where f(theta) = n_t (scan + brentq), censored / below-at-start answers
+    series.py          Series: one dataset's samples (theta, n_inliers per image, in stop order)
     fig2.py            the Fig. 2 experiment on the stage-02 artifacts table
 """
 
-from poseintegrity.artifacts.base_functions import BASE_FUNCTIONS, EMG, BaseFunction, emg, emg_pdf
-from poseintegrity.artifacts.fig2 import dataset_series, fig2_rmse, fit_first_stops, fits_metrics, mean_rmse
-from poseintegrity.artifacts.fitted import FallbackLine, FittedModel
-from poseintegrity.artifacts.mlp import fit_mlp
-from poseintegrity.artifacts.models import MODEL_NAMES, fit_model
-from poseintegrity.artifacts.params import FitParams, MLPParams
-from poseintegrity.artifacts.roots import EnvelopeBoundary, envelope_boundary
+from poseintegrity.artifact_models.base_functions import BASE_FUNCTIONS, EMG, BaseFunction, emg, emg_pdf
+from poseintegrity.artifact_models.fig2 import fig2_rmse, fit_first_stops, fits_metrics, mean_rmse
+from poseintegrity.artifact_models.fitted import FallbackLine, FittedModel
+from poseintegrity.artifact_models.mlp import fit_mlp
+from poseintegrity.artifact_models.models import MODEL_NAMES, fit_model
+from poseintegrity.artifact_models.params import FitParams, MLPParams
+from poseintegrity.artifact_models.series import Series, dataset_series
 
 __all__ = [
     "BASE_FUNCTIONS",
     "EMG",
     "MODEL_NAMES",
     "BaseFunction",
-    "EnvelopeBoundary",
     "FallbackLine",
     "FitParams",
     "FittedModel",
     "MLPParams",
+    "Series",
     "dataset_series",
     "emg",
     "emg_pdf",
-    "envelope_boundary",
     "fig2_rmse",
     "fit_first_stops",
     "fit_mlp",

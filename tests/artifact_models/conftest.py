@@ -8,8 +8,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from poseintegrity.artifacts import FitParams
-from poseintegrity.artifacts.synthetic import synthetic_artifacts
+from poseintegrity.artifact_models import FitParams
+from poseintegrity.artifact_models.synthetic import synthetic_artifacts
 
 # The tiny ``fit`` section used by the tests (and, in YAML, by the notebook test).
 TINY_FIT = {

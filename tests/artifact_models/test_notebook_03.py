@@ -11,7 +11,7 @@ import papermill
 import pytest
 import yaml
 
-from poseintegrity.artifacts.synthetic import synthetic_artifacts
+from poseintegrity.artifact_models.synthetic import synthetic_artifacts
 
 ROOT = Path(__file__).resolve().parents[2]
 NOTEBOOK = ROOT / "notebooks" / "03_fit_artifact_models.ipynb"

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from poseintegrity.artifacts import EMG, dataset_series, fig2_rmse, fits_metrics, mean_rmse
+from poseintegrity.artifact_models import EMG, dataset_series, fig2_rmse, fits_metrics, mean_rmse
 
 MODELS = ("emg", "exponential", "gaussian", "logistic", "power_law", "mlp_scratch", "mlp_pretrained")
 

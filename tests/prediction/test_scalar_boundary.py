@@ -7,8 +7,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from poseintegrity.artifacts import EMG, emg, envelope_boundary
-from poseintegrity.artifacts.base_functions import exponential
+from poseintegrity.artifact_models import EMG, emg
+from scalar_boundary import envelope_boundary
+from poseintegrity.artifact_models.base_functions import exponential
 
 
 def test_exponential_decay_root_is_analytic():

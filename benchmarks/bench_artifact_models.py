@@ -7,7 +7,7 @@
     3. the whole Fig. 2 experiment at paper scale           target: <= 5 min on 2 cores
        (21 arcs + 4 lines of synthetic eq. 1 data, k = 3 .. all, all models, n_jobs from params)
 
-Usage: PYTHONPATH=src .venv/bin/python benchmarks/bench_artifacts.py [--params params.yaml] [--skip-stage]
+Usage: PYTHONPATH=src .venv/bin/python benchmarks/bench_artifact_models.py [--params params.yaml] [--skip-stage]
 """
 
 from __future__ import annotations
@@ -22,8 +22,8 @@ from joblib import effective_n_jobs
 from scipy.optimize import curve_fit
 from scipy.stats import exponnorm
 
-from poseintegrity.artifacts import EMG, FitParams, emg, fig2_rmse, fit_mlp, fits_metrics
-from poseintegrity.artifacts.synthetic import synthetic_artifacts
+from poseintegrity.artifact_models import EMG, FitParams, emg, fig2_rmse, fit_mlp, fits_metrics
+from poseintegrity.artifact_models.synthetic import synthetic_artifacts
 from timing import paired_medians  # benchmarks/timing.py
 
 

@@ -11,65 +11,18 @@ Input: the artifacts table of stage 02, one row per image and PnP method, with a
 from __future__ import annotations
 
 import zlib
-from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
 from joblib import Parallel, delayed
 from tqdm import tqdm
 
-from poseintegrity.artifacts.fitted import FittedModel
-from poseintegrity.artifacts.models import fit_model
-from poseintegrity.artifacts.params import FitParams
+from poseintegrity.artifact_models.fitted import FittedModel
+from poseintegrity.artifact_models.models import fit_model
+from poseintegrity.artifact_models.params import FitParams
+from poseintegrity.artifact_models.series import Series, dataset_series
 
-VARIABLE = {"arc": "theta_deg", "line": "x_mm"}  # independent variable of the artifact model per trajectory
 COLUMNS = ["trajectory", "dataset", "k", "model", "rmse", "converged", "reason", "n_samples"]  # of fig2_rmse
-
-
-@dataclass(frozen=True)
-class Series:
-    """One dataset's samples for one PnP method, in stop order.
-
-    stop : (m,) int, 0-based;  theta : (m,) float, deg (arc) or mm (line);  n_inliers : (m,) float
-    """
-
-    dataset: str
-    trajectory: str
-    stop: np.ndarray
-    theta: np.ndarray
-    n_inliers: np.ndarray
-
-    @property
-    def n_stops(self) -> int:
-        return int(np.unique(self.stop).size)
-
-    def first_stops(self, k: int) -> tuple[np.ndarray, np.ndarray]:
-        """(theta, n_inliers) of the images of the first k stops: what a robot has seen after k stops."""
-        keep = np.isin(self.stop, np.unique(self.stop)[:k])
-        return self.theta[keep], self.n_inliers[keep]
-
-
-def dataset_series(artifacts: pd.DataFrame, pnp_method: str) -> list[Series]:
-    """Split the artifacts table into one :class:`Series` per (trajectory, dataset) for ``pnp_method``."""
-    rows = artifacts[artifacts["method"] == pnp_method]
-    if rows.empty:
-        raise ValueError(f"no rows with method {pnp_method!r}; methods present: {sorted(artifacts['method'].unique())}")
-    unknown = set(rows["trajectory"]) - set(VARIABLE)
-    if unknown:
-        raise ValueError(f"unknown trajectory type(s) {sorted(unknown)}; expected {sorted(VARIABLE)}")
-    series = []
-    for (trajectory, dataset), group in rows.groupby(["trajectory", "dataset"], sort=True):
-        group = group.sort_values(["stop", "image"], kind="stable")
-        series.append(
-            Series(
-                dataset=str(dataset),
-                trajectory=str(trajectory),
-                stop=group["stop"].to_numpy(dtype=int),
-                theta=group[VARIABLE[trajectory]].to_numpy(dtype=float),
-                n_inliers=group["n_inliers"].to_numpy(dtype=float),
-            )
-        )
-    return series
 
 
 def fit_first_stops(series: Series, k: int, params: FitParams) -> dict[str, FittedModel]:

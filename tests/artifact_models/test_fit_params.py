@@ -9,8 +9,8 @@ import pytest
 import yaml
 from pydantic import ValidationError
 
-from poseintegrity.artifacts import MODEL_NAMES, FitParams
-from poseintegrity.artifacts.params import ModelName
+from poseintegrity.artifact_models import MODEL_NAMES, FitParams
+from poseintegrity.artifact_models.params import ModelName
 
 ROOT = Path(__file__).resolve().parents[2]
 

@@ -1,4 +1,8 @@
-"""The predicted localization envelope boundary theta_p, where the artifact model falls to n_t (III-E).
+"""A scalar reference for theta_p, the boundary where an artifact model falls to n_t (Windsor et al. III-E).
+
+The package computes theta_p for all thresholds at once (:func:`poseintegrity.prediction.predictors.boundaries`,
+a vectorized scan and bisection); this is the independent reference it is checked against (tests) and timed
+against (benchmarks/bench_prediction.py): one threshold at a time, scipy.optimize.brentq in the bracket.
 
 Windsor et al. predict failure for theta > theta_p, theta_p the root of f(theta) = n_t found by root finding.
 The model need not be monotone, so the boundary is the *first* downward crossing met when moving from the

@@ -1,0 +1,60 @@
+"""One dataset's artifact samples, the input of every artifact model and predictor.
+
+A :class:`Series` holds the images of one dataset (one trajectory: an arc in theta_deg or a straight line in x_mm)
+for one PnP method, in stop order: what a robot has seen after each stop (Windsor et al. III-D, IV-A).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+VARIABLE = {"arc": "theta_deg", "line": "x_mm"}  # independent variable of the artifact model per trajectory
+
+
+@dataclass(frozen=True)
+class Series:
+    """One dataset's samples for one PnP method, in stop order.
+
+    stop : (m,) int, 0-based;  theta : (m,) float, deg (arc) or mm (line);  n_inliers : (m,) float
+    """
+
+    dataset: str
+    trajectory: str
+    stop: np.ndarray
+    theta: np.ndarray
+    n_inliers: np.ndarray
+
+    @property
+    def n_stops(self) -> int:
+        return int(np.unique(self.stop).size)
+
+    def first_stops(self, k: int) -> tuple[np.ndarray, np.ndarray]:
+        """(theta, n_inliers) of the images of the first k stops: what a robot has seen after k stops."""
+        keep = np.isin(self.stop, np.unique(self.stop)[:k])
+        return self.theta[keep], self.n_inliers[keep]
+
+
+def dataset_series(artifacts: pd.DataFrame, pnp_method: str) -> list[Series]:
+    """Split the artifacts table into one :class:`Series` per (trajectory, dataset) for ``pnp_method``."""
+    rows = artifacts[artifacts["method"] == pnp_method]
+    if rows.empty:
+        raise ValueError(f"no rows with method {pnp_method!r}; methods present: {sorted(artifacts['method'].unique())}")
+    unknown = set(rows["trajectory"]) - set(VARIABLE)
+    if unknown:
+        raise ValueError(f"unknown trajectory type(s) {sorted(unknown)}; expected {sorted(VARIABLE)}")
+    series = []
+    for (trajectory, dataset), group in rows.groupby(["trajectory", "dataset"], sort=True):
+        group = group.sort_values(["stop", "image"], kind="stable")
+        series.append(
+            Series(
+                dataset=str(dataset),
+                trajectory=str(trajectory),
+                stop=group["stop"].to_numpy(dtype=int),
+                theta=group[VARIABLE[trajectory]].to_numpy(dtype=float),
+                n_inliers=group["n_inliers"].to_numpy(dtype=float),
+            )
+        )
+    return series

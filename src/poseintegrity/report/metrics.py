@@ -1,0 +1,38 @@
+"""Writing a stage's metrics file (``reports/metrics/<stage>.json``, read by ``dvc metrics`` and the summary).
+
+One writer for every stage: numpy scalars become plain numbers, NaN and inf become JSON null (``json.dumps`` would
+write the invalid tokens NaN / Infinity), and the file is replaced atomically, so an interrupted stage leaves no
+metrics file that looks complete.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+
+def json_ready(value: Any) -> Any:
+    """Nested dicts/lists with numpy scalars and NaN/inf turned into plain JSON values (NaN -> null)."""
+    if isinstance(value, dict):
+        return {str(key): json_ready(item) for key, item in value.items()}
+    if isinstance(value, (list, tuple, np.ndarray)):
+        return [json_ready(item) for item in value]
+    if isinstance(value, (bool, np.bool_)):
+        return bool(value)
+    if isinstance(value, (int, np.integer)):
+        return int(value)
+    if isinstance(value, (float, np.floating)):
+        return float(value) if np.isfinite(value) else None
+    return value
+
+
+def write_metrics(path: str | Path, metrics: dict[str, Any]) -> None:
+    """Write ``metrics`` (nested dicts / lists of numbers, strings, bools) as indented, key-sorted JSON."""
+    path = Path(path)
+    partial = path.with_name(path.name + ".partial")
+    partial.write_text(json.dumps(json_ready(metrics), indent=2, sort_keys=True, allow_nan=False) + "\n")
+    os.replace(partial, path)
