@@ -1,8 +1,11 @@
 """Load and validate ``params.yaml`` before any work starts.
 
 Every stage of ``dvc.yaml`` owns one top-level section of ``params.yaml``; the schema of a section lives
-next to the code that uses it (``poseintegrity.<subpackage>.params``) and is collected here. A bad value
-raises :class:`ParamsError` whose message names the offending key, e.g. ``generate.scenes.2.targets.0``.
+next to the code that uses it (``poseintegrity.<subpackage>.params``) and is collected here. The ``protocol``
+section holds the facts several stages share (:mod:`poseintegrity.protocol`); every other section is validated
+with it at hand, so that a rule across sections (a tolerance named in ``predict`` must be one of
+``protocol.tolerances``) names its key too. A bad value raises :class:`ParamsError` whose message names the
+offending key, e.g. ``generate.scenes.2.targets.0``.
 
 A params file may start with ``extends: <path>``: it is then an overlay on that file (relative to the overlay),
 merged key by key (mappings recursively, everything else replaced). ``tests/params_tiny.yaml`` is such an overlay
@@ -22,6 +25,7 @@ from poseintegrity.artifact_models.params import FitParams
 from poseintegrity.localization.params import ExtractParams
 from poseintegrity.parallel import ParallelParams
 from poseintegrity.prediction.params import PredictParams
+from poseintegrity.protocol import ProtocolParams
 from poseintegrity.scenes.params import GenerateParams
 from poseintegrity.schema import KeyRule
 from poseintegrity.tracking.params import TrackParams
@@ -36,6 +40,7 @@ class Params(BaseModel):
 
     model_config = ConfigDict(extra="forbid", frozen=True)
 
+    protocol: ProtocolParams  # stages 01-05: the facts of Windsor et al.'s protocol they share
     generate: GenerateParams  # stage 01
     extract: ExtractParams  # stages 02 and 05
     fit: FitParams  # stage 03
@@ -59,12 +64,23 @@ def _format_errors(error: ValidationError, prefix: tuple = ()) -> str:
     return "\n".join(lines)
 
 
+def _protocol(raw: Any, source: str) -> ProtocolParams:
+    """The validated ``protocol`` section, which every other section is checked against."""
+    if not isinstance(raw, dict) or "protocol" not in raw:
+        raise ParamsError(f"{source}: section 'protocol' is missing")
+    try:
+        return ProtocolParams.model_validate(raw["protocol"])
+    except ValidationError as error:
+        raise ParamsError(f"{source} has invalid values:\n{_format_errors(error, ('protocol',))}") from None
+
+
 def parse_params(raw: dict[str, Any], source: str = "params", base_dir: Path | None = None) -> Params:
     """Validate a parsed YAML mapping; raise :class:`ParamsError` naming every bad key."""
     if not isinstance(raw, dict):
         raise ParamsError(f"{source}: expected a mapping of sections, got {type(raw).__name__}")
+    context = {"base_dir": base_dir, "protocol": _protocol(raw, source)}
     try:
-        return Params.model_validate(raw, context={"base_dir": base_dir})
+        return Params.model_validate(raw, context=context)
     except ValidationError as error:
         raise ParamsError(f"{source} has invalid values:\n{_format_errors(error)}") from None
 
@@ -102,14 +118,15 @@ def load_params(path: str | Path = "params.yaml") -> Params:
 
 
 def load_section(path: str | Path, section: str) -> BaseModel:
-    """Read and validate one stage's section only: a stage is not stopped by another stage's bad values
-    (DVC tracks each stage's own section too)."""
+    """Read and validate one stage's section (with ``protocol``, which it is checked against): a stage is not
+    stopped by another stage's bad values (DVC tracks each stage's own sections too)."""
     if section not in Params.model_fields:
         raise ParamsError(f"unknown params section {section!r}; sections: {list(Params.model_fields)}")
     raw, base_dir = read_raw(path)
     if not isinstance(raw, dict) or section not in raw:
         raise ParamsError(f"{path}: section {section!r} is missing")
+    context = {"base_dir": base_dir, "protocol": _protocol(raw, str(path))}
     try:
-        return Params.model_fields[section].annotation.model_validate(raw[section], context={"base_dir": base_dir})
+        return Params.model_fields[section].annotation.model_validate(raw[section], context=context)
     except ValidationError as error:
         raise ParamsError(f"{path} has invalid values:\n{_format_errors(error, (section,))}") from None

@@ -19,6 +19,12 @@ TINY_PARAMS = Path(__file__).resolve().parents[1] / "params_tiny.yaml"
 
 
 @pytest.fixture(scope="session")
+def protocol():
+    """The ``protocol`` section the tiny parameters share with params.yaml."""
+    return load_params(TINY_PARAMS).protocol
+
+
+@pytest.fixture(scope="session")
 def extract_params() -> ExtractParams:
     """The ``extract`` section of the tiny parameters (sequential, so monkeypatching reaches the work)."""
     return load_params(TINY_PARAMS).extract

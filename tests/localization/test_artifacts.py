@@ -7,7 +7,8 @@ from poseintegrity.localization.frame_artifacts import frame_artifacts
 from poseintegrity.localization.realism import realism_metrics
 from poseintegrity.localization.summaries import method_summary
 from poseintegrity.localization.envelope import envelopes
-from poseintegrity.localization.params import RealismParams
+from poseintegrity.config import load_params
+from repository import ROOT
 from poseintegrity.localization.pnp import PnPResult, failed
 
 K = np.array([[500.0, 0.0, 0.0], [0.0, 500.0, 0.0], [0.0, 0.0, 1.0]])
@@ -34,7 +35,8 @@ def test_failed_result_has_zero_inliers_and_nan_geometry():
     assert row["n_inliers"] == 0 and row["inlier_ratio"] == 0.0 and np.isnan(row["inlier_spread_px"])
 
 
-REALISM = RealismParams(fit_stops=4, max_nfev=400)
+PARAMS = load_params(ROOT / "params.yaml")  # the pipeline's own realism settings and protocol
+REALISM, PROTOCOL = PARAMS.extract.realism, PARAMS.protocol
 
 
 def world(counts_by_dataset, trajectory="arc"):
@@ -60,7 +62,7 @@ def linear(decay):
 
 def test_realism_metrics_of_a_world_with_known_answers():
     table = world({"a": linear(1.5), "b": linear(2.2), "c": linear(0.8)})  # strictly decreasing n_i, never 0
-    metrics = realism_metrics(table, envelopes(table, [(2.0, 3.0), (4.0, 10.0)]), REALISM)
+    metrics = realism_metrics(table, envelopes(table, PROTOCOL.tolerances), REALISM, PROTOCOL)
     assert metrics["min_abs_spearman"] == pytest.approx(1.0)
     assert metrics["min_first_stop_mean_inliers"] == 100  # every dataset starts at the model view
     low = 50.0 / table.loc[table.n_inliers < 15, "n_inliers"]
@@ -86,7 +88,7 @@ def test_r1_prefers_the_emg_only_on_emg_shaped_decays():
     emg_world = world({f"d{i}": lambda t, K=K: emg(np.array([t]), 3000.0, K, -1.0)[0] for i, K in enumerate((5, 7, 9))})
     gauss_world = world({f"d{i}": lambda t, s=s: 300 * np.exp(-0.5 * (t / s) ** 2) for i, s in enumerate((10, 14, 18))})
     for table, near_best in ((emg_world, True), (gauss_world, False)):
-        metrics = realism_metrics(table, envelopes(table, [(2.0, 3.0), (4.0, 10.0)]), REALISM)
+        metrics = realism_metrics(table, envelopes(table, PROTOCOL.tolerances), REALISM, PROTOCOL)
         assert set(metrics["rmse_by_base_function"]) == {"emg", "exponential", "gaussian", "logistic", "power_law"}
         assert metrics["passed"]["r1_emg_near_best"] == near_best, metrics["rmse_by_base_function"]
 
@@ -94,7 +96,7 @@ def test_r1_prefers_the_emg_only_on_emg_shaped_decays():
 def test_r2_flags_envelopes_inside_the_sampled_stops_and_r5_compares_lines():
     table = pd.concat([world({"early": lambda t: 30 - 3 * t, "late": linear(2.0)}),
                        world({"line": linear(0.2)}, trajectory="line")], ignore_index=True)
-    metrics = realism_metrics(table, envelopes(table, [(2.0, 3.0), (4.0, 10.0)]), REALISM)
+    metrics = realism_metrics(table, envelopes(table, PROTOCOL.tolerances), REALISM, PROTOCOL)
     # early: E_t = 50 / n_i > 2 once n_i < 25, i.e. at theta 2.25 (n_i 23) -> theta_a <= 6.75, the 4th stop
     assert metrics["theta_a_2mm3deg_within_sampling"] == ["early"]
     assert not metrics["passed"]["r2_envelopes_beyond_sampling"]

@@ -48,9 +48,9 @@ def test_runs_repeat_exactly(table, synthetic_data_dir, extract_params):
     np.testing.assert_array_equal(again["E_t_mm"], first["E_t_mm"])
 
 
-def test_envelope_of_the_synthetic_arc(table, extract_params):
-    env = envelopes(table, extract_params.tolerances)
-    assert len(env) == 2 * len(METHODS) * len(extract_params.tolerances)
+def test_envelope_of_the_synthetic_arc(table, protocol):
+    env = envelopes(table, protocol.tolerances)
+    assert len(env) == 2 * len(METHODS) * len(protocol.tolerances)
     arc = env[env.dataset == "arc_a"]
     assert ((arc.theta_a > 10.0) & (arc.theta_a <= 55.0)).all()
 

@@ -1,18 +1,18 @@
 from pathlib import Path
 
 import pytest
-import yaml
 from pydantic import ValidationError
 
-from poseintegrity.localization.params import ExtractParams, tolerance_name
+from poseintegrity.config import load_params
+from poseintegrity.localization.params import ExtractParams
 
 PARAMS_YAML = Path(__file__).parents[2] / "params.yaml"
 
 
 def test_yaml_section_validates_with_paper_tolerances():
-    params = ExtractParams.model_validate(yaml.safe_load(PARAMS_YAML.read_text())["extract"])
-    assert [tolerance_name(t) for t in params.tolerances] == ["2mm_3deg", "4mm_10deg"]
-    assert params.pnp_method == "usac_magsac"
+    params = load_params(PARAMS_YAML)
+    assert params.protocol.tolerance_names == ["2mm_3deg", "4mm_10deg"]
+    assert params.protocol.pnp_method == "usac_magsac" and params.extract.pnp_methods[0] == "epnp"
 
 
 @pytest.mark.parametrize(
@@ -21,7 +21,6 @@ def test_yaml_section_validates_with_paper_tolerances():
         ({"ratio_test": 1.5}, "ratio_test"),
         ({"sift": {"sigma": -1}}, "sift.sigma"),
         ({"pnp_methods": ["dls"]}, "pnp_methods.0"),
-        ({"tolerances": [[2, -3]]}, "tolerances"),
         ({"n_jobs": 0}, "n_jobs"),
         ({"ransac_typo": 3}, "ransac_typo"),
     ],

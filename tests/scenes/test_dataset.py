@@ -8,7 +8,11 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from poseintegrity.config import load_params
 from poseintegrity.scenes import dataset, renderer
+from repository import ROOT
+
+TINY = load_params(ROOT / "tests" / "params_tiny.yaml")  # params.yaml shrunk: the pipeline's configuration
 
 
 def digest(root) -> dict[str, str]:
@@ -18,13 +22,9 @@ def digest(root) -> dict[str, str]:
 
 @pytest.fixture(scope="module")
 def tiny_root(tmp_path_factory):
-    from pathlib import Path
-
-    from poseintegrity.config import load_params
-
-    params = load_params(Path(__file__).resolve().parents[1] / "params_tiny.yaml").generate
+    params = TINY.generate
     root = tmp_path_factory.mktemp("datasets")
-    dataset.generate(params, root, progress=False)
+    dataset.generate(params, TINY.protocol, root, progress=False)
     return params, root
 
 
@@ -83,7 +83,7 @@ def test_board_ground_truth_agrees_with_opencv_aruco_pose(tiny_root):
 
 def test_rerun_reproduces_every_file_byte_for_byte(tiny_root, tmp_path):
     params, root = tiny_root
-    dataset.generate(params, tmp_path, progress=False)
+    dataset.generate(params, TINY.protocol, tmp_path, progress=False)
     assert digest(tmp_path) == digest(root)
 
 
@@ -100,6 +100,6 @@ def test_interrupted_run_leaves_nothing_that_looks_complete(tiny_root, tmp_path,
 
     monkeypatch.setattr(renderer, "expose", failing_expose)
     with pytest.raises(KeyboardInterrupt):
-        dataset.generate(params.model_copy(update={"n_jobs": 1}), tmp_path, progress=False)
+        dataset.generate(params.model_copy(update={"n_jobs": 1}), TINY.protocol, tmp_path, progress=False)
     assert not (tmp_path / "index.parquet").exists()
     assert [p.name for p in tmp_path.iterdir() if not p.name.startswith(".")] == []

@@ -64,7 +64,7 @@ def test_arcs_of_different_azimuths_diverge():
 @pytest.mark.parametrize("offset", [0.0, 5.0, 15.0])
 def test_line_moves_back_along_the_optical_axis(offset):
     T0, _ = model_view()
-    stops = trajectories.line(T0, AIM, offset, 10.0, 15)
+    stops = trajectories.line(T0, AIM, offset, 150.0, 15)
     start = stops[0].T_world_cam[:3, 3]
     for k, stop in enumerate(stops):
         assert stop.x_mm == pytest.approx(10.0 * k)

@@ -21,6 +21,7 @@ from poseintegrity.artifact_models.fitted import FittedModel
 from poseintegrity.artifact_models.models import fit_model
 from poseintegrity.artifact_models.params import FitParams
 from poseintegrity.artifact_models.series import Series, dataset_series
+from poseintegrity.protocol import ProtocolParams
 
 COLUMNS = ["trajectory", "dataset", "k", "model", "rmse", "converged", "reason", "n_samples"]  # of fig2_rmse
 
@@ -32,11 +33,10 @@ def fit_first_stops(series: Series, k: int, params: FitParams) -> dict[str, Fitt
     the same for any n_jobs, any order of work, any other datasets in the table and any other models.
     """
     theta, n_inliers = series.first_stops(k)
-    theta_max = params.range_end(series.trajectory)
     key = [params.seed, _crc32(f"{series.trajectory}/{series.dataset}"), k]
     return {
         name: fit_model(
-            name, theta, n_inliers, theta_max=theta_max, params=params, rng=np.random.default_rng([*key, _crc32(name)])
+            name, theta, n_inliers, theta_max=series.theta_end, params=params, rng=np.random.default_rng([*key, _crc32(name)])
         )
         for name in params.models
     }
@@ -68,14 +68,14 @@ def _fig2_rows(series: Series, k: int, params: FitParams) -> list[dict]:
     ]
 
 
-def fig2_rmse(artifacts: pd.DataFrame, params: FitParams, progress: bool = True) -> pd.DataFrame:
-    """The Fig. 2 experiment: one row per (trajectory, dataset, k, model).
+def fig2_rmse(artifacts: pd.DataFrame, params: FitParams, protocol: ProtocolParams, progress: bool = True) -> pd.DataFrame:
+    """The Fig. 2 experiment on the ``protocol.pnp_method`` rows: one row per (trajectory, dataset, k, model).
 
     Columns: trajectory, dataset, k, model, rmse (inliers, over every image of the dataset), converged,
     reason ("ok" or why the fit failed; the RMSE is then that of the fallback line), n_samples.
     Runs on ``params.n_jobs`` joblib workers. Raises ValueError when no dataset has k_min stops.
     """
-    all_series = dataset_series(artifacts, params.pnp_method)
+    all_series = dataset_series(artifacts, protocol.pnp_method, protocol)
     tasks = [
         (series, k)
         for series in all_series
@@ -100,14 +100,15 @@ def mean_rmse(table: pd.DataFrame) -> pd.DataFrame:
     )
 
 
-def fits_metrics(table: pd.DataFrame, params: FitParams) -> dict[str, dict[str, float]]:
-    """Headline figures of stage 03 for ``reports/metrics/fits.json``.
+def fits_metrics(table: pd.DataFrame, params: FitParams, protocol: ProtocolParams) -> dict[str, dict[str, float]]:
+    """Headline figures of stage 03 for ``reports/metrics/fits.json``, at the stops a robot samples
+    (``protocol.sampled_stops``: k = 4 on arcs, 5 on lines in the paper).
 
-    rmse_k<k_report_arc>.<model> : mean RMSE across arc datasets at k = k_report_arc (paper: 4)
-    line_rmse_k<k_report_line>.<model> : the same for line datasets at k = k_report_line (paper: 5)
+    rmse_k<arc stops>.<model> : mean RMSE across arc datasets at k = sampled arc stops
+    line_rmse_k<line stops>.<model> : the same for line datasets
     converged.<model> : fraction of all fits (every dataset, every k) that converged
     Every model of ``params.models`` has every key; the value is None where there was no fit (e.g. no
-    dataset with k_report_arc stops).
+    dataset with that many stops).
     """
     means = mean_rmse(table)
     converged = table.groupby("model")["converged"].mean()
@@ -117,7 +118,7 @@ def fits_metrics(table: pd.DataFrame, params: FitParams) -> dict[str, dict[str, 
         return {m: float(rows[m]) if m in rows.index else None for m in params.models}
 
     return {
-        f"rmse_k{params.k_report_arc}": at("arc", params.k_report_arc),
-        f"line_rmse_k{params.k_report_line}": at("line", params.k_report_line),
+        f"rmse_k{protocol.sampled_stops.arc}": at("arc", protocol.sampled_stops.arc),
+        f"line_rmse_k{protocol.sampled_stops.line}": at("line", protocol.sampled_stops.line),
         "converged": {m: float(converged[m]) if m in converged.index else None for m in params.models},
     }

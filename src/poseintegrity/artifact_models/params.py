@@ -8,9 +8,9 @@ from __future__ import annotations
 
 from typing import Literal
 
-from pydantic import Field, model_validator
+from pydantic import Field, ValidationInfo, model_validator
 
-from poseintegrity.schema import Section
+from poseintegrity.schema import KeyRule, Section
 
 ModelName = Literal[
     "emg", "exponential", "gaussian", "logistic", "power_law", "mlp_scratch", "mlp_pretrained"
@@ -38,29 +38,26 @@ class MLPParams(Section):
 class FitParams(Section):
     """Stage 03: fit artifact models f: theta -> n_inliers and run the Fig. 2 experiment."""
 
-    pnp_method: str = Field(min_length=1, description="PnP method whose n_inliers are modelled")
     models: tuple[ModelName, ...] = Field(min_length=1, description="artifact models compared in Fig. 2")
     k_min: int = Field(ge=2, description="fewest stops (from the start) used for a fit")
     k_max: int | None = Field(ge=2, description="most stops used for a fit; null = all stops")
-    k_report_arc: int = Field(ge=2, description="k of the headline RMSE for arcs (paper: 4)")
-    k_report_line: int = Field(ge=2, description="k of the headline RMSE for lines (paper: 5)")
-    theta_max_deg: float = Field(gt=0, description="end of the arc range: artificial MLP point (45, 0)")
-    x_max_mm: float = Field(gt=0, description="end of the line range: artificial MLP point (150, 0)")
     max_nfev: int = Field(ge=10, description="curve_fit evaluation budget per base-function fit")
     seed: int = Field(ge=0, description="seed of every random draw of the stage (MLP initial weights)")
     n_jobs: int = Field(description="joblib workers; -1 = all cores")
     mlp: MLPParams
 
     @model_validator(mode="after")
-    def _check_ranges(self) -> FitParams:
+    def _check_ranges(self, info: ValidationInfo) -> FitParams:
         if self.k_max is not None and self.k_max < self.k_min:
-            raise ValueError(f"k_max ({self.k_max}) must be null or >= k_min ({self.k_min})")
+            raise KeyRule("k_max", f"must be null or >= k_min ({self.k_min}), got {self.k_max}")
+        protocol = (info.context or {}).get("protocol")  # the headline RMSE is taken at its sampled stops
+        stops = (protocol.sampled_stops.arc, protocol.sampled_stops.line) if protocol else (self.k_min,)
+        if min(stops) < self.k_min:
+            raise KeyRule("k_min", f"must be <= protocol.sampled_stops ({min(stops)}), got {self.k_min}")
+        if self.k_max is not None and max(stops) > self.k_max:
+            raise KeyRule("k_max", f"must be null or >= protocol.sampled_stops ({max(stops)}), got {self.k_max}")
         if self.n_jobs == 0:
             raise ValueError("n_jobs must be a positive count or negative (joblib convention), not 0")
         if len(set(self.models)) != len(self.models):
             raise ValueError(f"models has duplicates: {list(self.models)}")
         return self
-
-    def range_end(self, trajectory: str) -> float:
-        """End of the search / extrapolation range of a trajectory type ("arc": deg, "line": mm)."""
-        return {"arc": self.theta_max_deg, "line": self.x_max_mm}[trajectory]

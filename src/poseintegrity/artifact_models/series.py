@@ -11,6 +11,8 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from poseintegrity.protocol import ProtocolParams
+
 VARIABLE = {"arc": "theta_deg", "line": "x_mm"}  # independent variable of the artifact model per trajectory
 
 
@@ -19,6 +21,8 @@ class Series:
     """One dataset's samples for one PnP method, in stop order.
 
     stop : (m,) int, 0-based;  theta : (m,) float, deg (arc) or mm (line);  n_inliers : (m,) float
+    theta_end : end of the trajectory's range (protocol.arc_span_deg or line_length_mm): where the search for
+    theta_p ends and the MLP's artificial point (theta_end, 0) lies (III-D, III-E)
     """
 
     dataset: str
@@ -26,6 +30,7 @@ class Series:
     stop: np.ndarray
     theta: np.ndarray
     n_inliers: np.ndarray
+    theta_end: float
 
     @property
     def n_stops(self) -> int:
@@ -37,8 +42,9 @@ class Series:
         return self.theta[keep], self.n_inliers[keep]
 
 
-def dataset_series(artifacts: pd.DataFrame, pnp_method: str) -> list[Series]:
-    """Split the artifacts table into one :class:`Series` per (trajectory, dataset) for ``pnp_method``."""
+def dataset_series(artifacts: pd.DataFrame, pnp_method: str, protocol: ProtocolParams) -> list[Series]:
+    """Split the artifacts table into one :class:`Series` per (trajectory, dataset) for ``pnp_method``, each
+    ending where ``protocol`` ends its trajectory type."""
     rows = artifacts[artifacts["method"] == pnp_method]
     if rows.empty:
         raise ValueError(f"no rows with method {pnp_method!r}; methods present: {sorted(artifacts['method'].unique())}")
@@ -55,6 +61,7 @@ def dataset_series(artifacts: pd.DataFrame, pnp_method: str) -> list[Series]:
                 stop=group["stop"].to_numpy(dtype=int),
                 theta=group[VARIABLE[trajectory]].to_numpy(dtype=float),
                 n_inliers=group["n_inliers"].to_numpy(dtype=float),
+                theta_end=protocol.range_end(trajectory),
             )
         )
     return series

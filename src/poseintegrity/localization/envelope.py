@@ -20,7 +20,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from poseintegrity.localization.params import tolerance_name
+from poseintegrity.protocol import tolerance_name
 
 
 def actual_envelope(theta: np.ndarray, mean_errors: np.ndarray, tolerance: np.ndarray) -> tuple[float, bool]:

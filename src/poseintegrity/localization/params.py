@@ -6,14 +6,10 @@ experiments"): every value here is our choice and is documented next to its fiel
 
 from __future__ import annotations
 
-from typing import Literal
+from pydantic import Field
 
-from pydantic import Field, field_validator
-
+from poseintegrity.protocol import PnPMethod
 from poseintegrity.schema import Section, WorkerCount
-
-PnPMethod = Literal["usac_magsac", "epnp", "p3p", "ap3p", "sqpnp", "iterative"]
-
 
 
 class ClaheParams(Section):
@@ -34,9 +30,9 @@ class SiftParams(Section):
 
 
 class RealismParams(Section):
-    """The realism checks of the rendered world (:func:`poseintegrity.localization.realism.realism_metrics`)."""
+    """The realism checks of the rendered world (:func:`poseintegrity.localization.realism.realism_metrics`); the
+    stops they sample are ``protocol.sampled_stops``."""
 
-    fit_stops: int = Field(ge=2, description="stops the R1 fits and the R2 / R5 sampling use (paper: 4)")
     max_nfev: int = Field(ge=10, description="curve_fit evaluation budget of each R1 fit")
 
 
@@ -62,29 +58,11 @@ class ExtractParams(Section):
         " docs/references.md, 'OpenCV 5': EPnP needed ~10 000 at 80 % outliers, so the classic solvers give up earlier than USAC on low-inlier"
         " frames (where each 5-point EPnP iteration costs ~0.1-0.2 ms)",
     )
-    pnp_method: PnPMethod = Field("usac_magsac", description="stage 02: the paper's PnP-RANSAC (OpenCV USAC)")
     pnp_methods: list[PnPMethod] = Field(
         ["epnp", "p3p", "ap3p", "sqpnp", "iterative"], min_length=1, description="stage 05 (paper Fig. 6)"
-    )
-    tolerances: list[tuple[float, float]] = Field(
-        [(2.0, 3.0), (4.0, 10.0)], min_length=1, description="(E_t mm, E_r deg) error tolerances of IV-E"
     )
     seed: int = Field(0, ge=0, description="seeds every RANSAC run (one derived seed per frame)")
     n_jobs: WorkerCount = Field(2, description="joblib workers over images (-1: all cores)")
     features_dir: str = Field("features", min_length=1, description="SIFT cache, relative to data_dir")
     datasets: list[str] | None = Field(None, description="dataset ids to process; null: every dataset")
     realism: RealismParams
-
-    @field_validator("tolerances")
-    @classmethod
-    def _positive_tolerances(cls, tolerances: list[tuple[float, float]]) -> list[tuple[float, float]]:
-        for E_t_mm, E_r_deg in tolerances:
-            if E_t_mm <= 0 or E_r_deg <= 0:
-                raise ValueError(f"tolerances must be positive (mm, deg), got ({E_t_mm}, {E_r_deg})")
-        return tolerances
-
-
-def tolerance_name(tolerance: tuple[float, float]) -> str:
-    """``(2, 3)`` -> ``"2mm_3deg"`` (the ``tolerance`` column of the envelope tables)."""
-    E_t_mm, E_r_deg = tolerance
-    return f"{E_t_mm:g}mm_{E_r_deg:g}deg"

@@ -14,15 +14,17 @@ import pandas as pd
 from scipy.stats import spearmanr
 
 from poseintegrity.artifact_models.base_functions import BASE_FUNCTIONS
-from poseintegrity.localization.params import RealismParams, tolerance_name
+from poseintegrity.localization.params import RealismParams
+from poseintegrity.protocol import ProtocolParams, tolerance_name
 
 
 def realism_metrics(
-    table: pd.DataFrame, envelope_table: pd.DataFrame, realism: RealismParams, method: str = "usac_magsac"
+    table: pd.DataFrame, envelope_table: pd.DataFrame, realism: RealismParams, protocol: ProtocolParams
 ) -> dict[str, Any]:
     """Properties of the rendered world that the paper's real datasets had (issues 3 and 10, "Realism").
 
-    table : artifacts rows; envelope_table : :func:`envelope.envelopes` rows. Only ``method`` rows are used.
+    table : artifacts rows; envelope_table : :func:`envelope.envelopes` rows. Only the rows of
+    ``protocol.pnp_method`` are used; the sampled stops are ``protocol.sampled_stops.arc`` (IV-A: 4).
     Keys (bars in ``passed``):
     - ``min_abs_spearman``: weakest decay of mean n_i with theta over the arc datasets, as min over datasets of
       -rho (Spearman of stop theta vs mean n_i per stop); equals |rho| when rho < 0 (bar: >= 0.8).
@@ -40,17 +42,18 @@ def realism_metrics(
       linearly interpolated at theta_a (bar: <= 30). The paper's thresholds at zero incursion (n_t 12-28,
       Table III) say that its localization failed once inliers ran short.
     - R1 (Fig. 2) ``emg_rmse_ratio``: mean RMSE over the arc datasets of eq. 1 fitted to the first
-      ``realism.fit_stops`` stops and measured over the whole dataset, over the best other least-squares base
+      sampled stops and measured over the whole dataset, over the best other least-squares base
       function's (bar: <= 1.10); ``rmse_by_base_function`` holds every mean
     - R2 (IV-A) ``n_theta_a_2mm3deg_within_sampling``: arc datasets whose theta_a at 2 mm/3 deg is not beyond the
-      last sampled stop of the long range predictor (the ``fit_stops``-th stop, 6.75 deg) (bar: 0, and the
+      last sampled stop of the long range predictor (the 4th stop, 6.75 deg) (bar: 0, and the
       smallest theta_a <= 12 deg)
     - R3 (Tables I-II) ``median_theta_a_gap``: median over arcs uncensored at both tolerances of
       theta_a(4 mm/10 deg) - theta_a(2 mm/3 deg) (bar: <= 2 stops = 4.5 deg): failure is abrupt
     - R4 (Table III) medians of n_i at theta_a in [10, 35] at both tolerances, 90th percentiles <= 50
-    - R5 (V-A) ``median_decay_ratio_arc``: median over arcs of mean n_i at the ``fit_stops``-th stop over the
+    - R5 (V-A) ``median_decay_ratio_arc``: median over arcs of mean n_i at the 4th (sampled) stop over the
       first stop's (bar: <= 0.75); ``median_decay_ratio_line`` the same on lines (bar: larger than on arcs)
     """
+    method, sampled = protocol.pnp_method, protocol.sampled_stops.arc
     rows = table[table["method"] == method]
     arcs = rows[rows["trajectory"] == "arc"]
     per_stop = arcs.groupby(["dataset", "stop"]).agg(theta=("theta_deg", "mean"), n_i=("n_inliers", "mean"))
@@ -81,11 +84,11 @@ def realism_metrics(
     at_failure_strict, at_failure_loose = inliers_at_failure(strict), inliers_at_failure(loose)
     both_uncensored = strict.index[~strict["censored"]].intersection(loose.index[~loose["censored"]])
     gap = (loose.loc[both_uncensored, "theta_a"] - strict.loc[both_uncensored, "theta_a"]).to_dict()
-    last_sampled = per_stop["theta"].groupby("dataset").nth(realism.fit_stops - 1).droplevel("stop")
+    last_sampled = per_stop["theta"].groupby("dataset").nth(sampled - 1).droplevel("stop")
     within_sampling = sorted(d for d, row in strict.iterrows() if d in last_sampled and row["theta_a"] <= last_sampled[d])
-    rmse = base_function_rmse(rows, realism)
+    rmse = base_function_rmse(rows, sampled, realism.max_nfev)
     others = {name: value for name, value in rmse.items() if name != "emg"}
-    decay_arc, decay_line = decay_ratios(rows, "arc", realism.fit_stops), decay_ratios(rows, "line", realism.fit_stops)
+    decay_arc, decay_line = decay_ratios(rows, "arc", sampled), decay_ratios(rows, "line", sampled)
     n_arcs = int(arcs["dataset"].nunique())
     metrics = dict(
         method=method,
@@ -145,15 +148,15 @@ def realism_metrics(
     return metrics
 
 
-def base_function_rmse(rows: pd.DataFrame, realism: RealismParams) -> dict[str, float]:
+def base_function_rmse(rows: pd.DataFrame, sampled_stops: int, max_nfev: int) -> dict[str, float]:
     """R1: per least-squares base function (eq. 1 and the other decays of Fig. 2), the mean over arc datasets of
-    the RMSE over every image when fitted to the images of the first ``realism.fit_stops`` stops."""
+    the RMSE over every image when fitted to the images of the first ``sampled_stops`` stops."""
     sums: dict[str, list[float]] = {name: [] for name in BASE_FUNCTIONS}
     for _, frames in rows[rows["trajectory"] == "arc"].groupby("dataset"):
         theta, n_i = frames["theta_deg"].to_numpy(float), frames["n_inliers"].to_numpy(float)
-        fitted_stops = np.isin(frames["stop"], np.sort(frames["stop"].unique())[: realism.fit_stops])
+        fitted_stops = np.isin(frames["stop"], np.sort(frames["stop"].unique())[:sampled_stops])
         for name, base in BASE_FUNCTIONS.items():
-            model = base.fit(theta[fitted_stops], n_i[fitted_stops], realism.max_nfev)
+            model = base.fit(theta[fitted_stops], n_i[fitted_stops], max_nfev)
             sums[name].append(float(np.sqrt(np.mean((model.predict(theta) - n_i) ** 2))))
     return {name: _nanmean(values) for name, values in sums.items()}
 

@@ -10,10 +10,10 @@ from __future__ import annotations
 from typing import Literal
 
 import numpy as np
-from pydantic import Field, model_validator
+from pydantic import Field, ValidationInfo, model_validator
 
 from poseintegrity.artifact_models.params import ModelName
-from poseintegrity.schema import Section
+from poseintegrity.schema import KeyRule, Section
 
 IntervalMethod = Literal["covariance", "bootstrap"]
 
@@ -40,25 +40,21 @@ class UncertaintyParams(Section):
 class PredictParams(Section):
     """Stage 04: predictors, the n_t sweep, the static baseline, LOSO threshold choice, live-trial simulation."""
 
-    pnp_method: str = Field(min_length=1, description="the paper's PnP path (Tables I-III); others only in Fig. 6")
     n_t_min: int = Field(ge=1, description="smallest inlier threshold of the sweep (paper: 4)")
     n_t_max: int = Field(ge=1, description="largest inlier threshold of the sweep (paper: 100)")
     relative_min: float = Field(gt=0, lt=1, description="beyond the paper: smallest n_t / first-stop mean n_i")
     relative_max: float = Field(gt=0, lt=1, description="largest n_t / first-stop mean n_i of the sweep")
     relative_step: float = Field(gt=0, lt=1, description="step of the relative-threshold sweep")
-    long_range_stops_arc: int = Field(ge=2, description="stops the long range predictor fits on arcs (paper: 4)")
-    long_range_stops_line: int = Field(ge=2, description="the same on straight lines (paper: 5)")
-    next_step_first_stops: int = Field(ge=2, description="stops of the next-step predictor's first fit (paper: 4)")
-    static_max_deg: float = Field(gt=0, description="static baseline swept from 0 to this on arcs (paper: 45)")
-    static_max_mm: float = Field(gt=0, description="static baseline swept from 0 to this on lines (paper: 150)")
-    n_static: int = Field(ge=2, description="envelope sizes of the static sweep (evenly spaced, both ends included)")
+    n_static: int = Field(ge=2, description="envelope sizes of the static sweep, 0 .. the range end of protocol")
     tolerance_fig6_fig7: str = Field(
-        min_length=1, description="tolerance of the PnP (Fig. 6) and straight-line (Fig. 7) curves (paper: 2mm_3deg)"
+        min_length=1, description="tolerance of the PnP (Fig. 6) and straight-line (Fig. 7) curves (paper: 2mm_3deg),"
+        " one of protocol.tolerances"
     )
     n_grid: int = Field(ge=16, description="grid points of the theta_p crossing scan per fitted curve")
     models: PredictorModels
     live_n_t: int = Field(ge=1, description="fixed n_t of the simulated live trials (paper: 15, from Table III)")
-    live_tolerance: str = Field(min_length=1, description="tolerance of the simulated live trials (paper: 4mm_10deg)")
+    live_tolerance: str = Field(min_length=1, description="tolerance of the simulated live trials (paper: 4mm_10deg), one of"
+                                                            " protocol.tolerances")
     loso_target_rates: tuple[float, ...] = Field(
         min_length=1, description="target incursion rates of the leave-one-scene-out threshold choice; first = headline"
     )
@@ -67,7 +63,12 @@ class PredictParams(Section):
     n_jobs: int = Field(description="joblib workers; -1 = all cores")
 
     @model_validator(mode="after")
-    def _check(self) -> PredictParams:
+    def _check(self, info: ValidationInfo) -> PredictParams:
+        protocol = (info.context or {}).get("protocol")
+        for key in ("tolerance_fig6_fig7", "live_tolerance"):
+            if protocol is not None and getattr(self, key) not in protocol.tolerance_names:
+                raise KeyRule(key, f"must name one of protocol.tolerances {protocol.tolerance_names}, "
+                                   f"got {getattr(self, key)!r}")
         if self.n_t_max < self.n_t_min:
             raise ValueError(f"n_t_max ({self.n_t_max}) must be >= n_t_min ({self.n_t_min})")
         if self.relative_max < self.relative_min:
@@ -91,11 +92,6 @@ class PredictParams(Section):
         n = int(np.floor((self.relative_max - self.relative_min) / self.relative_step + 1e-9)) + 1
         return np.round(self.relative_min + self.relative_step * np.arange(n), 9)
 
-    def long_range_stops(self, trajectory: str) -> int:
-        """Stops the long range predictor fits ("arc": 4, "line": 5 in the paper)."""
-        return {"arc": self.long_range_stops_arc, "line": self.long_range_stops_line}[trajectory]
-
-    def static_sizes(self, trajectory: str) -> np.ndarray:
-        """Static baseline envelope sizes : (n_static,) float, deg (arcs) or mm (lines)."""
-        end = {"arc": self.static_max_deg, "line": self.static_max_mm}[trajectory]
-        return np.linspace(0.0, end, self.n_static)
+    def static_sizes(self, theta_end: float) -> np.ndarray:
+        """Static baseline envelope sizes 0 .. theta_end : (n_static,) float, deg (arcs) or mm (lines)."""
+        return np.linspace(0.0, theta_end, self.n_static)

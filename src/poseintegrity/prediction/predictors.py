@@ -118,7 +118,7 @@ def fit_stops(
     """The artifact model fitted to the images of ``stops`` : (fitted, theta (m,), n_inliers (m,))."""
     keep = np.isin(series.stop, stops)
     theta, n_inliers = series.theta[keep], series.n_inliers[keep]
-    fitted = fit_model(model, theta, n_inliers, theta_max=fit.range_end(series.trajectory), params=fit, rng=rng)
+    fitted = fit_model(model, theta, n_inliers, theta_max=series.theta_end, params=fit, rng=rng)
     return fitted, theta, n_inliers
 
 
@@ -160,8 +160,7 @@ def long_range(
     if stops.size < k:
         return LongRange(flagged(thresholds, "too_few_stops"), None, np.empty(0), np.empty(0))
     fitted, theta, n_inliers = fit_stops(series, stops[:k], model, fit, rng)
-    theta_end = fit.range_end(series.trajectory)
-    prediction = envelope_prediction(fitted.predict, thresholds, theta_stops[0], theta_end, n_grid)
+    prediction = envelope_prediction(fitted.predict, thresholds, theta_stops[0], series.theta_end, n_grid)
     return LongRange(prediction, fitted, theta, n_inliers)
 
 
@@ -200,7 +199,7 @@ def next_step(
     stops, theta_stops = stop_positions(series)
     if stops.size < max(k0, 2):
         return NextStep(flagged(thresholds, "too_few_stops"), np.full(np.shape(thresholds), np.nan), 0, 0)
-    theta_b, theta_end = sampling_interval(theta_stops), fit.range_end(series.trajectory)
+    theta_b = sampling_interval(theta_stops)
     stop_at = np.full(np.shape(thresholds), theta_stops[-1])
     boundary = np.full(np.shape(thresholds), np.nan)
     moving = np.isfinite(thresholds)
@@ -210,7 +209,7 @@ def next_step(
             break
         fitted, _, _ = fit_stops(series, stops[: i + 1], model, fit, fit_rng(seed, method, series, i + 1))
         n_fits, n_failed = n_fits + 1, n_failed + (not fitted.converged)
-        theta_p = envelope_prediction(fitted.predict, thresholds[moving], theta_stops[0], theta_end, n_grid).theta_p
+        theta_p = envelope_prediction(fitted.predict, thresholds[moving], theta_stops[0], series.theta_end, n_grid).theta_p
         stop = next_step_stops(theta_p, theta_stops[i], theta_b)
         index = moving.nonzero()[0][stop]
         stop_at[index], boundary[index] = theta_stops[i], theta_p[stop]

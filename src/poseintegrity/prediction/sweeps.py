@@ -11,7 +11,7 @@ Predictors (column ``predictor``): "long_range", "long_range_lower" (stops on th
 prediction interval, :mod:`.uncertainty`), "mlp", "next_step", "static", and beyond the paper
 "long_range_relative" / "next_step_relative", whose operating point is n_t as a fraction of the dataset's mean n_i
 at the first stop (the same fits as "long_range" / "next_step"). Only "long_range" and "static" run on PnP methods
-other than ``predict.pnp_method`` (Fig. 6).
+other than ``protocol.pnp_method`` (Fig. 6).
 """
 
 from __future__ import annotations
@@ -35,6 +35,7 @@ from poseintegrity.prediction.predictors import (
     static_baseline,
 )
 from poseintegrity.prediction.uncertainty import prediction_interval
+from poseintegrity.protocol import ProtocolParams
 
 COLUMNS = [
     "predictor", "model", "method", "trajectory", "dataset", "operating_point", "theta_p", "status", "converged",
@@ -66,29 +67,32 @@ def _split(found: Boundaries, n: int) -> tuple[Boundaries, Boundaries]:
     return (Boundaries(found.theta_p[:n], found.status[:n]), Boundaries(found.theta_p[n:], found.status[n:]))
 
 
-def predict_dataset(series: Series, method: str, predict: PredictParams, fit: FitParams) -> pd.DataFrame:
-    """Every predictor's theta_p over the operating points for one dataset and PnP method (rows of COLUMNS).
+def predict_dataset(
+    series: Series, method: str, predict: PredictParams, fit: FitParams, protocol: ProtocolParams
+) -> pd.DataFrame:
+    """Every predictor's theta_p over the operating points for one dataset and PnP method (rows of COLUMNS); the
+    predictors sample ``protocol.stops_sampled`` stops first (IV-A).
 
     The absolute thresholds n_t and the relative ones (fraction x first-stop mean n_i) go through one fit of each
     predictor: the fit does not depend on the threshold.
     """
-    n_t, k, models = predict.thresholds, predict.long_range_stops(series.trajectory), predict.models
+    n_t, k, models = predict.thresholds, protocol.stops_sampled(series.trajectory), predict.models
     fractions = predict.relative_thresholds
     both = np.concatenate([n_t, relative_thresholds(series, fractions)])
-    sizes = predict.static_sizes(series.trajectory)
+    sizes = predict.static_sizes(series.theta_end)
     tables = [_rows("static", "", method, series, sizes, static_baseline(sizes), True, "ok")]
     answer = long_range(series, k, models.long_range, both, fit, fit_rng(predict.seed, method, series, k), predict.n_grid)
     absolute, relative = _split(answer.prediction, n_t.size)
     converged, reason = (answer.fitted.converged, answer.fitted.reason) if answer.fitted else (False, "too few stops")
     tables.append(_rows("long_range", models.long_range, method, series, n_t, absolute, converged, reason))
-    if method != predict.pnp_method:  # Fig. 6: the long range predictor alone on the other PnP methods
+    if method != protocol.pnp_method:  # Fig. 6: the long range predictor alone on the other PnP methods
         return pd.concat(tables, ignore_index=True)
     tables.append(_rows("long_range_relative", models.long_range, method, series, fractions, relative, converged,
                         reason))  # fmt: skip
 
     interval = prediction_interval(
         models.long_range, answer.fitted, answer.theta, answer.n_inliers, n_t,
-        theta_end=fit.range_end(series.trajectory), fit=fit, uncertainty=predict.uncertainty,
+        theta_end=series.theta_end, fit=fit, uncertainty=predict.uncertainty,
         rng=fit_rng(predict.seed + 1, method, series, k), n_grid=predict.n_grid,
     )  # fmt: skip
     no_interval = np.isnan(interval.lower) & ~np.isnan(absolute.theta_p)
@@ -97,8 +101,7 @@ def predict_dataset(series: Series, method: str, predict: PredictParams, fit: Fi
     mlp = long_range(series, k, models.mlp, n_t, fit, fit_rng(predict.seed, method, series, k), predict.n_grid)
     mlp_converged, mlp_reason = (mlp.fitted.converged, mlp.fitted.reason) if mlp.fitted else (False, "too few stops")
     tables.append(_rows("mlp", models.mlp, method, series, n_t, mlp.prediction, mlp_converged, mlp_reason))
-    step = next_step(series, predict.next_step_first_stops, models.next_step, both, fit, predict.seed, method,
-                     predict.n_grid)  # fmt: skip
+    step = next_step(series, k, models.next_step, both, fit, predict.seed, method, predict.n_grid)
     step_absolute, step_relative = _split(step.prediction, n_t.size)
     step_ok, step_reason = step.n_failed == 0, f"{step.n_fits} fits, {step.n_failed} not converged"
     tables.append(_rows("next_step", models.next_step, method, series, n_t, step_absolute, step_ok, step_reason))
@@ -107,7 +110,9 @@ def predict_dataset(series: Series, method: str, predict: PredictParams, fit: Fi
     return pd.concat(tables, ignore_index=True)
 
 
-def sweep(artifacts: pd.DataFrame, predict: PredictParams, fit: FitParams, progress: bool = True) -> pd.DataFrame:
+def sweep(
+    artifacts: pd.DataFrame, predict: PredictParams, fit: FitParams, protocol: ProtocolParams, progress: bool = True
+) -> pd.DataFrame:
     """theta_p of every predictor, dataset, PnP method and operating point (rows of COLUMNS).
 
     artifacts : the stage-02 table (dataset, trajectory, stop, image, theta_deg, x_mm, method, n_inliers, ...)
@@ -115,10 +120,10 @@ def sweep(artifacts: pd.DataFrame, predict: PredictParams, fit: FitParams, progr
     tasks = [
         (series, str(method))
         for method in sorted(artifacts["method"].unique())
-        for series in dataset_series(artifacts, str(method))
+        for series in dataset_series(artifacts, str(method), protocol)
     ]
     results = Parallel(n_jobs=predict.n_jobs, return_as="generator")(
-        delayed(predict_dataset)(series, method, predict, fit) for series, method in tasks
+        delayed(predict_dataset)(series, method, predict, fit, protocol) for series, method in tasks
     )
     return pd.concat(list(tqdm(results, total=len(tasks), disable=not progress)), ignore_index=True)
 
@@ -145,14 +150,14 @@ def best_table(curves: pd.DataFrame, max_incursion_rate: float = 0.0) -> pd.Data
     return pd.DataFrame(rows)
 
 
-def live_trials(table: pd.DataFrame, predict: PredictParams, static_size: float) -> pd.DataFrame:
+def live_trials(table: pd.DataFrame, predict: PredictParams, protocol: ProtocolParams, static_size: float) -> pd.DataFrame:
     """The simulated live trials (V-C): next-step at n_t = live_n_t vs the static baseline at ``static_size``.
 
-    One row per arc dataset of ``predict.pnp_method`` at ``predict.live_tolerance``: theta_a, the stop angle and
+    One row per arc dataset of ``protocol.pnp_method`` at ``predict.live_tolerance``: theta_a, the stop angle and
     its incursion, the share of the actual envelope used (SPL / theta_a), and the same for the static baseline.
     """
     rows = table[
-        (table["trajectory"] == "arc") & (table["method"] == predict.pnp_method)
+        (table["trajectory"] == "arc") & (table["method"] == protocol.pnp_method)
         & (table["tolerance"] == predict.live_tolerance)
     ]  # fmt: skip
     ours = rows[(rows["predictor"] == "next_step") & (rows["operating_point"] == predict.live_n_t)]
@@ -169,7 +174,8 @@ def live_trials(table: pd.DataFrame, predict: PredictParams, static_size: float)
 
 
 def headline_metrics(
-    table: pd.DataFrame, curves: pd.DataFrame, loso: pd.DataFrame, live: pd.DataFrame, predict: PredictParams
+    table: pd.DataFrame, curves: pd.DataFrame, loso: pd.DataFrame, live: pd.DataFrame, predict: PredictParams,
+    protocol: ProtocolParams,
 ) -> dict:
     """The content of ``reports/metrics/predictors.json``.
 
@@ -185,7 +191,7 @@ def headline_metrics(
     """
     best = best_table(curves)
 
-    def get(predictor: str, trajectory: str, tolerance: str, method: str = predict.pnp_method) -> tuple[float, float]:
+    def get(predictor: str, trajectory: str, tolerance: str, method: str = protocol.pnp_method) -> tuple[float, float]:
         row = best[(best.predictor == predictor) & (best.trajectory == trajectory) & (best.tolerance == tolerance)
                    & (best.method == method)]  # fmt: skip
         return (float(row.max_mean_spl.iloc[0]), float(row.best_operating_point.iloc[0])) if len(row) else (np.nan,) * 2

@@ -20,6 +20,7 @@ import pandas as pd
 from joblib import Parallel, delayed
 from tqdm.auto import tqdm
 
+from poseintegrity.protocol import ProtocolParams
 from poseintegrity.scenes import catalog, renderer, trajectories
 from poseintegrity.scenes.camera import Intrinsics, defocus_sigma_px, inverse
 from poseintegrity.scenes.params import GenerateParams
@@ -127,8 +128,9 @@ def _flat(T: np.ndarray) -> list[float]:
     return [float(v) for v in T.ravel()]
 
 
-def write_dataset(params: GenerateParams, plan: DatasetPlan, root: Path) -> dict:
-    """Render one dataset into ``root / plan.dataset``; returns its row of the index."""
+def write_dataset(params: GenerateParams, protocol: ProtocolParams, plan: DatasetPlan, root: Path) -> dict:
+    """Render one dataset into ``root / plan.dataset`` (its trajectory spans ``protocol``'s range); returns its row
+    of the index."""
     world = _world(params, plan.scene_index)
     spec = params.scenes[plan.scene_index]
     cam = Intrinsics.from_params(params.camera)
@@ -137,10 +139,10 @@ def write_dataset(params: GenerateParams, plan: DatasetPlan, root: Path) -> dict
     distance_mm = spec.distance_mm if plan.trajectory == "arc" else params.lines.distance_mm
     model_views = trajectories.model_pair(scene.aim, scene.view_dir, distance_mm, params.model_baseline_mm)
     if plan.trajectory == "arc":
-        stops = trajectories.arc(model_views[0], scene.aim, plan.azimuth_deg, params.arcs.span_deg,
+        stops = trajectories.arc(model_views[0], scene.aim, plan.azimuth_deg, protocol.arc_span_deg,
                                  params.arcs.n_stops)
     else:
-        stops = trajectories.line(model_views[0], scene.aim, plan.offset_deg, params.lines.step_mm,
+        stops = trajectories.line(model_views[0], scene.aim, plan.offset_deg, protocol.line_length_mm,
                                   params.lines.n_stops)
 
     final = root / plan.dataset
@@ -199,7 +201,7 @@ def write_dataset(params: GenerateParams, plan: DatasetPlan, root: Path) -> dict
             "path": f"datasets/{plan.dataset}"}
 
 
-def generate(params: GenerateParams, root: Path, progress: bool = True) -> pd.DataFrame:
+def generate(params: GenerateParams, protocol: ProtocolParams, root: Path, progress: bool = True) -> pd.DataFrame:
     """Render every planned dataset under ``root`` (in parallel, ``params.n_jobs``) after :func:`check_world`;
     returns and writes the index."""
     check_world(params)
@@ -210,7 +212,7 @@ def generate(params: GenerateParams, root: Path, progress: bool = True) -> pd.Da
     # datasets of one scene go to the same worker in sequence, so it builds each scene once
     plans_sorted = sorted(plans, key=lambda p: p.scene_index)
     jobs = Parallel(n_jobs=params.n_jobs, return_as="generator")(
-        delayed(write_dataset)(params, plan, root) for plan in plans_sorted)
+        delayed(write_dataset)(params, protocol, plan, root) for plan in plans_sorted)
     rows = list(tqdm(jobs, total=len(plans), desc="datasets", disable=not progress))
     index = pd.DataFrame(rows).set_index("dataset").loc[[p.dataset for p in plans]].reset_index()
     index.to_parquet(root / "index.parquet", index=False)

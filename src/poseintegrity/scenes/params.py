@@ -8,13 +8,13 @@ from typing import Annotated
 
 import cv2
 import numpy as np
-from pydantic import Field, field_validator, model_validator
+from pydantic import Field, ValidationInfo, field_validator, model_validator
 
 from poseintegrity.scenes.catalog import TARGET_NAMES, TEXTURE_NAMES
 from poseintegrity.scenes.foam import ReliefVolume, relief_volume
 from poseintegrity.scenes.mesh import Material
 from poseintegrity.scenes.scapula import read_mesh
-from poseintegrity.schema import ProjectPath, Section
+from poseintegrity.schema import KeyRule, ProjectPath, Section
 
 PositiveInt = Annotated[int, Field(gt=0)]
 
@@ -134,7 +134,6 @@ class ArcParams(Section):
     """Viewing-angle datasets: arcs about the target (IV-D)."""
 
     azimuths_deg: list[float] = Field(default=[0.0, 90.0, 270.0], min_length=1)
-    span_deg: float = Field(45.0, gt=0, le=90, description="arc length; stops at span/n_stops * (1..n_stops)")
     n_stops: PositiveInt = 20
 
 
@@ -145,7 +144,6 @@ class LineParams(Section):
     distance_mm: float = Field(220.0, gt=50, description="camera to target centre at the lines' own model pair")
     offsets_deg: list[float] = Field(default=[0.0, 5.0, 10.0, 15.0])
     n_stops: PositiveInt = 15
-    step_mm: float = Field(10.0, gt=0)
 
     @field_validator("offsets_deg")
     @classmethod
@@ -185,10 +183,15 @@ class GenerateParams(Section):
         return textures
 
     @model_validator(mode="after")
-    def _line_scene_exists(self) -> "GenerateParams":
+    def _line_scene_exists(self, info: ValidationInfo) -> "GenerateParams":
         names = [s.name for s in self.scenes]
         if len(set(names)) != len(names):
-            raise ValueError("scene names must be unique")
+            raise KeyRule("scenes", f"scene names must be unique, got {names}")
         if self.lines is not None and self.lines.scene not in names:
-            raise ValueError(f"lines.scene {self.lines.scene!r} is not one of the scenes {names}")
+            raise KeyRule("lines.scene", f"{self.lines.scene!r} is not one of the scenes {names}")
+        protocol = (info.context or {}).get("protocol")  # a robot must move past the stops it samples (IV-A)
+        for key, trajectory in (("arcs", self.arcs), ("lines", self.lines)):
+            if protocol is not None and trajectory is not None and trajectory.n_stops <= protocol.stops_sampled(key[:-1]):
+                raise KeyRule(f"{key}.n_stops", f"must exceed protocol.sampled_stops.{key[:-1]} "
+                                                f"({protocol.stops_sampled(key[:-1])}), got {trajectory.n_stops}")
         return self

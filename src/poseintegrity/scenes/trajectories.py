@@ -65,15 +65,15 @@ def arc(T_start: np.ndarray, aim: np.ndarray, azimuth_deg: float, span_deg: floa
             for t in thetas]
 
 
-def line(T_model: np.ndarray, aim: np.ndarray, offset_deg: float, step_mm: float, n_stops: int) -> list[Stop]:
+def line(T_model: np.ndarray, aim: np.ndarray, offset_deg: float, length_mm: float, n_stops: int) -> list[Stop]:
     """Straight line along the camera's -z axis from a start view ``offset_deg`` away from the model view
-    (about the aim point, horizontally); stops at x = k * step_mm, k = 0..n_stops-1: x_i is "the absolute
-    magnitude of the 3D camera translation between the first position of the trajectory and position i" (V-A),
-    so the first stop is the start view (x = 0)."""
+    (about the aim point, horizontally); stops at x = k * length / n_stops, k = 0..n_stops-1 (IV-D: every 10 mm
+    of 150 mm): x_i is "the absolute magnitude of the 3D camera translation between the first position of the
+    trajectory and position i" (V-A), so the first stop is the start view (x = 0)."""
     start = _rotate_about(T_model, aim, Rotation.from_rotvec(np.deg2rad(offset_deg) * arc_axis(T_model, 0.0)))
     stops = []
-    for k in range(n_stops):
+    for x_mm in length_mm * np.arange(n_stops) / n_stops:
         T = start.copy()
-        T[:3, 3] -= k * step_mm * start[:3, 2]
-        stops.append(Stop(T, float(offset_deg), float(k * step_mm)))
+        T[:3, 3] -= x_mm * start[:3, 2]
+        stops.append(Stop(T, float(offset_deg), float(x_mm)))
     return stops

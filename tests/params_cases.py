@@ -1,0 +1,30 @@
+"""The helper behind every table of bad parameter values: set one dotted key of a params mapping, validate the
+whole file as a stage would, and return the error message (which must name the key before any work)."""
+
+from __future__ import annotations
+
+import copy
+from typing import Any
+
+import pytest
+
+from poseintegrity.config import ParamsError, parse_params
+
+
+def with_value(raw: dict, dotted_key: str, value: Any) -> dict:
+    """A deep copy of ``raw`` with ``dotted_key`` (``"generate.scenes.0.targets"``: list indices as numbers) set."""
+    raw = copy.deepcopy(raw)
+    *parents, leaf = dotted_key.split(".")
+    node: Any = raw
+    for part in parents:
+        node = node[int(part)] if isinstance(node, list) else node.setdefault(part, {})
+    node[int(leaf) if isinstance(node, list) else leaf] = value
+    return raw
+
+
+def refusal(raw: dict, dotted_key: str, value: Any) -> str:
+    """The :class:`ParamsError` message for ``raw`` with ``dotted_key`` set to ``value`` (fails if it is accepted)."""
+    parse_params(raw)  # valid before the change: the error below is the change's
+    with pytest.raises(ParamsError) as info:
+        parse_params(with_value(raw, dotted_key, value))
+    return str(info.value)
