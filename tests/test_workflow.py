@@ -57,8 +57,13 @@ def test_stage_params_are_validated_sections():
     sections = set(Params.model_fields)
     assert set(params) == sections
     for name, stage in DVC["stages"].items():
-        for section in stage.get("params", []):
+        for key in stage.get("params", []):  # a section, or a dotted key inside one
+            section, *inner = key.split(".")
             assert section in sections, f"{name} tracks unknown params section {section}"
+            node = params[section]
+            for part in inner:
+                assert part in node, f"{name} tracks {key}, which params.yaml does not have"
+                node = node[part]
 
 
 def test_tiny_params_are_an_overlay_that_only_shrinks_params_yaml():
@@ -109,8 +114,11 @@ def test_dvc_lock_matches_committed_notebooks_and_params():
             if dep["path"].startswith("notebooks/"):
                 digest = hashlib.md5((ROOT / dep["path"]).read_bytes()).hexdigest()
                 assert digest == dep["md5"], f"{dep['path']} differs from the one {name} ran (re-run the stage)"
-        for section, value in stage.get("params", {}).get("params.yaml", {}).items():
-            assert params[section] == value, f"params.yaml section {section} changed since {name} ran"
+        for key, value in stage.get("params", {}).get("params.yaml", {}).items():  # a section or a dotted key
+            current = params
+            for part in key.split("."):
+                current = current[part]
+            assert current == value, f"params.yaml {key} changed since {name} ran"
 
 
 SHIPPED = ["src", "notebooks", "benchmarks", "docs", "assets/README.md", "README.md", "params.yaml", "dvc.yaml",
