@@ -48,7 +48,7 @@ def test_values_nulls_and_missing_stages_are_told_apart():
         "predictors": {"long_range": {"2mm_3deg": {"max_mean_spl_zero_incursion": None},
                                       "4mm_10deg": {"max_mean_spl_zero_incursion": 14.25}}},
     }
-    text = render_summary(metrics)
+    text = render_summary(metrics, [])
     assert "| viewing-angle datasets | 21 | 21 (7 scenes x 3 azimuths) | - |" in text
     assert "| disk (GB) | 1.473 | - | <= 3 |" in text
     # each tolerance beside the paper's value for that tolerance (Table I), not the mean of both
@@ -59,8 +59,20 @@ def test_values_nulls_and_missing_stages_are_told_apart():
 
 def test_the_summary_points_nowhere_outside_the_repository():
     summary = ROOT / "reports" / "summary.md"
-    assert "docs/references.md" in render_summary({})
-    assert outside_references(render_summary({}), summary.parent) == []
+    assert "docs/references.md" in render_summary({}, [])
+    assert outside_references(render_summary({}, []), summary.parent) == []
+
+
+def test_stage_wall_times_say_where_the_tasks_ran():
+    from poseintegrity.timing import StageTiming
+
+    timings = [StageTiming("01_generate_datasets", 101.4, "local", 2, None, "2026-11-23T10:02:03"),
+               StageTiming("02_extract_artifacts", 250.0, "dask", 8, "tcp://10.0.0.5:8786", "2026-11-23T10:06:13")]
+    text = render_summary({}, timings)
+    assert "| 01_generate_datasets | 101 | local, n_jobs 2 | 2026-11-23 10:02 |" in text
+    assert "| 02_extract_artifacts | 250 | dask at tcp://10.0.0.5:8786, n_jobs 8 | 2026-11-23 10:06 |" in text
+    assert "| total (without this report) | 351 | | |" in text
+    assert "No stage timing yet" in render_summary({}, [])
 
 
 def test_metrics_file_is_valid_json_with_null_for_nan(tmp_path):

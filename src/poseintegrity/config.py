@@ -31,6 +31,9 @@ from poseintegrity.schema import KeyRule
 from poseintegrity.tracking.params import TrackParams
 
 
+PROTOCOL_READERS = ("protocol", "generate", "extract", "fit", "predict")  # sections checked against ``protocol``
+
+
 class ParamsError(ValueError):
     """``params.yaml`` is unreadable or one of its keys has an invalid value."""
 
@@ -118,15 +121,17 @@ def load_params(path: str | Path = "params.yaml") -> Params:
 
 
 def load_section(path: str | Path, section: str) -> BaseModel:
-    """Read and validate one stage's section (with ``protocol``, which it is checked against): a stage is not
-    stopped by another stage's bad values (DVC tracks each stage's own sections too)."""
+    """Read and validate one stage's section (with ``protocol`` if the section reads it, see
+    :data:`PROTOCOL_READERS`): a stage is not stopped by another stage's bad values (DVC tracks each stage's own
+    sections too)."""
     if section not in Params.model_fields:
         raise ParamsError(f"unknown params section {section!r}; sections: {list(Params.model_fields)}")
     raw, base_dir = read_raw(path)
     if not isinstance(raw, dict) or section not in raw:
         raise ParamsError(f"{path}: section {section!r} is missing")
-    context = {"base_dir": base_dir, "protocol": _protocol(raw, str(path))}
+    protocol = _protocol(raw, str(path)) if section in PROTOCOL_READERS else None
     try:
-        return Params.model_fields[section].annotation.model_validate(raw[section], context=context)
+        return Params.model_fields[section].annotation.model_validate(
+            raw[section], context={"base_dir": base_dir, "protocol": protocol})
     except ValidationError as error:
         raise ParamsError(f"{path} has invalid values:\n{_format_errors(error, (section,))}") from None

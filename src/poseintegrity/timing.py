@@ -48,9 +48,14 @@ class StageTiming:
         return f"{self.stage:<24} {self.wall_time_s:6.0f} s   {where:<28} finished {finished}"
 
 
+def read_timings(folder: Path) -> list[StageTiming]:
+    """Every stage timing file of ``folder``, in stage name order ([] when there is none)."""
+    return [StageTiming.read(path) for path in sorted(Path(folder).glob("*.json"))]
+
+
 def summary(folder: Path) -> list[str]:
     """One line per timing file of ``folder`` (stage name order), then the total; [] when there is none."""
-    timings = [StageTiming.read(path) for path in sorted(folder.glob("*.json"))]
+    timings = read_timings(folder)
     if not timings:
         return []
     return [t.line() for t in timings] + [f"{'total':<24} {sum(t.wall_time_s for t in timings):6.0f} s"]
