@@ -23,7 +23,7 @@ import numpy as np  # noqa: E402
 from poseintegrity.config import load_section  # noqa: E402
 from poseintegrity.tracking.evaluation import detect_match_kabsch  # noqa: E402
 from poseintegrity.tracking.frames import draw_phantoms, intrinsics, render_frame  # noqa: E402
-from poseintegrity.tracking.geometry import MARKER_DIAMETER_M, MARKERS_BODY  # noqa: E402
+from poseintegrity.tracking.geometry import MARKER_DIAMETER_M  # noqa: E402
 from poseintegrity.tracking.peers import filter_speed  # noqa: E402
 
 
@@ -39,7 +39,8 @@ def main():
     cv2.setNumThreads(1)
     rng = np.random.default_rng(0)
     params = load_section(Path(__file__).resolve().parents[1] / "params.yaml", "track")
-    speed = filter_speed(MARKERS_BODY, params.filter, 400, rng)
+    geometry = np.array(params.markers_body)
+    speed = filter_speed(geometry, params.filter, 400, rng)
     print("filter predict + update (4 markers + gyro, params.yaml constants)")
     for name in ("srukf", "ukf", "filterpy", "pykalman"):
         print(f"  {name:9s} {speed[name]:8.3f} ms")
@@ -47,10 +48,10 @@ def main():
     print(f"  SR-UKF speed-up over pykalman: {speed['speedup_vs_pykalman']:.1f}x")
 
     K = intrinsics(params.camera)
-    markers = MARKERS_BODY + [0.02, -0.01, 0.45]
+    markers = geometry + [0.02, -0.01, 0.45]
     ir, depth = render_frame(markers, draw_phantoms(1, params.camera, params.frames, 1.0, rng), params.camera, params.frames, MARKER_DIAMETER_M / 2, rng)
-    assert np.isfinite(detect_match_kabsch(ir, depth, K, params, MARKERS_BODY)).all()
-    chain = per_call_ms(lambda: detect_match_kabsch(ir, depth, K, params, MARKERS_BODY), 500)
+    assert np.isfinite(detect_match_kabsch(ir, depth, K, params, geometry)).all()
+    chain = per_call_ms(lambda: detect_match_kabsch(ir, depth, K, params, geometry), 500)
     raw_threshold = params.detection.threshold * params.detection.ir_clip / 255.0
     bare = per_call_ms(lambda: cv2.findContours(cv2.compare(ir, raw_threshold, cv2.CMP_GT), cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE), 500)
     print("detection + correspondence + Kabsch, one 512 x 512 frame")

@@ -1,9 +1,6 @@
-from pathlib import Path
-
 import numpy as np
 import pandas as pd
 
-from poseintegrity.config import load_section
 from poseintegrity.tracking.detection_sweep import small_blob_sweep, sweep_summary
 from poseintegrity.tracking.errors import rms
 from poseintegrity.tracking.evaluation import (
@@ -23,7 +20,7 @@ from poseintegrity.tracking.evaluation import (
 )
 from poseintegrity.tracking.simulation import run_filter, run_no_filter, simulate
 
-TINY = load_section(Path(__file__).resolve().parents[1] / "params_tiny.yaml", "track")
+from tracking.track_section import TINY
 
 
 def test_lag_of_a_delayed_signal_is_recovered():

@@ -15,10 +15,10 @@ Points are expressed in the camera frame (T_world_cam = identity).
 Usage, e.g. on a HoloLens 2 recording with the probe of the paper::
 
     from poseintegrity.config import load_section
-    from poseintegrity.tracking import MARKERS_BODY, read_recording, read_tools, track_recording
+    from poseintegrity.tracking import read_recording, read_tools, track_recording
 
     params = load_section("params.yaml", "track")
-    tools = {"probe": MARKERS_BODY}  # or read_tools("tools.json", params.matching.distinct_m)
+    tools = {"probe": np.array(params.markers_body)}  # or read_tools("tools.json", params.matching.distinct_m)
     poses = track_recording(read_recording("my_recording"), tools, params, gyro_tool="probe")
     poses.to_csv("poses.csv", index=False)
 
