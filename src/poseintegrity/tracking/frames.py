@@ -9,6 +9,7 @@ reports it), so the detector's depth lookup lands on the sphere surface, not its
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
@@ -65,12 +66,19 @@ def draw_phantoms(n: int, camera: CameraParams, frames: FrameParams, round_fract
     return phantoms
 
 
-def _subpixel_grid(u0: int, v0: int, u1: int, v1: int, s: int) -> tuple[np.ndarray, np.ndarray]:
-    """Sample positions (h, w, s*s) of ``s x s`` rays per pixel in the patch [u0, u1) x [v0, v1)."""
+@lru_cache(maxsize=8)
+def _subpixel_offsets(s: int) -> tuple[np.ndarray, np.ndarray]:
+    """Offsets (s*s,) in u and in v of ``s x s`` rays from the centre of their pixel, px (row-major grid)."""
     offsets = (np.arange(s) + 0.5) / s - 0.5
     du, dv = np.meshgrid(offsets, offsets)
-    uu = np.arange(u0, u1, dtype=float)[None, :, None] + du.ravel()[None, None, :]
-    vv = np.arange(v0, v1, dtype=float)[:, None, None] + dv.ravel()[None, None, :]
+    return du.ravel(), dv.ravel()
+
+
+def _subpixel_grid(u0: int, v0: int, u1: int, v1: int, s: int) -> tuple[np.ndarray, np.ndarray]:
+    """Sample positions (h, w, s*s) of ``s x s`` rays per pixel in the patch [u0, u1) x [v0, v1)."""
+    du, dv = _subpixel_offsets(s)
+    uu = np.arange(u0, u1, dtype=float)[None, :, None] + du
+    vv = np.arange(v0, v1, dtype=float)[:, None, None] + dv
     return np.broadcast_to(uu, (v1 - v0, u1 - u0, s * s)), np.broadcast_to(vv, (v1 - v0, u1 - u0, s * s))
 
 
