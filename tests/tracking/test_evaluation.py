@@ -8,6 +8,7 @@ from poseintegrity.tracking.evaluation import (
     accuracy_runs,
     agreement_runs,
     experiment_rng,
+    filter_agreement,
     normalized_lag_ms,
     study_filter_runs,
     success_rates,
@@ -95,3 +96,15 @@ def test_small_blob_sweep_and_two_tools_and_jump_on_tiny_params():
     [sim] = simulate(TINY, experiment_rng(TINY, "accuracy"))
     jump = ten_metre_jump(sim, TINY, jump_at_s=1.0, jump_m=10.0)
     assert jump["ok_while_off"] == 0 and jump["frames_to_restart"] == TINY.filter.restart_after_rejections - 1
+
+
+def test_lag_and_agreement_are_nan_when_there_is_nothing_to_compare():
+    t = np.arange(0, 2, 0.046)
+    signal = np.sin(t)
+    assert np.isnan(normalized_lag_ms(t, signal, t, np.full_like(t, np.nan), 300))  # the filter never ran
+    assert np.isnan(normalized_lag_ms(t, signal, t + 10.0, signal, 300))  # no common stretch
+    never = pd.DataFrame({"x_mm": [np.nan] * 3, "y_mm": [np.nan] * 3, "z_mm": [np.nan] * 3})
+    ran = pd.DataFrame({"x_mm": [1.0, 2.0, 3.0], "y_mm": [0.0] * 3, "z_mm": [450.0] * 3})
+    a, b = FilterRun("accuracy", True, TINY.filter), FilterRun("accuracy", False, TINY.filter)
+    assert np.isnan(filter_agreement({a: (ran, None), b: (never, None)}, (a, b)))
+    assert filter_agreement({a: (ran, None), b: (ran, None)}, (a, b)) == 0.0

@@ -64,3 +64,21 @@ def test_bad_recordings_are_refused_naming_the_problem(tmp_path):
     (tmp_path / "frames.csv").unlink()
     with pytest.raises(RecordingError, match="frames.csv is missing"):
         read_recording(tmp_path)
+
+
+def test_a_missing_frame_file_is_refused_before_tracking_and_an_undecodable_one_is_a_flagged_row(tmp_path):
+    _write(tmp_path)
+    (tmp_path / "ir" / "000002.png").write_bytes(b"not a png")  # present but truncated / corrupt
+    with pytest.warns(RuntimeWarning, match="cannot decode ir/000002.png"):
+        table = track_recording(read_recording(tmp_path), {"tool": GEOMETRY}, PARAMS)
+    assert list(table.flag) == ["initialized", "ok", "bad_frame", "ok"] and table.n_points.iloc[2] == 0
+    (tmp_path / "depth" / "000001.png").unlink()
+    with pytest.raises(RecordingError, match="1 frame file.* missing, e.g. 'depth/000001.png'"):
+        read_recording(tmp_path)
+
+
+def test_a_gyro_rate_that_is_not_a_number_is_refused_naming_its_row(tmp_path):
+    _write(tmp_path)
+    pd.DataFrame({"t_s": [0.01, 0.02], "wx": [0.1, "0.2 rad/s"], "wy": [0.0, 0.0], "wz": [0.0, 0.0]}).to_csv(tmp_path / "gyro.csv", index=False)
+    with pytest.raises(RecordingError, match="wx of row 1 is not a number"):
+        read_recording(tmp_path)

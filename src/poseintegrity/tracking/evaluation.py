@@ -51,21 +51,24 @@ def normalized_lag_ms(t_ref: np.ndarray, ref: np.ndarray, t_sig: np.ndarray, sig
     """Delay (ms) of sig behind ref: the lag maximising their normalized cross-correlation (section II-F).
 
     Both signals (k,) are resampled on a common 1 ms grid (linear interpolation over their finite samples);
-    lags 0..lag_max_ms are searched.
+    lags 0..lag_max_ms are searched.  NaN when there is nothing to correlate: fewer than two finite samples
+    of either signal, no common stretch of at least 2 ms, or no lag at which both vary.
     """
     ok_r, ok_s = np.isfinite(ref), np.isfinite(sig)
+    if ok_r.sum() < 2 or ok_s.sum() < 2:
+        return float("nan")
     start, stop = max(t_ref[ok_r][0], t_sig[ok_s][0]), min(t_ref[ok_r][-1], t_sig[ok_s][-1])
     grid = np.arange(start, stop, 0.001)
     a = np.interp(grid, t_ref[ok_r], ref[ok_r])
     b = np.interp(grid, t_sig[ok_s], sig[ok_s])
-    best, best_ncc = 0, -np.inf
+    best, best_ncc = float("nan"), -np.inf
     for lag in range(0, min(int(lag_max_ms), len(grid) // 2)):
         x, y = a[: len(a) - lag], b[lag:]
         x, y = x - x.mean(), y - y.mean()
         ncc = (x @ y) / np.sqrt((x @ x) * (y @ y))
         if ncc > best_ncc:
-            best, best_ncc = lag, ncc
-    return float(best)
+            best, best_ncc = float(lag), ncc
+    return best
 
 
 def filter_lag_ms(no_filter: pd.DataFrame, filtered: pd.DataFrame, lag_max_ms: float) -> float:
@@ -184,6 +187,8 @@ def filter_agreement(runs: FilterResults, pair: tuple[FilterRun, FilterRun]) -> 
     (a, _), (b, _) = runs[pair[0]], runs[pair[1]]
     xa, xb = a[["x_mm", "y_mm", "z_mm"]].to_numpy(), b[["x_mm", "y_mm", "z_mm"]].to_numpy()
     both = np.isfinite(xa).all(axis=1) & np.isfinite(xb).all(axis=1)
+    if not both.any():  # the two never ran at the same event: nothing to compare
+        return float("nan")
     return float(np.abs(xa[both] - xb[both]).max() / np.abs(xb[both]).max())
 
 
@@ -370,7 +375,7 @@ def ten_metre_jump(sim: Simulation, params: TrackParams, jump_at_s: float = 2.0,
     restart = flags.index("restart") if "restart" in flags else -1
     return {"frames_after_jump": len(flags), "ok_while_off": int(sum(fl == "ok" and e > 0.1 for fl, e in zip(flags, errors))),
             "flags": {fl: flags.count(fl) for fl in sorted(set(flags))}, "frames_to_restart": restart,
-            "error_after_restart_mm": float(np.nanmax(errors[restart + 1 :]) * 1000) if restart >= 0 else float("nan")}
+            "error_after_restart_mm": float(np.nanmax(errors[restart + 1 :]) * 1000) if 0 <= restart < len(errors) - 1 else float("nan")}
 
 
 def recording_replay(params: TrackParams, folder: Path) -> tuple[pd.DataFrame, dict]:
