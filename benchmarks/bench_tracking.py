@@ -5,6 +5,9 @@
    square-root UKF (pykalman.sqrt.AdditiveUnscentedKalmanFilter.filter_update) on the additive-noise model.
 2. Detection + correspondence + Kabsch on one 512 x 512 frame (4 markers, one round phantom), in frames
    per second on one core, beside a bare OpenCV threshold + findContours on the same frame.  Target: >= 300.
+3. Frame synthesis (render_frame, the same frame) against drawing its IR sensor noise alone (512 x 512 float32
+   normals), the floor of any synthesis that draws this noise: stage 06 renders ~90 000 frames, and after the
+   in-place IR and whole-millimetre depth (same bits) the noise draw is most of a frame.
 
 Run: .venv/bin/python benchmarks/bench_tracking.py (from the repository root)
 """
@@ -57,6 +60,13 @@ def main():
     print("detection + correspondence + Kabsch, one 512 x 512 frame")
     print(f"  full chain        {chain:8.3f} ms = {1000 / chain:7.0f} frames/s (target >= 300)")
     print(f"  threshold+contours{bare:8.3f} ms = {1000 / bare:7.0f} frames/s (reference); chain / reference = {chain / bare:.1f}")
+
+    phantoms = draw_phantoms(1, params.camera, params.frames, 1.0, rng)
+    synthesis = per_call_ms(lambda: render_frame(markers, phantoms, params.camera, params.frames, MARKER_DIAMETER_M / 2, rng), 300)
+    shape = (params.camera.height, params.camera.width)
+    noise = per_call_ms(lambda: rng.standard_normal(shape, dtype=np.float32), 300)
+    print("frame synthesis, one 512 x 512 IR + depth frame (4 markers, one round phantom)")
+    print(f"  render_frame      {synthesis:8.3f} ms; its IR noise draw alone {noise:8.3f} ms; synthesis / noise = {synthesis / noise:.2f} (floor 1)")
 
 
 if __name__ == "__main__":
