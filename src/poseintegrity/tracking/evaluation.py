@@ -467,19 +467,25 @@ def run_study(params: TrackParams, recording_folder: Path, workers: Workers) -> 
     recording_folder : where :func:`recording_replay` writes the replayed recording.  workers : where the
     recordings, scenes and filter runs run (tasks of their own generators, so the tables do not depend on
     the number of workers); the timings run in this process afterwards, with no task of ours beside them.
+    Two rounds of tasks, each listed longest first so that the workers finish together: first the recordings
+    the filter runs need (accuracy; motion (a), 4 markers) beside one stress recording (rendered once,
+    detected twice: the longest) and the small scenes; then the filter runs beside the other recordings.
     """
     ev, hand = params.evaluation, SuccessRun("a", "markers4", -1)
-    scenes = [partial(success_recording, params, run, run == hand) for run in success_runs(params)]
-    scenes += [partial(accuracy_recording, params), partial(recording_replay, params, recording_folder),
-               partial(two_tools_success, params, params.motion.max_phantoms, "two_tools"),
-               partial(two_tools_success, params, ev.phantom_rich_max, "two_tools_phantom_rich"),
-               partial(small_blob_sweep, params, experiment_rng(params, "small_blobs"))]
-    *successes, (sim, no_filter), (replay, replay_metrics), tools, rich_tools, blobs = workers.map(call, scenes, desc="tracking recordings")
-    success_tables = {name: table for recorded in successes for name, (table, _) in recorded.items()}
-    recordings = {"accuracy": sim, "hand": successes[0]["a_markers4"][1]}
+    others = sorted((run for run in success_runs(params) if run != hand), key=lambda run: run.motion != "b")  # (b) first
+    first = [partial(success_recording, params, others[0]), partial(success_recording, params, hand, True), partial(accuracy_recording, params),
+             partial(two_tools_success, params, params.motion.max_phantoms, "two_tools"),
+             partial(two_tools_success, params, ev.phantom_rich_max, "two_tools_phantom_rich"),
+             partial(small_blob_sweep, params, experiment_rng(params, "small_blobs")),
+             partial(recording_replay, params, Path(recording_folder).resolve())]
+    stress, motion_a, (sim, no_filter), tools, rich_tools, blobs, (replay, replay_metrics) = workers.map(call, first, desc="tracking recordings")
+    recordings = {"accuracy": sim, "hand": motion_a["a_markers4"][1]}
     filter_runs = study_filter_runs(params)
-    results = workers.map(call, [partial(run_filter_task, recordings[run.recording], params, run) for run in filter_runs], desc="tracking filter runs")
-    runs = dict(zip(filter_runs, results))
+    second = [partial(success_recording, params, run) for run in others[1:]]
+    second += [partial(run_filter_task, recordings[run.recording], params, run) for run in filter_runs]
+    results = workers.map(call, second, desc="tracking recordings and filter runs")
+    runs = dict(zip(filter_runs, results[len(others) - 1 :]))
+    success_tables = {name: table for recorded in [stress, motion_a, *results[: len(others) - 1]] for name, (table, _) in recorded.items()}
 
     tables, accuracy = accuracy_and_occlusion(sim, no_filter, params, runs)
     success, success_frames = success_rates(params, success_tables)
