@@ -31,11 +31,11 @@ BAD = [
     ("track.hand.pause_s", [1.5, 0.3], "track.hand.pause_s"),
     ("track.hand.pause_s", [-0.3, 1.5], "track.hand.pause_s"),
     ("track.hand.occlusion_s", [0.3, 0.1], "track.hand.occlusion_s"),
-    ("track.markers_body", [SAME, SAME, SAME, SAME], "track.markers_body"),  # identical markers
+    ("track.markers_body", [SAME, SAME, SAME, [0.05, -0.02, 0.01]], "track.markers_body"),  # three identical markers
     ("track.markers_body", [[0.0, 0.0, 0.0], [0.01, 0.0, 0.0], [0.03, 0.0, 0.0], [0.07, 0.0, 0.0]], "track.markers_body"),  # collinear
     ("track.markers_body", [[0.0, 0.0, 0.0], [0.03, 0.0, 0.0], [0.0, 0.03, 0.0], [0.03, 0.03, 0.0]], "track.markers_body"),  # a square: equal sides
     ("track.markers_body", [[0.0, 0.0, 0.0], [0.03, 0.0, 0.0], [0.0, 0.05, 0.0]], "track.markers_body"),  # none left to drop
-    ("track.evaluation.second_tool", [SAME, SAME, SAME, SAME], "track.evaluation.second_tool"),
+    ("track.evaluation.second_tool", [SAME, SAME, SAME, [0.05, -0.02, 0.01]], "track.evaluation.second_tool"),
     ("track.evaluation.second_tool", [[0.0, 0.0, 0.0], [0.01, 0.0, 0.0], [0.03, 0.0, 0.0]], "track.evaluation.second_tool"),
     # a copy of the first tool, shifted: every distance equals one of markers_body
     ("track.evaluation.second_tool", [[0.13455, 0.01295, 0.01797], [0.11721, -0.01669, 0.00796], [0.08431, -0.01049, -0.01109]],
