@@ -5,6 +5,9 @@
    square-root UKF (pykalman.sqrt.AdditiveUnscentedKalmanFilter.filter_update) on the additive-noise model.
 2. Detection + correspondence + Kabsch on one 512 x 512 frame (4 markers, one round phantom), in frames
    per second on one core, beside a bare OpenCV threshold + findContours on the same frame.  Target: >= 300.
+3. Frame synthesis (render_frame, the same frame) against drawing its IR sensor noise alone (512 x 512 float32
+   normals), the floor of any synthesis that draws this noise: stage 06 renders ~90 000 frames, and after the
+   in-place IR and whole-millimetre depth (same bits) the noise draw is most of a frame.
 
 Run: .venv/bin/python benchmarks/bench_tracking.py (from the repository root)
 """
@@ -23,7 +26,7 @@ import numpy as np  # noqa: E402
 from poseintegrity.config import load_section  # noqa: E402
 from poseintegrity.tracking.evaluation import detect_match_kabsch  # noqa: E402
 from poseintegrity.tracking.frames import draw_phantoms, intrinsics, render_frame  # noqa: E402
-from poseintegrity.tracking.geometry import MARKER_DIAMETER_M, MARKERS_BODY  # noqa: E402
+from poseintegrity.tracking.geometry import MARKER_DIAMETER_M  # noqa: E402
 from poseintegrity.tracking.peers import filter_speed  # noqa: E402
 
 
@@ -39,7 +42,8 @@ def main():
     cv2.setNumThreads(1)
     rng = np.random.default_rng(0)
     params = load_section(Path(__file__).resolve().parents[1] / "params.yaml", "track")
-    speed = filter_speed(MARKERS_BODY, params.filter, 400, rng)
+    geometry = np.array(params.markers_body)
+    speed = filter_speed(geometry, params.filter, 400, rng)
     print("filter predict + update (4 markers + gyro, params.yaml constants)")
     for name in ("srukf", "ukf", "filterpy", "pykalman"):
         print(f"  {name:9s} {speed[name]:8.3f} ms")
@@ -47,15 +51,22 @@ def main():
     print(f"  SR-UKF speed-up over pykalman: {speed['speedup_vs_pykalman']:.1f}x")
 
     K = intrinsics(params.camera)
-    markers = MARKERS_BODY + [0.02, -0.01, 0.45]
+    markers = geometry + [0.02, -0.01, 0.45]
     ir, depth = render_frame(markers, draw_phantoms(1, params.camera, params.frames, 1.0, rng), params.camera, params.frames, MARKER_DIAMETER_M / 2, rng)
-    assert np.isfinite(detect_match_kabsch(ir, depth, K, params, MARKERS_BODY)).all()
-    chain = per_call_ms(lambda: detect_match_kabsch(ir, depth, K, params, MARKERS_BODY), 500)
+    assert np.isfinite(detect_match_kabsch(ir, depth, K, params, geometry)).all()
+    chain = per_call_ms(lambda: detect_match_kabsch(ir, depth, K, params, geometry), 500)
     raw_threshold = params.detection.threshold * params.detection.ir_clip / 255.0
     bare = per_call_ms(lambda: cv2.findContours(cv2.compare(ir, raw_threshold, cv2.CMP_GT), cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE), 500)
     print("detection + correspondence + Kabsch, one 512 x 512 frame")
     print(f"  full chain        {chain:8.3f} ms = {1000 / chain:7.0f} frames/s (target >= 300)")
     print(f"  threshold+contours{bare:8.3f} ms = {1000 / bare:7.0f} frames/s (reference); chain / reference = {chain / bare:.1f}")
+
+    phantoms = draw_phantoms(1, params.camera, params.frames, 1.0, rng)
+    synthesis = per_call_ms(lambda: render_frame(markers, phantoms, params.camera, params.frames, MARKER_DIAMETER_M / 2, rng), 300)
+    shape = (params.camera.height, params.camera.width)
+    noise = per_call_ms(lambda: rng.standard_normal(shape, dtype=np.float32), 300)
+    print("frame synthesis, one 512 x 512 IR + depth frame (4 markers, one round phantom)")
+    print(f"  render_frame      {synthesis:8.3f} ms; its IR noise draw alone {noise:8.3f} ms; synthesis / noise = {synthesis / noise:.2f} (floor 1)")
 
 
 if __name__ == "__main__":

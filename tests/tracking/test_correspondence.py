@@ -10,11 +10,12 @@ from poseintegrity.tracking.correspondence import (
     match_markers,
     match_voting,
 )
-from poseintegrity.tracking.geometry import MARKERS_BODY
-from poseintegrity.tracking.params import MatchingParams
 
-G = MARKERS_BODY
-MATCHING = MatchingParams()
+
+from tracking.track_section import GEOMETRY, TRACK
+
+G = GEOMETRY
+MATCHING = TRACK.matching
 TOL = MATCHING.tolerance_m
 
 

@@ -6,16 +6,17 @@ from scipy.spatial.transform import Rotation
 
 from poseintegrity.tracking.detection import detect_markers, validate_frame
 from poseintegrity.tracking.frames import Phantom, intrinsics, render_frame, unit_plane_lut
-from poseintegrity.tracking.geometry import MARKER_DIAMETER_M, MARKERS_BODY
-from poseintegrity.tracking.params import CameraParams, DetectionParams, FrameParams
+from poseintegrity.tracking.geometry import MARKER_DIAMETER_M
 
-CAMERA, FRAMES, DETECTION = CameraParams(), FrameParams(), DetectionParams()
+from tracking.track_section import GEOMETRY, TRACK
+
+CAMERA, FRAMES, DETECTION = TRACK.camera, TRACK.frames, TRACK.detection
 K = intrinsics(CAMERA)
 
 
 def _frame(seed=0, phantoms=()):
     rng = np.random.default_rng(seed)
-    markers = MARKERS_BODY @ Rotation.from_rotvec([0.3, 0.2, 0.1]).as_matrix().T + [0.02, -0.01, 0.45]
+    markers = GEOMETRY @ Rotation.from_rotvec([0.3, 0.2, 0.1]).as_matrix().T + [0.02, -0.01, 0.45]
     ir, depth = render_frame(markers, list(phantoms), CAMERA, FRAMES, MARKER_DIAMETER_M / 2, rng)
     return markers, ir, depth
 

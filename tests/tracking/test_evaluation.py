@@ -1,22 +1,27 @@
-from pathlib import Path
-
 import numpy as np
 import pandas as pd
 
-from poseintegrity.config import load_section
 from poseintegrity.tracking.detection_sweep import small_blob_sweep, sweep_summary
 from poseintegrity.tracking.errors import rms
 from poseintegrity.tracking.evaluation import (
+    FilterRun,
+    accuracy_runs,
+    agreement_runs,
     experiment_rng,
+    filter_agreement,
     normalized_lag_ms,
+    study_filter_runs,
     success_rates,
+    success_recording,
+    success_runs,
     summarize_accuracy,
+    sweep_runs,
     ten_metre_jump,
     two_tools_success,
 )
 from poseintegrity.tracking.simulation import run_filter, run_no_filter, simulate
 
-TINY = load_section(Path(__file__).resolve().parents[1] / "params_tiny.yaml", "track")
+from tracking.track_section import TINY
 
 
 def test_lag_of_a_delayed_signal_is_recovered():
@@ -28,7 +33,7 @@ def test_lag_of_a_delayed_signal_is_recovered():
 
 
 def test_simulation_is_bit_identical_for_a_seed_and_the_filter_beats_no_filter_on_rotation():
-    sims = [simulate(TINY, np.random.default_rng(11)) for _ in range(2)]
+    sims = [simulate(TINY, np.random.default_rng(11))[0] for _ in range(2)]
     tables = [run_no_filter(s, TINY) for s in sims]
     pd.testing.assert_frame_equal(tables[0], tables[1])
     filtered, _ = run_filter(sims[0], TINY, use_gyro=True)
@@ -43,14 +48,42 @@ def test_simulation_is_bit_identical_for_a_seed_and_the_filter_beats_no_filter_o
     assert np.isfinite(inside.rot_err_deg).all()  # the gyro keeps the filter running through the occlusion
 
 
+def success_tables(params):
+    return {name: table for run in success_runs(params) for name, (table, _) in success_recording(params, run).items()}
+
+
 def test_success_rates_cover_both_motions_and_the_split_variant():
-    table, sims, frames = success_rates(TINY)
+    table, frames = success_rates(TINY, success_tables(TINY))
     assert len(table) == 9 and set(table.motion) == {"a", "b"}  # (a): 4 markers, 3 with each marker dropped; (b): 4, 3, split or not
     assert set(table.dropped[table.motion == "a"]) == {0, 1, 2, 3, 4}
     assert (table.frames == TINY.evaluation.success_frames).all()
     assert ((table.rate >= 0) & (table.rate <= table.possible)).all()  # a hidden marker cannot be found
-    again, _, _ = success_rates(TINY)
+    again, _ = success_rates(TINY, success_tables(TINY))
     pd.testing.assert_frame_equal(table, again)
+
+
+def test_the_stress_recording_is_rendered_once_for_both_detectors():
+    """With and without splitting touching blobs, (b) runs on the same frames: the same rendering and a detector
+    run alone on it (simulate with one detector) gives the same points as with two."""
+    run = next(r for r in success_runs(TINY) if r.motion == "b")
+    both = success_recording(TINY, run, keep=True)
+    split, unsplit = both[f"b_{run.label}"][1], both[f"b_{run.label}_no_split"][1]
+    np.testing.assert_array_equal(split.T_true, unsplit.T_true)
+    duration = split.trajectory.t[-1]
+    [alone] = simulate(TINY, experiment_rng(TINY, f"stress_{run.label}"), np.array(TINY.markers_body), TINY.evaluation.success_omega_std,
+                       duration, [TINY.detection.model_copy(update={"split_touching": False})])
+    assert all(np.array_equal(a, b) for a, b in zip(alone.points, unsplit.points)) and len(alone.points) == len(unsplit.points)
+
+
+def test_each_filter_run_is_made_once_and_shared_by_the_experiments_that_need_it():
+    params = TINY.model_copy(update={"evaluation": TINY.evaluation.model_copy(update={"sigma_scales": [0.5, 1.0, 2.0]})})
+    runs = study_filter_runs(params)
+    assert len(runs) == len(set(runs))
+    assert sweep_runs(params)[1.0] == accuracy_runs(params)["ukf"]  # the sweep at scale 1 is the accuracy run
+    sr, _ = agreement_runs(params)[f"alpha_{params.filter.alpha:g}"]
+    assert sr == accuracy_runs(params)["ukf_gyro"] and isinstance(sr, FilterRun)
+    # 5 sigma variants on motion (a), ukf and ukf_gyro, 2 new sweep scales, and 3 new agreement runs
+    assert len(runs) == 5 + 2 + 2 + 3
 
 
 def test_small_blob_sweep_and_two_tools_and_jump_on_tiny_params():
@@ -60,6 +93,18 @@ def test_small_blob_sweep_and_two_tools_and_jump_on_tiny_params():
     assert set(sweep.measure) == {"contour", "pixel"} and set(sweep.kind) == {"marker", "phantom"}
     tools = two_tools_success(TINY, 6, "phantom_rich")
     assert set(tools.tool) == {"tool1", "tool2"} and tools.correct.mean() > 0.8
-    sim = simulate(TINY, experiment_rng(TINY, "accuracy"))
+    [sim] = simulate(TINY, experiment_rng(TINY, "accuracy"))
     jump = ten_metre_jump(sim, TINY, jump_at_s=1.0, jump_m=10.0)
     assert jump["ok_while_off"] == 0 and jump["frames_to_restart"] == TINY.filter.restart_after_rejections - 1
+
+
+def test_lag_and_agreement_are_nan_when_there_is_nothing_to_compare():
+    t = np.arange(0, 2, 0.046)
+    signal = np.sin(t)
+    assert np.isnan(normalized_lag_ms(t, signal, t, np.full_like(t, np.nan), 300))  # the filter never ran
+    assert np.isnan(normalized_lag_ms(t, signal, t + 10.0, signal, 300))  # no common stretch
+    never = pd.DataFrame({"x_mm": [np.nan] * 3, "y_mm": [np.nan] * 3, "z_mm": [np.nan] * 3})
+    ran = pd.DataFrame({"x_mm": [1.0, 2.0, 3.0], "y_mm": [0.0] * 3, "z_mm": [450.0] * 3})
+    a, b = FilterRun("accuracy", True, TINY.filter), FilterRun("accuracy", False, TINY.filter)
+    assert np.isnan(filter_agreement({a: (ran, None), b: (never, None)}, (a, b)))
+    assert filter_agreement({a: (ran, None), b: (ran, None)}, (a, b)) == 0.0

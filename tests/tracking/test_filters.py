@@ -3,12 +3,13 @@ import pytest
 from pykalman.sqrt.unscented import Moments, moments2points, unscented_filter_correct
 from scipy.spatial.transform import Rotation
 
-from poseintegrity.tracking.geometry import MARKERS_BODY
-from poseintegrity.tracking.params import FilterParams
+
 from poseintegrity.tracking.peers import additive_model, correlated_state, filterpy_filter, pykalman_time_update
 from poseintegrity.tracking.srukf import SquareRootUKF
 from poseintegrity.tracking.ukf import UnscentedKalmanFilter
 from poseintegrity.tracking.unscented import unscented_weights
+
+from tracking.track_section import GEOMETRY, TRACK
 
 
 def _measurements(n_steps, seed=0):
@@ -18,13 +19,13 @@ def _measurements(n_steps, seed=0):
     out = []
     for k in range(n_steps):
         R = Rotation.from_rotvec(omega * 0.01 * k).as_matrix()
-        markers = MARKERS_BODY @ R.T + [0.001 * k, 0.0, 0.45] + rng.normal(0, 0.001, (4, 3))
+        markers = GEOMETRY @ R.T + [0.001 * k, 0.0, 0.45] + rng.normal(0, 0.001, (4, 3))
         out.append((markers, omega + rng.normal(0, 0.05, 3)))
     return out
 
 
 def _run(cls, params, steps):
-    f = cls(MARKERS_BODY, params)
+    f = cls(GEOMETRY, params)
     f.initialize(steps[0][0])
     states = []
     for k, (markers, omega) in enumerate(steps):
@@ -39,7 +40,7 @@ def _run(cls, params, steps):
 
 @pytest.mark.parametrize("alpha, rtol", [(1.0, 1e-8), (1e-3, 1e-5)])
 def test_square_root_ukf_equals_plain_ukf(alpha, rtol):
-    params = FilterParams(alpha=alpha, sigma_r=0.002, sigma_c=3.0, sigma_alpha=10.0)
+    params = TRACK.filter.model_copy(update=dict(alpha=alpha, sigma_r=0.002, sigma_c=3.0, sigma_alpha=10.0))
     steps = _measurements(60)
     x_sr, f_sr = _run(SquareRootUKF, params, steps)
     x_ukf, f_ukf = _run(UnscentedKalmanFilter, params, steps)
@@ -48,11 +49,11 @@ def test_square_root_ukf_equals_plain_ukf(alpha, rtol):
 
 
 def test_square_root_ukf_equals_filterpy_on_full_measurements():
-    params = FilterParams(alpha=1.0, sigma_r=0.002, sigma_c=3.0, sigma_alpha=10.0)
+    params = TRACK.filter.model_copy(update=dict(alpha=1.0, sigma_r=0.002, sigma_c=3.0, sigma_alpha=10.0))
     steps = _measurements(30, seed=1)
-    f = SquareRootUKF(MARKERS_BODY, params)
+    f = SquareRootUKF(GEOMETRY, params)
     f.initialize(steps[0][0])
-    ref, step = filterpy_filter(MARKERS_BODY, params)
+    ref, step = filterpy_filter(GEOMETRY, params)
     ref.x, ref.P = f.x.copy(), f.covariance().copy()
     for markers, omega in steps:
         z = np.r_[markers.ravel(), omega]
@@ -78,7 +79,7 @@ def test_weights_and_unscented_transform_of_a_linear_map():
 
 
 def test_filter_tracks_and_counts_failed_downdates_without_crashing():
-    f = SquareRootUKF(MARKERS_BODY, FilterParams(sigma_r=0.002, sigma_c=3.0, sigma_alpha=10.0))
+    f = SquareRootUKF(GEOMETRY, TRACK.filter.model_copy(update=dict(sigma_r=0.002, sigma_c=3.0, sigma_alpha=10.0)))
     steps = _measurements(80, seed=2)
     f.initialize(steps[0][0])
     for markers, omega in steps:
@@ -93,11 +94,11 @@ def test_filter_tracks_and_counts_failed_downdates_without_crashing():
 
 
 def test_divergence_is_detected_and_the_filter_stops():
-    f = SquareRootUKF(MARKERS_BODY, FilterParams())
-    f.initialize(MARKERS_BODY + [0, 0, 0.5])
+    f = SquareRootUKF(GEOMETRY, TRACK.filter)
+    f.initialize(GEOMETRY + [0, 0, 0.5])
     assert not f.update(np.full(12, np.nan), np.ones(4, bool), gyro=False)
     assert not f.initialized and f.n_divergences == 1 and f.last_reason == "non-finite state or covariance"
-    f.initialize(MARKERS_BODY + [0, 0, 0.5])
+    f.initialize(GEOMETRY + [0, 0, 0.5])
     f.S = f.S * 1e4  # runaway covariance
     assert not f.predict(0.0025) and f.last_reason == "runaway covariance"
 
@@ -105,7 +106,7 @@ def test_divergence_is_detected_and_the_filter_stops():
 def test_time_update_agrees_with_pykalman_square_root_ukf():
     # pykalman's SR-UKF on the additive model, given the lower factor of Q: same mean and covariance; the
     # residual covariance difference is its |Wc[0]| centre term, 2 |Wc[0]| d d^T, and nothing else
-    diff = pykalman_time_update(MARKERS_BODY, FilterParams(), np.random.default_rng(3))
+    diff = pykalman_time_update(GEOMETRY, TRACK.filter, np.random.default_rng(3))
     assert diff["mean"] < 1e-8
     assert diff["covariance"] < 1e-8
     assert diff["covariance_after_centre_term"] < 1e-13
@@ -114,8 +115,8 @@ def test_time_update_agrees_with_pykalman_square_root_ukf():
 def test_our_update_is_the_kalman_update_and_pykalmans_is_not():
     # h is linear (rows of the state), so the exact update is x + K (z - x[rows]) with K = P H^T (H P H^T + R)^-1;
     # pykalman solves its gain with the transposed triangular factor (poseintegrity.tracking.peers), so it is not
-    settings, _, R = additive_model(MARKERS_BODY, FilterParams(), 1e-3)
-    prior = correlated_state(MARKERS_BODY, settings, np.random.default_rng(4))
+    settings, _, R = additive_model(GEOMETRY, TRACK.filter, 1e-3)
+    prior = correlated_state(GEOMETRY, settings, np.random.default_rng(4))
     x0, P = prior.x.copy(), prior.covariance()
     z = x0[:15] + 0.002
     expected = x0 + P[:, :15] @ np.linalg.solve(P[:15, :15] + R, z - x0[:15])

@@ -3,8 +3,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
-from poseintegrity.tracking.geometry import MARKERS_BODY
+
 from poseintegrity.tracking.kabsch import kabsch, kabsch_residuals, kabsch_rotations, pose_from_points
+
+from tracking.track_section import GEOMETRY
 
 
 @settings(deadline=None, max_examples=40)
@@ -21,7 +23,7 @@ def test_kabsch_matches_scipy_align_vectors(seed, n, noise):
 
 
 def test_kabsch_exact_pose_and_proper_rotation_for_reflected_input():
-    T = pose_from_points(MARKERS_BODY @ Rotation.from_rotvec([0.3, -1.0, 2.0]).as_matrix().T + [0.1, 0.2, 0.5], MARKERS_BODY)
+    T = pose_from_points(GEOMETRY @ Rotation.from_rotvec([0.3, -1.0, 2.0]).as_matrix().T + [0.1, 0.2, 0.5], GEOMETRY)
     np.testing.assert_allclose(T[:3, :3], Rotation.from_rotvec([0.3, -1.0, 2.0]).as_matrix(), atol=1e-12)
     np.testing.assert_allclose(T[:3, 3], [0.1, 0.2, 0.5], atol=1e-12)
     body = np.array([[0.0, 0.0, 0.0], [0.05, 0.0, 0.0], [0.0, 0.04, 0.0], [0.0, 0.0, 0.03]])  # not planar

@@ -1,31 +1,33 @@
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from poseintegrity.tracking.geometry import MARKERS_BODY, pairwise_distances, skew
+from poseintegrity.tracking.geometry import pairwise_distances, skew
 from poseintegrity.tracking.model import centred, process_model, process_model_reference, process_noise_sqrt
+
+from tracking.track_section import GEOMETRY
 
 
 def _state(rng, R, omega, v):
-    markers = MARKERS_BODY @ R.T + [0.0, 0.1, 0.5]
+    markers = GEOMETRY @ R.T + [0.0, 0.1, 0.5]
     return np.concatenate([markers.ravel(), omega, v])
 
 
 def test_compiled_process_model_equals_the_plain_one_per_sigma_point():
     rng = np.random.default_rng(3)
     X = np.stack([_state(rng, Rotation.random(random_state=k).as_matrix(), rng.normal(size=3), rng.normal(size=3)) + rng.normal(0, 1e-3, 18) for k in range(37)], axis=1)
-    expected = np.stack([process_model_reference(X[:, k], 0.01, MARKERS_BODY) for k in range(37)], axis=1)
-    np.testing.assert_allclose(process_model(X, 0.01, centred(MARKERS_BODY)), expected, atol=1e-14)
+    expected = np.stack([process_model_reference(X[:, k], 0.01, GEOMETRY) for k in range(37)], axis=1)
+    np.testing.assert_allclose(process_model(X, 0.01, centred(GEOMETRY)), expected, atol=1e-14)
 
 
 def test_process_model_moves_a_rigid_body_like_a_rotation():
     R0 = Rotation.from_rotvec([0.2, 0.4, -0.1])
     omega, dt = np.array([0.5, -1.0, 2.0]), 1e-3
     x = _state(None, R0.as_matrix(), omega, np.zeros(3))
-    x_next = process_model(x[:, None], dt, centred(MARKERS_BODY))[:, 0]
+    x_next = process_model(x[:, None], dt, centred(GEOMETRY))[:, 0]
     markers = x_next[:12].reshape(4, 3)
-    exact = (centred(MARKERS_BODY) @ (Rotation.from_rotvec(omega * dt) * R0).as_matrix().T) + x[:12].reshape(4, 3).mean(0)
+    exact = (centred(GEOMETRY) @ (Rotation.from_rotvec(omega * dt) * R0).as_matrix().T) + x[:12].reshape(4, 3).mean(0)
     np.testing.assert_allclose(markers, exact, atol=1e-6)  # first order in dt
-    np.testing.assert_allclose(pairwise_distances(markers), pairwise_distances(MARKERS_BODY), atol=1e-6)
+    np.testing.assert_allclose(pairwise_distances(markers), pairwise_distances(GEOMETRY), atol=1e-6)
 
 
 def test_process_noise_square_root_gives_the_rederived_eq_30():
@@ -33,9 +35,9 @@ def test_process_noise_square_root_gives_the_rederived_eq_30():
     R = Rotation.random(random_state=4).as_matrix()
     omega, dt, sc, sa = rng.normal(size=3), 0.0025, 0.7, 0.9
     x = _state(rng, R, omega, rng.normal(size=3))
-    B = process_noise_sqrt(x, dt, centred(MARKERS_BODY), sc, sa)
+    B = process_noise_sqrt(x, dt, centred(GEOMETRY), sc, sa)
     Q = B @ B.T
-    a = centred(MARKERS_BODY) @ R.T
+    a = centred(GEOMETRY) @ R.T
     W2 = skew(omega) @ skew(omega)
     for i in range(4):
         for j in range(4):
@@ -53,8 +55,8 @@ def test_process_noise_matches_monte_carlo_of_the_noise_vector():
     R = Rotation.random(random_state=5).as_matrix()
     x = _state(rng, R, np.zeros(3), np.zeros(3))  # omega = 0: no deterministic term
     dt, sc, sa = 0.01, 1.0, 2.0
-    Q = process_noise_sqrt(x, dt, centred(MARKERS_BODY), sc, sa) @ process_noise_sqrt(x, dt, centred(MARKERS_BODY), sc, sa).T
+    Q = process_noise_sqrt(x, dt, centred(GEOMETRY), sc, sa) @ process_noise_sqrt(x, dt, centred(GEOMETRY), sc, sa).T
     c_dd, alpha = rng.normal(0, sc, (200_000, 3)), rng.normal(0, sa, (200_000, 3))
-    a = centred(MARKERS_BODY) @ R.T
+    a = centred(GEOMETRY) @ R.T
     v = np.concatenate([(0.5 * dt**2 * (c_dd[:, None, :] + np.cross(alpha[:, None, :], a[None]))).reshape(-1, 12), dt * alpha, dt * c_dd], axis=1)  # eq. 11
     np.testing.assert_allclose(np.cov(v.T), Q, atol=0.02 * np.abs(Q).max())

@@ -1,13 +1,11 @@
 import numpy as np
-import pytest
-import yaml
-from pydantic import ValidationError
 from scipy.spatial.transform import Rotation
 
 from poseintegrity.tracking.motion import brief_occlusions, sample_sensors, simulate_hand_motion, simulate_trajectory
-from poseintegrity.tracking.params import HandMotionParams, MotionParams, TrackParams
 
-TINY = MotionParams(duration_s=4.0, occlusions=[(2.0, 0.5)])
+from tracking.track_section import TRACK
+
+TINY = TRACK.motion.model_copy(update={"duration_s": 4.0, "occlusions": [(2.0, 0.5)]})
 
 
 def test_same_seed_same_trajectory_and_sensors():
@@ -32,20 +30,9 @@ def test_gyro_matches_the_orientation_and_arrives_two_or_three_times_per_frame()
     assert 0.03 < np.diff(t).mean() < 0.06
 
 
-def test_params_validate_and_name_the_bad_key():
-    raw = yaml.safe_load("seed: 1\nmotion: {duration_s: 5}\nfilter: {alpha: 1.0}\n")
-    assert TrackParams.model_validate(raw).motion.duration_s == 5
-    with pytest.raises(ValidationError, match="motion.p_occlusion"):
-        TrackParams.model_validate({"motion": {"p_occlusion": 1.5}})
-    with pytest.raises(ValidationError, match="detection.depth_typo"):
-        TrackParams.model_validate({"detection": {"depth_typo": 1}})
-    with pytest.raises(ValidationError, match="drop_marker"):
-        TrackParams.model_validate({"drop_marker": 9})
-
-
 def test_full_turns_make_whole_revolutions_and_brief_occlusions_hide_about_the_planned_share():
-    hand = HandMotionParams(pause_s=(0.5, 0.5), turn_s=(2.0, 2.0), wobble_std=0.0)
-    motion = MotionParams(duration_s=10.2)  # turns about x, y, z, x; the next one would start at 10.5 s
+    hand = TRACK.hand.model_copy(update={"pause_s": (0.5, 0.5), "turn_s": (2.0, 2.0), "wobble_std": 0.0})
+    motion = TRACK.motion.model_copy(update=dict(duration_s=10.2))  # turns about x, y, z, x; the next one would start at 10.5 s
     traj = simulate_hand_motion(motion, hand, np.random.default_rng(5))
     turned = np.abs(traj.omega_body).sum(axis=0) * motion.sim_dt / (2 * np.pi)  # turns about x, y, z
     np.testing.assert_allclose(turned, np.round(turned), atol=0.01)
@@ -53,6 +40,6 @@ def test_full_turns_make_whole_revolutions_and_brief_occlusions_hide_about_the_p
     R = Rotation.from_quat(traj.quat)
     assert np.abs((R[:-1].inv() * R[1:]).as_rotvec() / motion.sim_dt - traj.omega_body[:-1]).max() < 1e-9
     t = np.arange(0, 2000, 0.046)
-    hidden = brief_occlusions(t, 4, HandMotionParams(), np.random.default_rng(6))
-    expected = HandMotionParams().occlusion_rate_hz * np.mean(HandMotionParams().occlusion_s)
+    hidden = brief_occlusions(t, 4, TRACK.hand, np.random.default_rng(6))
+    expected = TRACK.hand.occlusion_rate_hz * np.mean(TRACK.hand.occlusion_s)
     assert abs(hidden.mean() - expected) < 0.3 * expected

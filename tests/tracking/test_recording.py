@@ -1,16 +1,14 @@
-from pathlib import Path
-
 import numpy as np
 import pandas as pd
 import pytest
 
-from poseintegrity.config import load_section
 from poseintegrity.tracking.evaluation import recording_replay
 from poseintegrity.tracking.frames import intrinsics, render_frame, unit_plane_lut
-from poseintegrity.tracking.geometry import MARKER_DIAMETER_M, MARKERS_BODY
+from poseintegrity.tracking.geometry import MARKER_DIAMETER_M
 from poseintegrity.tracking.recording import RecordingError, RecordingWriter, read_recording, track_recording
 
-PARAMS = load_section(Path(__file__).resolve().parents[1] / "params_tiny.yaml", "track")
+from tracking.track_section import GEOMETRY
+from tracking.track_section import TINY as PARAMS
 
 
 def test_replay_from_disk_gives_the_in_memory_poses(tmp_path):
@@ -25,7 +23,7 @@ def _write(folder, n=4, depth_scale=1.0, npy=False):
     writer = RecordingWriter(folder, unit_plane_lut(intrinsics(camera), camera.width, camera.height))
     rng = np.random.default_rng(0)
     for k in range(n):
-        ir, depth = render_frame(MARKERS_BODY + [0.0, 0.0, 0.45], [], camera, PARAMS.frames, MARKER_DIAMETER_M / 2, rng)
+        ir, depth = render_frame(GEOMETRY + [0.0, 0.0, 0.45], [], camera, PARAMS.frames, MARKER_DIAMETER_M / 2, rng)
         writer.add_frame(0.046 * k, ir, depth)
     writer.close()
     if npy or depth_scale != 1.0:  # replace the last frame's depth by a .npy in other units
@@ -38,11 +36,11 @@ def _write(folder, n=4, depth_scale=1.0, npy=False):
 def test_depth_in_metres_and_wrong_shapes_are_flagged_rows_with_a_warning(tmp_path):
     _write(tmp_path, depth_scale=0.001)
     with pytest.warns(RuntimeWarning, match="last.npy|metres"):
-        table = track_recording(read_recording(tmp_path), {"tool": MARKERS_BODY}, PARAMS)
+        table = track_recording(read_recording(tmp_path), {"tool": GEOMETRY}, PARAMS)
     assert list(table.flag) == ["initialized", "ok", "ok", "bad_frame"]
     np.save(tmp_path / "depth" / "last.npy", np.zeros((10, 10)))
     with pytest.warns(RuntimeWarning, match="differs from IR shape"):
-        table = track_recording(read_recording(tmp_path), {"tool": MARKERS_BODY}, PARAMS)
+        table = track_recording(read_recording(tmp_path), {"tool": GEOMETRY}, PARAMS)
     assert table.flag.iloc[-1] == "bad_frame" and np.isfinite(table.x_mm.iloc[-1])  # the filter's pose, not NaN points
 
 
@@ -65,4 +63,22 @@ def test_bad_recordings_are_refused_naming_the_problem(tmp_path):
         read_recording(tmp_path)
     (tmp_path / "frames.csv").unlink()
     with pytest.raises(RecordingError, match="frames.csv is missing"):
+        read_recording(tmp_path)
+
+
+def test_a_missing_frame_file_is_refused_before_tracking_and_an_undecodable_one_is_a_flagged_row(tmp_path):
+    _write(tmp_path)
+    (tmp_path / "ir" / "000002.png").write_bytes(b"not a png")  # present but truncated / corrupt
+    with pytest.warns(RuntimeWarning, match="cannot decode ir/000002.png"):
+        table = track_recording(read_recording(tmp_path), {"tool": GEOMETRY}, PARAMS)
+    assert list(table.flag) == ["initialized", "ok", "bad_frame", "ok"] and table.n_points.iloc[2] == 0
+    (tmp_path / "depth" / "000001.png").unlink()
+    with pytest.raises(RecordingError, match="1 frame file.* missing, e.g. 'depth/000001.png'"):
+        read_recording(tmp_path)
+
+
+def test_a_gyro_rate_that_is_not_a_number_is_refused_naming_its_row(tmp_path):
+    _write(tmp_path)
+    pd.DataFrame({"t_s": [0.01, 0.02], "wx": [0.1, "0.2 rad/s"], "wy": [0.0, 0.0], "wz": [0.0, 0.0]}).to_csv(tmp_path / "gyro.csv", index=False)
+    with pytest.raises(RecordingError, match="wx of row 1 is not a number"):
         read_recording(tmp_path)

@@ -3,13 +3,14 @@ import pandas as pd
 import pytest
 from scipy.spatial.transform import Rotation
 
-from poseintegrity.tracking.geometry import MARKERS_BODY, transform_points
+from poseintegrity.tracking.geometry import transform_points
 from poseintegrity.tracking.kabsch import pose_from_points
-from poseintegrity.tracking.params import FilterParams, MatchingParams, TrackParams
 from poseintegrity.tracking.tools import MultiToolTracker, ToolError, read_tools, write_tools
 
-SECOND = np.array(TrackParams().evaluation.second_tool)
-TOOLS = {"probe": MARKERS_BODY, "needle": SECOND}
+from tracking.track_section import GEOMETRY, TRACK
+
+SECOND = np.array(TRACK.evaluation.second_tool)
+TOOLS = {"probe": GEOMETRY, "needle": SECOND}
 
 
 def test_json_and_csv_tool_files_round_trip(tmp_path):
@@ -27,8 +28,8 @@ def test_duplicate_distances_are_refused_naming_the_pairs(tmp_path):
     write_tools(tmp_path / "square.json", {"square": square})
     with pytest.raises(ToolError, match="square markers 1-2 = 50.00 mm and square markers"):
         read_tools(tmp_path / "square.json", 0.001)
-    shifted = MARKERS_BODY * (62.6 + 0.5) / 62.6  # its 1-3 distance lands 0.5 mm from the probe's
-    write_tools(tmp_path / "two.json", {"probe": MARKERS_BODY, "copy": shifted})
+    shifted = GEOMETRY * (62.6 + 0.5) / 62.6  # its 1-3 distance lands 0.5 mm from the probe's
+    write_tools(tmp_path / "two.json", {"probe": GEOMETRY, "copy": shifted})
     with pytest.raises(ToolError, match="probe markers .* and copy markers"):
         read_tools(tmp_path / "two.json", 0.001)
     (tmp_path / "bad.json").write_text('{"tools": [{"name": "a"}]}')
@@ -38,7 +39,7 @@ def test_duplicate_distances_are_refused_naming_the_pairs(tmp_path):
 
 def test_two_tools_with_phantoms_are_told_apart_one_filter_each():
     rng = np.random.default_rng(0)
-    tracker = MultiToolTracker(TOOLS, FilterParams(), MatchingParams())
+    tracker = MultiToolTracker(TOOLS, TRACK.filter, TRACK.matching)
     for k in range(20):
         t = 0.046 * k
         poses = {name: pose_from_points(m @ Rotation.from_rotvec([0.4 * t, 0.1 * i, -0.3 * t]).as_matrix().T + [0.08 * (2 * i - 1), 0, 0.5], m)

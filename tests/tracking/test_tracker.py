@@ -2,27 +2,29 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from poseintegrity.tracking.geometry import MARKERS_BODY, transform_points
+from poseintegrity.tracking.geometry import transform_points
 from poseintegrity.tracking.kabsch import pose_from_points
-from poseintegrity.tracking.params import PAPER_SIGMAS, FilterParams, MatchingParams
+from poseintegrity.tracking.params import PAPER_SIGMAS
 from poseintegrity.tracking.tracker import MarkerTracker
 
-FILTER = FilterParams(sigma_r=0.002, sigma_c=3.0, sigma_alpha=30.0)
-MATCHING = MatchingParams()
+from tracking.track_section import GEOMETRY, TRACK
+
+FILTER = TRACK.filter.model_copy(update=dict(sigma_r=0.002, sigma_c=3.0, sigma_alpha=30.0))
+MATCHING = TRACK.matching
 
 
 def _pose(t):
-    return pose_from_points(MARKERS_BODY @ Rotation.from_rotvec([0.3 * t, -0.2 * t, 0.5 * t]).as_matrix().T + [0.01 * t, 0.0, 0.45], MARKERS_BODY)
+    return pose_from_points(GEOMETRY @ Rotation.from_rotvec([0.3 * t, -0.2 * t, 0.5 * t]).as_matrix().T + [0.01 * t, 0.0, 0.45], GEOMETRY)
 
 
 def test_bad_frames_are_flagged_and_the_filter_keeps_predicting():
     rng = np.random.default_rng(0)
-    tracker = MarkerTracker(MARKERS_BODY, FILTER, MATCHING)
+    tracker = MarkerTracker(GEOMETRY, FILTER, MATCHING)
     assert tracker.frame(0.0, np.zeros((0, 3))).flag == "no_points"
-    assert tracker.frame(0.05, transform_points(_pose(0.05), MARKERS_BODY)[:2]).flag == "no_markers"
+    assert tracker.frame(0.05, transform_points(_pose(0.05), GEOMETRY)[:2]).flag == "no_markers"
     for k in range(2, 30):
         t = 0.05 * k
-        points = transform_points(_pose(t), MARKERS_BODY) + rng.normal(0, 0.0005, (4, 3))
+        points = transform_points(_pose(t), GEOMETRY) + rng.normal(0, 0.0005, (4, 3))
         result = tracker.frame(t, points[rng.permutation(4)])
         assert result.flag in ("initialized", "ok")
         tracker.gyro(t + 0.02, np.array([0.3, -0.2, 0.5]) @ np.eye(3))
@@ -35,34 +37,34 @@ def test_bad_frames_are_flagged_and_the_filter_keeps_predicting():
 
 
 def test_restart_after_a_second_without_markers_and_reinitialisation():
-    tracker = MarkerTracker(MARKERS_BODY, FILTER, MATCHING, use_gyro=False)
-    tracker.frame(0.0, transform_points(_pose(0.0), MARKERS_BODY))
+    tracker = MarkerTracker(GEOMETRY, FILTER, MATCHING, use_gyro=False)
+    tracker.frame(0.0, transform_points(_pose(0.0), GEOMETRY))
     assert tracker.filter.initialized
     assert tracker.frame(1.5, np.zeros((0, 3))).flag == "restart" and not tracker.filter.initialized
-    result = tracker.frame(1.6, transform_points(_pose(1.6), MARKERS_BODY))
+    result = tracker.frame(1.6, transform_points(_pose(1.6), GEOMETRY))
     assert result.flag == "initialized"
     np.testing.assert_allclose(result.T_filtered, _pose(1.6), atol=1e-9)
 
 
 def test_divergence_is_recovered_from_the_next_good_frame():
-    tracker = MarkerTracker(MARKERS_BODY, FILTER, MATCHING)
-    tracker.frame(0.0, transform_points(_pose(0.0), MARKERS_BODY))
+    tracker = MarkerTracker(GEOMETRY, FILTER, MATCHING)
+    tracker.frame(0.0, transform_points(_pose(0.0), GEOMETRY))
     tracker.filter.x[:] = np.nan  # e.g. a NaN from a bad update
-    result = tracker.frame(0.05, transform_points(_pose(0.05), MARKERS_BODY))
+    result = tracker.frame(0.05, transform_points(_pose(0.05), GEOMETRY))
     assert result.flag == "diverged" and tracker.filter.initialized  # restarted from this good frame
     np.testing.assert_allclose(result.T_filtered, _pose(0.05), atol=1e-9)
-    assert tracker.frame(0.10, transform_points(_pose(0.10), MARKERS_BODY)).flag == "ok"
+    assert tracker.frame(0.10, transform_points(_pose(0.10), GEOMETRY)).flag == "ok"
     assert tracker.filter.n_divergences == 1
 
 
 def test_a_persistent_ten_metre_jump_is_gated_then_restarted_never_ok_while_off():
     rng = np.random.default_rng(1)
-    tracker = MarkerTracker(MARKERS_BODY, FILTER, MATCHING, use_gyro=False)
+    tracker = MarkerTracker(GEOMETRY, FILTER, MATCHING, use_gyro=False)
     flags = []
     for k in range(60):
         t = 0.046 * k
         shift = [10.0, 0.0, 0.0] if k >= 20 else [0.0, 0.0, 0.0]
-        result = tracker.frame(t, transform_points(_pose(t), MARKERS_BODY) + rng.normal(0, 0.001, (4, 3)) + shift)
+        result = tracker.frame(t, transform_points(_pose(t), GEOMETRY) + rng.normal(0, 0.001, (4, 3)) + shift)
         off = np.linalg.norm(result.T_filtered[:3, 3] - _pose(t)[:3, 3] - shift)
         if result.flag == "ok":
             assert off < 0.01  # "ok" only when the estimate is where the measurements are
@@ -74,25 +76,25 @@ def test_a_persistent_ten_metre_jump_is_gated_then_restarted_never_ok_while_off(
 
 
 def test_non_finite_timestamps_are_rejected_with_a_clear_error():
-    tracker = MarkerTracker(MARKERS_BODY, FILTER, MATCHING)
-    tracker.frame(0.0, transform_points(_pose(0.0), MARKERS_BODY))
+    tracker = MarkerTracker(GEOMETRY, FILTER, MATCHING)
+    tracker.frame(0.0, transform_points(_pose(0.0), GEOMETRY))
     with pytest.raises(ValueError, match="timestamp must be a finite number of seconds, got nan"):
-        tracker.frame(float("nan"), transform_points(_pose(0.0), MARKERS_BODY))
+        tracker.frame(float("nan"), transform_points(_pose(0.0), GEOMETRY))
     with pytest.raises(ValueError, match="timestamp"):
         tracker.gyro(float("inf"), np.zeros(3))
     assert tracker.gyro(0.01, np.array([np.nan, 0.0, 0.0])) == "bad_gyro"
-    assert tracker.frame(-1.0, transform_points(_pose(0.0), MARKERS_BODY)).flag == "stale"
+    assert tracker.frame(-1.0, transform_points(_pose(0.0), GEOMETRY)).flag == "stale"
 
 
 def test_published_sigmas_track_a_constant_rate_turn():
     # no defect in the filter with the published sigmas: a body turning at a constant 0.62 rad/s is tracked to
     # about a millimetre and a degree; their trouble on hand motion is the stiff process model (params.yaml)
     rng = np.random.default_rng(2)
-    tracker = MarkerTracker(MARKERS_BODY, FilterParams().model_copy(update=PAPER_SIGMAS), MATCHING, use_gyro=False)
+    tracker = MarkerTracker(GEOMETRY, TRACK.filter.model_copy(update=PAPER_SIGMAS), MATCHING, use_gyro=False)
     errors = []
     for k in range(300):
         t = 0.046 * k
-        result = tracker.frame(t, transform_points(_pose(t), MARKERS_BODY) + rng.normal(0, 0.001, (4, 3)))
+        result = tracker.frame(t, transform_points(_pose(t), GEOMETRY) + rng.normal(0, 0.001, (4, 3)))
         R_err = result.T_filtered[:3, :3] @ _pose(t)[:3, :3].T
         errors.append((np.linalg.norm(result.T_filtered[:3, 3] - _pose(t)[:3, 3]), np.degrees(np.arccos(np.clip((np.trace(R_err) - 1) / 2, -1, 1)))))
     late = np.array(errors[100:])

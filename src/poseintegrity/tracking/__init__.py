@@ -22,7 +22,6 @@ Module map (paper section -> module):
 
 from poseintegrity.tracking.correspondence import match_brute_force, match_frobenius, match_gated, match_markers, match_voting
 from poseintegrity.tracking.detection import detect_markers, validate_frame
-from poseintegrity.tracking.geometry import MARKERS_BODY
 from poseintegrity.tracking.kabsch import kabsch, pose_from_points
 from poseintegrity.tracking.params import TrackParams
 from poseintegrity.tracking.recording import Recording, RecordingError, RecordingWriter, read_recording, track_recording
@@ -32,7 +31,6 @@ from poseintegrity.tracking.tracker import MarkerTracker
 from poseintegrity.tracking.ukf import UnscentedKalmanFilter
 
 __all__ = [
-    "MARKERS_BODY",
     "MarkerTracker",
     "MultiToolTracker",
     "Recording",

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numba
 import numpy as np
+from scipy.linalg.lapack import dgeqrf
 
 
 def tril_from_qr(A: np.ndarray) -> np.ndarray:
@@ -17,9 +18,23 @@ def tril_from_qr(A: np.ndarray) -> np.ndarray:
     A : (N, p) float, p >= N, full row rank.  Returns (N, N) float with a non-negative diagonal
     (column signs of the QR factor are flipped, which leaves ``S @ S.T`` unchanged).
     """
-    R = np.linalg.qr(A.T, mode="r")  # qr{[...]} of Alg. 5, R upper (N, N)
-    signs = np.where(np.diag(R) < 0, -1.0, 1.0)
-    return R.T * signs[None, :]
+    qr, _, _, info = dgeqrf(A.T)  # qr{[...]} of Alg. 5: LAPACK's Householder QR, R in the upper triangle
+    if info != 0:
+        raise np.linalg.LinAlgError(f"QR factorisation failed (LAPACK dgeqrf info {info})")
+    return _signed_transpose_of_r(qr, A.shape[0])
+
+
+@numba.njit(cache=True)
+def _signed_transpose_of_r(qr, N):  # pragma: no cover - compiled
+    """S = R^T diag(signs) (N, N) from the upper triangle R of qr[:N], signs = -1 where R's diagonal is negative.
+    Every entry is R^T's times its column's sign, so the zeros above the diagonal keep that sign (-0.0), as
+    ``triu(qr)[:N].T * signs`` gives them."""
+    S = np.empty((N, N))
+    for j in range(N):
+        sign = -1.0 if qr[j, j] < 0 else 1.0
+        for i in range(N):
+            S[i, j] = (qr[j, i] if i >= j else 0.0) * sign
+    return S
 
 
 @numba.njit(cache=True)

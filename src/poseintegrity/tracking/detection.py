@@ -66,6 +66,16 @@ def validate_frame(ir: np.ndarray, depth_mm: np.ndarray, unproject: np.ndarray) 
     return ""
 
 
+def small_median(values: np.ndarray) -> float:
+    """``np.median`` of a 1-D float array (NaN if empty) without its overhead: the middle of the sorted values,
+    or the mean of the two middle ones, (a + b) / 2, as np.median computes it (same bits)."""
+    ordered = np.sort(values)
+    k = len(ordered) // 2
+    if len(ordered) == 0:
+        return float("nan")
+    return float(ordered[k]) if len(ordered) % 2 else float((ordered[k - 1] + ordered[k]) / 2)
+
+
 def blob_shape(contour: np.ndarray, measure: str) -> tuple[float, float, float]:
     """(area px^2, circularity, convexity) of one external contour (k, 1, 2) int.
 
@@ -191,7 +201,7 @@ def split_by_depth(pixels: np.ndarray, depth_mm: np.ndarray, detection: Detectio
     centres, depths = [], []
     if front.sum() >= detection.min_area:
         c_front = pixels[front].mean(axis=0)
-        d_front, d_back = float(np.median(d_all[front])), float(np.median(d_all[back]))
+        d_front, d_back = small_median(d_all[front]), small_median(d_all[back])
         centres.append(c_front)
         depths.append(d_front)
         if back.sum() >= detection.min_area:
@@ -205,7 +215,7 @@ def split_by_depth(pixels: np.ndarray, depth_mm: np.ndarray, detection: Detectio
             depths.append(d_back)
     elif back.sum() >= detection.min_area:
         centres.append(pixels[back].mean(axis=0))
-        depths.append(float(np.median(d_all[back])))
+        depths.append(small_median(d_all[back]))
     return np.array(centres, dtype=float).reshape(-1, 2), np.array(depths)
 
 
@@ -264,7 +274,7 @@ def lookup_depth(depth_mm: np.ndarray, uv: np.ndarray, detection: DetectionParam
         patch = np.asarray(depth_mm[max(v - w, 0) : v + w + 1, max(u - w, 0) : u + w + 1], dtype=float)
         valid = patch[np.isfinite(patch) & (patch >= detection.depth_min_mm) & (patch <= detection.depth_max_mm)]
         if valid.size:
-            out[k] = np.median(valid)
+            out[k] = small_median(valid)
     return out
 
 

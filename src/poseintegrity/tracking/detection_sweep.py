@@ -4,6 +4,8 @@ published shape measure against ours; :mod:`poseintegrity.tracking.detection`)."
 
 from __future__ import annotations
 
+from typing import get_args
+
 import numpy as np
 import pandas as pd
 from scipy.spatial.transform import Rotation
@@ -11,9 +13,9 @@ from scipy.spatial.transform import Rotation
 from poseintegrity.tracking.detection import detect_markers
 from poseintegrity.tracking.frames import Phantom, intrinsics, render_frame
 from poseintegrity.tracking.geometry import MARKER_DIAMETER_M, pairwise_distances
-from poseintegrity.tracking.params import TrackParams
+from poseintegrity.tracking.params import DetectionParams, TrackParams
 
-MEASURES = ("contour", "pixel")
+MEASURES = get_args(DetectionParams.model_fields["shape_measure"].annotation)  # ("contour", "pixel")
 
 
 def _unoccluded(markers_cam: np.ndarray, focal_px: float) -> np.ndarray:

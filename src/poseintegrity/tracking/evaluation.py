@@ -3,14 +3,20 @@
 
 Each experiment draws from its own generator, ``numpy.random.default_rng([params.seed, crc32(name)])``, so the
 experiments do not depend on each other's order and the per-frame tables are bit-identical for one seed
-(timings are the only non-deterministic outputs and are kept apart).
+(timings are the only non-deterministic outputs and are kept apart).  That lets :func:`run_study` run them as
+independent tasks on :class:`~poseintegrity.parallel.Workers`: first the recordings (render + detect + the
+no-filter chain) and the self-contained scenes, then every distinct filter run over those recordings once
+(:class:`FilterRun`; an experiment that needs a run another already made reuses it), then the timings in the
+calling process, alone on the machine.
 """
 
 from __future__ import annotations
 
 import time
 import zlib
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -24,11 +30,13 @@ from poseintegrity.tracking.frames import draw_phantoms, intrinsics, render_fram
 from poseintegrity.tracking.geometry import MARKER_DIAMETER_M, pose_matrix, transform_points
 from poseintegrity.tracking.kabsch import kabsch, pose_from_points
 from poseintegrity.tracking.motion import sample_sensors, simulate_trajectory
+from poseintegrity.parallel import Workers
 from poseintegrity.report.paper import BLACK_RESULTS
-from poseintegrity.tracking.params import PAPER_SIGMAS, TrackParams
+from poseintegrity.tracking.params import PAPER_SIGMAS, FilterParams, TrackParams
 from poseintegrity.tracking.peers import filter_speed, pykalman_time_update
 from poseintegrity.tracking.recording import RecordingWriter, read_recording, track_recording
 from poseintegrity.tracking.simulation import Simulation, T_world_cam, run_filter, run_no_filter, simulate, simulate_hand
+from poseintegrity.tracking.srukf import SquareRootUKF
 from poseintegrity.tracking.tools import MultiToolTracker
 from poseintegrity.tracking.tracker import MarkerTracker
 from poseintegrity.tracking.ukf import UnscentedKalmanFilter
@@ -43,21 +51,24 @@ def normalized_lag_ms(t_ref: np.ndarray, ref: np.ndarray, t_sig: np.ndarray, sig
     """Delay (ms) of sig behind ref: the lag maximising their normalized cross-correlation (section II-F).
 
     Both signals (k,) are resampled on a common 1 ms grid (linear interpolation over their finite samples);
-    lags 0..lag_max_ms are searched.
+    lags 0..lag_max_ms are searched.  NaN when there is nothing to correlate: fewer than two finite samples
+    of either signal, no common stretch of at least 2 ms, or no lag at which both vary.
     """
     ok_r, ok_s = np.isfinite(ref), np.isfinite(sig)
+    if ok_r.sum() < 2 or ok_s.sum() < 2:
+        return float("nan")
     start, stop = max(t_ref[ok_r][0], t_sig[ok_s][0]), min(t_ref[ok_r][-1], t_sig[ok_s][-1])
     grid = np.arange(start, stop, 0.001)
     a = np.interp(grid, t_ref[ok_r], ref[ok_r])
     b = np.interp(grid, t_sig[ok_s], sig[ok_s])
-    best, best_ncc = 0, -np.inf
+    best, best_ncc = float("nan"), -np.inf
     for lag in range(0, min(int(lag_max_ms), len(grid) // 2)):
         x, y = a[: len(a) - lag], b[lag:]
         x, y = x - x.mean(), y - y.mean()
         ncc = (x @ y) / np.sqrt((x @ x) * (y @ y))
         if ncc > best_ncc:
-            best, best_ncc = lag, ncc
-    return float(best)
+            best, best_ncc = float(lag), ncc
+    return best
 
 
 def filter_lag_ms(no_filter: pd.DataFrame, filtered: pd.DataFrame, lag_max_ms: float) -> float:
@@ -99,53 +110,127 @@ def occlusion_summary(runs: dict[str, pd.DataFrame]) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-def filter_agreement(sim: Simulation, params: TrackParams, alpha: float, other_cls: type[UnscentedMarkerFilter]) -> float:
-    """Largest relative difference of the filtered positions of the SR-UKF and another filter class on the
-    same recording (gyro fused) at the given alpha: max |x_sr - x_other| / max |x_other|."""
-    fp = params.filter.model_copy(update={"alpha": alpha})
-    a, _ = run_filter(sim, params, use_gyro=True, filter_params=fp)
-    b, _ = run_filter(sim, params, use_gyro=True, filter_params=fp, filter_cls=other_cls)
+@dataclass(frozen=True)
+class FilterRun:
+    """One run of the tracker over a recording (:func:`~poseintegrity.tracking.simulation.run_filter`).
+
+    recording : "accuracy" (the accuracy recording) or "hand" (motion (a), 4 markers); settings : the filter's
+    constants; filter_cls : the filter (SR-UKF of Alg. 5, or the plain UKF it is checked against).  Equal runs
+    are equal keys: two experiments that need the same run share one.
+    """
+
+    recording: str
+    use_gyro: bool
+    settings: FilterParams
+    filter_cls: type[UnscentedMarkerFilter] = SquareRootUKF
+
+
+FilterResults = Mapping[FilterRun, tuple[pd.DataFrame, MarkerTracker]]
+
+
+def accuracy_runs(params: TrackParams) -> dict[str, FilterRun]:
+    """The filter runs of the accuracy recording: the UKF without and with the gyro."""
+    return {"ukf": FilterRun("accuracy", False, params.filter), "ukf_gyro": FilterRun("accuracy", True, params.filter)}
+
+
+def agreement_runs(params: TrackParams) -> dict[str, tuple[FilterRun, FilterRun]]:
+    """SR-UKF against the plain UKF (gyro fused) on the accuracy recording, at alpha 1 and at params' alpha."""
+    runs = {}
+    for alpha in (1.0, params.filter.alpha):
+        settings = params.filter.model_copy(update={"alpha": alpha})
+        runs[f"alpha_{alpha:g}"] = (FilterRun("accuracy", True, settings), FilterRun("accuracy", True, settings, UnscentedKalmanFilter))
+    return runs
+
+
+def sweep_runs(params: TrackParams) -> dict[float, FilterRun]:
+    """The noise-vs-lag runs (UKF, no gyro, accuracy recording): sigma_c and sigma_alpha times each of
+    evaluation.sigma_scales."""
+    fp = params.filter
+    return {scale: FilterRun("accuracy", False, fp.model_copy(update={"sigma_c": fp.sigma_c * scale, "sigma_alpha": fp.sigma_alpha * scale}))
+            for scale in params.evaluation.sigma_scales}
+
+
+def sigma_variants(params: TrackParams) -> dict[str, FilterParams]:
+    """The filter constants compared on motion (a) (:func:`published_against_our_sigmas`): the published sigmas,
+    ours, the two halves swapped, and the published process sigmas read as per-second intensities."""
+    process = ("sigma_c", "sigma_alpha")
+    fp = params.filter
+    return {
+        "published": fp.model_copy(update=PAPER_SIGMAS),
+        "ours": fp,
+        "published_measurement_our_process": fp.model_copy(update={k: v for k, v in PAPER_SIGMAS.items() if k not in process}),
+        "our_measurement_published_process": fp.model_copy(update={k: v for k, v in PAPER_SIGMAS.items() if k in process}),
+        "published_per_second": fp.model_copy(update={**PAPER_SIGMAS, **{k: PAPER_SIGMAS[k] / np.sqrt(fp.dt) for k in process}}),
+    }
+
+
+def sigma_runs(params: TrackParams) -> dict[str, FilterRun]:
+    """The runs of :func:`sigma_variants` on motion (a), 4 markers, UKF without gyro."""
+    return {name: FilterRun("hand", False, settings) for name, settings in sigma_variants(params).items()}
+
+
+def study_filter_runs(params: TrackParams) -> list[FilterRun]:
+    """Every distinct filter run of the study, the long motion (a) runs first (they set the critical path)."""
+    runs = [*sigma_runs(params).values(), *accuracy_runs(params).values(), *sweep_runs(params).values()]
+    runs += [run for pair in agreement_runs(params).values() for run in pair]
+    return list(dict.fromkeys(runs))
+
+
+def run_filter_task(sim: Simulation, params: TrackParams, run: FilterRun) -> tuple[pd.DataFrame, MarkerTracker]:
+    """:func:`~poseintegrity.tracking.simulation.run_filter` of one :class:`FilterRun` on its recording ``sim``."""
+    return run_filter(sim, params, run.use_gyro, run.settings, run.filter_cls)
+
+
+def filter_agreement(runs: FilterResults, pair: tuple[FilterRun, FilterRun]) -> float:
+    """Largest relative difference of the filtered positions of the SR-UKF and another filter on the same
+    recording: max |x_sr - x_other| / max |x_other| over the events where both run.  pair : (SR-UKF run, other)."""
+    (a, _), (b, _) = runs[pair[0]], runs[pair[1]]
     xa, xb = a[["x_mm", "y_mm", "z_mm"]].to_numpy(), b[["x_mm", "y_mm", "z_mm"]].to_numpy()
     both = np.isfinite(xa).all(axis=1) & np.isfinite(xb).all(axis=1)
+    if not both.any():  # the two never ran at the same event: nothing to compare
+        return float("nan")
     return float(np.abs(xa[both] - xb[both]).max() / np.abs(xb[both]).max())
 
 
 # -- experiments ---------------------------------------------------------------------------------------------
 
 
-def accuracy_and_occlusion(params: TrackParams) -> tuple[Simulation, dict[str, pd.DataFrame], dict]:
-    """The accuracy recording (params.motion, with its deliberate occlusion): no filter, UKF, UKF + gyro; RMS
-    errors both ways, lag, orientation through the occlusion, restarts, failed downdates, SR-UKF vs plain UKF."""
-    sim = simulate(params, experiment_rng(params, "accuracy"))
-    no_filter = run_no_filter(sim, params)
-    (ukf, t_ukf), (gyro, t_gyro) = run_filter(sim, params, use_gyro=False), run_filter(sim, params, use_gyro=True)
-    runs, trackers = {"ukf": ukf, "ukf_gyro": gyro}, {"ukf": t_ukf, "ukf_gyro": t_gyro}
-    occlusion = occlusion_summary(runs)
+def accuracy_recording(params: TrackParams) -> tuple[Simulation, pd.DataFrame]:
+    """The accuracy recording (params.motion, with its deliberate occlusion) and its no-filter table."""
+    [sim] = simulate(params, experiment_rng(params, "accuracy"))
+    return sim, run_no_filter(sim, params)
+
+
+def accuracy_and_occlusion(sim: Simulation, no_filter: pd.DataFrame, params: TrackParams, runs: FilterResults) -> tuple[dict[str, pd.DataFrame], dict]:
+    """On the accuracy recording: no filter, UKF, UKF + gyro; RMS errors both ways, lag, orientation through
+    the occlusion, restarts, failed downdates, SR-UKF vs plain UKF.  runs : the results of :func:`accuracy_runs`
+    and :func:`agreement_runs`."""
+    named = {name: runs[run] for name, run in accuracy_runs(params).items()}
+    frames, trackers = {name: df for name, (df, _) in named.items()}, {name: t for name, (_, t) in named.items()}
+    occlusion = occlusion_summary(frames)
     metrics = {
-        "rms": summarize_accuracy(no_filter, runs),
-        "lag_ms": {name: filter_lag_ms(no_filter, df, params.evaluation.lag_max_ms) for name, df in runs.items()},
+        "rms": summarize_accuracy(no_filter, frames),
+        "lag_ms": {name: filter_lag_ms(no_filter, df, params.evaluation.lag_max_ms) for name, df in frames.items()},
         "occlusion_rms_deg": dict(zip(occlusion.run, occlusion.rms_deg)),
         "occlusion_share_tracked": dict(zip(occlusion.run, occlusion.share_tracked)),
         "failed_downdates": int(sum(t.filter.failed_downdates for t in trackers.values())),
-        "filter_steps": {name: int((df.flag == "ok").sum()) for name, df in runs.items()},
+        "filter_steps": {name: int((df.flag == "ok").sum()) for name, df in frames.items()},
         "divergences": {name: t.filter.n_divergences for name, t in trackers.items()},
         "restarts": {name: t.n_restarts for name, t in trackers.items()},
         "gated_markers": {name: t.n_gated for name, t in trackers.items()},
-        "srukf_vs_ukf_max_rel_diff": {f"alpha_{a:g}": filter_agreement(sim, params, a, UnscentedKalmanFilter) for a in (1.0, params.filter.alpha)},
+        "srukf_vs_ukf_max_rel_diff": {name: filter_agreement(runs, pair) for name, pair in agreement_runs(params).items()},
         "n_frames": int(len(sim.t)),
     }
-    return sim, {"no_filter": no_filter, **runs, "occlusion": occlusion}, metrics
+    return {"no_filter": no_filter, **frames, "occlusion": occlusion}, metrics
 
 
-def noise_against_lag(sim: Simulation, params: TrackParams, no_filter: pd.DataFrame) -> pd.DataFrame:
-    """Noise-vs-lag trade-off (Figs. 6, 9): sigma_c and sigma_alpha scaled by evaluation.sigma_scales.
-
-    One row per scale: RMS position (mm) and rotation (deg) error and lag (ms) of the UKF without gyro.
-    """
+def noise_against_lag(no_filter: pd.DataFrame, params: TrackParams, runs: FilterResults) -> pd.DataFrame:
+    """Noise-vs-lag trade-off (Figs. 6, 9) from the runs of :func:`sweep_runs`: sigma_c and sigma_alpha scaled
+    by evaluation.sigma_scales.  One row per scale: RMS position (mm) and rotation (deg) error and lag (ms) of
+    the UKF without gyro."""
     rows, frames = [], accuracy_frames(no_filter)
-    for scale in params.evaluation.sigma_scales:
-        fp = params.filter.model_copy(update={"sigma_c": params.filter.sigma_c * scale, "sigma_alpha": params.filter.sigma_alpha * scale})
-        df, _ = run_filter(sim, params, use_gyro=False, filter_params=fp)
+    for scale, run in sweep_runs(params).items():
+        df, _ = runs[run]
         at_frames = df[(df.kind == "frame") & df.frame.isin(frames)]
         rows.append({"scale": scale, "rms_mm": rms(at_frames.pos_err_mm), "rms_deg": rms(at_frames.rot_err_deg),
                      "lag_ms": filter_lag_ms(no_filter, df, params.evaluation.lag_max_ms)})
@@ -157,65 +242,81 @@ def success_frames_duration(params: TrackParams) -> float:
     return params.evaluation.success_frames * params.motion.frame_interval_s * 1.2 + 1.0
 
 
-def success_rates(params: TrackParams) -> tuple[pd.DataFrame, dict[str, Simulation], dict[str, pd.DataFrame]]:
+@dataclass(frozen=True)
+class SuccessRun:
+    """One success-rate recording: motion "a" (paper-like) or "b" (stress); label markers4 / markers3 /
+    markers3_drop<k>; dropped : index of the removed marker, -1 for none.  On (b) the frames are detected
+    with and without splitting touching blobs (the same frames)."""
+
+    motion: str
+    label: str
+    dropped: int
+
+
+def success_runs(params: TrackParams) -> list[SuccessRun]:
+    """(a) with 4 markers and with each marker removed (params.drop_marker's run is ``markers3``); (b) with 4
+    markers and without params.drop_marker."""
+    n = len(params.markers_body)
+    three = {"markers3" if i == params.drop_marker else f"markers3_drop{i + 1}": i for i in range(n)}
+    runs = [SuccessRun("a", "markers4", -1)] + [SuccessRun("a", label, i) for label, i in three.items()]
+    return runs + [SuccessRun("b", "markers4", -1), SuccessRun("b", "markers3", params.drop_marker)]
+
+
+def success_recording(params: TrackParams, run: SuccessRun, keep: bool = False) -> dict[str, tuple[pd.DataFrame, Simulation | None]]:
+    """The recording of one :class:`SuccessRun` (success_frames_duration seconds) and its no-filter tables,
+    by run name (``a_markers4``, ``b_markers3_no_split``, ...): {name: (no-filter table, recording if keep
+    else None)} (a recording of motion (a) holds ~50 MB of ground truth: only the one filtered later is kept)."""
+    geometry = np.array(params.markers_body)
+    body = geometry if run.dropped < 0 else np.delete(geometry, run.dropped, axis=0)
+    duration = success_frames_duration(params)
+    if run.motion == "a":
+        sims = {f"a_{run.label}": simulate_hand(params, experiment_rng(params, f"hand_{run.label}"), body, duration)}
+    else:
+        no_split = params.detection.model_copy(update={"split_touching": False})
+        split, unsplit = simulate(params, experiment_rng(params, f"stress_{run.label}"), body, params.evaluation.success_omega_std,
+                                  duration, [params.detection, no_split])
+        sims = {f"b_{run.label}": split, f"b_{run.label}_no_split": unsplit}
+    return {name: (run_no_filter(sim, params), sim if keep else None) for name, sim in sims.items()}
+
+
+def success_rates(params: TrackParams, no_filter: Mapping[str, pd.DataFrame]) -> tuple[pd.DataFrame, dict[str, pd.DataFrame]]:
     """Share of evaluation.success_frames frames with a correct pose (section III) on motion (a), paper-like, and
     motion (b), the stress test, with 4 and with 3 markers (params.drop_marker removed; the paper does not say
     which one it removed, so on (a) every other choice is run too, ``markers3_drop<k>``); on (b) also without
-    splitting touching blobs (the same frames: same generator).  Returns (table motion/markers/dropped/split/
-    rate/possible, the motion (a) recordings by label, per-frame tables).  ``possible``: share of frames with
-    >= 3 markers not hidden by an occlusion (a marker hidden behind another still counts as possible)."""
-    geometry = np.array(params.markers_body)
-    duration, n = success_frames_duration(params), params.evaluation.success_frames
-    no_split = params.detection.model_copy(update={"split_touching": False})
-    stress = params.evaluation.success_omega_std
-    three = {"markers3" if i == params.drop_marker else f"markers3_drop{i + 1}": i for i in range(len(geometry))}
-    runs = [("a", "markers4", -1, True)] + [("a", label, i, True) for label, i in three.items()]
-    runs += [("b", label, i, split) for label, i in [("markers4", -1), ("markers3", params.drop_marker)] for split in (True, False)]
-    rows, sims, tables = [], {}, {}
-    for motion, label, dropped, split in runs:
-        body = geometry if dropped < 0 else np.delete(geometry, dropped, axis=0)
-        if motion == "a":
-            sim = simulate_hand(params, experiment_rng(params, f"hand_{label}"), body, duration)
-            sims[label] = sim
-        else:
-            sim = simulate(params, experiment_rng(params, f"stress_{label}"), body, stress, duration, None if split else no_split)
-        df = run_no_filter(sim, params).iloc[:n]
-        name = f"{motion}_{label}" + ("" if split else "_no_split")
-        tables[f"success_{name}"] = df
-        rows.append({"run": name, "motion": motion, "markers": label, "dropped": dropped + 1, "split_touching": split,
-                     "rate": float(df.correct.mean()), "possible": float((df.n_visible >= 3).mean()), "frames": len(df)})
-    return pd.DataFrame(rows), sims, tables
+    splitting touching blobs (the same frames).  no_filter : the tables of :func:`success_recording` by run name.
+    Returns (table motion/markers/dropped/split/rate/possible, per-frame tables ``success_<run>``).  ``possible``:
+    share of frames with >= 3 markers not hidden by an occlusion (a marker hidden behind another still counts)."""
+    n = params.evaluation.success_frames
+    rows, tables = [], {}
+    for run in success_runs(params):
+        for split in (True,) if run.motion == "a" else (True, False):
+            name = f"{run.motion}_{run.label}" + ("" if split else "_no_split")
+            df = no_filter[name].iloc[:n]
+            tables[f"success_{name}"] = df
+            rows.append({"run": name, "motion": run.motion, "markers": run.label, "dropped": run.dropped + 1, "split_touching": split,
+                         "rate": float(df.correct.mean()), "possible": float((df.n_visible >= 3).mean()), "frames": len(df)})
+    return pd.DataFrame(rows), tables
 
 
-def published_against_our_sigmas(sim: Simulation, params: TrackParams) -> tuple[pd.DataFrame, dict]:
-    """On motion (a) (4 markers): the UKF with the published sigmas and with ours, no gyro; the two halves
-    swapped (published measurement sigma_r with our process sigmas, and the reverse) to see which half makes
-    the difference; and the published process sigmas read as per-second intensities.  Eq. 30 adds
-    dt^2 sigma^2 to omega's variance at every filter step, so over one second the variance grows by
-    dt sigma^2: the published sigma_alpha = 0.71 rad/s^2 at the 400 Hz clock lets omega drift 0.035 rad/s in
-    a second.  Read as a per-second intensity (variance sigma^2 per second, clock-independent) it is
-    sigma / sqrt(dt / 1 s) per step.  RMS both ways on the correct no-filter frames, lag behind the no-filter
-    signal, and how often the filter was gated or restarted."""
-    no_filter = run_no_filter(sim, params)
+def published_against_our_sigmas(no_filter: pd.DataFrame, params: TrackParams, runs: FilterResults) -> tuple[pd.DataFrame, dict]:
+    """On motion (a) (4 markers; no_filter : its no-filter table): the UKF with the published sigmas and with
+    ours, no gyro; the two halves swapped (published measurement sigma_r with our process sigmas, and the
+    reverse) to see which half makes the difference; and the published process sigmas read as per-second
+    intensities (:func:`sigma_variants`, run as :func:`sigma_runs`).  Eq. 30 adds dt^2 sigma^2 to omega's
+    variance at every filter step, so over one second the variance grows by dt sigma^2: the published
+    sigma_alpha = 0.71 rad/s^2 at the 400 Hz clock lets omega drift 0.035 rad/s in a second.  Read as a
+    per-second intensity (variance sigma^2 per second, clock-independent) it is sigma / sqrt(dt / 1 s) per
+    step.  RMS both ways on the correct no-filter frames, lag behind the no-filter signal, and how often the
+    filter was gated or restarted."""
     frames = accuracy_frames(no_filter)
-    process = ("sigma_c", "sigma_alpha")
-    variants = {
-        "published": params.filter.model_copy(update=PAPER_SIGMAS),
-        "ours": params.filter,
-        "published_measurement_our_process": params.filter.model_copy(update={k: v for k, v in PAPER_SIGMAS.items() if k not in process}),
-        "our_measurement_published_process": params.filter.model_copy(update={k: v for k, v in PAPER_SIGMAS.items() if k in process}),
-        "published_per_second": params.filter.model_copy(
-            update={**PAPER_SIGMAS, **{k: PAPER_SIGMAS[k] / np.sqrt(params.filter.dt) for k in process}}
-        ),
-    }
     rows, metrics = [], {}
-    for name, fp in variants.items():
-        df, tracker = run_filter(sim, params, use_gyro=False, filter_params=fp)
+    for name, run in sigma_runs(params).items():
+        df, tracker = runs[run]
         summary = rms_summary(df[(df.kind == "frame") & df.frame.isin(frames)])
         lag = filter_lag_ms(no_filter, df, params.evaluation.lag_max_ms)
         frames_df = df[df.kind == "frame"]
         metrics[name] = {**summary, "lag_ms": lag, "restarts": tracker.n_restarts, "gated_markers": tracker.n_gated,
-                         "share_ok": float((frames_df.flag == "ok").mean()), **{k: getattr(fp, k) for k in PAPER_SIGMAS}}
+                         "share_ok": float((frames_df.flag == "ok").mean()), **{k: getattr(run.settings, k) for k in PAPER_SIGMAS}}
         rows.append({"sigmas": name, **metrics[name]})
     metrics["no_filter"] = rms_summary(no_filter[no_filter.frame.isin(frames)])
     return pd.DataFrame(rows), metrics
@@ -274,7 +375,7 @@ def ten_metre_jump(sim: Simulation, params: TrackParams, jump_at_s: float = 2.0,
     restart = flags.index("restart") if "restart" in flags else -1
     return {"frames_after_jump": len(flags), "ok_while_off": int(sum(fl == "ok" and e > 0.1 for fl, e in zip(flags, errors))),
             "flags": {fl: flags.count(fl) for fl in sorted(set(flags))}, "frames_to_restart": restart,
-            "error_after_restart_mm": float(np.nanmax(errors[restart + 1 :]) * 1000) if restart >= 0 else float("nan")}
+            "error_after_restart_mm": float(np.nanmax(errors[restart + 1 :]) * 1000) if 0 <= restart < len(errors) - 1 else float("nan")}
 
 
 def recording_replay(params: TrackParams, folder: Path) -> tuple[pd.DataFrame, dict]:
@@ -282,7 +383,7 @@ def recording_replay(params: TrackParams, folder: Path) -> tuple[pd.DataFrame, d
     gyro.csv, the unit-plane LUT) and replay it from disk with :func:`track_recording`; the in-memory run of the
     same recording (:func:`run_filter`, gyro fused) must give the same poses.  Returns (pose table, agreement)."""
     writer = RecordingWriter(folder, unit_plane_lut(intrinsics(params.camera), params.camera.width, params.camera.height))
-    sim = simulate(params, experiment_rng(params, "replay"), duration_s=params.evaluation.replay_s, sink=writer.add_frame)
+    [sim] = simulate(params, experiment_rng(params, "replay"), duration_s=params.evaluation.replay_s, sink=writer.add_frame)
     writer.close(sim.trajectory.t[sim.timeline.gyro_index], sim.timeline.gyro)
     table = track_recording(read_recording(folder), {"tool": sim.markers_body}, params, gyro_tool="tool")
     direct, _ = run_filter(sim, params, use_gyro=True)
@@ -354,20 +455,44 @@ class Study:
     metrics: dict
 
 
-def run_study(params: TrackParams, recording_folder: Path) -> Study:
+def call(task: Callable[[], object]) -> object:
+    """task(): what :meth:`~poseintegrity.parallel.Workers.map` runs for a list of heterogeneous tasks
+    (``functools.partial`` of module-level functions)."""
+    return task()
+
+
+def run_study(params: TrackParams, recording_folder: Path, workers: Workers) -> Study:
     """Section III on our simulation: every experiment above, their tables and the metrics of tracking.json.
 
-    recording_folder : where :func:`recording_replay` writes the replayed recording."""
-    sim, tables, accuracy = accuracy_and_occlusion(params)
-    sweep = noise_against_lag(sim, params, tables["no_filter"])
-    success, hand_sims, success_tables = success_rates(params)
-    sigmas, sigma_metrics = published_against_our_sigmas(hand_sims["markers4"], params)
-    blobs = small_blob_sweep(params, experiment_rng(params, "small_blobs"))
-    tools = pd.concat([two_tools_success(params, params.motion.max_phantoms, "two_tools"),
-                       two_tools_success(params, params.evaluation.phantom_rich_max, "two_tools_phantom_rich")], ignore_index=True)
-    replay, replay_metrics = recording_replay(params, recording_folder)
+    recording_folder : where :func:`recording_replay` writes the replayed recording.  workers : where the
+    recordings, scenes and filter runs run (tasks of their own generators, so the tables do not depend on
+    the number of workers); the timings run in this process afterwards, with no task of ours beside them.
+    Two rounds of tasks, each listed longest first so that the workers finish together: first the recordings
+    the filter runs need (accuracy; motion (a), 4 markers) beside one stress recording (rendered once,
+    detected twice: the longest) and the small scenes; then the filter runs beside the other recordings.
+    """
+    ev, hand = params.evaluation, SuccessRun("a", "markers4", -1)
+    others = sorted((run for run in success_runs(params) if run != hand), key=lambda run: run.motion != "b")  # (b) first
+    first = [partial(success_recording, params, others[0]), partial(success_recording, params, hand, True), partial(accuracy_recording, params),
+             partial(two_tools_success, params, params.motion.max_phantoms, "two_tools"),
+             partial(two_tools_success, params, ev.phantom_rich_max, "two_tools_phantom_rich"),
+             partial(small_blob_sweep, params, experiment_rng(params, "small_blobs")),
+             partial(recording_replay, params, Path(recording_folder).resolve())]
+    stress, motion_a, (sim, no_filter), tools, rich_tools, blobs, (replay, replay_metrics) = workers.map(call, first, desc="tracking recordings")
+    recordings = {"accuracy": sim, "hand": motion_a["a_markers4"][1]}
+    filter_runs = study_filter_runs(params)
+    second = [partial(success_recording, params, run) for run in others[1:]]
+    second += [partial(run_filter_task, recordings[run.recording], params, run) for run in filter_runs]
+    results = workers.map(call, second, desc="tracking recordings and filter runs")
+    runs = dict(zip(filter_runs, results[len(others) - 1 :]))
+    success_tables = {name: table for recorded in [stress, motion_a, *results[: len(others) - 1]] for name, (table, _) in recorded.items()}
+
+    tables, accuracy = accuracy_and_occlusion(sim, no_filter, params, runs)
+    success, success_frames = success_rates(params, success_tables)
+    sigmas, sigma_metrics = published_against_our_sigmas(success_tables["a_markers4"], params, runs)
+    multi_tool = pd.concat([tools, rich_tools], ignore_index=True)
     geometry = np.array(params.markers_body)
-    speed = filter_speed(geometry, params.filter, params.evaluation.timing_repeats, experiment_rng(params, "speed"))
+    speed = filter_speed(geometry, params.filter, ev.timing_repeats, experiment_rng(params, "speed"))
     rate = dict(zip(success.run, success.rate))
     metrics = {
         **accuracy,
@@ -381,7 +506,7 @@ def run_study(params: TrackParams, recording_folder: Path) -> Study:
         "success_possible": dict(zip(success.run, success.possible)),
         "sigmas_motion_a": sigma_metrics,
         "small_blobs": sweep_summary(blobs),
-        "multi_tool_success": tools.groupby(["scene", "tool"]).correct.mean().unstack().to_dict(orient="index"),
+        "multi_tool_success": multi_tool.groupby(["scene", "tool"]).correct.mean().unstack().to_dict(orient="index"),
         "ten_metre_jump": ten_metre_jump(sim, params),
         "recording_replay": replay_metrics,
         "pykalman_time_update_max_diff": pykalman_time_update(geometry, params.filter, experiment_rng(params, "pykalman")),
@@ -390,6 +515,6 @@ def run_study(params: TrackParams, recording_folder: Path) -> Study:
         "filter_step_ms": {k: v for k, v in speed.items() if not k.startswith("speedup")},
         "paper": BLACK_RESULTS,
     }
-    tables = {**tables, "sigma_sweep": sweep, "success": success, **success_tables, "sigmas_motion_a": sigmas,
-              "small_blobs": blobs, "multi_tool": tools, "replay_poses": replay}
+    tables = {**tables, "sigma_sweep": noise_against_lag(no_filter, params, runs), "success": success, **success_frames,
+              "sigmas_motion_a": sigmas, "small_blobs": blobs, "multi_tool": multi_tool, "replay_poses": replay}
     return Study(tables=tables, timing=timing_table(sim, params), metrics=metrics)

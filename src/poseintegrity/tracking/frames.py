@@ -9,6 +9,7 @@ reports it), so the detector's depth lookup lands on the sphere surface, not its
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
@@ -65,12 +66,19 @@ def draw_phantoms(n: int, camera: CameraParams, frames: FrameParams, round_fract
     return phantoms
 
 
-def _subpixel_grid(u0: int, v0: int, u1: int, v1: int, s: int) -> tuple[np.ndarray, np.ndarray]:
-    """Sample positions (h, w, s*s) of ``s x s`` rays per pixel in the patch [u0, u1) x [v0, v1)."""
+@lru_cache(maxsize=8)
+def _subpixel_offsets(s: int) -> tuple[np.ndarray, np.ndarray]:
+    """Offsets (s*s,) in u and in v of ``s x s`` rays from the centre of their pixel, px (row-major grid)."""
     offsets = (np.arange(s) + 0.5) / s - 0.5
     du, dv = np.meshgrid(offsets, offsets)
-    uu = np.arange(u0, u1, dtype=float)[None, :, None] + du.ravel()[None, None, :]
-    vv = np.arange(v0, v1, dtype=float)[:, None, None] + dv.ravel()[None, None, :]
+    return du.ravel(), dv.ravel()
+
+
+def _subpixel_grid(u0: int, v0: int, u1: int, v1: int, s: int) -> tuple[np.ndarray, np.ndarray]:
+    """Sample positions (h, w, s*s) of ``s x s`` rays per pixel in the patch [u0, u1) x [v0, v1)."""
+    du, dv = _subpixel_offsets(s)
+    uu = np.arange(u0, u1, dtype=float)[None, :, None] + du
+    vv = np.arange(v0, v1, dtype=float)[:, None, None] + dv
     return np.broadcast_to(uu, (v1 - v0, u1 - u0, s * s)), np.broadcast_to(vv, (v1 - v0, u1 - u0, s * s))
 
 
@@ -88,11 +96,14 @@ def render_frame(
     phantoms : reflections to draw.  marker_radius_m : sphere radius, m.
     Returns ir : (H, W) uint16 (raw reflectivity, background ~80, markers saturate above 1000) and
     depth_mm : (H, W) uint16, millimetres along the ray (background_depth_mm where nothing is hit).
+
+    Depth is kept as whole millimetres throughout: rounding and clipping to uint16 are monotone, so rounding
+    each surface before taking the nearest one gives the same image as rounding the nearest float depth.
     """
     H, W, s = camera.height, camera.width, frames.supersampling
     K = intrinsics(camera)
     brightness = np.zeros((H, W), dtype=np.float32)
-    depth = np.full((H, W), frames.background_depth_mm, dtype=np.float64)
+    depth = np.full((H, W), depth_mm_uint16(frames.background_depth_mm), dtype=np.uint16)
     frame_bias = rng.normal(0.0, frames.frame_depth_bias_std_mm)
     for c in markers_cam[np.argsort(-markers_cam[:, 2])] if len(markers_cam) else []:
         if c[2] <= marker_radius_m:
@@ -113,7 +124,7 @@ def render_frame(
         cover = hit.mean(axis=-1)
         near = t_mm.min(axis=-1)
         bias = frame_bias + rng.normal(0.0, frames.depth_bias_std_mm)
-        noisy = near + bias + rng.normal(0.0, frames.depth_noise_mm, near.shape)
+        noisy = depth_mm_uint16(near + bias + rng.normal(0.0, frames.depth_noise_mm, near.shape))
         patch = (slice(v0, v1), slice(u0, u1))
         depth[patch] = np.where(cover > 0, np.minimum(depth[patch], noisy), depth[patch])
         level = frames.marker_ir + rng.normal(0.0, frames.marker_ir_std)
@@ -128,8 +139,16 @@ def render_frame(
         b = (-(uu - p.u) * sin + (vv - p.v) * cos) / p.radius_px
         cover = (a * a + b * b <= 1.0).mean(axis=-1)
         patch = (slice(v0, v1), slice(u0, u1))
-        noisy = p.depth_mm + rng.normal(0.0, frames.depth_noise_mm, cover.shape)
+        noisy = depth_mm_uint16(p.depth_mm + rng.normal(0.0, frames.depth_noise_mm, cover.shape))
         depth[patch] = np.where(cover > 0, np.minimum(depth[patch], noisy), depth[patch])
         brightness[patch] = np.maximum(brightness[patch], (frames.marker_ir + rng.normal(0.0, frames.marker_ir_std)) * cover)
-    ir = frames.ir_background + frames.ir_noise_std * rng.standard_normal((H, W), dtype=np.float32) + brightness
-    return np.clip(np.rint(ir), 0, 65535).astype(np.uint16), np.clip(np.rint(depth), 0, 65535).astype(np.uint16)
+    ir = rng.standard_normal((H, W), dtype=np.float32)  # in place: frames.ir_background + frames.ir_noise_std * noise + brightness
+    ir *= np.float32(frames.ir_noise_std)
+    ir += np.float32(frames.ir_background)
+    ir += brightness
+    return np.clip(np.rint(ir, out=ir), 0, 65535, out=ir).astype(np.uint16), depth
+
+
+def depth_mm_uint16(depth_mm: np.ndarray | float) -> np.ndarray:
+    """Depth (any shape) in mm rounded to whole millimetres and clipped to the uint16 range, as the sensor stores it."""
+    return np.clip(np.rint(depth_mm), 0, 65535).astype(np.uint16)

@@ -28,14 +28,29 @@ def centred(points_body: np.ndarray) -> np.ndarray:
 
 
 @numba.njit(cache=True)
+def _same_rows(X, k, rows):  # pragma: no cover - compiled
+    """Whether column k of X equals column 0 in its first ``rows`` rows."""
+    for i in range(rows):
+        if X[i, k] != X[i, 0]:
+            return False
+    return True
+
+
+@numba.njit(cache=True)
 def _process_model_kernel(X, dt, ell):  # pragma: no cover - compiled
     n = ell.shape[0]
     X_next = X.copy()
     r = np.empty((n, 3))
+    R_first = np.empty((3, 3))
     for k in range(X.shape[1]):  # one sigma point per column
-        for i in range(n):
-            r[i] = X[3 * i : 3 * i + 3, k]
-        R = horn_rotation(centred_cross_covariance(r, ell))  # R_k by Alg. 4, recomputed every step
+        if k > 0 and _same_rows(X, k, 3 * n):  # it differs from the first only in omega or c_dot: same markers, same R_k
+            R = R_first
+        else:
+            for i in range(n):
+                r[i] = X[3 * i : 3 * i + 3, k]
+            R = horn_rotation(centred_cross_covariance(r, ell))  # R_k by Alg. 4, recomputed every step
+            if k == 0:
+                R_first = R
         w = X[3 * n : 3 * n + 3, k]
         v = X[3 * n + 3 : 3 * n + 6, k]
         for i in range(n):
@@ -74,20 +89,32 @@ def process_noise_sqrt(x: np.ndarray, dt: float, ell: np.ndarray, sigma_c: float
     7 < N, so it has no Cholesky factor; the rectangular B feeds the QR of Alg. 5 directly.
     """
     n = ell.shape[0]
-    N = state_dim(n)
     R = horn_rotation(centred_cross_covariance(x[: 3 * n].reshape(n, 3), ell))
     a = ell @ R.T  # (n, 3)
-    omega = x[3 * n : 3 * n + 3]
-    W = skew(omega)
+    W = skew(x[3 * n : 3 * n + 3])  # [omega]x
     half_dt2 = 0.5 * dt * dt
-    B_r = np.zeros((n, 3, 7))  # marker rows, one (3, 7) block per marker
-    B_r[:, :, 0:3] = half_dt2 * sigma_c * np.eye(3)
-    B_r[:, :, 3:6] = -half_dt2 * sigma_alpha * skew(a)  # [alpha]x a_i = -[a_i]x alpha
-    B_r[:, :, 6] = half_dt2 * a @ (W @ W).T  # [omega]x^2 a_i
-    B = np.zeros((N, 7))
-    B[: 3 * n] = B_r.reshape(3 * n, 7)
-    B[3 * n : 3 * n + 3, 3:6] = dt * sigma_alpha * np.eye(3)  # omega_{k+1} = omega_k + dt alpha_k
-    B[3 * n + 3 :, 0:3] = dt * sigma_c * np.eye(3)  # c_dot_{k+1} = c_dot_k + dt c_ddot_k
+    return _noise_sqrt_kernel(a, half_dt2 * a @ (W @ W).T, dt, sigma_c, sigma_alpha)
+
+
+@numba.njit(cache=True)
+def _noise_sqrt_kernel(a, centripetal, dt, sigma_c, sigma_alpha):  # pragma: no cover - compiled
+    """B (N, 7) of :func:`process_noise_sqrt` from a_i = R ell^i (n, 3) and (dt^2 / 2) [omega]x^2 a_i (n, 3)."""
+    n = a.shape[0]
+    half_dt2 = 0.5 * dt * dt
+    position, rotation = half_dt2 * sigma_c, -half_dt2 * sigma_alpha
+    B = np.zeros((3 * n + 6, 7))
+    for i in range(n):
+        r = 3 * i
+        for j in range(3):
+            B[r + j, j] = position  # c_ddot (eq. 8)
+            B[r + j, 6] = centripetal[i, j]  # [omega]x^2 a_i (eq. 29)
+        # [alpha]x a_i = -[a_i]x alpha (eq. 9): rotation * skew(a_i), skew(v) = [[0, -v2, v1], [v2, 0, -v0], [-v1, v0, 0]]
+        B[r, 3], B[r, 4], B[r, 5] = rotation * 0.0, rotation * -a[i, 2], rotation * a[i, 1]
+        B[r + 1, 3], B[r + 1, 4], B[r + 1, 5] = rotation * a[i, 2], rotation * 0.0, rotation * -a[i, 0]
+        B[r + 2, 3], B[r + 2, 4], B[r + 2, 5] = rotation * -a[i, 1], rotation * a[i, 0], rotation * 0.0
+    for j in range(3):
+        B[3 * n + j, 3 + j] = dt * sigma_alpha  # omega_{k+1} = omega_k + dt alpha_k
+        B[3 * n + 3 + j, j] = dt * sigma_c  # c_dot_{k+1} = c_dot_k + dt c_ddot_k
     return B
 
 

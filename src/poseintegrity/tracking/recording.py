@@ -15,16 +15,18 @@ Points are expressed in the camera frame (T_world_cam = identity).
 Usage, e.g. on a HoloLens 2 recording with the probe of the paper::
 
     from poseintegrity.config import load_section
-    from poseintegrity.tracking import MARKERS_BODY, read_recording, read_tools, track_recording
+    from poseintegrity.tracking import read_recording, read_tools, track_recording
 
     params = load_section("params.yaml", "track")
-    tools = {"probe": MARKERS_BODY}  # or read_tools("tools.json", params.matching.distinct_m)
+    tools = {"probe": np.array(params.markers_body)}  # or read_tools("tools.json", params.matching.distinct_m)
     poses = track_recording(read_recording("my_recording"), tools, params, gyro_tool="probe")
     poses.to_csv("poses.csv", index=False)
 
-Bad input: a missing file, a non-finite or decreasing timestamp, or an all-zero lookup table raises
-:class:`RecordingError` naming it; a frame of the wrong shape, dtype or units (depth in metres) gives a row
-flagged ``bad_frame`` and a RuntimeWarning naming the file and the reason; no NaN point is ever produced.
+Bad input: a missing file (frames.csv, a frame it lists, the lookup table), a non-finite or decreasing
+timestamp, a gyro rate that is not a number, or an all-zero lookup table raises :class:`RecordingError` naming
+it when the recording is read, before any frame is tracked; a frame file that cannot be decoded, or a frame of
+the wrong shape, dtype or units (depth in metres) gives a row flagged ``bad_frame`` and a RuntimeWarning naming
+the file and the reason; no NaN point is ever produced.
 """
 
 from __future__ import annotations
@@ -57,13 +59,21 @@ class Recording:
     gyro: pd.DataFrame | None
 
 
-def _read_table(path: Path, columns: list[str]) -> pd.DataFrame:
+def _read_table(path: Path, columns: list[str], numeric: tuple[str, ...] = ()) -> pd.DataFrame:
+    """The csv at path with its columns checked: t_s finite and non-decreasing, the ``numeric`` columns numbers
+    (NaN allowed: a non-finite gyro sample is flagged by the tracker)."""
     if not path.exists():
         raise RecordingError(f"{path} is missing")
     table = pd.read_csv(path)
     missing = [c for c in columns if c not in table.columns]
     if missing:
         raise RecordingError(f"{path} lacks the columns {missing}")
+    for column in numeric:
+        values = pd.to_numeric(table[column], errors="coerce")
+        text = np.flatnonzero(values.isna() & table[column].notna())
+        if text.size:
+            raise RecordingError(f"{path}: {column} of row {text[0]} is not a number ({table[column].iloc[text[0]]!r})")
+        table[column] = values
     t = pd.to_numeric(table["t_s"], errors="coerce").to_numpy(float)
     bad = np.flatnonzero(~np.isfinite(t))
     if bad.size:
@@ -78,6 +88,9 @@ def read_recording(folder: str | Path) -> Recording:
     """Read and check frames.csv, the lookup table and gyro.csv (if present) of a recording folder."""
     folder = Path(folder)
     frames = _read_table(folder / "frames.csv", ["t_s", "ir", "depth"])
+    absent = [name for name in [*frames.ir, *frames.depth] if not (folder / str(name)).is_file()]
+    if absent:
+        raise RecordingError(f"{folder}: {len(absent)} frame file(s) listed in frames.csv are missing, e.g. {absent[0]!r}")
     try:
         lut = np.stack([np.load(folder / "lut_x.npy"), np.load(folder / "lut_y.npy")], axis=-1).astype(float)
     except (OSError, ValueError) as error:
@@ -86,18 +99,29 @@ def read_recording(folder: str | Path) -> Recording:
         raise RecordingError(f"{folder}: lut_x.npy and lut_y.npy must be (H, W) arrays, got {lut.shape[:-1]}")
     if not np.all(np.isfinite(lut)) or not np.any(lut):
         raise RecordingError(f"{folder}: the unit-plane lookup table is all zero or not finite; it cannot unproject pixels")
-    gyro = _read_table(folder / "gyro.csv", ["t_s", "wx", "wy", "wz"]) if (folder / "gyro.csv").exists() else None
+    gyro = _read_table(folder / "gyro.csv", ["t_s", "wx", "wy", "wz"], ("wx", "wy", "wz")) if (folder / "gyro.csv").exists() else None
     return Recording(folder, frames, lut, gyro)
 
 
-def load_image(path: Path) -> np.ndarray:
-    """One frame array from a 16-bit (or 8-bit) PNG or a .npy file, unchanged."""
+def load_image(path: Path) -> np.ndarray | None:
+    """One frame array from a 16-bit (or 8-bit) PNG or a .npy file, unchanged; None if the file cannot be
+    decoded (a truncated or corrupt file: :func:`track_recording` flags its frame ``bad_frame``)."""
     if path.suffix.lower() == ".npy":
-        return np.load(path)
-    image = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
-    if image is None:
-        raise RecordingError(f"{path} is missing or not an image")
-    return image
+        try:
+            return np.load(path)
+        except (OSError, ValueError):
+            return None
+    return cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
+
+
+def frame_problem(recording: Recording, k: int) -> tuple[str, np.ndarray, np.ndarray]:
+    """(why frame k cannot be used or "", ir, depth_mm) of a recording, reading its two files."""
+    row = recording.frames.iloc[k]
+    ir, depth = load_image(recording.folder / row.ir), load_image(recording.folder / row.depth)
+    unreadable = [name for name, image in ((row.ir, ir), (row.depth, depth)) if image is None]
+    if unreadable:
+        return f"cannot decode {', '.join(map(str, unreadable))}", np.zeros((0, 0)), np.zeros((0, 0))
+    return validate_frame(ir, depth, recording.lut), ir, depth
 
 
 class RecordingWriter:
@@ -143,12 +167,10 @@ def track_recording(recording: Recording, tools: dict[str, np.ndarray], params: 
         if is_gyro:
             tracker.gyro(t, gyro[k])
             continue
-        row = recording.frames.iloc[k]
-        ir, depth = load_image(recording.folder / row.ir), load_image(recording.folder / row.depth)
-        reason = validate_frame(ir, depth, recording.lut)
+        reason, ir, depth = frame_problem(recording, k)
         if reason:
             if reason not in warned:
-                warnings.warn(f"{recording.folder / row.ir}: {reason} (frame flagged bad_frame)", RuntimeWarning, stacklevel=2)
+                warnings.warn(f"{recording.folder / recording.frames.ir.iloc[k]}: {reason} (frame flagged bad_frame)", RuntimeWarning, stacklevel=2)
                 warned.add(reason)
             results = {name: None for name in tools}
             points = np.zeros((0, 3))

@@ -7,7 +7,7 @@ Every random draw comes from the generator passed in; the same generator state g
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -63,13 +63,14 @@ def record(
     timeline: SensorTimeline,
     markers_body: np.ndarray,
     rng: np.random.Generator,
-    detection: DetectionParams | None = None,
+    detections: Sequence[DetectionParams],
     sink: Callable[[float, np.ndarray, np.ndarray], None] | None = None,
     label: str = "frames",
-) -> Simulation:
-    """Render every marker frame of a timeline (AHAT-like, with phantoms) and run the detector on it.
+) -> list[Simulation]:
+    """Render every marker frame of a timeline (AHAT-like, with phantoms) and run each detector on it.
 
-    detection : overrides params.detection; sink(t, ir, depth_mm) receives each rendered frame.
+    detections : the detectors' constants; one :class:`Simulation` per detector is returned, all of the same
+    rendered frames (detection draws no random number).  sink(t, ir, depth_mm) receives each rendered frame.
     The points of a frame come from detection on the rendered images, so their error is the detector's.
     """
     idx = timeline.frame_index
@@ -77,27 +78,28 @@ def record(
     T_wc = T_world_cam(params)
     T_cw = np.linalg.inv(T_wc)
     K = intrinsics(params.camera)
-    detection = detection or params.detection
     t = trajectory.t[idx]
-    points = []
+    points: list[list[np.ndarray]] = [[] for _ in detections]
     for f in tqdm(range(len(idx)), desc=label, leave=False, mininterval=5):
         markers_cam = transform_points(T_cw, transform_points(T_true[f], markers_body))[~timeline.occluded[f]]
         phantoms = draw_phantoms(int(timeline.n_phantoms[f]), params.camera, params.frames, params.motion.phantom_round_fraction, rng)
         ir, depth_mm = render_frame(markers_cam, phantoms, params.camera, params.frames, MARKER_DIAMETER_M / 2, rng)
         if sink is not None:
             sink(float(t[f]), ir, depth_mm)
-        points.append(detect_markers(ir, depth_mm, K, detection, T_world_cam=T_wc))
+        for found, detection in zip(points, detections):
+            found.append(detect_markers(ir, depth_mm, K, detection, T_world_cam=T_wc))
     occlusions = [tuple(o) for o in params.motion.occlusions]
     in_occlusion = np.zeros(len(idx), dtype=bool)
     for start, duration in occlusions:
         in_occlusion |= (t >= start) & (t < start + duration)
-    return Simulation(trajectory, timeline, markers_body, t, T_true, points, in_occlusion, occlusions)
+    return [Simulation(trajectory, timeline, markers_body, t, T_true, found, in_occlusion, occlusions) for found in points]
 
 
 def simulate(params: TrackParams, rng: np.random.Generator, markers_body: np.ndarray | None = None, omega_std: float | None = None,
-             duration_s: float | None = None, detection: DetectionParams | None = None, sink=None) -> Simulation:
+             duration_s: float | None = None, detections: Sequence[DetectionParams] | None = None, sink=None) -> list[Simulation]:
     """The accuracy recording (params.motion), or motion (b), the stress test, with omega_std and no deliberate
-    occlusion when omega_std is given.  markers_body : (m, 3) geometry (default params.markers_body)."""
+    occlusion when omega_std is given.  markers_body : (m, 3) geometry (default params.markers_body).
+    One :class:`Simulation` per detector of ``detections`` (default: params.detection alone), see :func:`record`."""
     markers_body = np.array(params.markers_body) if markers_body is None else markers_body
     update = {} if duration_s is None else {"duration_s": duration_s}
     if omega_std is not None:
@@ -105,11 +107,11 @@ def simulate(params: TrackParams, rng: np.random.Generator, markers_body: np.nda
     params = params.model_copy(update={"motion": params.motion.model_copy(update=update)})
     trajectory = simulate_trajectory(params.motion, rng, omega_std=omega_std)
     timeline = sample_sensors(trajectory, len(markers_body), params.motion, rng)
-    return record(params, trajectory, timeline, markers_body, rng, detection, sink, label="stress" if omega_std else "recording")
+    return record(params, trajectory, timeline, markers_body, rng, detections or [params.detection], sink,
+                  label="stress" if omega_std else "recording")
 
 
-def simulate_hand(params: TrackParams, rng: np.random.Generator, markers_body: np.ndarray, duration_s: float,
-                  detection: DetectionParams | None = None) -> Simulation:
+def simulate_hand(params: TrackParams, rng: np.random.Generator, markers_body: np.ndarray, duration_s: float) -> Simulation:
     """Motion (a), paper-like (:class:`~poseintegrity.tracking.params.HandMotionParams`): full turns about every
     axis, large translations, brief per-marker occlusions in place of the i.i.d. P_o and the deliberate occlusion."""
     motion = params.motion.model_copy(update={"duration_s": duration_s, "p_occlusion": 0.0, "occlusions": []})
@@ -118,7 +120,7 @@ def simulate_hand(params: TrackParams, rng: np.random.Generator, markers_body: n
     timeline = sample_sensors(trajectory, len(markers_body), motion, rng)
     hidden = brief_occlusions(trajectory.t[timeline.frame_index], len(markers_body), params.hand, rng)
     timeline = replace(timeline, occluded=timeline.occluded | hidden)
-    return record(params, trajectory, timeline, markers_body, rng, detection, label="hand motion")
+    return record(params, trajectory, timeline, markers_body, rng, [params.detection], label="hand motion")[0]
 
 
 def run_no_filter(sim: Simulation, params: TrackParams) -> pd.DataFrame:

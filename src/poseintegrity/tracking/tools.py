@@ -11,13 +11,12 @@ Tool file formats (metres, body frame):
 from __future__ import annotations
 
 import json
-from itertools import combinations
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
-from poseintegrity.tracking.geometry import pairwise_distances
+from poseintegrity.tracking.geometry import tool_geometry_problem
 from poseintegrity.tracking.params import FilterParams, MatchingParams
 from poseintegrity.tracking.tracker import FrameResult, MarkerTracker
 
@@ -27,24 +26,12 @@ class ToolError(ValueError):
 
 
 def check_distinct_distances(tools: dict[str, np.ndarray], distinct_m: float) -> None:
-    """Raise :class:`ToolError` naming the two marker pairs whose distances differ by <= distinct_m (m).
-
-    tools : name -> (m, 3) metres.  Every pair of markers of every tool is compared with every other pair,
-    within a tool and across tools.
-    """
-    pairs = []
-    for name, markers in tools.items():
-        if len(markers) < 3:
-            raise ToolError(f"tool {name!r} has {len(markers)} markers; at least 3 are needed for a pose")
-        D = pairwise_distances(markers)
-        pairs += [(D[i, j], f"{name} markers {i + 1}-{j + 1}") for i, j in combinations(range(len(markers)), 2)]
-    pairs.sort()
-    for (d1, a), (d2, b) in zip(pairs, pairs[1:]):
-        if d2 - d1 <= distinct_m:
-            raise ToolError(
-                f"inter-marker distances are not distinct: {a} = {d1 * 1000:.2f} mm and {b} = {d2 * 1000:.2f} mm "
-                f"differ by <= {distinct_m * 1000:g} mm (correspondence by distance voting cannot tell them apart)"
-            )
+    """Raise :class:`ToolError` saying why the tools (name -> (m, 3) metres) cannot be told apart or posed:
+    fewer than 3 markers, markers on one line, or two inter-marker distances (within a tool or across tools)
+    within distinct_m (m) of each other (:func:`~poseintegrity.tracking.geometry.tool_geometry_problem`)."""
+    problem = tool_geometry_problem(tools, distinct_m)
+    if problem:
+        raise ToolError(problem)
 
 
 def read_tools(path: str | Path, distinct_m: float) -> dict[str, np.ndarray]:

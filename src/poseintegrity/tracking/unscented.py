@@ -8,6 +8,7 @@ A subclass decides how the covariance is carried (factor S or matrix P).
 
 from __future__ import annotations
 
+import numba
 import numpy as np
 
 from poseintegrity.tracking.kabsch import pose_from_points
@@ -30,6 +31,19 @@ def unscented_weights(N: int, alpha: float, beta: float, kappa: float) -> tuple[
     Wm[0] = lam / (N + lam)
     Wc[0] = lam / (N + lam) + 1.0 - alpha**2 + beta
     return Wm, Wc, float(np.sqrt(N + lam))
+
+
+@numba.njit(cache=True)
+def _sigma_points_kernel(x, S, gamma):  # pragma: no cover - compiled
+    """X = [x, x + gamma S, x - gamma S] (N, 2N + 1), element by element as numpy would compute it."""
+    N = x.shape[0]
+    X = np.empty((N, 2 * N + 1))
+    for i in range(N):
+        X[i, 0] = x[i] + gamma * 0.0
+        for j in range(N):
+            X[i, 1 + j] = x[i] + gamma * S[i, j]
+            X[i, 1 + N + j] = x[i] + gamma * -S[i, j]
+    return X
 
 
 class UnscentedMarkerFilter:
@@ -91,8 +105,7 @@ class UnscentedMarkerFilter:
 
     def sigma_points(self) -> np.ndarray:
         """X_{k-1} of Alg. 5: (N, 2N + 1), the state and x +/- gamma S as columns."""
-        S = self.sqrt_covariance()
-        return self.x[:, None] + self.gamma * np.hstack([np.zeros((self.N, 1)), S, -S])
+        return _sigma_points_kernel(self.x, np.ascontiguousarray(self.sqrt_covariance()), self.gamma)
 
     def predict(self, dt: float, noise_sqrt: np.ndarray | None = None) -> bool:
         """Time update over dt seconds (Alg. 5, "State Update").  Returns False if the filter diverged.
