@@ -5,7 +5,8 @@
     2. the MLP recipes (pretrain + fine-tune; scratch)      target: pretrained <= 2 s
        reference: a 500 x 500 float64 numpy matmul
     3. the whole Fig. 2 experiment at paper scale           target: <= 5 min on 2 cores
-       (21 arcs + 4 lines of synthetic eq. 1 data, k = 3 .. all, all models, n_jobs from params)
+       (21 arcs + 4 lines of synthetic eq. 1 data, k = 3 .. all, all models, on the workers of ``parallel``),
+       with the fit statuses it reports (fits.json)
 
 Usage: PYTHONPATH=src .venv/bin/python benchmarks/bench_artifact_models.py [--params params.yaml] [--skip-stage]
 """
@@ -17,13 +18,13 @@ import time
 from pathlib import Path
 
 import numpy as np
-import yaml
-from joblib import effective_n_jobs
 from scipy.optimize import curve_fit
 from scipy.stats import exponnorm
 
-from poseintegrity.artifact_models import EMG, FitParams, emg, fig2_rmse, fit_mlp, fits_metrics
+from poseintegrity.artifact_models import EMG, emg, fig2_rmse, fit_mlp, fits_metrics, status_counts
 from poseintegrity.artifact_models.synthetic import synthetic_artifacts
+from poseintegrity.config import load_section
+from poseintegrity.parallel import Workers, worker_count
 from timing import paired_medians  # benchmarks/timing.py
 
 
@@ -34,10 +35,13 @@ def report(label: str, seconds: float, reference: float, target: float | None = 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--params", type=Path, default=Path("params.yaml"), help="YAML file with a `fit` section")
+    parser.add_argument("--params", type=Path, default=Path("params.yaml"),
+                        help="params file (its fit, protocol and parallel sections)")
     parser.add_argument("--skip-stage", action="store_true", help="skip the paper-scale stage run (3)")
+    parser.add_argument("--save", type=Path, help="write the table of 3 to this parquet file")
     args = parser.parse_args()
-    params = FitParams.model_validate(yaml.safe_load(args.params.read_text())["fit"])
+    params, protocol, parallel = (load_section(args.params, s) for s in ("fit", "protocol", "parallel"))
+    theta_end = protocol.range_end("arc")
     rng = np.random.default_rng(0)
 
     theta = np.repeat(2.25 * np.arange(1, 5), 10)  # 4 stops x 10 images, deg
@@ -49,7 +53,8 @@ def main() -> None:
         curve_fit(lambda t, alpha, K, mu: alpha * exponnorm.pdf(t - mu, K), theta, n, p0=p0)
 
     print("1. EMG fit, 4 stops x 10 images")
-    reference, seconds = paired_medians(scipy_reference, lambda: EMG.fit(theta, n, params.max_nfev), 200)
+    reference, seconds = paired_medians(
+        scipy_reference, lambda: EMG.fit(theta, n, theta_end=theta_end, max_nfev=params.max_nfev), 200)
     report("reference: curve_fit(alpha * exponnorm.pdf)", reference, reference)
     report("EMG.fit (bounded trf, analytic Jacobian)", seconds, reference, 5e-3)
 
@@ -58,7 +63,7 @@ def main() -> None:
     for pretrain, target in ((True, 2.0), (False, None)):
         reference, seconds = paired_medians(
             lambda: a @ b,
-            lambda: fit_mlp(theta, n, theta_max=params.theta_max_deg, mlp=params.mlp, rng=rng, pretrain=pretrain),
+            lambda: fit_mlp(theta, n, theta_end=theta_end, mlp=params.mlp, rng=rng, pretrain=pretrain),
             7,
         )
         report("reference: 500 x 500 numpy matmul", reference, reference)
@@ -66,26 +71,32 @@ def main() -> None:
 
     if args.skip_stage:
         return
-    print(f"3. Fig. 2 experiment at paper scale (21 arcs + 4 lines, n_jobs = {params.n_jobs})")
+    workers = worker_count(parallel)
+    print(f"3. Fig. 2 experiment at paper scale (21 arcs + 4 lines, {workers} workers)")
     artifacts, _ = synthetic_artifacts(np.random.default_rng(1), n_arcs=21, n_lines=4)
     reference = paired_medians(scipy_reference, scipy_reference, 50)[0]
     # CPU seconds of one arc and one line dataset run serially: a load-independent estimate of the stage
     sample = artifacts[artifacts.dataset.isin(["arc_00", "line_00"])]
     cpu_start = time.process_time()
-    sample_table = fig2_rmse(sample, params.model_copy(update={"n_jobs": 1}), progress=False)
+    with Workers(parallel.model_copy(update={"n_jobs": 1})) as one:  # in this process, where process_time sees it
+        sample_table = fig2_rmse(sample, params, protocol, one, progress=False)
     cpu_per_fit = (time.process_time() - cpu_start) / len(sample_table)
     start = time.perf_counter()
-    table = fig2_rmse(artifacts, params, progress=False)
+    with Workers(parallel) as pool:
+        table = fig2_rmse(artifacts, params, protocol, pool, progress=False)
     seconds = time.perf_counter() - start
-    workers = effective_n_jobs(params.n_jobs)
     estimate = cpu_per_fit * len(table) / workers
     print(f"  {len(table)} fits in {seconds:.1f} s wall = {seconds / reference:.0f} x the curve_fit reference  "
           f"[{'meets' if seconds <= 300 else 'MISSES'} target 300 s]")  # fmt: skip
     print(f"  CPU-time estimate on {workers} free cores: {estimate:.0f} s "
           f"({cpu_per_fit * 1e3:.0f} ms CPU per fit, from a serial run of 2 datasets)")  # fmt: skip
-    metrics = fits_metrics(table, params)
-    print("  mean RMSE at k = 4 (arcs):", {k: round(v, 1) for k, v in metrics[f"rmse_k{params.k_report_arc}"].items()})
-    print("  converged fraction:", {k: round(v, 4) for k, v in metrics["converged"].items()})
+    metrics = fits_metrics(table, params, protocol)
+    k = protocol.stops_sampled("arc")
+    print(f"  mean RMSE at k = {k} (arcs):", {m: round(v, 1) for m, v in metrics[f"rmse_k{k}"].items()})
+    print("  fits per status (fits.json shares them):")
+    print(status_counts(table).to_string())
+    if args.save:
+        table.to_parquet(args.save, index=False)
 
 
 if __name__ == "__main__":

@@ -6,9 +6,10 @@
        (21 arcs + 4 lines of synthetic eq. 1 data x 10 images per stop, 6 PnP methods; long range,
        its lower-bound variant, MLP and next-step on the paper's path, long range + static on the others)
        reference: the same datasets' long range predictor with the per-threshold reference of 1.
+       Prints the fit statuses of the sweep's rows (predictors.json shares them).
 
 Usage: PYTHONPATH=src .venv/bin/python benchmarks/bench_prediction.py [--params params.yaml]
-(the ``fit`` and ``predict`` sections of --params)
+(the ``fit``, ``predict``, ``protocol`` and ``parallel`` sections of --params)
 """
 
 from __future__ import annotations
@@ -24,7 +25,8 @@ from poseintegrity.artifact_models import emg, fit_model
 from poseintegrity.artifact_models.series import dataset_series
 from poseintegrity.artifact_models.synthetic import synthetic_artifacts
 from poseintegrity.config import load_section
-from poseintegrity.prediction import boundaries, sweep
+from poseintegrity.parallel import Workers, worker_count
+from poseintegrity.prediction import boundaries, fit_status_shares, sweep
 from timing import paired_medians  # benchmarks/timing.py
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
@@ -36,22 +38,23 @@ METHODS = ("usac_magsac", "epnp", "p3p", "ap3p", "sqpnp", "iterative")
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--params", type=Path, default=Path("params.yaml"))
+    parser.add_argument("--save", type=Path, help="write the sweep's table to this parquet file")
     args = parser.parse_args()
-    fit = load_section(args.params, "fit")
-    predict = load_section(args.params, "predict")
+    fit, predict, protocol, parallel = (load_section(args.params, s) for s in ("fit", "predict", "protocol", "parallel"))
     n_t = predict.thresholds
+    arc_end = protocol.range_end("arc")
 
     print(f"1. theta_p for {n_t.size} thresholds from one fitted EMG")
     theta = np.repeat(2.25 * np.arange(1, 5), 10)
     rng = np.random.default_rng(0)
     n = np.maximum(np.round(emg(theta, 3000.0, 9.0, 1.0) + rng.normal(0.0, 4.0, theta.size)), 0.0)
-    fitted = fit_model("emg", theta, n, theta_max=45.0, params=fit, rng=rng)
+    fitted = fit_model("emg", theta, n, theta_end=arc_end, params=fit, rng=rng)
 
     def per_threshold() -> list:
-        return [envelope_boundary(fitted.predict, t, 2.25, 45.0, n_scan=predict.n_grid) for t in n_t]
+        return [envelope_boundary(fitted.predict, t, 2.25, arc_end, n_scan=predict.n_grid) for t in n_t]
 
     def vectorized() -> object:
-        return boundaries(fitted.predict, n_t, 2.25, 45.0, predict.n_grid)
+        return boundaries(fitted.predict, n_t, 2.25, arc_end, predict.n_grid)
 
     reference, subject = paired_medians(per_threshold, vectorized, repeats=15)
     print(f"   per-threshold envelope_boundary (reference) {reference * 1e3:8.2f} ms")
@@ -62,20 +65,25 @@ def main() -> None:
     artifacts, _ = synthetic_artifacts(np.random.default_rng(1), n_arcs=21, n_lines=4, methods=METHODS)
     start = time.perf_counter()
     for method in METHODS:
-        for series in dataset_series(artifacts, method):
-            k = predict.long_range_stops(series.trajectory)
-            model = fit_model("emg", *series.first_stops(k), theta_max=fit.range_end(series.trajectory), params=fit,
-                              rng=rng)  # fmt: skip
+        for series in dataset_series(artifacts, method, protocol):
+            k = protocol.stops_sampled(series.trajectory)
+            model = fit_model("emg", *series.first_stops(k), theta_end=series.theta_end, params=fit, rng=rng)
             first = float(np.min(series.theta))
-            [envelope_boundary(model.predict, t, first, fit.range_end(series.trajectory), predict.n_grid) for t in n_t]
+            [envelope_boundary(model.predict, t, first, series.theta_end, predict.n_grid) for t in n_t]
     reference = time.perf_counter() - start
     start = time.perf_counter()
-    table = sweep(artifacts, predict, fit, progress=False)
+    with Workers(parallel) as workers:
+        table = sweep(artifacts, predict, fit, protocol, workers, progress=False)
     seconds = time.perf_counter() - start
     verdict = "meets" if seconds <= 60.0 else "MISSES"
     print(f"   reference: long range only, per-threshold root finding {reference:7.2f} s")
-    print(f"   whole sweep ({len(table)} rows, n_jobs={predict.n_jobs})        {seconds:7.2f} s   "
+    print(f"   whole sweep ({len(table)} rows, {worker_count(parallel)} workers)     {seconds:7.2f} s   "
           f"{seconds / reference:6.2f} x reference   [{verdict} target 60 s]")  # fmt: skip
+    print("   share of rows per fit status:")
+    for predictor, entry in fit_status_shares(table).items():
+        print(f"     {predictor:<20s} " + "  ".join(f"{k} {v:.4g}" for k, v in entry.items()))
+    if args.save:
+        table.to_parquet(args.save, index=False)
 
 
 if __name__ == "__main__":

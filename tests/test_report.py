@@ -87,3 +87,23 @@ def test_metrics_file_is_valid_json_with_null_for_nan(tmp_path):
     write_metrics(path, {"a": np.float64("nan"), "b": [np.int64(3), np.bool_(True), np.inf], "c": {"d": np.float32(0.5)}})
     assert json.loads(path.read_text()) == {"a": None, "b": [3, True, None], "c": {"d": 0.5}}
     assert [p.name for p in tmp_path.iterdir()] == ["stage.json"]  # the partial file was renamed
+
+
+def test_fit_statuses_have_a_row_per_model_and_predictor():
+    """Stages 03 and 04 count flagged fits (artifact_models/fitted.py): the summary shows every status of every model
+    of Fig. 2 and of every predictor, beside the RMSE and SPL they qualify."""
+    from poseintegrity.artifact_models import FIT_STATUSES, MODEL_NAMES
+    from poseintegrity.report.summary import FIT_STATUS_LABELS, MODEL_LABELS
+
+    assert list(FIT_STATUS_LABELS) == list(FIT_STATUSES) and set(MODEL_LABELS) == set(MODEL_NAMES)
+    keys = {(h.stage, h.key) for h in HEADLINES}
+    assert {("fits", f"fit_status.{m}.{s}") for m in MODEL_NAMES for s in FIT_STATUSES} <= keys
+    assert {("predictors", f"fit_status.{p}.{s}") for p in ("long_range", "mlp", "next_step")
+            for s in FIT_STATUSES} <= keys
+    metrics = {"fits": {"fit_status": {"emg": {"ok": 0.975, "at_bound": 0.025, "non_physical": 0.0, "fallback": 0.0}}},
+               "predictors": {"fit_status": {"next_step": {"non_physical": 0.125}}, "live": {"n_flagged_fits": 2}}}
+    text = render_summary(metrics)
+    assert "| EMG (eq. 1): share of fits ok | 97.5% | - | >= 0.99 |" in text
+    assert "| ... at a bound | 2.5% | - | - |" in text
+    assert "| ... non-physical | 12.5% | - | - |" in text  # next step's rows
+    assert "| simulated live trials that went by a flagged fit | 2 | - | - |" in text

@@ -1,4 +1,4 @@
-"""The ``fit`` section schema: valid sections load, bad values raise naming the key."""
+"""The ``fit`` section schema: params.yaml validates, every bad value is refused naming its key."""
 
 from __future__ import annotations
 
@@ -6,55 +6,72 @@ import typing
 from pathlib import Path
 
 import pytest
-import yaml
 from pydantic import ValidationError
 
-from poseintegrity.artifact_models import MODEL_NAMES, FitParams
+from params_cases import refusal
+from poseintegrity.artifact_models import BASE_FUNCTIONS, MODEL_NAMES
+from poseintegrity.artifact_models.models import distinct_theta_needed
 from poseintegrity.artifact_models.params import ModelName
+from poseintegrity.config import load_params
 
 ROOT = Path(__file__).resolve().parents[2]
 
 
-def with_change(raw: dict, path: str, value: object) -> dict:
-    *parents, leaf = path.split(".")
-    node = raw
-    for key in parents:
-        node = node[key]
-    node[leaf] = value
-    return raw
-
-
 def test_paper_scale_section_validates():
-    params = FitParams.model_validate(yaml.safe_load((ROOT / "params.yaml").read_text())["fit"])
-    assert params.k_max is None
-    assert (params.mlp.hidden_layers, params.mlp.hidden_units) == (3, 10)  # Windsor et al. IV-E
-    assert params.range_end("arc") == 45.0 and params.range_end("line") == 150.0
+    fit = load_params(ROOT / "params.yaml").fit
+    assert fit.k_max is None
+    assert (fit.mlp.hidden_layers, fit.mlp.hidden_units) == (3, 10)  # Windsor et al. IV-E
 
 
 def test_schema_model_names_match_the_fitters():
     assert set(typing.get_args(ModelName)) == set(MODEL_NAMES)
 
 
-@pytest.mark.parametrize(
-    ("path", "value", "match"),
-    [
-        ("models", ["emg", "spline"], r"models\.1"),
-        ("models", ["emg", "emg"], "duplicates"),
-        ("models", [], "models"),
-        ("k_min", 1, "k_min"),
-        ("k_max", 2, "k_max"),
-        ("n_jobs", 0, "n_jobs"),
-        ("theta_max_deg", -45.0, "theta_max_deg"),
-        ("mlp.hidden_units", 0, r"mlp\.hidden_units"),
-        ("mlp.max_iter_finetune", 0, r"mlp\.max_iter_finetune"),
-        ("mlp.optimizer", "adam", r"mlp\.optimizer"),
-        ("seed", -1, "seed"),
-    ],
-)
-def test_bad_value_raises_naming_the_key(tiny_fit_raw, path, value, match):
-    FitParams.model_validate(tiny_fit_raw)  # valid before the change
-    with pytest.raises(ValidationError, match=match):
-        FitParams.model_validate(with_change(tiny_fit_raw, path, value))
+def test_stops_needed_are_the_parameter_counts():
+    assert distinct_theta_needed("emg") == 3  # alpha, K, mu of eq. 1
+    assert distinct_theta_needed("exponential") == 2
+    assert {distinct_theta_needed(name) for name in ("mlp_scratch", "mlp_pretrained")} == {2}
+    assert all(distinct_theta_needed(name) == len(base.param_names) for name, base in BASE_FUNCTIONS.items())
+
+
+# (dotted key, bad value, what the error names): each refused before any work (tests/params_cases.py)
+BAD_VALUES = [
+    ("fit.models", ["emg", "spline"], "fit.models.1"),
+    ("fit.models", ["emg", "emg"], "fit.models"),  # distinct
+    ("fit.models", [], "fit.models"),
+    ("fit.k_min", 1, "fit.k_min"),
+    ("fit.k_min", 2, "fit.k_min"),  # eq. 1 has 3 parameters: every EMG fit on 2 stops would fall back to a line
+    ("fit.k_max", 2, "fit.k_max"),  # < k_min
+    ("fit.k_max", 1000, "fit.k_max"),
+    ("fit.max_nfev", 5, "fit.max_nfev"),
+    ("fit.max_nfev", 10**7, "fit.max_nfev"),
+    ("fit.seed", -1, "fit.seed"),
+    ("fit.seed", 2**64, "fit.seed"),
+    ("fit.n_jobs", 2, "fit.n_jobs"),  # gone: parallel.n_jobs is the only worker count
+    ("fit.mlp.hidden_units", 0, "fit.mlp.hidden_units"),
+    ("fit.mlp.hidden_units", 5000, "fit.mlp.hidden_units"),
+    ("fit.mlp.hidden_layers", 11, "fit.mlp.hidden_layers"),
+    ("fit.mlp.max_iter_finetune", 0, "fit.mlp.max_iter_finetune"),
+    ("fit.mlp.max_iter_scratch", 10**6, "fit.mlp.max_iter_scratch"),
+    ("fit.mlp.tolerance_change", 0.0, "fit.mlp.tolerance_change"),
+    ("fit.mlp.tolerance_change", float("nan"), "fit.mlp.tolerance_change"),
+    ("fit.mlp.n_pretrain_points", 1, "fit.mlp.n_pretrain_points"),
+    ("fit.mlp.n_artificial", 10**4, "fit.mlp.n_artificial"),
+    ("fit.mlp.optimizer", "adam", "fit.mlp.optimizer"),
+]
+
+
+@pytest.mark.parametrize(("key", "value", "expected"), BAD_VALUES)
+def test_bad_value_is_refused_naming_its_key(tiny_raw, key, value, expected):
+    assert expected in refusal(tiny_raw, key, value)
+
+
+def test_a_model_needing_fewer_stops_allows_a_smaller_k_min(tiny_raw):
+    """k_min = 2 is refused for eq. 1 (above) but fits the exponential and the MLPs, which need 2 stops."""
+    from poseintegrity.config import parse_params
+
+    tiny_raw["fit"].update(models=["exponential", "mlp_pretrained"], k_min=2)
+    assert parse_params(tiny_raw).fit.k_min == 2
 
 
 def test_params_are_frozen(tiny_fit):

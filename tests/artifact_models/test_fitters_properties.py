@@ -1,8 +1,9 @@
 """Property tests: every fitter survives random decays, flat data, one distinct theta, NaN and negative counts.
 
-Whatever the samples, a fit returns a FittedModel whose predictions are finite, whose flag agrees with its
-reason, and which uses the fallback line exactly when it did not converge; a converged least squares fit
-is never worse than its own starting values.
+Whatever the samples, a fit returns a FittedModel whose predictions are finite, whose status agrees with its
+reason, which uses the fallback line exactly when its status is "fallback", and whose "ok" is physical over
+[first stop, range end] (no count below zero, a decay from the first stop, no absurd level); a least squares fit
+with a curve is never worse than its own starting values.
 """
 
 from __future__ import annotations
@@ -11,10 +12,11 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from poseintegrity.artifact_models import BASE_FUNCTIONS, MODEL_NAMES, fit_model
-from poseintegrity.artifact_models.fitted import valid_samples
+from poseintegrity.artifact_models import BASE_FUNCTIONS, FIT_STATUSES, MODEL_NAMES, fit_model
+from poseintegrity.artifact_models.fitted import FALLBACK, OK, valid_samples
 
-GRID = np.linspace(0.0, 45.0, 91)
+END = 45.0  # samples are drawn over an arc of 45 deg; the range end passed to every fit
+GRID = np.linspace(0.0, END, 91)
 
 
 @st.composite
@@ -51,22 +53,25 @@ def check_fitted(model, name, theta, n):
     assert model.n_samples == theta_ok.size
     prediction = model.predict(GRID)
     assert prediction.shape == GRID.shape and np.all(np.isfinite(prediction))
-    assert model.converged == (model.reason == "ok")
-    if not model.converged:
+    assert model.status in FIT_STATUSES and (model.status == OK) == (model.reason == "ok")
+    if model.status == FALLBACK:
         np.testing.assert_array_equal(prediction, model.fallback.predict(GRID))
     if np.unique(theta_ok).size < 2:
-        assert not model.converged and ("distinct" in model.reason or "no valid" in model.reason)
+        assert model.status == FALLBACK and ("distinct" in model.reason or "no valid" in model.reason)
+    if model.status == OK:  # physical from the first sample to the range end, at the grid points of the check
+        f = model.predict(np.linspace(theta_ok.min(), END, 181))
+        assert f.min() >= -0.5 and (f[-1] < f[0] or f.max() < 0.5)
     return theta_ok, n_ok
 
 
 @settings(deadline=None, max_examples=50)
 @given(data=samples())
-def test_base_function_fits_never_raise_and_flag_failures(data):
+def test_base_function_fits_never_raise_and_flag_failures(tiny_fit, data):
     theta, n = data
     for name, base in BASE_FUNCTIONS.items():
-        model = base.fit(theta, n, max_nfev=400)
+        model = base.fit(theta, n, theta_end=END, max_nfev=tiny_fit.max_nfev)
         theta_ok, n_ok = check_fitted(model, name, theta, n)
-        if model.converged:  # least squares never ends worse than where it started
+        if model.has_curve:  # least squares never ends worse than where it started
             p0 = base.initial_guess(theta_ok, n_ok)[0]
             sse_fit = np.sum((model.predict(theta_ok) - n_ok) ** 2)
             sse_start = np.sum((base.f(theta_ok, *p0) - n_ok) ** 2)
@@ -75,10 +80,10 @@ def test_base_function_fits_never_raise_and_flag_failures(data):
 
 @settings(deadline=None, max_examples=15)
 @given(data=samples())
-def test_mlp_fits_never_raise_and_flag_failures(tiny_fit_mlp_only, data):
+def test_mlp_fits_never_raise_and_flag_failures(tiny_fit, data):
     theta, n = data
     for name in ("mlp_scratch", "mlp_pretrained"):
-        model = fit_model(name, theta, n, theta_max=45.0, params=tiny_fit_mlp_only, rng=np.random.default_rng(0))
+        model = fit_model(name, theta, n, theta_end=END, params=tiny_fit, rng=np.random.default_rng(0))
         check_fitted(model, name, theta, n)
 
 
@@ -86,4 +91,4 @@ def test_every_model_name_dispatches(tiny_fit):
     theta = np.repeat(2.25 * np.arange(1, 5), 5)
     n = 300.0 * np.exp(-theta / 10.0)
     for name in MODEL_NAMES:
-        assert fit_model(name, theta, n, theta_max=45.0, params=tiny_fit, rng=np.random.default_rng(0)).name == name
+        assert fit_model(name, theta, n, theta_end=END, params=tiny_fit, rng=np.random.default_rng(0)).name == name

@@ -1,36 +1,24 @@
-"""Fixtures of the predictor tests: tiny ``predict`` and ``fit`` sections and synthetic stage-02 tables."""
+"""Fixtures of the predictor tests: the sections of tests/params_tiny.yaml and synthetic stage-02 tables."""
 
 from __future__ import annotations
 
-import copy
 import sys
 from pathlib import Path
 
 import pytest
 
-from poseintegrity.artifact_models import FitParams
-from poseintegrity.prediction import PredictParams
+from artifact_models.tiny import protocol, tiny, tiny_fit, workers  # noqa: F401 (fixtures)
 
 sys.path.insert(0, str(Path(__file__).parent))
-from pred_synthetic import TINY_FIT, TINY_PREDICT, scene_tables  # noqa: E402
-
-
-@pytest.fixture
-def tiny_predict_raw() -> dict:
-    return copy.deepcopy(TINY_PREDICT)
+from pred_synthetic import scene_tables  # noqa: E402
 
 
 @pytest.fixture(scope="session")
-def tiny_predict() -> PredictParams:
-    return PredictParams.model_validate(TINY_PREDICT)
+def tiny_predict(tiny):
+    return tiny.predict
 
 
 @pytest.fixture(scope="session")
-def tiny_fit() -> FitParams:
-    return FitParams.model_validate(TINY_FIT)
-
-
-@pytest.fixture(scope="session")
-def tables():
+def tables(protocol):
     """(artifacts, envelopes): 6 arc datasets over 3 scenes, 2 line datasets, 2 PnP methods."""
-    return scene_tables()
+    return scene_tables(protocol)

@@ -1,12 +1,18 @@
-"""Leave-one-scene-out threshold choice on a table with known answers; the ``predict`` schema rejects bad values."""
+"""Leave-one-scene-out threshold choice on a table with known answers; the ``predict`` schema refuses bad values."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
+import numpy as np
 import pandas as pd
 import pytest
-from pydantic import ValidationError
 
-from poseintegrity.prediction import PredictParams, loso_folds, loso_summary, scene_of
+from params_cases import refusal
+from poseintegrity.config import load_params
+from poseintegrity.prediction import loso_folds, loso_summary, pooled, scene_of
+
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def test_scene_of_dataset_ids():
@@ -15,7 +21,7 @@ def test_scene_of_dataset_ids():
     assert scene_of("other") == "other"
 
 
-def test_loso_chooses_on_other_scenes_and_scores_the_held_out_one():
+def _folds() -> pd.DataFrame:
     # scenes a, b are safe at n_t = 10 (theta_p 5 < theta_a 6); scene c needs n_t = 20 (theta_p 3 < theta_a 4)
     rows = []
     for scene, theta_a in (("a", 6.0), ("b", 6.0), ("c", 4.0)):
@@ -23,31 +29,77 @@ def test_loso_chooses_on_other_scenes_and_scores_the_held_out_one():
             rows.append(dict(predictor="long_range", method="m", trajectory="arc", tolerance="t",
                              dataset=f"{scene}_arc0", operating_point=n_t, theta_p=theta_p, theta_a=theta_a,
                              spl=min(theta_p, theta_a), incursion=float(theta_p > theta_a)))  # fmt: skip
-    folds = loso_folds(pd.DataFrame(rows), 0.0, conservative_high=True)
+    return loso_folds(pd.DataFrame(rows), 0.0, conservative_high=True)
+
+
+def test_loso_chooses_on_other_scenes_and_scores_the_held_out_one():
+    folds = _folds()
     assert dict(zip(folds.scene, folds.operating_point, strict=True)) == {"a": 20.0, "b": 20.0, "c": 10.0}
     assert list(folds.heldout_incursions) == [0.0, 0.0, 1.0]  # the threshold from a, b is unsafe on c
     summary = loso_summary(folds, 0.0)["long_range"]["t"]
     assert summary["heldout_incursion_rate"] == pytest.approx(1 / 3)
     assert summary["heldout_mean_spl"] == pytest.approx((3.0 + 3.0 + 4.0) / 3)
+    assert summary["thresholds"] == {"a": 20.0, "b": 20.0, "c": 10.0} and summary["n_infeasible_folds"] == 0
 
 
-def test_params_thresholds_and_sizes(tiny_predict):
-    assert tiny_predict.thresholds[0] == 4 and tiny_predict.thresholds[-1] == 100 and tiny_predict.thresholds.size == 97
-    assert tiny_predict.static_sizes("line")[-1] == 150.0 and tiny_predict.long_range_stops("line") == 5
+def test_pooled_is_what_the_summary_reports_and_survives_empty_folds():
+    folds = _folds()
+    row = pooled(folds).iloc[0]
+    assert (row.predictor, row.tolerance, row.target_rate, row.heldout_n) == ("long_range", "t", 0.0, 3)
+    assert row.heldout_incursion_rate == pytest.approx(1 / 3) and row.heldout_mean_spl == pytest.approx(10 / 3)
+    empty = pooled(folds.assign(heldout_n=0, heldout_incursions=0.0, heldout_spl_sum=0.0)).iloc[0]
+    assert np.isnan(empty.heldout_incursion_rate) and np.isnan(empty.heldout_mean_spl)  # no held-out data: no rate
 
 
-@pytest.mark.parametrize(
-    ("key", "value", "message"),
-    [
-        ("n_t_max", 3, "n_t_max"),
-        ("n_t_min", 0, "n_t_min"),
-        ("models", {"long_range": "spline", "next_step": "emg", "mlp": "mlp_pretrained"}, "models.long_range"),
-        ("loso_target_rates", [1.5], "loso_target_rates"),
-        ("uncertainty", {"method": "covariance", "level": 1.0, "n_bootstrap": 5}, "uncertainty.level"),
-        ("unknown_key", 1, "unknown_key"),
-    ],
-)
-def test_bad_values_raise_naming_the_key(tiny_predict_raw, key, value, message):
-    tiny_predict_raw[key] = value
-    with pytest.raises(ValidationError, match=message):
-        PredictParams.model_validate(tiny_predict_raw)
+def test_paper_scale_thresholds_and_sizes():
+    params = load_params(ROOT / "params.yaml")
+    predict, protocol = params.predict, params.protocol
+    np.testing.assert_array_equal(predict.thresholds, np.arange(4.0, 101.0))  # IV-A: n_t from 4 to 100
+    assert predict.static_sizes(protocol.range_end("line"))[-1] == 150.0
+    relative = predict.relative_thresholds
+    assert (relative[0], relative[-1]) == (predict.relative_min, predict.relative_max)  # both ends on the grid
+
+
+# (dotted key, bad value, what the error names): each refused before any work (tests/params_cases.py)
+BAD_VALUES = [
+    ("predict.n_t_max", 3, "predict.n_t_max"),  # < n_t_min
+    ("predict.n_t_min", 0, "predict.n_t_min"),
+    ("predict.n_t_max", 10**6, "predict.n_t_max"),
+    ("predict.live_n_t", 200, "predict.live_n_t"),  # not a swept threshold: the live trials would be empty
+    ("predict.live_n_t", 2, "predict.live_n_t"),
+    ("predict.relative_min", 0.6, "predict.relative_max"),  # relative_min > relative_max
+    ("predict.relative_step", 0.07, "predict.relative_step"),  # 0.02 .. 0.5 is not whole steps of 0.07
+    ("predict.relative_max", 1.5, "predict.relative_max"),
+    ("predict.n_static", 1, "predict.n_static"),
+    ("predict.n_grid", 8, "predict.n_grid"),
+    ("predict.models.long_range", "spline", "predict.models.long_range"),
+    ("predict.loso_target_rates", [1.5], "predict.loso_target_rates.0"),
+    ("predict.loso_target_rates", [0.0, -0.1], "predict.loso_target_rates.1"),
+    ("predict.loso_target_rates", [0.0, 0.0], "predict.loso_target_rates"),  # distinct
+    ("predict.loso_target_rates", [], "predict.loso_target_rates"),
+    ("predict.uncertainty.level", 1.0, "predict.uncertainty.level"),
+    ("predict.uncertainty.n_bootstrap", 1, "predict.uncertainty.n_bootstrap"),
+    ("predict.seed", -1, "predict.seed"),
+    ("predict.n_jobs", 2, "predict.n_jobs"),  # gone: parallel.n_jobs is the only worker count
+    ("predict.unknown_key", 1, "predict.unknown_key"),
+]
+
+
+@pytest.mark.parametrize(("key", "value", "expected"), BAD_VALUES)
+def test_bad_value_is_refused_naming_its_key(tiny_raw, key, value, expected):
+    assert expected in refusal(tiny_raw, key, value)
+
+
+def test_covariance_intervals_need_a_least_squares_long_range_model(tiny_raw):
+    tiny_raw["predict"]["uncertainty"]["method"] = "bootstrap"  # any model: valid with the MLP below
+    tiny_raw["predict"]["models"]["long_range"] = "mlp_pretrained"
+    assert "predict.uncertainty.method" in refusal(tiny_raw, "predict.uncertainty.method", "covariance")
+
+
+def test_a_model_needing_more_stops_than_sampled_is_refused(tiny_raw):
+    """With 2 sampled stops on arcs, eq. 1 (3 parameters) could never be fitted by the long range predictor."""
+    tiny_raw["protocol"]["sampled_stops"]["arc"] = 2
+    tiny_raw["fit"].update(models=["exponential", "mlp_pretrained"], k_min=2)  # 2-parameter models only
+    tiny_raw["predict"]["models"].update(long_range="exponential", next_step="exponential")
+    assert "predict.models.long_range" in refusal(tiny_raw, "predict.models.long_range", "emg")
+    assert "predict.models.next_step" in refusal(tiny_raw, "predict.models.next_step", "gaussian")

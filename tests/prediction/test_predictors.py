@@ -7,18 +7,24 @@ import pytest
 from scipy.optimize import brentq
 
 from poseintegrity.artifact_models.base_functions import emg
+from poseintegrity.artifact_models.fitted import OK, worst
 from poseintegrity.artifact_models.series import Series
-from poseintegrity.prediction import NextStepSupervisor, long_range, next_step, static_baseline
+from poseintegrity.prediction import NO_FIT, NextStepSupervisor, long_range, next_step, static_baseline
 
 ALPHA, K, MU = 3000.0, 8.0, -1.0  # exact eq. 1: ~290 inliers at the first stop, 18 at 45 deg
-THETA_STOPS = 2.25 * np.arange(20)  # IV-D: from the model view
+THETA_STOPS = 2.25 * np.arange(20)  # IV-D: from the model view, up to the arc's range end of 45 deg
 N_T = np.arange(4.0, 101.0)
 
 
 def exact_series(n_inliers=None, n_stops: int = 20, images: int = 3) -> Series:
     theta = np.repeat(THETA_STOPS[:n_stops], images)
     counts = emg(theta, ALPHA, K, MU) if n_inliers is None else n_inliers
-    return Series("scene_1_arc000", "arc", np.repeat(np.arange(n_stops), images), theta, np.asarray(counts, float))
+    return Series("scene_1_arc000", "arc", np.repeat(np.arange(n_stops), images), theta, np.asarray(counts, float),
+                  theta_end=45.0)  # fmt: skip
+
+
+def test_the_test_arcs_end_where_the_protocol_ends_them(protocol):
+    assert exact_series().theta_end == protocol.range_end("arc")
 
 
 def true_crossing(n_t: float) -> float:
@@ -27,7 +33,7 @@ def true_crossing(n_t: float) -> float:
 
 def test_long_range_on_an_exact_emg_finds_the_true_crossing(tiny_fit):
     answer = long_range(exact_series(), 4, "emg", N_T, tiny_fit, np.random.default_rng(0), 256)
-    assert answer.fitted.converged
+    assert answer.fitted.status == OK
     root = answer.prediction.status == "root"
     assert root.sum() > 50
     expected = [true_crossing(n) for n in N_T[root]]
@@ -54,6 +60,7 @@ def test_too_few_stops_or_all_nan_counts_are_flagged_not_raised(series, tiny_fit
     assert set(answer.prediction.status) == {"too_few_stops"} and np.all(np.isnan(answer.prediction.theta_p))
     step = next_step(series, 4, "emg", N_T, tiny_fit, 0, "usac_magsac", 256)
     assert set(step.prediction.status) == {"too_few_stops"} and step.n_fits == 0
+    assert set(step.fit_status) == {NO_FIT}
 
 
 def test_next_step_stops_where_the_supervisor_does(tiny_fit):
@@ -62,8 +69,8 @@ def test_next_step_stops_where_the_supervisor_does(tiny_fit):
     assert set(step.prediction.status) <= {"stopped", "end_of_path"}
     assert np.all(np.diff(step.prediction.theta_p) <= 0.0)  # a larger n_t never lets the robot further
     for index in (0, 20, 60):
-        supervisor = NextStepSupervisor(n_t=N_T[index], theta_b=2.25, theta_end=45.0, fit=tiny_fit,
-                                        rng=np.random.default_rng(0))  # fmt: skip
+        supervisor = NextStepSupervisor(n_t=N_T[index], theta_b=2.25, theta_end=series.theta_end, fit=tiny_fit,
+                                        rng=np.random.default_rng(0), model="emg", first_stops=4, n_grid=256)  # fmt: skip
         stopped_at = THETA_STOPS[-1]
         for theta in THETA_STOPS:
             decision = supervisor.update(theta, emg(np.full(3, theta), ALPHA, K, MU))
@@ -77,12 +84,30 @@ def test_next_step_stops_where_the_supervisor_does(tiny_fit):
 
 def test_next_step_on_exact_data_stops_at_the_last_stop_before_the_true_crossing(tiny_fit):
     step = next_step(exact_series(), 4, "emg", N_T, tiny_fit, 0, "usac_magsac", 256)
-    assert step.n_failed == 0 and set(step.prediction.theta_p[step.prediction.status == "stopped"]) <= set(THETA_STOPS)
+    assert set(step.fit_status) == {OK} and set(step.prediction.theta_p[step.prediction.status == "stopped"]) <= set(
+        THETA_STOPS)
     for n_t, stop, status in zip(N_T, step.prediction.theta_p, step.prediction.status, strict=True):
         crossing = true_crossing(n_t) if emg(np.array([45.0]), ALPHA, K, MU)[0] < n_t else np.inf
         if status == "stopped" and crossing > THETA_STOPS[3]:
             # the robot stands at the last stop from which the next step would cross the boundary
             assert stop <= crossing + 1e-3 and crossing <= stop + 2.25 + 1e-3
+
+
+def test_next_step_rows_carry_the_worst_fit_the_robot_went_by(tiny_fit):
+    """Counts that decay over the 4 sampled stops, then rise again: the later fits (on more of the rise) are flagged,
+    and each row carries the most severe status among the fits made up to the one that stopped the robot."""
+    counts = np.where(THETA_STOPS < 7.0, 300.0 - 30.0 * THETA_STOPS, 97.5 + 10.0 * (THETA_STOPS - 6.75))
+    series = exact_series(np.repeat(counts, 3))
+    n_t = np.array([250.0, 60.0, 10.0])
+    step = next_step(series, 4, "emg", n_t, tiny_fit, 0, "usac_magsac", 256)
+    statuses = [long_range(series, k, "emg", n_t, tiny_fit, np.random.default_rng(0), 256).fitted.status
+                for k in range(4, THETA_STOPS.size + 1)]  # the fit on the first k stops  # fmt: skip
+    assert statuses[0] == OK and statuses[-1] != OK  # a decay, then no decay any more
+    for theta_p, status, fit_status in zip(step.prediction.theta_p, step.prediction.status, step.fit_status,
+                                           strict=True):  # fmt: skip
+        last_fit = int(np.flatnonzero(THETA_STOPS == theta_p)[0]) + 1 if status == "stopped" else THETA_STOPS.size
+        assert fit_status == worst(statuses[: last_fit - 3])
+    assert step.prediction.status[0] == "stopped" and step.fit_status[0] == OK  # n_t = 250: stopped by the first fit
 
 
 def test_static_baseline_is_the_size_for_every_dataset():

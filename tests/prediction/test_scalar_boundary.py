@@ -50,9 +50,9 @@ def test_empty_range_is_a_programming_error():
         envelope_boundary(lambda t: t, 1.0, 10.0, 10.0)
 
 
-def test_boundary_of_a_fitted_emg_model():
+def test_boundary_of_a_fitted_emg_model(tiny_fit):
     theta = np.repeat(2.25 * np.arange(1, 5), 10)  # the long range predictor's 4 stops
-    model = EMG.fit(theta, emg(theta, 3000.0, 8.0, 1.0))
+    model = EMG.fit(theta, emg(theta, 3000.0, 8.0, 1.0), theta_end=45.0, max_nfev=tiny_fit.max_nfev)
     boundary = envelope_boundary(model.predict, 15.0, 0.0, 45.0)
     assert boundary.status == "root"
     assert model.predict(np.array([boundary.theta_p]))[0] == pytest.approx(15.0, abs=1e-6)

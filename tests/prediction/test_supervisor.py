@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 from poseintegrity.artifact_models.base_functions import emg
-from poseintegrity.prediction import NextStepSupervisor, UncertaintyParams
+from poseintegrity.artifact_models.fitted import FIT_STATUSES
+from poseintegrity.prediction import NO_FIT, NextStepSupervisor
 
 STOPS = 2.25 * np.arange(20)  # IV-D: the first stop is the model view
 
@@ -16,13 +17,21 @@ def counts(theta: float, seed: int = 0) -> np.ndarray:
     return np.maximum(emg(np.full(4, theta), 3000.0, 8.0, -1.0) + rng.normal(0.0, 5.0, 4), 0.0)
 
 
-def make(tiny_fit, **kwargs) -> NextStepSupervisor:
-    return NextStepSupervisor(n_t=30.0, theta_b=2.25, theta_end=45.0, fit=tiny_fit, rng=np.random.default_rng(0),
-                              **kwargs)  # fmt: skip
+def make(tiny, **kwargs) -> NextStepSupervisor:
+    return NextStepSupervisor.from_params(tiny, "arc", n_t=30.0, theta_b=2.25, rng=np.random.default_rng(0), **kwargs)
 
 
-def test_bad_input_raises_with_a_clear_message(tiny_fit):
-    supervisor = make(tiny_fit)
+def test_the_supervisor_of_the_params(tiny):
+    supervisor = make(tiny)
+    assert (supervisor.theta_end, supervisor.first_stops) == (tiny.protocol.range_end("arc"),
+                                                              tiny.protocol.stops_sampled("arc"))  # fmt: skip
+    assert (supervisor.model, supervisor.n_grid) == (tiny.predict.models.next_step, tiny.predict.n_grid)
+    assert supervisor.fit == tiny.fit and supervisor.uncertainty is None
+    assert make(tiny, with_interval=True).uncertainty == tiny.predict.uncertainty
+
+
+def test_bad_input_raises_with_a_clear_message(tiny):
+    supervisor = make(tiny)
     with pytest.raises(ValueError, match="theta must be finite"):
         supervisor.update(float("nan"), 100.0)
     with pytest.raises(ValueError, match="n_inliers must be finite"):
@@ -31,16 +40,19 @@ def test_bad_input_raises_with_a_clear_message(tiny_fit):
     with pytest.raises(ValueError, match="theta must not decrease"):
         supervisor.update(2.25, 100.0)
     with pytest.raises(ValueError, match="needs an uncertainty method"):
-        make(tiny_fit, stop_on_lower_bound=True)
+        NextStepSupervisor(n_t=30.0, theta_b=2.25, theta_end=45.0, fit=tiny.fit, rng=np.random.default_rng(0),
+                           model="emg", first_stops=4, n_grid=64, stop_on_lower_bound=True)  # fmt: skip
 
 
-def test_collects_first_then_stops_before_the_envelope_edge(tiny_fit):
-    supervisor = make(tiny_fit)
-    decisions = [supervisor.update(theta, counts(theta)) for theta in STOPS[:3]]
+def test_collects_first_then_stops_before_the_envelope_edge(tiny):
+    supervisor = make(tiny)
+    first = tiny.protocol.stops_sampled("arc")
+    decisions = [supervisor.update(theta, counts(theta)) for theta in STOPS[: first - 1]]
     assert all(d.proceed and d.status == "collecting" and np.isnan(d.theta_p) for d in decisions)
-    for theta in STOPS[3:]:
+    assert {d.fit_status for d in decisions} == {NO_FIT}
+    for theta in STOPS[first - 1:]:
         decision = supervisor.update(theta, counts(theta))
-        assert np.isfinite(decision.theta_p)
+        assert np.isfinite(decision.theta_p) and decision.fit_status in FIT_STATUSES
         if not decision.proceed:
             assert decision.theta_p < theta + 2.25  # III-E's stop rule
             break
@@ -48,15 +60,14 @@ def test_collects_first_then_stops_before_the_envelope_edge(tiny_fit):
         pytest.fail("the supervisor never stopped although the counts fall below n_t = 30 near 27 deg")
 
 
-def test_stopping_on_the_lower_bound_is_never_later(tiny_fit):
+def test_stopping_on_the_lower_bound_is_never_later(tiny):
     def stop_angle(**kwargs) -> float:
-        supervisor = make(tiny_fit, **kwargs)
+        supervisor = make(tiny, **kwargs)
         for theta in STOPS:
             decision = supervisor.update(theta, counts(theta, seed=3))
             if not decision.proceed:
                 return theta
         return STOPS[-1]
 
-    uncertainty = UncertaintyParams(method="covariance", level=0.9, n_bootstrap=2)
-    plain = stop_angle(uncertainty=uncertainty)
-    assert stop_angle(uncertainty=uncertainty, stop_on_lower_bound=True) <= plain
+    plain = stop_angle(with_interval=True)
+    assert stop_angle(stop_on_lower_bound=True) <= plain

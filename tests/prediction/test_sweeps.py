@@ -1,4 +1,5 @@
-"""The whole operating-point sweep on synthetic stage-02 tables: shape, invariants, bad datasets, metrics keys."""
+"""The whole operating-point sweep on synthetic stage-02 tables: shape, invariants, fit statuses, bad datasets,
+metrics keys, and the same answers on any number of workers."""
 
 from __future__ import annotations
 
@@ -8,27 +9,33 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from poseintegrity.report.metrics import json_ready
+from poseintegrity.artifact_models import FIT_STATUSES
+from poseintegrity.artifact_models.series import dataset_series
+from poseintegrity.parallel import Workers
 from poseintegrity.prediction import (
+    FITTED_PREDICTORS,
+    NO_FIT,
     PAPER_PREDICTORS,
     attach_envelopes,
     best_table,
+    fit_status_shares,
     headline_metrics,
     live_trials,
     long_range,
     loso,
     operating_curves,
     sweep,
+    with_pnp_variants,
 )
-
-TOLERANCES = ("2mm_3deg", "4mm_10deg")
+from poseintegrity.prediction.predictors import fit_rng
+from poseintegrity.report.metrics import json_ready
 
 
 @pytest.fixture(scope="module")
-def swept(tables, tiny_predict, tiny_fit):
+def swept(tables, tiny_predict, tiny_fit, protocol, workers):
     artifacts, envelopes = tables
-    theta_p = sweep(artifacts, tiny_predict, tiny_fit, progress=False)
-    table = attach_envelopes(theta_p, envelopes)
+    theta_p = sweep(artifacts, tiny_predict, tiny_fit, protocol, workers, progress=False)
+    table = attach_envelopes(theta_p, envelopes, protocol)
     return theta_p, table, operating_curves(table)
 
 
@@ -38,29 +45,54 @@ def test_every_predictor_every_dataset_every_operating_point(swept, tables, tiny
     paper = counts.loc["usac_magsac"]
     assert set(paper.columns) == {"static", "long_range", "long_range_lower", "mlp", "next_step",
                                   "long_range_relative", "next_step_relative"}
-    assert (paper[["long_range", "long_range_lower", "mlp", "next_step"]] == 97).all().all()
+    assert (paper[["long_range", "long_range_lower", "mlp", "next_step"]] == tiny_predict.thresholds.size).all().all()
     relative = tiny_predict.relative_thresholds
-    assert relative[0] == 0.02 and relative[-1] == 0.5  # 0.02 .. 0.5 in steps of 0.04: both ends on the grid
+    assert (relative[0], relative[-1]) == (tiny_predict.relative_min, tiny_predict.relative_max)
     assert (paper[["long_range_relative", "next_step_relative"]] == relative.size).all().all()
     assert (paper["static"] == tiny_predict.n_static).all()
     assert counts.loc["epnp"][["mlp", "next_step", "long_range_relative"]].isna().all().all()  # Fig. 6: long range
     assert len(paper) == tables[0]["dataset"].nunique()
 
 
-def test_relative_thresholds_are_fractions_of_the_first_stop_mean(swept, tables, tiny_predict, tiny_fit):
+def test_relative_thresholds_are_fractions_of_the_first_stop_mean(swept, tables, tiny_predict, tiny_fit, protocol):
     """long_range_relative at fraction r is the long range predictor at n_t = r x (mean n_i of the first stop)."""
-    from poseintegrity.artifact_models.series import dataset_series
-    from poseintegrity.prediction.predictors import fit_rng
-
     theta_p, _, _ = swept
-    series = next(s for s in dataset_series(tables[0], "usac_magsac") if s.dataset == "scene_2_arc01")
+    series = next(s for s in dataset_series(tables[0], "usac_magsac", protocol) if s.dataset == "scene_2_arc01")
     first_mean = series.n_inliers[series.stop == 0].mean()
-    k = tiny_predict.long_range_stops_arc
+    k = protocol.stops_sampled("arc")
     fractions = tiny_predict.relative_thresholds
-    direct = long_range(series, k, "emg", fractions * first_mean, tiny_fit,
-                        fit_rng(tiny_predict.seed, "usac_magsac", series, k), tiny_predict.n_grid)
+    direct = long_range(series, k, tiny_predict.models.long_range, fractions * first_mean, tiny_fit,
+                        fit_rng(tiny_predict.seed, "usac_magsac", series, k), tiny_predict.n_grid)  # fmt: skip
     rows = theta_p[(theta_p.dataset == "scene_2_arc01") & (theta_p.predictor == "long_range_relative")]
     np.testing.assert_allclose(rows.sort_values("operating_point")["theta_p"], direct.prediction.theta_p)
+    assert set(rows.fit_status) == {direct.fitted.status} and set(rows.reason) == {direct.fitted.reason}
+
+
+def test_every_row_says_what_its_fit_was_worth(swept, tables, tiny_predict, tiny_fit, protocol):
+    theta_p, _, _ = swept
+    assert set(theta_p.fit_status) <= {*FIT_STATUSES, NO_FIT}
+    assert set(theta_p[theta_p.predictor == "static"].fit_status) == {NO_FIT}
+    for series in dataset_series(tables[0], "usac_magsac", protocol):  # the long range and MLP rows: their one fit
+        k = protocol.stops_sampled(series.trajectory)
+        for predictor, model in (("long_range", tiny_predict.models.long_range), ("mlp", tiny_predict.models.mlp)):
+            fitted = long_range(series, k, model, tiny_predict.thresholds, tiny_fit,
+                                fit_rng(tiny_predict.seed, "usac_magsac", series, k), tiny_predict.n_grid).fitted
+            rows = theta_p[(theta_p.dataset == series.dataset) & (theta_p.predictor == predictor)
+                           & (theta_p.method == "usac_magsac")]  # fmt: skip
+            assert set(rows.fit_status) == {fitted.status} and set(rows.reason) == {fitted.reason}
+    flagged = theta_p[theta_p.fit_status.isin(["at_bound", "non_physical"])]
+    assert flagged.theta_p.notna().all()  # a flagged fit's theta_p counts: the robot would have acted on it
+
+
+def test_fit_status_shares_count_rows_once_per_tolerance_set(swept):
+    theta_p, table, _ = swept
+    shares = fit_status_shares(table)
+    assert set(shares) == set(FITTED_PREDICTORS)
+    for predictor, entry in shares.items():
+        rows = theta_p[theta_p.predictor == predictor]
+        assert entry["n_rows"] == len(rows)  # not once per tolerance joined
+        for status in (*FIT_STATUSES, NO_FIT):
+            assert entry[status] == pytest.approx((rows.fit_status == status).mean())
 
 
 def test_spl_and_incursions_obey_eq_3_and_4(swept):
@@ -78,16 +110,15 @@ def test_incursion_rate_never_grows_with_n_t_for_the_long_range_predictor(swept)
         assert np.all(np.diff(rates) <= 1e-12)
 
 
-def test_headline_metrics_have_the_issue_keys_and_are_json(swept, tiny_predict):
+def test_headline_metrics_have_the_issue_keys_and_are_json(swept, tiny_predict, protocol):
     _, table, curves = swept
-    folds = loso(table, tiny_predict.loso_target_rates, PAPER_PREDICTORS, tiny_predict.pnp_method)
+    folds = loso(table, tiny_predict.loso_target_rates, PAPER_PREDICTORS, protocol.pnp_method)
     best = best_table(curves)
-    static = best[(best.predictor == "static") & (best.trajectory == "arc") & (best.method == "usac_magsac")
-                  & (best.tolerance == tiny_predict.live_tolerance)].best_operating_point.iloc[0]  # fmt: skip
-    live = live_trials(table, tiny_predict, static)
-    metrics = json.loads(json.dumps(json_ready(headline_metrics(table, curves, folds, live, tiny_predict)), allow_nan=False))
+    live = live_trials(table, best, tiny_predict, protocol)
+    metrics = json.loads(json.dumps(json_ready(headline_metrics(table, curves, folds, live, tiny_predict, protocol)),
+                                    allow_nan=False))  # fmt: skip
     for predictor in PAPER_PREDICTORS:
-        for tolerance in TOLERANCES:
+        for tolerance in protocol.tolerance_names:
             assert {"max_mean_spl_zero_incursion", "best_n_t"} <= set(metrics[predictor][tolerance])
             if predictor != "static":
                 assert {"heldout_incursion_rate", "heldout_mean_spl"} <= set(metrics["loso"][predictor][tolerance])
@@ -96,12 +127,24 @@ def test_headline_metrics_have_the_issue_keys_and_are_json(swept, tiny_predict):
     assert all("max_mean_spl_zero_incursion" in entry for entry in metrics["pnp"].values())
     assert metrics["live"]["n_trials"] == 6 and len(live) == 6
     ours = table[(table.predictor == "next_step") & (table.operating_point == tiny_predict.live_n_t)
-                 & (table.tolerance == tiny_predict.live_tolerance) & (table.method == "usac_magsac")
+                 & (table.tolerance == tiny_predict.live_tolerance) & (table.method == protocol.pnp_method)
                  & (table.trajectory == "arc")]  # fmt: skip
     assert metrics["live"]["incursions"] == ours["incursion"].sum()
+    assert metrics["live"]["n_flagged_fits"] == int((ours.fit_status != "ok").sum())
+    assert set(metrics["fit_status"]) == set(FITTED_PREDICTORS)
 
 
-def test_bad_datasets_become_flagged_rows(tables, tiny_predict, tiny_fit):
+def test_live_trials_run_the_static_baseline_at_its_best_size(swept, tiny_predict, protocol):
+    _, table, curves = swept
+    best = best_table(curves)
+    live = live_trials(table, best, tiny_predict, protocol)
+    size = best[(best.predictor == "static") & (best.trajectory == "arc") & (best.method == protocol.pnp_method)
+                & (best.tolerance == tiny_predict.live_tolerance)].best_operating_point.item()  # fmt: skip
+    assert (live.static_size == size).all() and live.static_incursion.sum() == 0  # its zero-incursion size
+    np.testing.assert_allclose(live.static_share, np.minimum(size, live.theta_a) / live.theta_a)
+
+
+def test_bad_datasets_become_flagged_rows(tables, tiny_predict, tiny_fit, protocol, workers):
     artifacts, envelopes = tables
     one = artifacts[(artifacts.dataset == "scene_1_arc00") & (artifacts.method == "usac_magsac")]
     short = one[one.stop < 3].assign(dataset="scene_4_arc00")  # 3 stops: too few for the long range predictor
@@ -109,18 +152,59 @@ def test_bad_datasets_become_flagged_rows(tables, tiny_predict, tiny_fit):
     bad = pd.concat([short, blank], ignore_index=True)
     bad_envelopes = pd.concat([envelopes[(envelopes.dataset == "scene_1_arc00") & (envelopes.method == "usac_magsac")]
                                .assign(dataset=name) for name in ("scene_4_arc00", "scene_5_arc00")])  # fmt: skip
-    table = attach_envelopes(sweep(bad, tiny_predict, tiny_fit, progress=False), bad_envelopes)
+    table = attach_envelopes(sweep(bad, tiny_predict, tiny_fit, protocol, workers, progress=False), bad_envelopes,
+                             protocol)
     fitted = table[table.predictor != "static"]
     assert set(fitted.status) == {"too_few_stops"} and fitted["theta_p"].isna().all()
+    assert set(fitted.fit_status) == {NO_FIT}
     curves = operating_curves(table)
     assert (curves[curves.predictor == "long_range"]["n_flagged"] == 2).all()
 
 
-def test_a_dataset_gets_the_same_answers_alone_as_in_the_whole_sweep(swept, tables, tiny_predict, tiny_fit):
-    # every fit draws from a Generator seeded by (seed, method, dataset, k): the sweep is the same for any
-    # n_jobs and order of work, and a dataset's rows do not depend on the others (the MLP draws random weights)
+def test_a_dataset_gets_the_same_answers_alone_as_in_the_whole_sweep(swept, tables, tiny_predict, tiny_fit, protocol,
+                                                                     workers):  # fmt: skip
+    # every fit draws from a Generator seeded by (seed, method, dataset, k): a dataset's rows do not depend on the
+    # others nor on the order of work (the MLP draws random weights)
     theta_p, _, _ = swept
     artifacts = tables[0]
-    alone = sweep(artifacts[artifacts.dataset == "scene_2_arc01"], tiny_predict, tiny_fit, progress=False)
+    alone = sweep(artifacts[artifacts.dataset == "scene_2_arc01"], tiny_predict, tiny_fit, protocol, workers,
+                  progress=False)  # fmt: skip
     whole = theta_p[theta_p.dataset == "scene_2_arc01"].reset_index(drop=True)
     pd.testing.assert_frame_equal(alone, whole)
+
+
+def test_two_worker_processes_give_the_same_table(swept, tables, tiny, tiny_predict, tiny_fit, protocol):
+    """The one parallel layer (parallel.py): local processes return what the in-process run returns, to the bit."""
+    theta_p, _, _ = swept
+    two_datasets = tables[0][tables[0].dataset.isin(["scene_1_arc00", "scene_2_line01"])]
+    with Workers(tiny.parallel.model_copy(update={"n_jobs": 2})) as two:  # variation: two worker processes
+        apart = sweep(two_datasets, tiny_predict, tiny_fit, protocol, two, progress=False)
+    whole = theta_p[theta_p.dataset.isin(["scene_1_arc00", "scene_2_line01"])].reset_index(drop=True)
+    pd.testing.assert_frame_equal(apart, whole)
+
+
+def test_pnp_variants_add_methods_without_replacing_stage_02s(tables):
+    artifacts, envelopes = tables
+    usac, usac_envelopes = artifacts[artifacts.method == "usac_magsac"], envelopes[envelopes.method == "usac_magsac"]
+    variants = pd.concat([usac.assign(method="sqpnp"), usac.assign(n_inliers=-1.0)])  # usac rows: stage 02's stay
+    merged, merged_envelopes = with_pnp_variants(artifacts, envelopes, variants,
+                                                 pd.concat([usac_envelopes.assign(method="sqpnp"), usac_envelopes]))
+    assert set(merged.method) == {"usac_magsac", "epnp", "sqpnp"} and (merged.n_inliers >= 0).all()
+    assert len(merged) == len(artifacts) * 3 // 2
+    assert len(merged_envelopes) == len(envelopes) * 3 // 2
+
+
+# Envelopes checked on read: (how the table is spoiled, what the error says)
+BAD_ENVELOPES = [
+    (lambda e: e.drop(columns="censored"), r"lacks columns \['censored'\]"),
+    (lambda e: e.assign(tolerance=e.tolerance.replace("4mm_10deg", "5mm_10deg")), "another protocol"),
+    (lambda e: e[e.tolerance == "2mm_3deg"], "another protocol"),  # a tolerance of the protocol has no envelope
+    (lambda e: e.assign(theta_a=e.theta_a + 200.0), "outside"),
+]
+
+
+@pytest.mark.parametrize(("spoil", "message"), BAD_ENVELOPES)
+def test_envelopes_that_do_not_fit_the_protocol_are_refused(swept, tables, protocol, spoil, message):
+    theta_p, _, _ = swept
+    with pytest.raises(ValueError, match=message):
+        attach_envelopes(theta_p, spoil(tables[1]), protocol)

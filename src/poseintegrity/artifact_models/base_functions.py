@@ -13,30 +13,29 @@ Starting values and bounds are derived from the samples (see :class:`DecaySummar
 a decay length tau0 from a log-linear fit of the per-theta mean counts sets every scale parameter,
 bounds are multiples of the sampled span, and the amplitude starts at its linear least squares
 value given the starting shape. All theta units are those of the data (deg for arcs, mm for lines).
+A fit whose parameters end at a bound is flagged "at_bound" (fitted.py): the samples wanted a curve outside them.
 """
 
 from __future__ import annotations
 
-import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import OptimizeWarning, curve_fit
+from scipy.optimize import least_squares
 from scipy.special import erfc, erfcx
 
 from poseintegrity.artifact_models.fitted import (
-    OK,
-    FallbackLine,
+    LARGEST_LEVEL,
     FittedModel,
     line_fit,
+    per_theta_means,
     too_few_samples,
     valid_samples,
 )
 
 K_MIN = 0.05  # lower bound of the EMG shape K: exponnorm misbehaves as K -> 0 (docs/references.md, "SciPy")
 LONGEST_DECAY = 20.0  # longest decay length (K, tau, s) a fit may choose, in sampled spans
-LARGEST_LEVEL = 10.0  # largest amplitude (a level, in counts) a fit may choose, in largest mean counts
 
 
 def emg_pdf(x: np.ndarray, K: np.ndarray | float) -> np.ndarray:
@@ -64,7 +63,7 @@ def emg(theta: np.ndarray, alpha: float, K: float, mu: float) -> np.ndarray:
 
 
 def emg_jacobian(theta: np.ndarray, alpha: float, K: float, mu: float) -> np.ndarray:
-    """d eq.(1) / d(alpha, K, mu) : (m, 3), for curve_fit (the EMG fit has a speed target).
+    """d eq.(1) / d(alpha, K, mu) : (m, 3), for the least squares fit (the EMG fit has a speed target).
 
     With x = theta - mu, g = exponnorm.pdf(x, K) and phi the standard normal pdf,
     exp(1/(2K^2) - x/K) phi(x - 1/K) = phi(x), hence dg/dx = (phi - g) / K and
@@ -126,8 +125,7 @@ class DecaySummary:
 
     @classmethod
     def from_samples(cls, theta: np.ndarray, n_inliers: np.ndarray) -> DecaySummary:
-        theta_u, index = np.unique(theta, return_inverse=True)
-        mean_n = np.bincount(index, weights=n_inliers) / np.bincount(index)
+        theta_u, mean_n = per_theta_means(theta, n_inliers)
         t0, t1 = float(theta_u[0]), float(theta_u[-1])
         span = t1 - t0
         slope = line_fit(theta_u, np.log1p(mean_n))[1]
@@ -185,7 +183,7 @@ def _start_power_law(s: DecaySummary) -> tuple[list[float], list[float], list[fl
 
 @dataclass(frozen=True)
 class BaseCurve:
-    """A base function with its parameters bound: callable theta (m,) -> (m,) (picklable for joblib)."""
+    """A base function with its parameters bound: callable theta (m,) -> (m,) (picklable for the workers)."""
 
     f: Callable[..., np.ndarray]
     p: tuple[float, ...]
@@ -218,39 +216,41 @@ class BaseFunction:
         a0 = float(np.dot(g, n_inliers)) / gg if gg > 0 and np.isfinite(gg) else float(n_inliers.max())
         return np.array([np.clip(a0, lower[0], upper[0]), *shape0]), lower, upper
 
-    def fit(self, theta: np.ndarray, n_inliers: np.ndarray, max_nfev: int = 400) -> FittedModel:
-        """Fit by scipy.optimize.curve_fit (trf, bounded). Never raises on bad data.
+    def fit(self, theta: np.ndarray, n_inliers: np.ndarray, *, theta_end: float, max_nfev: int) -> FittedModel:
+        """Fit by bounded non-linear least squares (trf), as scipy.optimize.curve_fit does. Never raises on bad data.
 
         theta : (m,) float, deg or mm;  n_inliers : (m,) counts (NaN and negative samples are dropped)
-        Returns a converged :class:`FittedModel`, or a flagged one (reason given) that predicts with the
-        fallback line when there are too few distinct theta, the optimizer fails, or the fit is non-finite.
+        theta_end : end of the range (deg or mm), up to which the fitted curve is checked (fitted.py)
+        max_nfev : evaluation budget of the optimizer (``fit.max_nfev``)
+        Returns a :class:`FittedModel` whose status says whether the fit is "ok", "at_bound" (a parameter ended at a
+        bound: scipy.optimize.least_squares' ``active_mask``), "non_physical", or "fallback" (too few distinct
+        theta, the optimizer failed, or a non-finite curve).
         """
         theta, n_inliers = valid_samples(theta, n_inliers)
         reason = too_few_samples(theta, len(self.param_names))
         if reason is not None:
             return FittedModel.failed(self.name, self.param_names, reason, theta, n_inliers)
-        with np.errstate(all="ignore"), warnings.catch_warnings():
-            warnings.simplefilter("ignore", OptimizeWarning)  # the covariance is not used
+        # curve_fit(method="trf") is this least_squares call (same residuals, Jacobian and options, hence the same
+        # parameters); called directly for its active_mask, which curve_fit does not return
+        jac = (lambda p: self.jac(theta, *p)) if self.jac else "2-point"
+        with np.errstate(all="ignore"):
             try:
                 p0, lower, upper = self.initial_guess(theta, n_inliers)
-                popt, _ = curve_fit(
-                    self.f, theta, n_inliers, p0=p0, bounds=(lower, upper), method="trf",
-                    jac=self.jac or "2-point", x_scale="jac", max_nfev=max_nfev,
+                result = least_squares(
+                    lambda p: self.f(theta, *p) - n_inliers, p0, jac=jac, bounds=(lower, upper), method="trf",
+                    x_scale="jac", max_nfev=max_nfev,
                 )  # fmt: skip
-            except (RuntimeError, ValueError, np.linalg.LinAlgError) as error:  # e.g. max_nfev exceeded
-                return FittedModel.failed(self.name, self.param_names, f"curve_fit: {error}", theta, n_inliers)
-            curve = BaseCurve(self.f, tuple(float(v) for v in popt))
-            if not np.all(np.isfinite(curve(theta))):
-                return FittedModel.failed(self.name, self.param_names, "non-finite fit", theta, n_inliers)
-        return FittedModel(
-            name=self.name,
-            params=dict(zip(self.param_names, curve.p, strict=True)),
-            converged=True,
-            reason=OK,
-            n_samples=int(theta.size),
-            curve=curve,
-            fallback=FallbackLine.fit(theta, n_inliers),
-        )
+            except (ValueError, np.linalg.LinAlgError) as error:  # e.g. residuals not finite at p0
+                return FittedModel.failed(self.name, self.param_names, f"least squares: {error}", theta, n_inliers)
+            if not result.success:  # e.g. max_nfev exceeded
+                return FittedModel.failed(self.name, self.param_names, f"least squares: {result.message}", theta,
+                                          n_inliers)  # fmt: skip
+            curve = BaseCurve(self.f, tuple(float(v) for v in result.x))
+            at_bound = [f"{name} = {value:.4g} ({'lower' if side < 0 else 'upper'})"
+                        for name, value, side in zip(self.param_names, curve.p, result.active_mask, strict=True)
+                        if side != 0]  # fmt: skip
+            return FittedModel.checked(self.name, dict(zip(self.param_names, curve.p, strict=True)), curve, theta,
+                                       n_inliers, theta_end, at_bound)  # fmt: skip
 
 
 EMG = BaseFunction("emg", ("alpha", "K", "mu"), emg, _start_emg, emg_jacobian)

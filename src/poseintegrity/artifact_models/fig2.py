@@ -11,35 +11,34 @@ Input: the artifacts table of stage 02, one row per image and PnP method, with a
 from __future__ import annotations
 
 import zlib
+from functools import partial
 
 import numpy as np
 import pandas as pd
-from joblib import Parallel, delayed
-from tqdm import tqdm
 
-from poseintegrity.artifact_models.fitted import FittedModel
+from poseintegrity.artifact_models.fitted import FIT_STATUSES, OK, FittedModel
 from poseintegrity.artifact_models.models import fit_model
 from poseintegrity.artifact_models.params import FitParams
 from poseintegrity.artifact_models.series import Series, dataset_series
+from poseintegrity.parallel import Workers
 from poseintegrity.protocol import ProtocolParams
 
-COLUMNS = ["trajectory", "dataset", "k", "model", "rmse", "converged", "reason", "n_samples"]  # of fig2_rmse
+COLUMNS = ["trajectory", "dataset", "k", "model", "rmse", "status", "reason", "n_samples"]  # of fig2_rmse
 
 
 def fit_first_stops(series: Series, k: int, params: FitParams) -> dict[str, FittedModel]:
-    """Every model of ``params.models`` fitted to the first k stops of ``series``.
+    """Every model of ``params.models`` fitted to the first k stops of ``series``, checked up to its range end.
 
     Each fit draws from ``np.random.default_rng([seed, crc32(trajectory/dataset), k, crc32(model)])``:
-    the same for any n_jobs, any order of work, any other datasets in the table and any other models.
+    the same for any number of workers, any order of work, any other datasets in the table and any other models.
     """
     theta, n_inliers = series.first_stops(k)
     key = [params.seed, _crc32(f"{series.trajectory}/{series.dataset}"), k]
     return {
-        name: fit_model(
-            name, theta, n_inliers, theta_max=series.theta_end, params=params, rng=np.random.default_rng([*key, _crc32(name)])
-        )
+        name: fit_model(name, theta, n_inliers, theta_end=series.theta_end, params=params,
+                        rng=np.random.default_rng([*key, _crc32(name)]))
         for name in params.models
-    }
+    }  # fmt: skip
 
 
 def _crc32(text: str) -> int:
@@ -52,7 +51,9 @@ def rmse(model: FittedModel, theta: np.ndarray, n_inliers: np.ndarray) -> float:
     return float(np.sqrt(np.mean((model.predict(theta[keep]) - n_inliers[keep]) ** 2)))
 
 
-def _fig2_rows(series: Series, k: int, params: FitParams) -> list[dict]:
+def _fig2_rows(task: tuple[Series, int], params: FitParams) -> list[dict]:
+    """The rows of one (dataset, k) task: one per model."""
+    series, k = task
     return [
         {
             "trajectory": series.trajectory,
@@ -60,7 +61,7 @@ def _fig2_rows(series: Series, k: int, params: FitParams) -> list[dict]:
             "k": k,
             "model": name,
             "rmse": rmse(model, series.theta, series.n_inliers),
-            "converged": model.converged,
+            "status": model.status,
             "reason": model.reason,
             "n_samples": model.n_samples,
         }
@@ -68,12 +69,15 @@ def _fig2_rows(series: Series, k: int, params: FitParams) -> list[dict]:
     ]
 
 
-def fig2_rmse(artifacts: pd.DataFrame, params: FitParams, protocol: ProtocolParams, progress: bool = True) -> pd.DataFrame:
+def fig2_rmse(
+    artifacts: pd.DataFrame, params: FitParams, protocol: ProtocolParams, workers: Workers, progress: bool = True
+) -> pd.DataFrame:
     """The Fig. 2 experiment on the ``protocol.pnp_method`` rows: one row per (trajectory, dataset, k, model).
 
-    Columns: trajectory, dataset, k, model, rmse (inliers, over every image of the dataset), converged,
-    reason ("ok" or why the fit failed; the RMSE is then that of the fallback line), n_samples.
-    Runs on ``params.n_jobs`` joblib workers. Raises ValueError when no dataset has k_min stops.
+    Columns: trajectory, dataset, k, model, rmse (inliers, over every image of the dataset), status ("ok",
+    "at_bound", "non_physical" or "fallback", artifact_models/fitted.py), reason ("ok" or what was found; a
+    "fallback" fit is scored with its fallback line, every other with its fitted curve: what a predictor would
+    use), n_samples. One task per (dataset, k) on ``workers``. Raises ValueError when no dataset has k_min stops.
     """
     all_series = dataset_series(artifacts, protocol.pnp_method, protocol)
     tasks = [
@@ -84,41 +88,60 @@ def fig2_rmse(artifacts: pd.DataFrame, params: FitParams, protocol: ProtocolPara
     if not tasks:
         most = max(series.n_stops for series in all_series)
         raise ValueError(f"no dataset has k_min = {params.k_min} stops (the longest has {most}): lower fit.k_min")
-    results = Parallel(n_jobs=params.n_jobs, return_as="generator")(
-        delayed(_fig2_rows)(series, k, params) for series, k in tasks
-    )
-    rows = [row for result in tqdm(results, total=len(tasks), disable=not progress) for row in result]
-    return pd.DataFrame(rows, columns=COLUMNS)
+    results = workers.map(partial(_fig2_rows, params=params), tasks, desc="Fig. 2 fits (dataset, k)",
+                          progress=progress)  # fmt: skip
+    return pd.DataFrame([row for rows in results for row in rows], columns=COLUMNS)
 
 
 def mean_rmse(table: pd.DataFrame) -> pd.DataFrame:
-    """Fig. 2's curves: per (trajectory, model, k) the mean RMSE across datasets and the converged fraction."""
+    """Fig. 2's curves: per (trajectory, model, k) the mean RMSE across datasets and the share of fits "ok"."""
     return (
-        table.groupby(["trajectory", "model", "k"], sort=True)
-        .agg(mean_rmse=("rmse", "mean"), converged=("converged", "mean"), n_datasets=("dataset", "nunique"))
+        table.assign(ok=table["status"] == OK)
+        .groupby(["trajectory", "model", "k"], sort=True)
+        .agg(mean_rmse=("rmse", "mean"), share_ok=("ok", "mean"), n_datasets=("dataset", "nunique"))
         .reset_index()
     )
 
 
-def fits_metrics(table: pd.DataFrame, params: FitParams, protocol: ProtocolParams) -> dict[str, dict[str, float]]:
+def at_sampled_stops(means: pd.DataFrame, protocol: ProtocolParams) -> pd.DataFrame:
+    """The rows of :func:`mean_rmse` at k = the stops a robot samples on their trajectory type (protocol)."""
+    sampled = means["trajectory"].map(protocol.stops_sampled)
+    return means[means["k"] == sampled]
+
+
+def status_counts(table: pd.DataFrame) -> pd.DataFrame:
+    """Fits per model and status: index model, columns :data:`FIT_STATUSES` (counts) and n_fits."""
+    counts = pd.crosstab(table["model"], table["status"]).reindex(columns=list(FIT_STATUSES), fill_value=0)
+    return counts.assign(n_fits=counts.sum(axis=1))
+
+
+def fits_metrics(table: pd.DataFrame, params: FitParams, protocol: ProtocolParams) -> dict[str, dict]:
     """Headline figures of stage 03 for ``reports/metrics/fits.json``, at the stops a robot samples
     (``protocol.sampled_stops``: k = 4 on arcs, 5 on lines in the paper).
 
     rmse_k<arc stops>.<model> : mean RMSE across arc datasets at k = sampled arc stops
     line_rmse_k<line stops>.<model> : the same for line datasets
-    converged.<model> : fraction of all fits (every dataset, every k) that converged
+    fit_status.<model>.{ok, at_bound, non_physical, fallback} : share of all the model's fits (every dataset, every
+        k) with that status;  n_fits.<model> : how many fits
     Every model of ``params.models`` has every key; the value is None where there was no fit (e.g. no
     dataset with that many stops).
     """
-    means = mean_rmse(table)
-    converged = table.groupby("model")["converged"].mean()
+    at_k = at_sampled_stops(mean_rmse(table), protocol)
+    counts = status_counts(table)
 
-    def at(trajectory: str, k: int) -> dict[str, float | None]:
-        rows = means[(means["trajectory"] == trajectory) & (means["k"] == k)].set_index("model")["mean_rmse"]
+    def at(trajectory: str) -> dict[str, float | None]:
+        rows = at_k[at_k["trajectory"] == trajectory].set_index("model")["mean_rmse"]
         return {m: float(rows[m]) if m in rows.index else None for m in params.models}
 
+    def shares(model: str) -> dict[str, float] | None:
+        if model not in counts.index:
+            return None
+        row = counts.loc[model]
+        return {status: float(row[status] / row["n_fits"]) for status in FIT_STATUSES}
+
     return {
-        f"rmse_k{protocol.sampled_stops.arc}": at("arc", protocol.sampled_stops.arc),
-        f"line_rmse_k{protocol.sampled_stops.line}": at("line", protocol.sampled_stops.line),
-        "converged": {m: float(converged[m]) if m in converged.index else None for m in params.models},
+        f"rmse_k{protocol.stops_sampled('arc')}": at("arc"),
+        f"line_rmse_k{protocol.stops_sampled('line')}": at("line"),
+        "fit_status": {m: shares(m) for m in params.models},
+        "n_fits": {m: int(counts.loc[m, "n_fits"]) if m in counts.index else 0 for m in params.models},
     }

@@ -1,9 +1,22 @@
 """What every artifact-model fitter returns: a fitted model f: theta -> n_inliers, its status, a fallback.
 
 Windsor et al. III-D fit the artifact model thousands of times unattended (every dataset, every k, every
-step of the next-step predictor), so a fit never raises: it returns a :class:`FittedModel` whose
-``converged`` flag and ``reason`` say what happened and whose ``predict`` then falls back to a straight
-line through the samples (clipped at zero inliers), which exists for any data.
+step of the next-step predictor), so a fit never raises: it returns a :class:`FittedModel` whose ``status``
+and ``reason`` say what happened. Statuses, from the most to the least severe (:data:`FIT_STATUSES`):
+
+    "fallback"      the fit could not be done (too few distinct theta, optimizer error, non-finite curve):
+                    ``predict`` uses a straight line through the samples (clipped at zero inliers) instead
+    "non_physical"  the fitted curve, evaluated over [first stop, range end], predicts a count that rounds below
+                    zero, does not fall from the first stop to the range end (a decay is what the artifact
+                    model stands for, III-D), or exceeds LARGEST_LEVEL times the largest mean count sampled
+    "at_bound"      a least squares parameter ended at one of its bounds (base_functions.DecaySummary): the data
+                    wanted a curve outside the family allowed, e.g. a decay longer than 20 sampled spans
+    "ok"            none of these
+
+Only "fallback" changes what ``predict`` returns. A fit at a bound or a non-physical one still predicts with its
+fitted curve: that is what the predictor of III-E would act on (it has no other curve), so its theta_p counts in
+the SPL / R_i sweeps as the robot would really have moved; the tables carry the status beside every row and the
+metrics count them (fits.json, predictors.json), so that no such fit is ever reported as a clean one.
 """
 
 from __future__ import annotations
@@ -13,7 +26,17 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-OK = "ok"
+OK, AT_BOUND, NON_PHYSICAL, FALLBACK = "ok", "at_bound", "non_physical", "fallback"
+FIT_STATUSES = (OK, AT_BOUND, NON_PHYSICAL, FALLBACK)  # least to most severe
+LARGEST_LEVEL = 10.0  # largest count level a model may predict or a level parameter take, in largest mean counts
+NEGATIVE_COUNT = -0.5  # a prediction below this rounds to a negative inlier count
+ONE_INLIER = 0.5  # a prediction from this on rounds to at least one inlier
+CHECK_POINTS = 181  # grid of the physical check over [first stop, range end] (0.25 deg steps over a 45 deg arc)
+
+
+def worst(statuses) -> str:
+    """The most severe of some fit statuses (:data:`FIT_STATUSES` order); "ok" for none."""
+    return FIT_STATUSES[max((FIT_STATUSES.index(s) for s in statuses), default=0)]
 
 
 def valid_samples(theta: np.ndarray, n_inliers: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -48,6 +71,57 @@ def too_few_samples(theta: np.ndarray, n_distinct_needed: int) -> str | None:
     return None
 
 
+def per_theta_means(theta: np.ndarray, n_inliers: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(distinct theta, mean count at each) of valid samples : (s,), (s,), theta increasing."""
+    theta_u, index = np.unique(theta, return_inverse=True)
+    return theta_u, np.bincount(index, weights=n_inliers) / np.bincount(index)
+
+
+def largest_mean_count(theta: np.ndarray, n_inliers: np.ndarray) -> float:
+    """The largest per-theta mean count of valid samples, at least 1: the scale of a dataset's counts."""
+    return max(float(per_theta_means(theta, n_inliers)[1].max()), 1.0) if theta.size else 1.0
+
+
+def check_grid(theta: np.ndarray, theta_end: float) -> np.ndarray:
+    """The points of the physical check: [first sampled theta, theta_end] : (CHECK_POINTS,) (the first sample alone
+    when it lies at or past the range end)."""
+    first = float(np.min(theta))
+    return np.linspace(first, theta_end, CHECK_POINTS) if theta_end > first else np.array([first])
+
+
+def non_finite(curve: Callable[[np.ndarray], np.ndarray], theta: np.ndarray, grid: np.ndarray) -> str | None:
+    """Why ``curve`` cannot be used (a non-finite value at a sample or on the check grid); None if it can."""
+    for where, points in (("a sample", theta), ("the range", grid)):
+        with np.errstate(all="ignore"):
+            finite = np.all(np.isfinite(curve(points)))
+        if not finite:
+            return f"non-finite prediction at {where}"
+    return None
+
+
+def physical_problems(curve: Callable[[np.ndarray], np.ndarray], grid: np.ndarray, n_max: float) -> list[str]:
+    """What makes a finite fitted curve non-physical over ``grid`` (first stop .. range end); [] if nothing.
+
+    A count that rounds below zero (< NEGATIVE_COUNT); a curve that does not fall from the first stop to the range
+    end while it predicts at least one inlier somewhere (III-D: n_i decays with the viewing angle; a curve at zero
+    everywhere is a physical answer); a count above LARGEST_LEVEL x n_max, the largest per-theta mean count sampled
+    (the cap on the levels of the base functions, base_functions.DecaySummary).
+    """
+    f = curve(grid)
+    problems = []
+    low = int(np.argmin(f))
+    if f[low] < NEGATIVE_COUNT:
+        problems.append(f"negative count {f[low]:.3g} at theta {grid[low]:.4g}")
+    if grid.size > 1 and f.max() >= ONE_INLIER and f[-1] >= f[0]:
+        problems.append(f"no decay: {f[-1]:.4g} inliers at the range end {grid[-1]:.4g} >= {f[0]:.4g} at the first "
+                        f"stop {grid[0]:.4g}")
+    high = int(np.argmax(f))
+    if f[high] > LARGEST_LEVEL * n_max:
+        problems.append(f"count {f[high]:.3g} at theta {grid[high]:.4g} > {LARGEST_LEVEL:g} x the largest mean "
+                        f"count sampled ({n_max:.4g})")
+    return problems
+
+
 @dataclass(frozen=True)
 class FallbackLine:
     """n = max(0, intercept + slope * theta): least squares line through the valid samples.
@@ -79,38 +153,73 @@ class FittedModel:
 
     name : which model ("emg", "exponential", ..., "mlp_pretrained")
     params : fitted parameters by name (base functions) or training summary (MLP); nan when not fitted
-    converged : True when the fit succeeded; otherwise ``predict`` uses ``fallback``
-    reason : "ok" or why the fit failed (too few samples, optimizer message, non-finite output, ...)
+    status : one of :data:`FIT_STATUSES` (module docstring); ``predict`` uses ``fallback`` when it is "fallback"
+    reason : "ok" or every problem found, e.g. "at bound: K = 135 (upper); no decay: ..."
     n_samples : valid samples the fit used
-    curve : the fitted f, theta (m,) -> (m,); only meaningful when converged
-    fallback : the straight line used when the fit failed
+    curve : the fitted f, theta (m,) -> (m,); the fallback line's when the fit could not be done
+    fallback : the straight line used when the fit could not be done
     """
 
     name: str
     params: Mapping[str, float]
-    converged: bool
+    status: str
     reason: str
     n_samples: int
     curve: Callable[[np.ndarray], np.ndarray] = field(repr=False)
     fallback: FallbackLine
 
+    def __post_init__(self) -> None:
+        if self.status not in FIT_STATUSES:
+            raise ValueError(f"unknown fit status {self.status!r}; expected one of {FIT_STATUSES}")
+
+    @property
+    def has_curve(self) -> bool:
+        """True when ``predict`` uses the fitted curve (any status but "fallback")."""
+        return self.status != FALLBACK
+
     def predict(self, theta: np.ndarray) -> np.ndarray:
-        """Predicted inlier count at theta : (m,) float -> (m,) float (the fallback if not converged)."""
+        """Predicted inlier count at theta : (m,) float -> (m,) float (the fallback line for a "fallback" fit)."""
         theta = np.atleast_1d(np.asarray(theta, dtype=float))
-        return self.curve(theta) if self.converged else self.fallback.predict(theta)
+        return self.curve(theta) if self.has_curve else self.fallback.predict(theta)
 
     @classmethod
     def failed(
         cls, name: str, param_names: tuple[str, ...], reason: str, theta: np.ndarray, n_inliers: np.ndarray
     ) -> FittedModel:
-        """The flagged result of a fit that could not be done or did not converge."""
+        """The flagged result of a fit that could not be done: status "fallback"."""
         fallback = FallbackLine.fit(theta, n_inliers)
         return cls(
             name=name,
             params={key: float("nan") for key in param_names},
-            converged=False,
+            status=FALLBACK,
             reason=reason,
             n_samples=int(theta.size),
             curve=fallback.predict,
             fallback=fallback,
+        )
+
+    @classmethod
+    def checked(
+        cls, name: str, params: Mapping[str, float], curve: Callable[[np.ndarray], np.ndarray], theta: np.ndarray,
+        n_inliers: np.ndarray, theta_end: float, at_bound: list[str] = (),
+    ) -> FittedModel:  # fmt: skip
+        """A fitted curve with its status: "fallback" if it is non-finite at a sample or over [first stop,
+        theta_end], else "non_physical" / "at_bound" / "ok" (module docstring). ``at_bound`` : the parameters
+        that ended at a bound, e.g. ["K = 135 (upper)"]. theta, n_inliers : (m,) the valid samples fitted."""
+        grid = check_grid(theta, theta_end)
+        broken = non_finite(curve, theta, grid)
+        if broken is not None:
+            return cls.failed(name, tuple(params), broken, theta, n_inliers)
+        with np.errstate(all="ignore"):
+            problems = physical_problems(curve, grid, largest_mean_count(theta, n_inliers))
+        bounds = [f"at bound: {', '.join(at_bound)}"] if at_bound else []
+        status = NON_PHYSICAL if problems else AT_BOUND if at_bound else OK
+        return cls(
+            name=name,
+            params=dict(params),
+            status=status,
+            reason="; ".join([*problems, *bounds]) or OK,
+            n_samples=int(theta.size),
+            curve=curve,
+            fallback=FallbackLine.fit(theta, n_inliers),
         )

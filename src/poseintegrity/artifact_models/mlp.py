@@ -3,7 +3,7 @@
     scratch     trained on the samples only (the paper: "failed to generalize beyond the training range")
     pretrained  first trained on the EMG curve of the least squares starting values (eq. 1 with the p0
                 of :data:`poseintegrity.artifact_models.base_functions.EMG`), then fine-tuned on the samples
-                plus artificial points (theta_max, 0), e.g. (45 deg, 0) for arcs
+                plus artificial points (theta_end, 0), e.g. (45 deg, 0) for arcs
 
 The paper publishes no training details (docs/references.md, "Camera of the Windsor et al. experiments"); ours, all in params.yaml ``fit.mlp``: inputs scaled to
 u = 2 theta / theta_max - 1 in [-1, 1], outputs to y = n / max(n); float64; full batch; L-BFGS with a strong
@@ -23,10 +23,11 @@ from torch import nn
 from torch.nn.utils import skip_init
 
 from poseintegrity.artifact_models.base_functions import EMG
-from poseintegrity.artifact_models.fitted import OK, FallbackLine, FittedModel, too_few_samples, valid_samples
+from poseintegrity.artifact_models.fitted import FittedModel, too_few_samples, valid_samples
 from poseintegrity.artifact_models.params import MLPParams
 
 PARAM_NAMES = ("loss", "evaluations")  # FittedModel.params of an MLP: final scaled MSE, loss evaluations
+DISTINCT_THETA = 2  # distinct theta both recipes need (the EMG starting curve of the pretraining needs 2)
 
 
 def mlp_network(hidden_layers: int, hidden_units: int, generator: torch.Generator) -> nn.Sequential:
@@ -96,7 +97,7 @@ def fit_mlp(
     theta: np.ndarray,
     n_inliers: np.ndarray,
     *,
-    theta_max: float,
+    theta_end: float,
     mlp: MLPParams,
     rng: np.random.Generator,
     pretrain: bool,
@@ -104,50 +105,44 @@ def fit_mlp(
     """Train the MLP artifact model by the paper's recipe (``pretrain=True``) or from scratch. Never raises.
 
     theta : (m,) float, deg or mm;  n_inliers : (m,) counts (NaN and negative samples are dropped)
-    theta_max : end of the range (deg or mm): input scaling, pretraining grid, artificial points (theta_max, 0)
+    theta_end : end of the range (deg or mm): input scaling, pretraining grid, artificial points (theta_end, 0)
     rng : draws the seed of the initial weights (same rng state -> bit-identical model)
-    ``converged`` means that training ended with a finite loss and output (the short fine-tune always
-    uses its whole iteration budget). Fails (flagged, fallback line) with fewer than 2 distinct theta
-    (the EMG starting curve needs 2; the scratch recipe uses the same rule so that both recipes see the
-    same data) or a non-finite loss.
+    The status (fitted.py) is "fallback" with fewer than DISTINCT_THETA distinct theta (the EMG starting curve
+    needs 2; the scratch recipe uses the same rule so that both recipes see the same data) or a non-finite loss
+    or output, "non_physical" when the trained net predicts a negative count, no decay or an absurd level over
+    [first stop, theta_end], else "ok". A finite loss alone says nothing: the short fine-tune always uses its
+    whole iteration budget, and a net from scratch that fits 4 stops may predict -5e10 inliers at 45 deg.
     """
     name = "mlp_pretrained" if pretrain else "mlp_scratch"
     theta, n_inliers = valid_samples(theta, n_inliers)
-    reason = too_few_samples(theta, 2)
+    reason = too_few_samples(theta, DISTINCT_THETA)
     if reason is not None:
         return FittedModel.failed(name, PARAM_NAMES, reason, theta, n_inliers)
     torch.use_deterministic_algorithms(True)
-    torch.set_num_threads(1)  # a 10-neuron net is fastest on one thread; joblib gives the parallelism
+    torch.set_num_threads(1)  # a 10-neuron net is fastest on one thread; the worker processes give the parallelism
     generator = torch.Generator().manual_seed(int(rng.integers(0, 2**63 - 1)))
     curve = MLPCurve(
         mlp_network(mlp.hidden_layers, mlp.hidden_units, generator),
-        theta_max=float(theta_max),
+        theta_max=float(theta_end),
         n_scale=max(float(n_inliers.max()), 1.0),
     )
     evaluations, theta_train, n_train, max_iter = 0, theta, n_inliers, mlp.max_iter_scratch
     if pretrain:  # III-D: first fit the EMG curve of the least squares starting values
-        theta_grid = np.linspace(0.0, theta_max, mlp.n_pretrain_points)
+        theta_grid = np.linspace(0.0, theta_end, mlp.n_pretrain_points)
         emg_start = EMG.f(theta_grid, *EMG.initial_guess(theta, n_inliers)[0])
         _, evaluations = train_lbfgs(
             curve.net, curve.u(theta_grid), torch.as_tensor(emg_start / curve.n_scale).reshape(-1, 1),
             mlp.max_iter_pretrain, mlp.tolerance_change,
         )  # fmt: skip
-        # ... then fine-tune on the samples plus artificial points (theta_max, 0)
-        theta_train = np.concatenate([theta, np.full(mlp.n_artificial, theta_max)])
+        # ... then fine-tune on the samples plus artificial points (theta_end, 0)
+        theta_train = np.concatenate([theta, np.full(mlp.n_artificial, theta_end)])
         n_train = np.concatenate([n_inliers, np.zeros(mlp.n_artificial)])
         max_iter = mlp.max_iter_finetune
     loss, finetune_evaluations = train_lbfgs(
         curve.net, curve.u(theta_train), torch.as_tensor(n_train / curve.n_scale).reshape(-1, 1),
         max_iter, mlp.tolerance_change,
     )  # fmt: skip
-    if not (np.isfinite(loss) and np.all(np.isfinite(curve(np.linspace(0.0, theta_max, 16))))):
-        return FittedModel.failed(name, PARAM_NAMES, "non-finite training loss or output", theta, n_inliers)
-    return FittedModel(
-        name=name,
-        params={"loss": loss, "evaluations": float(evaluations + finetune_evaluations)},
-        converged=True,
-        reason=OK,
-        n_samples=int(theta.size),
-        curve=curve,
-        fallback=FallbackLine.fit(theta, n_inliers),
-    )
+    if not np.isfinite(loss):
+        return FittedModel.failed(name, PARAM_NAMES, "non-finite training loss", theta, n_inliers)
+    params = {"loss": loss, "evaluations": float(evaluations + finetune_evaluations)}
+    return FittedModel.checked(name, params, curve, theta, n_inliers, theta_end)

@@ -1,4 +1,4 @@
-"""One entry point for every artifact model of Fig. 2: base functions (curve_fit) and the two MLP recipes."""
+"""One entry point for every artifact model of Fig. 2: base functions (least squares) and the two MLP recipes."""
 
 from __future__ import annotations
 
@@ -6,11 +6,17 @@ import numpy as np
 
 from poseintegrity.artifact_models.base_functions import BASE_FUNCTIONS
 from poseintegrity.artifact_models.fitted import FittedModel
-from poseintegrity.artifact_models.mlp import fit_mlp
+from poseintegrity.artifact_models.mlp import DISTINCT_THETA, fit_mlp
 from poseintegrity.artifact_models.params import FitParams
 
 MLP_RECIPES = {"mlp_scratch": False, "mlp_pretrained": True}  # name -> pretrain on the EMG curve?
 MODEL_NAMES: tuple[str, ...] = (*BASE_FUNCTIONS, *MLP_RECIPES)
+
+
+def distinct_theta_needed(name: str) -> int:
+    """Fewest distinct theta (stops) model ``name`` can be fitted to: its parameter count for a base function
+    (eq. 1 has 3), 2 for the MLP recipes; with fewer its fit is a "fallback" (fitted.py)."""
+    return len(BASE_FUNCTIONS[name].param_names) if name in BASE_FUNCTIONS else DISTINCT_THETA
 
 
 def fit_model(
@@ -18,18 +24,19 @@ def fit_model(
     theta: np.ndarray,
     n_inliers: np.ndarray,
     *,
-    theta_max: float,
+    theta_end: float,
     params: FitParams,
     rng: np.random.Generator,
 ) -> FittedModel:
     """Fit artifact model ``name`` (one of :data:`MODEL_NAMES`) to samples; never raises on bad data.
 
     theta : (m,) float, deg (arcs) or mm (lines);  n_inliers : (m,) counts
-    theta_max : end of the trajectory range (MLP scaling and artificial points; unused by base functions)
+    theta_end : end of the trajectory range: the fitted curve is checked up to it (fitted.py), the MLP scales its
+    input by it and puts its artificial points there
     rng : seeds the MLP weights (unused by base functions)
     """
     if name in BASE_FUNCTIONS:
-        return BASE_FUNCTIONS[name].fit(theta, n_inliers, max_nfev=params.max_nfev)
+        return BASE_FUNCTIONS[name].fit(theta, n_inliers, theta_end=theta_end, max_nfev=params.max_nfev)
     if name in MLP_RECIPES:
-        return fit_mlp(theta, n_inliers, theta_max=theta_max, mlp=params.mlp, rng=rng, pretrain=MLP_RECIPES[name])
+        return fit_mlp(theta, n_inliers, theta_end=theta_end, mlp=params.mlp, rng=rng, pretrain=MLP_RECIPES[name])
     raise ValueError(f"unknown artifact model {name!r}; expected one of {MODEL_NAMES}")

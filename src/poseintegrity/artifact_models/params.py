@@ -1,7 +1,8 @@
 """Schema of the ``fit`` section of ``params.yaml`` (stage 03, artifact models).
 
-Every value is explicit in ``params.yaml``: none of these choices were published by Windsor et al.
-(docs/references.md, "Camera of the Windsor et al. experiments"), so each is ours and documented here.
+Every value is explicit in ``params.yaml`` (no default here): none of these choices were published by Windsor et al.
+(docs/references.md, "Camera of the Windsor et al. experiments"), so each is ours and documented here. The stops a
+robot samples and the range ends come from the ``protocol`` section; the workers from ``parallel``.
 """
 
 from __future__ import annotations
@@ -10,11 +11,12 @@ from typing import Literal
 
 from pydantic import Field, ValidationInfo, model_validator
 
-from poseintegrity.schema import KeyRule, Section
+from poseintegrity.schema import KeyRule, Seed, Section, distinct
 
 ModelName = Literal[
     "emg", "exponential", "gaussian", "logistic", "power_law", "mlp_scratch", "mlp_pretrained"
 ]
+ITERATIONS = 100_000  # upper bound of every iteration / evaluation budget: a typo, not a budget, beyond it
 
 
 class MLPParams(Section):
@@ -22,42 +24,46 @@ class MLPParams(Section):
 
     hidden_layers: int = Field(ge=1, le=10, description="hidden layers (paper: 3)")
     hidden_units: int = Field(ge=1, le=1000, description="neurons per hidden layer (paper: 10)")
-    max_iter_scratch: int = Field(ge=1, description="L-BFGS iterations of the scratch recipe (samples only)")
-    max_iter_pretrain: int = Field(ge=1, description="L-BFGS iterations on the EMG starting curve")
+    max_iter_scratch: int = Field(ge=1, le=ITERATIONS, description="L-BFGS iterations of the scratch recipe (samples"
+                                                                   " only)")
+    max_iter_pretrain: int = Field(ge=1, le=ITERATIONS, description="L-BFGS iterations on the EMG starting curve")
     max_iter_finetune: int = Field(
-        ge=1, description="L-BFGS iterations on samples + artificial points after pretraining (few: a longer"
-        " fine-tune forgets the pretrained shape between the last stop and theta_max)"
+        ge=1, le=ITERATIONS, description="L-BFGS iterations on samples + artificial points after pretraining (few: a"
+        " longer fine-tune forgets the pretrained shape between the last stop and the range end)"
     )
     tolerance_change: float = Field(
-        gt=0, description="early stop: L-BFGS stops when the loss or the step changes by less (scaled units)"
+        gt=0, lt=1, description="early stop: L-BFGS stops when the loss or the step changes by less (scaled units, in"
+        " which the counts are at most 1)"
     )
-    n_pretrain_points: int = Field(ge=2, description="grid points of the EMG curve used for pretraining")
-    n_artificial: int = Field(ge=1, description="copies of the artificial sample (range end, 0)")
+    n_pretrain_points: int = Field(ge=2, le=ITERATIONS, description="grid points of the EMG curve used for pretraining")
+    n_artificial: int = Field(ge=1, le=1000, description="copies of the artificial sample (range end, 0)")
 
 
 class FitParams(Section):
     """Stage 03: fit artifact models f: theta -> n_inliers and run the Fig. 2 experiment."""
 
-    models: tuple[ModelName, ...] = Field(min_length=1, description="artifact models compared in Fig. 2")
-    k_min: int = Field(ge=2, description="fewest stops (from the start) used for a fit")
-    k_max: int | None = Field(ge=2, description="most stops used for a fit; null = all stops")
-    max_nfev: int = Field(ge=10, description="curve_fit evaluation budget per base-function fit")
-    seed: int = Field(ge=0, description="seed of every random draw of the stage (MLP initial weights)")
-    n_jobs: int = Field(description="joblib workers; -1 = all cores")
+    models: distinct(ModelName) = Field(min_length=1, description="artifact models compared in Fig. 2")
+    k_min: int = Field(ge=2, le=100, description="fewest stops (from the start) used for a fit")
+    k_max: int | None = Field(ge=2, le=100, description="most stops used for a fit; null = all stops")
+    max_nfev: int = Field(ge=10, le=ITERATIONS, description="least squares evaluation budget per base-function fit")
+    seed: Seed = Field(description="seed of every random draw of the stage (MLP initial weights)")
     mlp: MLPParams
 
     @model_validator(mode="after")
     def _check_ranges(self, info: ValidationInfo) -> FitParams:
+        from poseintegrity.artifact_models.models import distinct_theta_needed  # models.py imports this module
+
         if self.k_max is not None and self.k_max < self.k_min:
             raise KeyRule("k_max", f"must be null or >= k_min ({self.k_min}), got {self.k_max}")
+        needs = {name: distinct_theta_needed(name) for name in self.models}
+        hardest = max(needs, key=needs.get)
+        if self.k_min < needs[hardest]:
+            raise KeyRule("k_min", f"must be >= {needs[hardest]}: model {hardest!r} cannot be fitted to fewer stops "
+                                   f"(every fit would fall back to a line), got {self.k_min}")
         protocol = (info.context or {}).get("protocol")  # the headline RMSE is taken at its sampled stops
         stops = (protocol.sampled_stops.arc, protocol.sampled_stops.line) if protocol else (self.k_min,)
         if min(stops) < self.k_min:
             raise KeyRule("k_min", f"must be <= protocol.sampled_stops ({min(stops)}), got {self.k_min}")
         if self.k_max is not None and max(stops) > self.k_max:
             raise KeyRule("k_max", f"must be null or >= protocol.sampled_stops ({max(stops)}), got {self.k_max}")
-        if self.n_jobs == 0:
-            raise ValueError("n_jobs must be a positive count or negative (joblib convention), not 0")
-        if len(set(self.models)) != len(self.models):
-            raise ValueError(f"models has duplicates: {list(self.models)}")
         return self

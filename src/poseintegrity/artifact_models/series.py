@@ -42,9 +42,20 @@ class Series:
         return self.theta[keep], self.n_inliers[keep]
 
 
+REQUIRED_COLUMNS = ("dataset", "trajectory", "stop", "image", "theta_deg", "x_mm", "method", "n_inliers")
+
+
 def dataset_series(artifacts: pd.DataFrame, pnp_method: str, protocol: ProtocolParams) -> list[Series]:
     """Split the artifacts table into one :class:`Series` per (trajectory, dataset) for ``pnp_method``, each
-    ending where ``protocol`` ends its trajectory type."""
+    ending where ``protocol`` ends its trajectory type.
+
+    Checked on read (ValueError naming the dataset): the columns of stage 02's table, a known trajectory type, stops
+    in order of theta, theta finite inside [0, range end] (a table rendered for another protocol would otherwise be
+    fitted and searched over the wrong range).
+    """
+    missing = [column for column in REQUIRED_COLUMNS if column not in artifacts.columns]
+    if missing:
+        raise ValueError(f"the artifacts table lacks columns {missing} (stage 02 writes {list(REQUIRED_COLUMNS)})")
     rows = artifacts[artifacts["method"] == pnp_method]
     if rows.empty:
         raise ValueError(f"no rows with method {pnp_method!r}; methods present: {sorted(artifacts['method'].unique())}")
@@ -54,14 +65,30 @@ def dataset_series(artifacts: pd.DataFrame, pnp_method: str, protocol: ProtocolP
     series = []
     for (trajectory, dataset), group in rows.groupby(["trajectory", "dataset"], sort=True):
         group = group.sort_values(["stop", "image"], kind="stable")
-        series.append(
-            Series(
-                dataset=str(dataset),
-                trajectory=str(trajectory),
-                stop=group["stop"].to_numpy(dtype=int),
-                theta=group[VARIABLE[trajectory]].to_numpy(dtype=float),
-                n_inliers=group["n_inliers"].to_numpy(dtype=float),
-                theta_end=protocol.range_end(trajectory),
-            )
+        one = Series(
+            dataset=str(dataset),
+            trajectory=str(trajectory),
+            stop=group["stop"].to_numpy(dtype=int),
+            theta=group[VARIABLE[trajectory]].to_numpy(dtype=float),
+            n_inliers=group["n_inliers"].to_numpy(dtype=float),
+            theta_end=protocol.range_end(trajectory),
         )
+        _check(one)
+        series.append(one)
     return series
+
+
+def _check(series: Series) -> None:
+    """ValueError unless ``series`` has finite theta in [0, theta_end] whose per-stop mean increases with the stop."""
+    variable = VARIABLE[series.trajectory]
+    where = f"dataset {series.dataset} ({series.trajectory}, {variable})"
+    if not np.all(np.isfinite(series.theta)):
+        raise ValueError(f"{where}: non-finite {variable}")
+    stops, index = np.unique(series.stop, return_inverse=True)
+    per_stop = np.bincount(index, weights=series.theta) / np.bincount(index)
+    if np.any(np.diff(per_stop) <= 0):
+        raise ValueError(f"{where}: {variable} does not increase with the stop: {np.round(per_stop, 3).tolist()}")
+    if series.theta.min() < 0 or series.theta.max() > series.theta_end:
+        raise ValueError(f"{where}: spans {series.theta.min():g} .. {series.theta.max():g}, outside [0, "
+                         f"{series.theta_end:g}] (the protocol's range end): was stage 02's table made with another "
+                         f"protocol?")

@@ -4,12 +4,12 @@
     predictors.py   theta_p for all n_t at once; long range, next-step (III-E) and static (IV-A) predictors
     metrics.py      SPL (eq. 3), R_i (eq. 4), SPL vs R_i curves, max mean SPL at zero incursion (Tables I-III)
     sweeps.py       the whole operating-point sweep over datasets, predictors, tolerances, PnP methods (V)
-    loso.py         n_t from a target incursion rate by leave-one-scene-out cross-validation (VI, future work)
+    loso.py         n_t from a target incursion rate by leave-one-scene-out cross-validation (VI, future work), pooled
     uncertainty.py  a prediction interval on theta_p (fit covariance or bootstrap) and its lower bound
     supervisor.py   NextStepSupervisor: the next-step predictor as a component of a robot loop
 """
 
-from poseintegrity.prediction.loso import loso, loso_folds, loso_summary, scene_of
+from poseintegrity.prediction.loso import loso, loso_folds, loso_summary, pooled, scene_of
 from poseintegrity.prediction.metrics import (
     best_operating_point,
     incursion,
@@ -20,6 +20,7 @@ from poseintegrity.prediction.metrics import (
 )
 from poseintegrity.prediction.params import PredictorModels, PredictParams, UncertaintyParams
 from poseintegrity.prediction.predictors import (
+    NO_FIT,
     Boundaries,
     boundaries,
     envelope_prediction,
@@ -31,18 +32,23 @@ from poseintegrity.prediction.predictors import (
 )
 from poseintegrity.prediction.supervisor import Decision, NextStepSupervisor
 from poseintegrity.prediction.sweeps import (
+    FITTED_PREDICTORS,
     PAPER_PREDICTORS,
     RELATIVE_PREDICTORS,
     attach_envelopes,
     best_table,
+    fit_status_shares,
     headline_metrics,
     live_trials,
     predict_dataset,
     sweep,
+    with_pnp_variants,
 )
 from poseintegrity.prediction.uncertainty import Interval, bootstrap_interval, covariance_interval, prediction_interval
 
 __all__ = [
+    "FITTED_PREDICTORS",
+    "NO_FIT",
     "PAPER_PREDICTORS",
     "RELATIVE_PREDICTORS",
     "Boundaries",
@@ -59,6 +65,7 @@ __all__ = [
     "boundaries",
     "covariance_interval",
     "envelope_prediction",
+    "fit_status_shares",
     "headline_metrics",
     "incursion",
     "live_trials",
@@ -69,6 +76,7 @@ __all__ = [
     "next_step",
     "next_step_stops",
     "operating_curves",
+    "pooled",
     "prediction_interval",
     "predict_dataset",
     "relative_thresholds",
@@ -78,4 +86,5 @@ __all__ = [
     "static_baseline",
     "sweep",
     "with_metrics",
+    "with_pnp_variants",
 ]

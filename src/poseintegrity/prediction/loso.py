@@ -70,23 +70,36 @@ def loso(
     return pd.concat(folds, ignore_index=True) if folds else pd.DataFrame(columns=FOLD_COLUMNS)
 
 
-def loso_summary(folds: pd.DataFrame, target_rate: float) -> dict:
-    """predictor -> tolerance -> pooled held-out figures at ``target_rate``.
+def pooled(folds: pd.DataFrame) -> pd.DataFrame:
+    """The folds pooled per (predictor, tolerance, target_rate): one row each, sorted, with
 
-    heldout_incursion_rate : sum of held-out incursions / held-out datasets (eq. 4 over all folds)
-    heldout_mean_spl : mean SPL over all held-out datasets;  n_infeasible_folds : folds where no threshold met
-    the target on the training scenes;  thresholds : the operating point chosen per held-out scene
+    heldout_incursion_rate : held-out incursions / held-out datasets (eq. 4 over all folds; NaN without any)
+    heldout_mean_spl : mean SPL over all held-out datasets (eq. 3);  heldout_n : held-out datasets
+    n_infeasible_folds : folds where no operating point met the target on the training scenes
     """
+    grouped = folds.assign(infeasible=~folds["feasible"].astype(bool)).groupby(
+        ["predictor", "tolerance", "target_rate"], sort=True)
+    sums = grouped.agg(incursions=("heldout_incursions", "sum"), heldout_n=("heldout_n", "sum"),
+                       spl=("heldout_spl_sum", "sum"), n_infeasible_folds=("infeasible", "sum"))
+    n = sums["heldout_n"].where(sums["heldout_n"] > 0)  # NaN rates for no held-out dataset, not a division by zero
+    return pd.DataFrame({
+        "heldout_incursion_rate": sums["incursions"] / n, "heldout_mean_spl": sums["spl"] / n,
+        "heldout_n": sums["heldout_n"].astype(int), "n_infeasible_folds": sums["n_infeasible_folds"].astype(int),
+    }).reset_index()  # fmt: skip
+
+
+def loso_summary(folds: pd.DataFrame, target_rate: float) -> dict:
+    """predictor -> tolerance -> the :func:`pooled` held-out figures at ``target_rate``, with target_incursion_rate
+    and the operating point chosen per held-out scene (``thresholds``)."""
+    at_rate = folds[folds["target_rate"] == target_rate]
     summary: dict = {}
-    for (predictor, tolerance), group in folds[folds["target_rate"] == target_rate].groupby(
-        ["predictor", "tolerance"], sort=True
-    ):
-        n = group["heldout_n"].sum()
-        summary.setdefault(str(predictor), {})[str(tolerance)] = {
+    for row in pooled(at_rate).itertuples(index=False):
+        group = at_rate[(at_rate["predictor"] == row.predictor) & (at_rate["tolerance"] == row.tolerance)]
+        summary.setdefault(str(row.predictor), {})[str(row.tolerance)] = {
             "target_incursion_rate": float(target_rate),
-            "heldout_incursion_rate": float(group["heldout_incursions"].sum() / n) if n else float("nan"),
-            "heldout_mean_spl": float(group["heldout_spl_sum"].sum() / n) if n else float("nan"),
-            "n_infeasible_folds": int((~group["feasible"].astype(bool)).sum()),
+            "heldout_incursion_rate": float(row.heldout_incursion_rate),
+            "heldout_mean_spl": float(row.heldout_mean_spl),
+            "n_infeasible_folds": int(row.n_infeasible_folds),
             "thresholds": {str(s): float(p) for s, p in zip(group["scene"], group["operating_point"], strict=True)},
         }
     return summary

@@ -1,21 +1,25 @@
 """Schema of the ``predict`` section of ``params.yaml`` (stage 04, localization-envelope predictors).
 
 The artifact models themselves are configured by the ``fit`` section (:class:`poseintegrity.artifact_models.FitParams`:
-curve_fit budget, MLP recipe, range ends theta_max / x_max); this section says how the predictors of
-Windsor et al. III-E use them and how the operating points are swept (IV-A, V). Lengths in mm, angles in deg.
+least squares budget, MLP recipe); the range ends, the stops sampled before predicting and the tolerances by
+``protocol``; the workers by ``parallel``. This section says how the predictors of Windsor et al. III-E use the
+models and how the operating points are swept (IV-A, V). Every value is explicit in ``params.yaml`` (no default
+here). Lengths in mm, angles in deg.
 """
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import Annotated, Literal
 
 import numpy as np
 from pydantic import Field, ValidationInfo, model_validator
 
 from poseintegrity.artifact_models.params import ModelName
-from poseintegrity.schema import KeyRule, Section
+from poseintegrity.schema import KeyRule, Seed, Section, distinct
 
 IntervalMethod = Literal["covariance", "bootstrap"]
+Rate = Annotated[float, Field(ge=0, le=1)]
+GRID = 100_000  # upper bound of every sweep or scan size: a typo, not a grid, beyond it
 
 
 class PredictorModels(Section):
@@ -34,50 +38,65 @@ class UncertaintyParams(Section):
         " resampled with replacement (any model)"
     )
     level: float = Field(gt=0, lt=1, description="two-sided coverage of the interval, e.g. 0.9")
-    n_bootstrap: int = Field(ge=2, description="bootstrap refits per dataset (method bootstrap)")
+    n_bootstrap: int = Field(ge=2, le=10_000, description="bootstrap refits per dataset (method bootstrap)")
 
 
 class PredictParams(Section):
     """Stage 04: predictors, the n_t sweep, the static baseline, LOSO threshold choice, live-trial simulation."""
 
     n_t_min: int = Field(ge=1, description="smallest inlier threshold of the sweep (paper: 4)")
-    n_t_max: int = Field(ge=1, description="largest inlier threshold of the sweep (paper: 100)")
+    n_t_max: int = Field(ge=1, le=GRID, description="largest inlier threshold of the sweep (paper: 100)")
     relative_min: float = Field(gt=0, lt=1, description="beyond the paper: smallest n_t / first-stop mean n_i")
     relative_max: float = Field(gt=0, lt=1, description="largest n_t / first-stop mean n_i of the sweep")
     relative_step: float = Field(gt=0, lt=1, description="step of the relative-threshold sweep")
-    n_static: int = Field(ge=2, description="envelope sizes of the static sweep, 0 .. the range end of protocol")
+    n_static: int = Field(ge=2, le=GRID, description="envelope sizes of the static sweep, 0 .. the range end of protocol")
     tolerance_fig6_fig7: str = Field(
         min_length=1, description="tolerance of the PnP (Fig. 6) and straight-line (Fig. 7) curves (paper: 2mm_3deg),"
         " one of protocol.tolerances"
     )
-    n_grid: int = Field(ge=16, description="grid points of the theta_p crossing scan per fitted curve")
+    n_grid: int = Field(ge=16, le=GRID, description="grid points of the theta_p crossing scan per fitted curve")
     models: PredictorModels
-    live_n_t: int = Field(ge=1, description="fixed n_t of the simulated live trials (paper: 15, from Table III)")
+    live_n_t: int = Field(ge=1, description="fixed n_t of the simulated live trials (paper: 15, from Table III), one of"
+                                            " the swept n_t_min .. n_t_max")
     live_tolerance: str = Field(min_length=1, description="tolerance of the simulated live trials (paper: 4mm_10deg), one of"
                                                             " protocol.tolerances")
-    loso_target_rates: tuple[float, ...] = Field(
-        min_length=1, description="target incursion rates of the leave-one-scene-out threshold choice; first = headline"
+    loso_target_rates: distinct(Rate) = Field(
+        min_length=1, description="target incursion rates (distinct, in [0, 1]) of the leave-one-scene-out threshold"
+        " choice; first = headline"
     )
     uncertainty: UncertaintyParams
-    seed: int = Field(ge=0, description="seed of every random draw of the stage (MLP weights, bootstrap)")
-    n_jobs: int = Field(description="joblib workers; -1 = all cores")
+    seed: Seed = Field(description="seed of every random draw of the stage (MLP weights, bootstrap)")
 
     @model_validator(mode="after")
     def _check(self, info: ValidationInfo) -> PredictParams:
+        from poseintegrity.artifact_models.models import BASE_FUNCTIONS, distinct_theta_needed  # no import cycle
+
         protocol = (info.context or {}).get("protocol")
         for key in ("tolerance_fig6_fig7", "live_tolerance"):
             if protocol is not None and getattr(self, key) not in protocol.tolerance_names:
                 raise KeyRule(key, f"must name one of protocol.tolerances {protocol.tolerance_names}, "
                                    f"got {getattr(self, key)!r}")
         if self.n_t_max < self.n_t_min:
-            raise ValueError(f"n_t_max ({self.n_t_max}) must be >= n_t_min ({self.n_t_min})")
+            raise KeyRule("n_t_max", f"must be >= n_t_min ({self.n_t_min}), got {self.n_t_max}")
+        if not self.n_t_min <= self.live_n_t <= self.n_t_max:
+            raise KeyRule("live_n_t", f"must be one of the swept thresholds n_t_min .. n_t_max ({self.n_t_min} .. "
+                                      f"{self.n_t_max}), got {self.live_n_t}")
         if self.relative_max < self.relative_min:
-            raise ValueError(f"relative_max ({self.relative_max}) must be >= relative_min ({self.relative_min})")
-        if self.n_jobs == 0:
-            raise ValueError("n_jobs must be a positive count or negative (joblib convention), not 0")
-        bad = [r for r in self.loso_target_rates if not 0.0 <= r <= 1.0]
-        if bad:
-            raise ValueError(f"loso_target_rates must lie in [0, 1], got {bad}")
+            raise KeyRule("relative_max", f"must be >= relative_min ({self.relative_min}), got {self.relative_max}")
+        steps = (self.relative_max - self.relative_min) / self.relative_step
+        if abs(steps - round(steps)) > 1e-6:
+            raise KeyRule("relative_step", f"must divide relative_max - relative_min ({self.relative_max} - "
+                                           f"{self.relative_min}) into whole steps, so that the sweep ends at "
+                                           f"relative_max; got {self.relative_step}")
+        fewest = min((protocol.sampled_stops.arc, protocol.sampled_stops.line)) if protocol else None
+        for predictor, model in self.models:
+            if fewest is not None and distinct_theta_needed(model) > fewest:
+                raise KeyRule(f"models.{predictor}", f"model {model!r} needs {distinct_theta_needed(model)} stops, "
+                                                     f"more than protocol.sampled_stops gives ({fewest})")
+        if self.uncertainty.method == "covariance" and self.models.long_range not in BASE_FUNCTIONS:
+            raise KeyRule("uncertainty.method", f"covariance needs a least squares long_range model (one of "
+                                                f"{sorted(BASE_FUNCTIONS)}), got {self.models.long_range!r}: use "
+                                                f"bootstrap")
         return self
 
     @property

@@ -19,6 +19,10 @@ Statuses of a theta_p (the first four as in the scalar reference ``envelope_boun
     "too_few_stops"   fewer stops with a valid inlier count than the predictor needs: theta_p = NaN (flagged)
     "stopped" / "end_of_path"   next-step only: the robot was stopped (theta_p = the stop where it stands) / it
                       reached the last stop (theta_p = the last stop)
+
+Beside the status of theta_p, every answer carries the status of the fit(s) behind it (ok / at_bound / non_physical
+/ fallback, artifact_models/fitted.py; NO_FIT where nothing was fitted). A flagged fit's theta_p still counts: it is
+what the robot would have done (a "fallback" fit predicts with its line, the others with their fitted curve).
 """
 
 from __future__ import annotations
@@ -29,10 +33,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from poseintegrity.artifact_models import FitParams, FittedModel, fit_model
+from poseintegrity.artifact_models import FIT_STATUSES, FitParams, FittedModel, fit_model
+from poseintegrity.artifact_models.fitted import OK
 from poseintegrity.artifact_models.series import Series
 
 BISECTION_XTOL = 1e-9  # theta units; the root refinement of :func:`boundaries`
+NO_FIT = "no_fit"  # fit status of an answer without a fit (too few stops, a bad threshold, the static baseline)
 
 
 @dataclass(frozen=True)
@@ -48,7 +54,7 @@ def boundaries(
     thresholds: np.ndarray,
     theta_start: float,
     theta_end: float,
-    n_grid: int = 256,
+    n_grid: int,
 ) -> Boundaries:
     """theta_p in [theta_start, theta_end] where predict first falls to each threshold n_t (III-E, vectorized).
 
@@ -58,6 +64,7 @@ def boundaries(
     all brackets at once (one call of ``predict`` per halving) down to BISECTION_XTOL.
 
     predict : f, (m,) float -> (m,) float inlier counts;  thresholds : (T,) float n_t
+    n_grid : scan points (``predict.n_grid``)
     """
     if not theta_end > theta_start:
         raise ValueError(f"empty search range [{theta_start}, {theta_end}]")
@@ -108,7 +115,7 @@ def stop_positions(series: Series) -> tuple[np.ndarray, np.ndarray]:
 
 
 def fit_rng(seed: int, method: str, series: Series, k: int) -> np.random.Generator:
-    """The Generator of one fit: the same for any n_jobs, order of work and other datasets in the table."""
+    """The Generator of one fit: the same for any number of workers, order of work and other datasets in the table."""
     return np.random.default_rng([seed, zlib.crc32(f"{method}/{series.trajectory}/{series.dataset}".encode()), k])
 
 
@@ -118,7 +125,7 @@ def fit_stops(
     """The artifact model fitted to the images of ``stops`` : (fitted, theta (m,), n_inliers (m,))."""
     keep = np.isin(series.stop, stops)
     theta, n_inliers = series.theta[keep], series.n_inliers[keep]
-    fitted = fit_model(model, theta, n_inliers, theta_max=series.theta_end, params=fit, rng=rng)
+    fitted = fit_model(model, theta, n_inliers, theta_end=series.theta_end, params=fit, rng=rng)
     return fitted, theta, n_inliers
 
 
@@ -155,6 +162,7 @@ def long_range(
     """Long range predictor (III-E, V-A): fit the first k stops once, theta_p for every n_t.
 
     "too_few_stops" (theta_p NaN) when fewer than k stops have a valid inlier count, e.g. all-NaN counts.
+    The fit's status (``fitted.status``) holds for every threshold.
     """
     stops, theta_stops = stop_positions(series)
     if stops.size < k:
@@ -180,8 +188,9 @@ class NextStep:
 
     prediction: Boundaries  # theta_p = where the robot stops; status "stopped" | "end_of_path" | "too_few_stops"
     boundary: np.ndarray  # (T,) the model's theta_p at the stop that stopped the robot (NaN: never stopped)
+    fit_status: np.ndarray  # (T,) str, the most severe status of the fits the robot went by (NO_FIT: none)
+    fit_reason: np.ndarray  # (T,) str, "ok" or the reason of the first fit of that status
     n_fits: int
-    n_failed: int  # fits that did not converge (their theta_p came from the fallback line)
 
 
 def next_step(
@@ -194,21 +203,28 @@ def next_step(
     found; a threshold whose theta_p < theta_i + theta_b (theta_b: the sampling interval, IV-A) stops the robot
     where it is, so its SPL position is theta_i (V-B: "the viewing angle where the predictor would stop the
     robot"). Thresholds never stopped reach the last stop ("end_of_path"); a non-finite n_t is flagged
-    "bad_threshold". Fits stop once every threshold has stopped.
+    "bad_threshold". Fits stop once every threshold has stopped. A threshold's fit status is the most severe
+    status among the fits it went by (up to and including the one that stopped it): its path relied on each.
     """
     stops, theta_stops = stop_positions(series)
+    no_fit = np.full(np.shape(thresholds), NO_FIT)
     if stops.size < max(k0, 2):
-        return NextStep(flagged(thresholds, "too_few_stops"), np.full(np.shape(thresholds), np.nan), 0, 0)
+        nan = np.full(np.shape(thresholds), np.nan)
+        return NextStep(flagged(thresholds, "too_few_stops"), nan, no_fit, np.full(nan.shape, "too few stops"), 0)
     theta_b = sampling_interval(theta_stops)
     stop_at = np.full(np.shape(thresholds), theta_stops[-1])
     boundary = np.full(np.shape(thresholds), np.nan)
     moving = np.isfinite(thresholds)
-    n_fits = n_failed = 0
+    severity = np.zeros(np.shape(thresholds), dtype=int)  # index into FIT_STATUSES
+    fit_reason = np.full(np.shape(thresholds), OK, dtype=object)
+    n_fits = 0
     for i in range(k0 - 1, stops.size):
         if not moving.any():
             break
         fitted, _, _ = fit_stops(series, stops[: i + 1], model, fit, fit_rng(seed, method, series, i + 1))
-        n_fits, n_failed = n_fits + 1, n_failed + (not fitted.converged)
+        n_fits += 1
+        worse = moving & (FIT_STATUSES.index(fitted.status) > severity)
+        severity[worse], fit_reason[worse] = FIT_STATUSES.index(fitted.status), f"fit on {i + 1} stops: {fitted.reason}"
         theta_p = envelope_prediction(fitted.predict, thresholds[moving], theta_stops[0], series.theta_end, n_grid).theta_p
         stop = next_step_stops(theta_p, theta_stops[i], theta_b)
         index = moving.nonzero()[0][stop]
@@ -217,7 +233,9 @@ def next_step(
     status = np.where(moving, "end_of_path", "stopped").astype(object)
     bad = ~np.isfinite(thresholds)
     stop_at[bad], status[bad] = np.nan, "bad_threshold"
-    return NextStep(Boundaries(stop_at, status.astype(str)), boundary, n_fits, n_failed)
+    fit_status = np.where(bad, NO_FIT, np.array(FIT_STATUSES)[severity])
+    fit_reason[bad] = "bad threshold"
+    return NextStep(Boundaries(stop_at, status.astype(str)), boundary, fit_status, fit_reason.astype(str), n_fits)
 
 
 def first_stop_mean(series: Series) -> float:

@@ -1,6 +1,7 @@
 """The next-step predictor as a component of a robot loop (Windsor et al. III-E; the live trials of V-C).
 
-    supervisor = NextStepSupervisor(n_t=15, theta_b=1.5, theta_end=45.0, fit=fit_params, rng=rng)
+    params = load_params("params.yaml")
+    supervisor = NextStepSupervisor.from_params(params, "arc", n_t=15, theta_b=2.25, rng=rng)
     for theta, n_inliers in stops:                  # the robot pauses at each stop and localizes
         decision = supervisor.update(theta, n_inliers)
         if not decision.proceed:
@@ -20,8 +21,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from poseintegrity.artifact_models import FitParams, fit_model
-from poseintegrity.prediction.params import UncertaintyParams
-from poseintegrity.prediction.predictors import envelope_prediction, next_step_stops
+from poseintegrity.prediction.params import PredictParams, UncertaintyParams
+from poseintegrity.prediction.predictors import NO_FIT, envelope_prediction, next_step_stops
 from poseintegrity.prediction.uncertainty import prediction_interval
 
 
@@ -31,13 +32,16 @@ class Decision:
 
     proceed : True: move on to the next step;  theta_p : predicted envelope boundary (NaN before the first fit)
     interval : (lower, upper) on theta_p (NaN without one);  status : theta_p's status ("collecting" before the
-    first fit);  reason : the fit's "ok" or why it failed (a failed fit falls back to a line, still used)
+    first fit);  fit_status : the fit's ok / at_bound / non_physical / fallback (artifact_models/fitted.py; "no_fit"
+    while collecting): a flagged fit is still used, as the robot has no other;  reason : the fit's "ok" or what
+    was found
     """
 
     proceed: bool
     theta_p: float
     interval: tuple[float, float]
     status: str
+    fit_status: str
     reason: str
 
 
@@ -46,7 +50,9 @@ class NextStepSupervisor:
     """Next-step supervision over one trajectory; theta in deg (arcs) or mm (lines), increasing.
 
     n_t : inlier threshold;  theta_b : step size (the distance to the next stop);  theta_end : end of the range
-    model : artifact model name;  first_stops : stops needed before the first fit (paper: 4)
+    model : artifact model name (``predict.models.next_step``);  first_stops : stops needed before the first fit
+    (``protocol.sampled_stops``);  n_grid : grid of the theta_p scan (``predict.n_grid``); :meth:`from_params` reads
+    all three from the params
     uncertainty : how to put an interval on theta_p (None: no interval);  stop_on_lower_bound : use its lower end
     """
 
@@ -55,11 +61,11 @@ class NextStepSupervisor:
     theta_end: float
     fit: FitParams
     rng: np.random.Generator
-    model: str = "emg"
-    first_stops: int = 4
+    model: str
+    first_stops: int
+    n_grid: int
     uncertainty: UncertaintyParams | None = None
     stop_on_lower_bound: bool = False
-    n_grid: int = 256
     theta: list[float] = field(default_factory=list, init=False)  # every image's theta so far
     n_inliers: list[float] = field(default_factory=list, init=False)
 
@@ -69,6 +75,20 @@ class NextStepSupervisor:
         if not (np.isfinite(self.n_t) and self.theta_b > 0 and np.isfinite(self.theta_end)):
             raise ValueError(f"need a finite n_t, theta_b > 0 and a finite theta_end; got {self.n_t}, "
                              f"{self.theta_b}, {self.theta_end}")  # fmt: skip
+
+    @classmethod
+    def from_params(cls, params, trajectory: str, *, n_t: float, theta_b: float, rng: np.random.Generator,
+                    with_interval: bool = False, stop_on_lower_bound: bool = False) -> NextStepSupervisor:  # fmt: skip
+        """The supervisor of params.yaml (:class:`poseintegrity.config.Params`) on a trajectory type ("arc" or
+        "line"): its range end and sampled stops from ``protocol``, model and scan grid from ``predict``, the fit from
+        ``fit``; ``with_interval`` (or ``stop_on_lower_bound``) adds ``predict.uncertainty``'s interval."""
+        predict: PredictParams = params.predict
+        return cls(
+            n_t=n_t, theta_b=theta_b, theta_end=params.protocol.range_end(trajectory), fit=params.fit, rng=rng,
+            model=predict.models.next_step, first_stops=params.protocol.stops_sampled(trajectory),
+            n_grid=predict.n_grid, uncertainty=predict.uncertainty if with_interval or stop_on_lower_bound else None,
+            stop_on_lower_bound=stop_on_lower_bound,
+        )  # fmt: skip
 
     def update(self, theta: float, n_inliers: float | np.ndarray) -> Decision:
         """Add the inlier counts of the images taken at stop ``theta`` and decide (III-E).
@@ -89,9 +109,9 @@ class NextStepSupervisor:
         samples_theta, samples_n = np.asarray(self.theta), np.asarray(self.n_inliers)
         nan2 = (float("nan"), float("nan"))
         if np.unique(samples_theta).size < self.first_stops:
-            return Decision(True, float("nan"), nan2, "collecting", "ok")
+            return Decision(True, float("nan"), nan2, "collecting", NO_FIT, "collecting the first stops")
         fitted = fit_model(
-            self.model, samples_theta, samples_n, theta_max=self.theta_end, params=self.fit, rng=self.rng
+            self.model, samples_theta, samples_n, theta_end=self.theta_end, params=self.fit, rng=self.rng
         )
         n_t = np.array([float(self.n_t)])
         found = envelope_prediction(fitted.predict, n_t, samples_theta[0], self.theta_end, self.n_grid)
@@ -105,4 +125,4 @@ class NextStepSupervisor:
         # a NaN lower bound (no interval) never lets the robot on: NaN < x is False, so compare the negation
         guard = interval[0] if self.stop_on_lower_bound else theta_p
         proceed = not bool(next_step_stops(np.array([guard]), float(theta), self.theta_b)[0]) and np.isfinite(guard)
-        return Decision(bool(proceed), theta_p, interval, str(found.status[0]), fitted.reason)
+        return Decision(bool(proceed), theta_p, interval, str(found.status[0]), fitted.status, fitted.reason)

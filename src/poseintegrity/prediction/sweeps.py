@@ -2,8 +2,9 @@
 
     sweep             theta_p of every predictor for every dataset, PnP method and operating point
                       (n_t = n_t_min .. n_t_max; static sizes 0 .. 45 deg / 0 .. 150 mm), fitted once per
-                      dataset (and stop for the next-step predictor), on ``predict.n_jobs`` joblib workers
-    attach_envelopes  joins the actual envelopes theta_a per tolerance and adds SPL (eq. 3), incursion (eq. 4)
+                      dataset (and stop for the next-step predictor), one task per dataset and method on the workers
+    attach_envelopes  joins the actual envelopes theta_a per tolerance (checked against the protocol) and adds SPL
+                      (eq. 3), incursion (eq. 4)
     live_trials       the simulated live trials (V-C): next-step supervision at one fixed n_t vs the static baseline
     headline_metrics  the keys of ``reports/metrics/predictors.json``
 
@@ -12,21 +13,29 @@ prediction interval, :mod:`.uncertainty`), "mlp", "next_step", "static", and bey
 "long_range_relative" / "next_step_relative", whose operating point is n_t as a fraction of the dataset's mean n_i
 at the first stop (the same fits as "long_range" / "next_step"). Only "long_range" and "static" run on PnP methods
 other than ``protocol.pnp_method`` (Fig. 6).
+
+Every row says how its theta_p was found (``status``, predictors.py) and what the fit behind it was worth
+(``fit_status``: ok / at_bound / non_physical / fallback, artifact_models/fitted.py; "no_fit" for the static
+baseline and rows without a fit). Flagged fits stay in the SPL / R_i curves, as what the robot would have done, and
+are counted in predictors.json (``fit_status``).
 """
 
 from __future__ import annotations
 
+from functools import partial
+
 import numpy as np
 import pandas as pd
-from joblib import Parallel, delayed
-from tqdm import tqdm
 
-from poseintegrity.artifact_models import FitParams
+from poseintegrity.artifact_models import FIT_STATUSES, FitParams
+from poseintegrity.artifact_models.fitted import OK
 from poseintegrity.artifact_models.series import Series, dataset_series
+from poseintegrity.parallel import Workers
 from poseintegrity.prediction.loso import loso_summary
 from poseintegrity.prediction.metrics import best_operating_point, relative_improvement, with_metrics
 from poseintegrity.prediction.params import PredictParams
 from poseintegrity.prediction.predictors import (
+    NO_FIT,
     Boundaries,
     fit_rng,
     long_range,
@@ -38,11 +47,12 @@ from poseintegrity.prediction.uncertainty import prediction_interval
 from poseintegrity.protocol import ProtocolParams
 
 COLUMNS = [
-    "predictor", "model", "method", "trajectory", "dataset", "operating_point", "theta_p", "status", "converged",
+    "predictor", "model", "method", "trajectory", "dataset", "operating_point", "theta_p", "status", "fit_status",
     "reason",
 ]  # fmt: skip
 PAPER_PREDICTORS = ("static", "long_range", "mlp", "next_step")  # the keys of predictors.json
 RELATIVE_PREDICTORS = ("long_range_relative", "next_step_relative")  # beyond the paper
+FITTED_PREDICTORS = ("long_range", "long_range_lower", "mlp", "next_step", *RELATIVE_PREDICTORS)
 CONSERVATIVE_HIGH = {"static": False}  # a larger operating point is more conservative for n_t, not for a size
 OPERATING_POINT_KEY = {"static": "best_size", "long_range_relative": "best_fraction",
                        "next_step_relative": "best_fraction"}  # predictors.json name of the best operating point
@@ -50,21 +60,23 @@ OPERATING_POINT_KEY = {"static": "best_size", "long_range_relative": "best_fract
 
 def _rows(
     predictor: str, model: str, method: str, series: Series, operating_point: np.ndarray, found: Boundaries,
-    converged: bool, reason: str,
+    fit_status: str | np.ndarray, reason: str | np.ndarray,
 ) -> pd.DataFrame:  # fmt: skip
     return pd.DataFrame(
         {
             "predictor": predictor, "model": model, "method": method, "trajectory": series.trajectory,
             "dataset": series.dataset, "operating_point": operating_point, "theta_p": found.theta_p,
-            "status": found.status, "converged": converged, "reason": reason,
+            "status": found.status, "fit_status": fit_status, "reason": reason,
         },
         columns=COLUMNS,
     )  # fmt: skip
 
 
-def _split(found: Boundaries, n: int) -> tuple[Boundaries, Boundaries]:
-    """The answers for the first n thresholds and for the rest."""
-    return (Boundaries(found.theta_p[:n], found.status[:n]), Boundaries(found.theta_p[n:], found.status[n:]))
+def _split(values, n: int) -> tuple:
+    """The answers (:class:`Boundaries` or an array) for the first n thresholds and for the rest."""
+    if isinstance(values, Boundaries):
+        return (Boundaries(values.theta_p[:n], values.status[:n]), Boundaries(values.theta_p[n:], values.status[n:]))
+    return values[:n], values[n:]
 
 
 def predict_dataset(
@@ -80,14 +92,14 @@ def predict_dataset(
     fractions = predict.relative_thresholds
     both = np.concatenate([n_t, relative_thresholds(series, fractions)])
     sizes = predict.static_sizes(series.theta_end)
-    tables = [_rows("static", "", method, series, sizes, static_baseline(sizes), True, "ok")]
+    tables = [_rows("static", "", method, series, sizes, static_baseline(sizes), NO_FIT, "no fit: one size for all")]
     answer = long_range(series, k, models.long_range, both, fit, fit_rng(predict.seed, method, series, k), predict.n_grid)
     absolute, relative = _split(answer.prediction, n_t.size)
-    converged, reason = (answer.fitted.converged, answer.fitted.reason) if answer.fitted else (False, "too few stops")
-    tables.append(_rows("long_range", models.long_range, method, series, n_t, absolute, converged, reason))
+    fit_status, reason = (answer.fitted.status, answer.fitted.reason) if answer.fitted else (NO_FIT, "too few stops")
+    tables.append(_rows("long_range", models.long_range, method, series, n_t, absolute, fit_status, reason))
     if method != protocol.pnp_method:  # Fig. 6: the long range predictor alone on the other PnP methods
         return pd.concat(tables, ignore_index=True)
-    tables.append(_rows("long_range_relative", models.long_range, method, series, fractions, relative, converged,
+    tables.append(_rows("long_range_relative", models.long_range, method, series, fractions, relative, fit_status,
                         reason))  # fmt: skip
 
     interval = prediction_interval(
@@ -97,23 +109,34 @@ def predict_dataset(
     )  # fmt: skip
     no_interval = np.isnan(interval.lower) & ~np.isnan(absolute.theta_p)
     lower = Boundaries(interval.lower, np.where(no_interval, "no_interval", absolute.status))
-    tables.append(_rows("long_range_lower", models.long_range, method, series, n_t, lower, converged, interval.reason))
+    lower_reason = interval.reason if fit_status == OK else f"{reason}; interval: {interval.reason}"
+    tables.append(_rows("long_range_lower", models.long_range, method, series, n_t, lower, fit_status, lower_reason))
     mlp = long_range(series, k, models.mlp, n_t, fit, fit_rng(predict.seed, method, series, k), predict.n_grid)
-    mlp_converged, mlp_reason = (mlp.fitted.converged, mlp.fitted.reason) if mlp.fitted else (False, "too few stops")
-    tables.append(_rows("mlp", models.mlp, method, series, n_t, mlp.prediction, mlp_converged, mlp_reason))
+    mlp_status, mlp_reason = (mlp.fitted.status, mlp.fitted.reason) if mlp.fitted else (NO_FIT, "too few stops")
+    tables.append(_rows("mlp", models.mlp, method, series, n_t, mlp.prediction, mlp_status, mlp_reason))
     step = next_step(series, k, models.next_step, both, fit, predict.seed, method, predict.n_grid)
     step_absolute, step_relative = _split(step.prediction, n_t.size)
-    step_ok, step_reason = step.n_failed == 0, f"{step.n_fits} fits, {step.n_failed} not converged"
-    tables.append(_rows("next_step", models.next_step, method, series, n_t, step_absolute, step_ok, step_reason))
-    tables.append(_rows("next_step_relative", models.next_step, method, series, fractions, step_relative, step_ok,
-                        step_reason))  # fmt: skip
+    status_absolute, status_relative = _split(step.fit_status, n_t.size)
+    reason_absolute, reason_relative = _split(step.fit_reason, n_t.size)
+    tables.append(_rows("next_step", models.next_step, method, series, n_t, step_absolute, status_absolute,
+                        reason_absolute))  # fmt: skip
+    tables.append(_rows("next_step_relative", models.next_step, method, series, fractions, step_relative,
+                        status_relative, reason_relative))  # fmt: skip
     return pd.concat(tables, ignore_index=True)
 
 
+def _predict_task(task: tuple[Series, str], predict: PredictParams, fit: FitParams, protocol: ProtocolParams
+                  ) -> pd.DataFrame:  # fmt: skip
+    series, method = task
+    return predict_dataset(series, method, predict, fit, protocol)
+
+
 def sweep(
-    artifacts: pd.DataFrame, predict: PredictParams, fit: FitParams, protocol: ProtocolParams, progress: bool = True
-) -> pd.DataFrame:
-    """theta_p of every predictor, dataset, PnP method and operating point (rows of COLUMNS).
+    artifacts: pd.DataFrame, predict: PredictParams, fit: FitParams, protocol: ProtocolParams, workers: Workers,
+    progress: bool = True,
+) -> pd.DataFrame:  # fmt: skip
+    """theta_p of every predictor, dataset, PnP method and operating point (rows of COLUMNS), one task per dataset
+    and PnP method on ``workers``.
 
     artifacts : the stage-02 table (dataset, trajectory, stop, image, theta_deg, x_mm, method, n_inliers, ...)
     """
@@ -122,17 +145,50 @@ def sweep(
         for method in sorted(artifacts["method"].unique())
         for series in dataset_series(artifacts, str(method), protocol)
     ]
-    results = Parallel(n_jobs=predict.n_jobs, return_as="generator")(
-        delayed(predict_dataset)(series, method, predict, fit, protocol) for series, method in tasks
+    results = workers.map(partial(_predict_task, predict=predict, fit=fit, protocol=protocol), tasks,
+                          desc="predictor sweep (dataset, PnP method)", progress=progress)  # fmt: skip
+    return pd.concat(results, ignore_index=True)
+
+
+def with_pnp_variants(
+    artifacts: pd.DataFrame, envelopes: pd.DataFrame, variants: pd.DataFrame, variant_envelopes: pd.DataFrame
+) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """Stage 02's (artifacts, envelopes) with stage 05's tables of the other PnP methods added (Fig. 6).
+
+    A method already in ``artifacts`` keeps stage 02's rows; an envelope (dataset, trajectory, tolerance, method)
+    present in both keeps stage 02's.
+    """
+    extra = variants[~variants["method"].isin(artifacts["method"].unique())]
+    return (
+        pd.concat([artifacts, extra], ignore_index=True),
+        pd.concat([envelopes, variant_envelopes], ignore_index=True).drop_duplicates(
+            ["dataset", "trajectory", "tolerance", "method"]
+        ),
     )
-    return pd.concat(list(tqdm(results, total=len(tasks), disable=not progress)), ignore_index=True)
 
 
-def attach_envelopes(theta_p: pd.DataFrame, envelopes: pd.DataFrame) -> pd.DataFrame:
+ENVELOPE_COLUMNS = ("dataset", "trajectory", "method", "tolerance", "theta_a", "censored")
+
+
+def attach_envelopes(theta_p: pd.DataFrame, envelopes: pd.DataFrame, protocol: ProtocolParams) -> pd.DataFrame:
     """The prediction table: one row per sweep row and tolerance, with theta_a, censored, spl, incursion.
 
-    A dataset / method without an actual envelope is dropped (it cannot be scored).
+    A dataset / method without an actual envelope is dropped (it cannot be scored). Checked on read (ValueError):
+    the envelopes' columns, and their tolerances are those of ``protocol`` (a tolerance the params name would
+    otherwise find no row, and its figures would silently be NaN), theta_a in [0, range end].
     """
+    missing = [column for column in ENVELOPE_COLUMNS if column not in envelopes.columns]
+    if missing:
+        raise ValueError(f"the envelopes table lacks columns {missing} (stage 02 writes {list(ENVELOPE_COLUMNS)})")
+    if set(envelopes["tolerance"]) != set(protocol.tolerance_names):
+        raise ValueError(f"the envelopes have tolerances {sorted(set(envelopes['tolerance']))}, protocol.tolerances "
+                         f"are {protocol.tolerance_names}: was stage 02 run with another protocol?")
+    end = envelopes["trajectory"].map(protocol.range_end)
+    outside = envelopes[~envelopes["theta_a"].between(0.0, end)]
+    if len(outside):
+        row = outside.iloc[0]
+        raise ValueError(f"{len(outside)} envelopes lie outside [0, the protocol's range end], e.g. {row.dataset} "
+                         f"({row.trajectory}, {row.tolerance}, {row.method}): theta_a = {row.theta_a}")
     keys = ["dataset", "trajectory", "method"]
     table = theta_p.merge(envelopes[[*keys, "tolerance", "theta_a", "censored"]], on=keys, how="inner")
     return with_metrics(table)
@@ -150,27 +206,50 @@ def best_table(curves: pd.DataFrame, max_incursion_rate: float = 0.0) -> pd.Data
     return pd.DataFrame(rows)
 
 
-def live_trials(table: pd.DataFrame, predict: PredictParams, protocol: ProtocolParams, static_size: float) -> pd.DataFrame:
-    """The simulated live trials (V-C): next-step at n_t = live_n_t vs the static baseline at ``static_size``.
+def live_trials(table: pd.DataFrame, best: pd.DataFrame, predict: PredictParams, protocol: ProtocolParams
+                ) -> pd.DataFrame:  # fmt: skip
+    """The simulated live trials (V-C): next-step at n_t = live_n_t vs the static baseline at its best size.
 
+    best : :func:`best_table`; the static baseline runs at its largest zero-incursion size on the arcs of
+    ``protocol.pnp_method`` at ``predict.live_tolerance`` (the paper's comparison; NaN rows if it has none).
     One row per arc dataset of ``protocol.pnp_method`` at ``predict.live_tolerance``: theta_a, the stop angle and
-    its incursion, the share of the actual envelope used (SPL / theta_a), and the same for the static baseline.
+    its incursion, the share of the actual envelope used (SPL / theta_a), the status of the fits the robot went by,
+    and the same for the static baseline.
     """
     rows = table[
         (table["trajectory"] == "arc") & (table["method"] == protocol.pnp_method)
         & (table["tolerance"] == predict.live_tolerance)
     ]  # fmt: skip
+    static_best = best[(best["predictor"] == "static") & (best["trajectory"] == "arc")
+                       & (best["method"] == protocol.pnp_method) & (best["tolerance"] == predict.live_tolerance)]
+    static_size = float(static_best["best_operating_point"].iloc[0]) if len(static_best) else np.nan  # fmt: skip
     ours = rows[(rows["predictor"] == "next_step") & (rows["operating_point"] == predict.live_n_t)]
     static = rows[(rows["predictor"] == "static") & np.isclose(rows["operating_point"], static_size)]
-    merged = ours.merge(static[["dataset", "spl", "incursion"]], on="dataset", suffixes=("", "_static"))
+    merged = ours.merge(static[["dataset", "spl", "incursion"]], on="dataset", how="left", suffixes=("", "_static"))
     return pd.DataFrame(
         {
             "dataset": merged["dataset"], "theta_a": merged["theta_a"], "stop_angle": merged["theta_p"],
             "incursion": merged["incursion"], "share": merged["spl"] / merged["theta_a"],
-            "static_size": static_size, "static_incursion": merged["incursion_static"],
-            "static_share": merged["spl_static"] / merged["theta_a"],
+            "fit_status": merged["fit_status"], "static_size": static_size,
+            "static_incursion": merged["incursion_static"], "static_share": merged["spl_static"] / merged["theta_a"],
         }
     )  # fmt: skip
+
+
+def fit_status_shares(table: pd.DataFrame) -> dict[str, dict]:
+    """predictor -> {n_rows, ok, at_bound, non_physical, fallback, no_fit}: the share of the predictor's rows (every
+    dataset, PnP method, trajectory and operating point of the table, once whatever the tolerances joined) whose
+    theta_p rests on a fit of that status."""
+    table = table.drop_duplicates(["predictor", "method", "trajectory", "dataset", "operating_point"])
+    shares = {}
+    for predictor in FITTED_PREDICTORS:
+        rows = table.loc[table["predictor"] == predictor, "fit_status"]
+        counts = rows.value_counts()
+        entry: dict = {"n_rows": int(len(rows))}
+        for status in (*FIT_STATUSES, NO_FIT):
+            entry[status] = float(counts.get(status, 0) / len(rows)) if len(rows) else np.nan
+        shares[predictor] = entry
+    return shares
 
 
 def headline_metrics(
@@ -186,7 +265,8 @@ def headline_metrics(
     next_step.relative_improvement_vs_long_range; straight_line.relative_improvement (Fig. 7);
     pnp.<method>.{max_mean_spl_zero_incursion, static_max_mean_spl_zero_incursion} (Fig. 6);
     loso.<predictor>.<tolerance>.{heldout_incursion_rate, heldout_mean_spl, ...} at the first target rate;
-    live.{n_t, incursions, n_trials, envelope_share, static_*} (V-C). NaN where there is no value
+    live.{n_t, incursions, n_trials, envelope_share, n_flagged_fits, static_*} (V-C); fit_status.<predictor>.{n_rows,
+    ok, at_bound, non_physical, fallback, no_fit} (:func:`fit_status_shares`). NaN where there is no value
     (:func:`poseintegrity.report.metrics.write_metrics` writes it as null).
     """
     best = best_table(curves)
@@ -237,9 +317,11 @@ def headline_metrics(
     metrics["live"] = {
         "n_t": predict.live_n_t, "tolerance": predict.live_tolerance, "n_trials": int(len(live)),
         "incursions": float(live["incursion"].sum()), "envelope_share": float(live["share"].mean()),
+        "n_flagged_fits": int((~live["fit_status"].isin([OK])).sum()),
         "static_size": float(live["static_size"].iloc[0]) if len(live) else np.nan,
         "static_incursions": float(live["static_incursion"].sum()),
         "static_envelope_share": float(live["static_share"].mean()),
     }  # fmt: skip
+    metrics["fit_status"] = fit_status_shares(table)
     return metrics
 

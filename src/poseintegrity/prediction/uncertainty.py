@@ -10,8 +10,9 @@ Two ways, chosen by ``predict.uncertainty.method``:
     bootstrap   refit on the images resampled with replacement, ``n_bootstrap`` times; the interval is the
                 (1 - level)/2 and (1 + level)/2 percentiles of the refits' theta_p (any artifact model)
 
-A fit that did not converge gives no interval: (NaN, NaN) with a reason, and the lower-bound variant then
-flags the row.
+A fit that fell back to its line (status "fallback", artifact_models/fitted.py) gives no interval: (NaN, NaN)
+with a reason, and the lower-bound variant then flags the row. A fit at a bound or non-physical gets one from its
+fitted curve, as its theta_p does; its rows carry that fit status.
 """
 
 from __future__ import annotations
@@ -51,11 +52,11 @@ def parameter_jacobian(curve: BaseCurve, theta: np.ndarray) -> np.ndarray:
 
 
 def parameter_covariance(fitted: FittedModel, theta: np.ndarray, n_inliers: np.ndarray) -> np.ndarray | None:
-    """P = s^2 (J^T J)^+ of a converged base-function fit : (p, p); None without one or with m <= p samples.
+    """P = s^2 (J^T J)^+ of a fitted base-function curve : (p, p); None for a fallback, an MLP or m <= p samples.
 
     theta, n_inliers : (m,) the fitted samples (invalid ones are dropped as the fit dropped them)
     """
-    if not (fitted.converged and isinstance(fitted.curve, BaseCurve)):
+    if not (fitted.has_curve and isinstance(fitted.curve, BaseCurve)):
         return None
     keep = np.isfinite(theta) & np.isfinite(n_inliers) & (n_inliers >= 0)
     theta, n_inliers = theta[keep], n_inliers[keep]
@@ -79,7 +80,7 @@ def covariance_interval(
     P = parameter_covariance(fitted, np.asarray(theta, float), np.asarray(n_inliers, float))
     if P is None:
         nan = np.full(np.shape(thresholds), np.nan)
-        return Interval(nan, nan, "no covariance: the fit is not a converged base function with m > p samples")
+        return Interval(nan, nan, "no covariance: the fit is not a fitted base function with m > p samples")
     z = float(norm.ppf(0.5 + level / 2.0))
 
     def band(sign: float) -> Callable[[np.ndarray], np.ndarray]:
@@ -101,19 +102,19 @@ def bootstrap_interval(
 ) -> Interval:  # fmt: skip
     """Percentile interval of theta_p over refits on images resampled with replacement. theta, n_inliers : (m,).
 
-    Refits that do not converge are left out; fewer than two converged refits give (NaN, NaN).
+    Refits that fall back to their line are left out; fewer than two fitted refits give (NaN, NaN).
     """
     theta, n_inliers = np.asarray(theta, dtype=float), np.asarray(n_inliers, dtype=float)
     theta_1 = float(np.nanmin(theta)) if theta.size else np.nan
     draws = []
     for _ in range(n_bootstrap):
         index = rng.integers(0, theta.size, theta.size)
-        refit = fit_model(model, theta[index], n_inliers[index], theta_max=theta_end, params=fit, rng=rng)
-        if refit.converged:
+        refit = fit_model(model, theta[index], n_inliers[index], theta_end=theta_end, params=fit, rng=rng)
+        if refit.has_curve:
             draws.append(envelope_prediction(refit.predict, thresholds, theta_1, theta_end, n_grid).theta_p)
     if len(draws) < 2:
         nan = np.full(np.shape(thresholds), np.nan)
-        return Interval(nan, nan, f"only {len(draws)} of {n_bootstrap} bootstrap refits converged")
+        return Interval(nan, nan, f"only {len(draws)} of {n_bootstrap} bootstrap refits fitted a curve")
     q = 100.0 * np.array([0.5 - level / 2.0, 0.5 + level / 2.0])
     lower, upper = np.percentile(np.stack(draws), q, axis=0)
     return Interval(lower, upper, "ok")

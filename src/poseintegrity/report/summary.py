@@ -37,6 +37,24 @@ SECTIONS = {
     "tracking": "Stage 06 · marker tracking (Black & Salcudean, IEEE TIM 2024, DOI 10.1109/TIM.2024.3398108, section III)",
 }
 
+FIT_STATUS_LABELS = {"ok": "ok", "at_bound": "at a bound", "non_physical": "non-physical",
+                     "fallback": "fallen back to a line"}  # the statuses of artifact_models/fitted.py
+MODEL_LABELS = {"emg": "EMG (eq. 1)", "exponential": "exponential", "gaussian": "Gaussian", "logistic": "logistic",
+                "power_law": "power law", "mlp_scratch": "MLP, samples only",
+                "mlp_pretrained": "MLP, EMG-pretrained + fine-tuned"}
+
+
+def _fit_status_rows() -> list[Headline]:
+    """fits.json: per model, the share of all its Fig. 2 fits per status (ok / at a bound / non-physical / fallback)."""
+    rows = []
+    for model, name in MODEL_LABELS.items():
+        for status, label in FIT_STATUS_LABELS.items():
+            rows.append(Headline("fits", f"fit_status.{model}.{status}",
+                                 f"{name}: share of fits {label}" if status == "ok" else f"... {label}",
+                                 target=">= 0.99" if (model, status) == ("emg", "ok") else "-", fmt="{:.1%}"))
+    return rows
+
+
 def _predictor_rows() -> list[Headline]:
     """Tables I-III per tolerance, each row beside the paper's own value for that tolerance (report/paper.py)."""
     names = {"static": "static baseline", "mlp": "MLP", "long_range": "long range (EMG, eq. 1)",
@@ -90,6 +108,13 @@ def _predictor_rows() -> list[Headline]:
     rows += [Headline("predictors", f"pnp.{method}.max_mean_spl_zero_incursion",
                       f"long range on {name}, 2 mm/3 deg (deg)", "similar to USAC (Fig. 6)" if method == "epnp" else "-")
              for method, name in (("epnp", "EPnP"), ("p3p", "P3P"), ("ap3p", "AP3P"), ("sqpnp", "SQPnP"))]
+    # every row of a predictor rests on a fit: the share resting on a flagged one (still counted, as the robot acted)
+    for predictor in ("long_range", "mlp", "next_step"):
+        rows += [Headline("predictors", f"fit_status.{predictor}.{status}",
+                          f"{names[predictor]}: share of rows (dataset x n_t) on a fit {label}" if status == "ok"
+                          else f"... {label}", fmt="{:.1%}")
+                 for status, label in FIT_STATUS_LABELS.items()]
+    rows.append(Headline("predictors", "live.n_flagged_fits", "simulated live trials that went by a flagged fit"))
     return rows
 
 
@@ -158,7 +183,7 @@ HEADLINES: list[Headline] = [
     Headline("fits", "rmse_k4.power_law", "power law"),
     Headline("fits", "rmse_k4.mlp_scratch", "MLP, samples only", "'very high RMSE'"),
     Headline("fits", "rmse_k4.mlp_pretrained", "MLP, EMG-pretrained + fine-tuned", "competitive with least squares"),
-    Headline("fits", "converged.emg", "share of EMG fits that converged", "-", ">= 0.99"),
+    *_fit_status_rows(),
     *_predictor_rows(),
     Headline("tracking", "rms_axis_mm.no_filter", "RMS position error per axis, no filter (mm; paper's metric)",
              f"{BLACK['rms_mm']['no_filter']:g}"),
