@@ -2,8 +2,9 @@
 
 Prints medians in ms and ratios against two references measured in the same run on the same frame:
 SIFT detectAndCompute (the per-frame work stage 02 does next) and a flat-picture perspective warp
-(cv2.warpPerspective), the cheap thing the renderer replaces. Target: render + sensor <= 100 ms.
-Run: .venv/bin/python benchmarks/bench_render.py
+(cv2.warpPerspective), the cheap thing the renderer replaces. Target: render + sensor <= 100 ms. Also the PNG
+encoding of one image (stage 01 renders once per stop, then exposes and encodes each of its images_per_stop).
+Parameters: params.yaml (generate, protocol). Run: .venv/bin/python benchmarks/bench_render.py
 """
 
 import time
@@ -16,7 +17,8 @@ from poseintegrity.scenes import dataset, renderer, trajectories
 from poseintegrity.scenes.camera import Intrinsics, inverse
 
 cv2.setNumThreads(1)
-params = load_params("params.yaml").generate
+everything = load_params("params.yaml")
+params, protocol = everything.generate, everything.protocol
 cam = Intrinsics.from_params(params.camera)
 sift = cv2.SIFT_create()
 
@@ -31,10 +33,12 @@ def median_ms(fn, repeats: int) -> float:
 
 
 for scene_index in (0, 1, 2, 4):  # a scapula, the drilled scapula, a block, a scapula + block
-    world = dataset._world(params, scene_index)
+    world = dataset.world(params, scene_index)
     spec = params.scenes[scene_index]
-    T0 = trajectories.model_pair(world.scene.aim, world.scene.view_dir, spec.distance_mm, 20.0)[0]
-    stop = trajectories.arc(T0, world.scene.aim, 90.0, 45.0, 20)[5]
+    T0 = trajectories.model_pair(world.scene.aim, world.scene.view_dir, spec.distance_mm, params.model_baseline_mm)[0]
+    azimuth = params.arcs.azimuths_deg[min(1, len(params.arcs.azimuths_deg) - 1)]  # 90: down towards the table
+    stop = trajectories.arc(T0, world.scene.aim, azimuth, protocol.arc_span_deg, params.arcs.n_stops)[
+        params.arcs.n_stops // 4]
     T_cam_world = inverse(stop.T_world_cam)
     rng = np.random.default_rng(0)
     renderer.render(world.geometry, cam.K, cam.width, cam.height, T_cam_world)  # compile / warm up
@@ -48,7 +52,9 @@ for scene_index in (0, 1, 2, 4):  # a scapula, the drilled scapula, a block, a s
         params.sensor, rng), 15)
     sift_ms = median_ms(lambda: sift.detectAndCompute(image, None), 7)
     warp_ms = median_ms(lambda: cv2.warpPerspective(image, H, (cam.width, cam.height)), 15)
+    png_ms = median_ms(lambda: cv2.imencode(".png", image, dataset.PNG_FLAGS), 15)
     print(f"{spec.name} ({'+'.join(spec.targets)}, {len(world.geometry.faces)} triangles, {cam.width}x{cam.height})")
     print(f"  render {render_ms:6.1f} ms | render + sensor {full_ms:6.1f} ms (target <= 100)")
     print(f"  SIFT detectAndCompute {sift_ms:6.1f} ms -> render + sensor = {full_ms / sift_ms:.2f} x SIFT")
     print(f"  warpPerspective {warp_ms:6.2f} ms -> render + sensor = {full_ms / warp_ms:.0f} x a flat warp")
+    print(f"  PNG encoding {png_ms:6.1f} ms per image")

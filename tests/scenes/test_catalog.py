@@ -18,6 +18,8 @@ def generate():
 
 
 def spec(targets, **extra):
+    if any(name.startswith("scapula") for name in targets):
+        extra.setdefault("glenoid_tilt_deg", (0.0, 0.0))
     return SceneSpec(name="s", targets=targets, distance_mm=350, elevation_deg=50, n_clutter=6, **extra)
 
 

@@ -1,4 +1,5 @@
-"""Stage 01 on tiny parameters: layout, ground truth consistency, byte-for-byte determinism, atomic writes."""
+"""Stage 01 on tiny parameters: layout, ground truth consistency, byte-for-byte determinism (whatever the worker
+count; another generate.seed gives another world), atomic writes."""
 
 import hashlib
 import json
@@ -9,6 +10,7 @@ import pandas as pd
 import pytest
 
 from poseintegrity.config import load_params
+from poseintegrity.parallel import Workers
 from poseintegrity.scenes import dataset, renderer
 from repository import ROOT
 
@@ -24,7 +26,8 @@ def digest(root) -> dict[str, str]:
 def tiny_root(tmp_path_factory):
     params = TINY.generate
     root = tmp_path_factory.mktemp("datasets")
-    dataset.generate(params, TINY.protocol, root, progress=False)
+    with Workers(TINY.parallel) as workers:
+        dataset.generate(params, TINY.protocol, root, workers, progress=False)
     return params, root
 
 
@@ -58,11 +61,9 @@ def test_board_ground_truth_agrees_with_opencv_aruco_pose(tiny_root):
     """T_cam_board of the renderer and the pose OpenCV recovers from the rendered board agree (half resolution)."""
     from poseintegrity.scenes import trajectories
     from poseintegrity.scenes.camera import Intrinsics, inverse
-    from poseintegrity.scenes.params import CameraParams
-
     params, _ = tiny_root
-    params = params.model_copy(update={"camera": CameraParams(downscale=2)})
-    world = dataset._world(params, 1)
+    params = params.model_copy(update={"camera": params.camera.model_copy(update={"downscale": 2})})
+    world = dataset.world(params, 1)
     cam = Intrinsics.from_params(params.camera)
     T_world_cam = trajectories.model_pair(world.scene.aim, world.scene.view_dir, params.scenes[1].distance_mm,
                                           20.0)[0]
@@ -81,10 +82,27 @@ def test_board_ground_truth_agrees_with_opencv_aruco_pose(tiny_root):
     assert np.degrees(np.arccos(np.clip((np.trace(R_err) - 1) / 2, -1, 1))) < 1.5
 
 
-def test_rerun_reproduces_every_file_byte_for_byte(tiny_root, tmp_path):
+def test_rerun_reproduces_every_file_byte_for_byte_on_two_workers(tiny_root, tmp_path):
     params, root = tiny_root
-    dataset.generate(params, TINY.protocol, tmp_path, progress=False)
+    with Workers(TINY.parallel.model_copy(update={"n_jobs": 2})) as workers:
+        dataset.generate(params, TINY.protocol, tmp_path, workers, progress=False)
     assert digest(tmp_path) == digest(root)
+
+
+def test_another_seed_lays_out_and_exposes_another_world(tiny_root, tmp_path):
+    """Every random draw derives from generate.seed: the scene layouts (board and target poses), the textures,
+    the foam and the sensor noise."""
+    params, root = tiny_root
+    with Workers(TINY.parallel) as workers:
+        dataset.generate(params.model_copy(update={"seed": params.seed + 1}), TINY.protocol, tmp_path, workers,
+                         progress=False)
+    first, other = digest(root), digest(tmp_path)
+    assert first.keys() == other.keys()
+    assert all(first[file] != other[file] for file in first if file.endswith(".png") and "mask" not in file)
+    for name in first:
+        if name.endswith("frames.parquet"):  # the board lies elsewhere (a phantom faces the camera as its tilt says)
+            boards = [np.stack(pd.read_parquet(folder / name)["T_cam_board"]) for folder in (root, tmp_path)]
+            assert not np.allclose(*boards)
 
 
 def test_interrupted_run_leaves_nothing_that_looks_complete(tiny_root, tmp_path, monkeypatch):
@@ -99,7 +117,7 @@ def test_interrupted_run_leaves_nothing_that_looks_complete(tiny_root, tmp_path,
         return real_expose(*args, **kwargs)
 
     monkeypatch.setattr(renderer, "expose", failing_expose)
-    with pytest.raises(KeyboardInterrupt):
-        dataset.generate(params.model_copy(update={"n_jobs": 1}), TINY.protocol, tmp_path, progress=False)
+    with Workers(TINY.parallel.model_copy(update={"n_jobs": 1})) as workers, pytest.raises(KeyboardInterrupt):
+        dataset.generate(params, TINY.protocol, tmp_path, workers, progress=False)
     assert not (tmp_path / "index.parquet").exists()
     assert [p.name for p in tmp_path.iterdir() if not p.name.startswith(".")] == []

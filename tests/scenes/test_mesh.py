@@ -25,7 +25,7 @@ def test_a_trimesh_becomes_an_untextured_mesh_with_outward_normals_split_at_crea
     import trimesh
 
     box = trimesh.creation.box((20.0, 30.0, 40.0))
-    m = mesh.from_trimesh(box, mesh.BONE_FOAM)
+    m = mesh.from_trimesh(box, mesh.Material(foam_albedo=0.8))
     assert m.texture is None and m.material.foam_albedo is not None
     assert signed_volume(m) == pytest.approx(24000.0)
     # every corner is a crease: its normals follow the faces (a box keeps flat faces), all unit and outward

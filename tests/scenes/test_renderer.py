@@ -6,15 +6,21 @@ import cv2
 import numpy as np
 import pytest
 
+from poseintegrity.config import load_params
 from poseintegrity.scenes import foam, mesh, renderer
 from poseintegrity.scenes.textures import build_atlas
+from repository import ROOT
+
+GENERATE = load_params(ROOT / "params.yaml").generate
 
 W, H = 320, 240
 K = np.array([[300.0, 0, (W - 1) / 2], [0, 300.0, (H - 1) / 2], [0, 0, 1]])
 NO_SPECULAR = mesh.Material(specular=0.0)
 LIGHTS = (0.2, 0.7, 0.3, 0.05)  # ambient, ring, room, background
 FLAT = foam.ReliefVolume(np.zeros((8, 8, 8), np.float32), 0.125, 0.2, 0.0, 1.0)  # no relief, no mottling
-RELIEF = foam.relief_volume(np.random.default_rng(0), n=64, pore_fraction=0.05, bump_slope=0.1, albedo_std=0.0)
+# the phantoms' foam with more contrast between pores and bumps, unmottled, on a smaller grid
+RELIEF = GENERATE.bone_foam.model_copy(update={"pore_fraction": 0.05, "bump_slope": 0.1, "albedo_std": 0.0}).relief(
+    0, n=64)
 
 
 def smooth_texture(seed: int, size: int = 256, sigma: float = 3.0) -> np.ndarray:
@@ -114,9 +120,8 @@ def test_mip_mapping_prevents_aliasing_of_fine_texture():
 
 
 def test_expose_is_seeded_and_models_noise():
-    from poseintegrity.scenes.params import SensorParams
-
-    sensor = SensorParams(flicker=0.0, blur_sigma_px=0.0, read_noise_dn=2.0, shot_noise_dn_per_dn=0.0)
+    sensor = GENERATE.sensor.model_copy(update={"flicker": 0.0, "blur_sigma_px": 0.0, "read_noise_dn": 2.0,
+                                                "shot_noise_dn_per_dn": 0.0})
     radiance = np.full((200, 200), 0.5, np.float32)
     a = renderer.expose(radiance, sensor, np.random.default_rng(1))
     b = renderer.expose(radiance, sensor, np.random.default_rng(1))

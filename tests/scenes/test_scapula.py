@@ -78,4 +78,4 @@ def test_a_scale_that_loses_the_target_stops_before_rendering(generate, length_m
         "scapula": generate.scapula.model_copy(update={"length_mm": length_mm}),
         "scenes": [generate.scenes[0]], "lines": None})  # scene_1: the plain scapula (no hole to drill)
     with pytest.raises(WorldError, match=f"generate.scenes.0: .*{message}.*generate.scapula.length_mm"):
-        check_world(scaled)
+        check_world(scaled, load_params(ROOT / "params.yaml").protocol)

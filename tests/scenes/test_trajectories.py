@@ -4,9 +4,12 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
+from poseintegrity.config import load_params
 from poseintegrity.scenes import trajectories
 from poseintegrity.scenes.camera import Intrinsics, look_at
-from poseintegrity.scenes.params import CameraParams
+from repository import ROOT
+
+CAMERA = load_params(ROOT / "params.yaml").generate.camera
 
 AIM = np.array([10.0, -20.0, 80.0])
 
@@ -42,7 +45,7 @@ def test_arc_stops_change_viewing_angle_by_theta_and_keep_the_target_centred(azi
     stops = trajectories.arc(T0, AIM, azimuth, 45.0, 20)
     assert [s.theta_deg for s in stops] == pytest.approx(2.25 * np.arange(20))  # from the model view
     np.testing.assert_allclose(stops[0].T_world_cam, T0)
-    K = Intrinsics.from_params(CameraParams()).K
+    K = Intrinsics.from_params(CAMERA).K
     for stop in stops:
         assert angle_between_deg(T0[:3, :3], stop.T_world_cam[:3, :3]) == pytest.approx(stop.theta_deg, abs=1e-9)
         assert np.linalg.norm(stop.T_world_cam[:3, 3] - AIM) == pytest.approx(350.0)
@@ -77,7 +80,7 @@ def test_line_moves_back_along_the_optical_axis(offset):
 def test_defocus_is_zero_in_focus_and_follows_the_thin_lens_law():
     from poseintegrity.scenes.camera import defocus_sigma_px
 
-    camera = CameraParams(lens_mm=12.0, f_number=4.0, pixel_um=5.86, downscale=2)
+    camera = CAMERA.model_copy(update={"lens_mm": 12.0, "f_number": 4.0, "pixel_um": 5.86, "downscale": 2})
     assert defocus_sigma_px(220.0, 220.0, camera) == 0.0
     # c = f^2/N |d - d_f| / (d (d_f - f)) = 144/4 * 150 / (370 * 208) mm; sigma = c/2 in half-resolution pixels
     c_mm = 36.0 * 150.0 / (370.0 * 208.0)

@@ -16,7 +16,8 @@ z up, millimetres.
 from __future__ import annotations
 
 import zlib
-from dataclasses import dataclass, field
+from dataclasses import dataclass
+from functools import lru_cache
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -44,9 +45,16 @@ def rng_for(seed: int, *key: str | int) -> np.random.Generator:
     return np.random.default_rng([seed, *(zlib.crc32(k.encode()) if isinstance(k, str) else k for k in key)])
 
 
+@lru_cache(maxsize=len(TEXTURE_NAMES))
 def procedural_texture(name: str, seed: int) -> np.ndarray:
-    """The albedo map of a texture name, the same in every scene and process."""
-    rng = rng_for(seed, "texture", name)
+    """The albedo map of a texture name, the same in every scene and process: drawn once per process (most of a
+    scene's layout time went into drawing the same textures again), read-only."""
+    texture = _draw_texture(name, rng_for(seed, "texture", name))
+    texture.flags.writeable = False
+    return texture
+
+
+def _draw_texture(name: str, rng: np.random.Generator) -> np.ndarray:
     if name == "block_print":
         return _faint_lid(tex.collage_texture(rng, (1024, 1536), density=3.0, contrast=0.45, text=True), rng)
     if name == "block_mosaic":
@@ -84,7 +92,8 @@ def target_mesh(name: str, params: "GenerateParams") -> meshes.Mesh:
 
 @dataclass
 class Scene:
-    """A laid-out scene: placed meshes, which of them are targets, the board, the model-view direction.
+    """A laid-out scene: placed meshes, which of them are targets, the board, the model-view direction (the
+    textures of its meshes: :func:`scene_textures`).
 
     T_world_target is the frame of the first target; ``aim`` is the point the camera looks at and the arcs turn
     about (the glenoid centre of a single scapula: the paper's robot keeps its guide wire in the drill hole).
@@ -99,7 +108,6 @@ class Scene:
     aim: np.ndarray
     view_dir: np.ndarray
     light_dir: np.ndarray
-    textures: dict[str, np.ndarray] = field(repr=False, default_factory=dict)
 
 
 def _model_view_frame(view_dir: np.ndarray) -> np.ndarray:
@@ -178,12 +186,18 @@ def build_scene(spec: "SceneSpec", index: int, params: "GenerateParams") -> Scen
     placed += _clutter(spec, params, rng, aim, toward_cam, board_centre)
 
     light_dir = np.array([rng.uniform(-0.5, 0.5), rng.uniform(-0.5, 0.3), 1.0])
-    used = {m.texture for _, m in placed if m.texture is not None}
+    return Scene(spec.name, placed, tuple(spec.targets), target_poses[0], T_world_board, board, aim, view_dir,
+                 light_dir)
+
+
+def scene_textures(scene: Scene, params: "GenerateParams") -> dict[str, np.ndarray]:
+    """The albedo map of every texture the scene's meshes use: an image file of ``generate.textures`` or the
+    procedural texture of that name, and the printed ArUco board."""
+    used = {m.texture for _, m in scene.placed if m.texture is not None}
     textures = {name: (tex.load_texture(params.textures[name]) if name in params.textures
                        else procedural_texture(name, params.seed)) for name in used if name != "aruco_board"}
-    textures["aruco_board"] = board.texture()
-    return Scene(spec.name, placed, tuple(spec.targets), target_poses[0], T_world_board, board, aim, view_dir,
-                 light_dir, textures)
+    textures["aruco_board"] = scene.board.texture()
+    return textures
 
 
 def _clutter(spec: "SceneSpec", params: "GenerateParams", rng: np.random.Generator, aim: np.ndarray,

@@ -5,28 +5,39 @@ Layout of ``<root>/<dataset>/``: ``meta.json`` (scene, targets, trajectory, intr
 row-major 16-float lists), ``model/`` (the two model images and their target masks) and ``images/``.
 A dataset is written into a hidden temporary folder and renamed when complete, so an interrupted run leaves
 nothing that looks finished; ``<root>/index.parquet`` is written last.
+
+The work is split into :class:`Shot` tasks, one per distinct camera pose of a scene, run by
+:class:`poseintegrity.parallel.Workers`: a shot renders its pose once and writes every image taken there. Poses
+that several datasets share are rendered once: a scene's model pair serves all its arcs (and the lines theirs),
+and an arc's first stop is its model view (IV-D: the robot returns to it). Every image draws its noise from its
+own generator, keyed by ``generate.seed`` and what the image is, so the files do not depend on the backend, the
+worker count or the order the shots run in.
 """
 
 from __future__ import annotations
 
 import json
 import shutil
+from collections import OrderedDict
 from dataclasses import dataclass
+from functools import lru_cache, partial
 from pathlib import Path
 
 import cv2
 import numpy as np
 import pandas as pd
-from joblib import Parallel, delayed
-from tqdm.auto import tqdm
 
+from poseintegrity.parallel import Workers
 from poseintegrity.protocol import ProtocolParams
 from poseintegrity.scenes import catalog, renderer, trajectories
 from poseintegrity.scenes.camera import Intrinsics, defocus_sigma_px, inverse
-from poseintegrity.scenes.params import GenerateParams
+from poseintegrity.scenes.foam import ReliefVolume
+from poseintegrity.scenes.params import BoneFoamParams, GenerateParams
 from poseintegrity.scenes.textures import build_atlas
 
 PNG_FLAGS = [cv2.IMWRITE_PNG_COMPRESSION, 3]
+MIN_TARGET_IN_VIEW = 0.5  # share of a target's vertices that must project inside the model images
+MIN_TARGET_AREA = 0.005  # share of the image its projected bounding box must cover (not a speck)
 
 
 @dataclass(frozen=True)
@@ -41,44 +52,56 @@ class DatasetPlan:
 
 
 def plan_datasets(params: GenerateParams) -> list[DatasetPlan]:
-    """Arcs: every scene x every azimuth; lines: every offset on ``lines.scene`` (IV-D)."""
-    plans = [DatasetPlan(f"{spec.name}_arc{az:03.0f}", i, "arc", az, 0.0)
-             for i, spec in enumerate(params.scenes) for az in params.arcs.azimuths_deg]
+    """Arcs: every scene x every azimuth; lines: every offset on ``lines.scene`` (IV-D). The ids are
+    :meth:`GenerateParams.dataset_ids` (validated distinct)."""
+    plans = [DatasetPlan(dataset, i, "arc", az, 0.0) for i, spec in enumerate(params.scenes)
+             for dataset, az in zip(params.arcs.dataset_ids(spec.name), params.arcs.azimuths_deg)]
     if params.lines is not None:
         i = [s.name for s in params.scenes].index(params.lines.scene)
-        plans += [DatasetPlan(f"{params.lines.scene}_line{off:02.0f}", i, "line", 0.0, off)
-                  for off in params.lines.offsets_deg]
+        plans += [DatasetPlan(dataset, i, "line", 0.0, off)
+                  for dataset, off in zip(params.lines.dataset_ids(), params.lines.offsets_deg)]
     return plans
 
 
 @dataclass(frozen=True)
-class _World:
-    scene: catalog.Scene
-    geometry: renderer.SceneGeometry
-    target_ids: np.ndarray
+class Trip:
+    """Where the camera of one dataset goes: its model pair (T_world_cam, the first is where the trajectory
+    starts) at ``distance_mm`` from the aim point, and the stops of its trajectory."""
+
+    distance_mm: float
+    model_views: list[np.ndarray]
+    stops: list[trajectories.Stop]
 
 
-_WORLDS: dict[tuple[str, int], _World] = {}
-
-
-MIN_TARGET_IN_VIEW = 0.5  # share of a target's vertices that must project inside the model images
-MIN_TARGET_AREA = 0.005  # share of the image its projected bounding box must cover (not a speck)
+def plan_trip(params: GenerateParams, protocol: ProtocolParams, plan: DatasetPlan, scene: catalog.Scene) -> Trip:
+    """The model pair and stops of ``plan`` in ``scene``; the trajectory spans ``protocol``'s range."""
+    # the straight lines have their own model pair (IV-D), closer to the target: the robot backs away from it
+    distance_mm = params.scenes[plan.scene_index].distance_mm if plan.trajectory == "arc" else params.lines.distance_mm
+    model_views = trajectories.model_pair(scene.aim, scene.view_dir, distance_mm, params.model_baseline_mm)
+    if plan.trajectory == "arc":
+        stops = trajectories.arc(model_views[0], scene.aim, plan.azimuth_deg, protocol.arc_span_deg,
+                                 params.arcs.n_stops)
+    else:
+        stops = trajectories.line(model_views[0], scene.aim, plan.offset_deg, protocol.line_length_mm,
+                                  params.lines.n_stops)
+    return Trip(distance_mm, model_views, stops)
 
 
 class WorldError(ValueError):
     """A scene cannot give the datasets: its target would leave (or vanish from) the model view."""
 
 
-def check_world(params: GenerateParams) -> None:
-    """Stop before any rendering, naming the key, when a scene cannot be rendered as the protocol needs: every
-    scene is built (an unreadable mesh or a hole outside the bone raises :class:`~.scapula.MeshError` here) and each
-    target must lie mostly inside both model views of its arcs and, for the lines' scene, of the lines' model pair
-    (a mesh scaled far too large or too small, or a distance that puts the target out of the picture)."""
+def check_world(params: GenerateParams, protocol: ProtocolParams) -> list[catalog.Scene]:
+    """Lay out every scene and stop before any rendering, naming the key, when one cannot be rendered as the
+    protocol needs; returns the scenes. Every scene is built (an unreadable mesh or a hole outside the bone raises
+    :class:`~.scapula.MeshError` here); each target must lie mostly inside both model views of its arcs and, for
+    the lines' scene, of the lines' model pair (a mesh scaled far too large or too small, or a distance that puts
+    the target out of the picture)."""
     cam = Intrinsics.from_params(params.camera)
-    for index, spec in enumerate(params.scenes):
-        scene = catalog.build_scene(spec, index, params)
-        distances = [spec.distance_mm]
-        if params.lines is not None and params.lines.scene == spec.name:
+    scenes = [catalog.build_scene(spec, index, params) for index, spec in enumerate(params.scenes)]
+    for index, scene in enumerate(scenes):
+        distances = [params.scenes[index].distance_mm]
+        if params.lines is not None and params.lines.scene == scene.name:
             distances.append(params.lines.distance_mm)
         for distance in distances:
             for T_world_cam in trajectories.model_pair(scene.aim, scene.view_dir, distance, params.model_baseline_mm):
@@ -87,6 +110,7 @@ def check_world(params: GenerateParams) -> None:
                     if name in scene.target_objects:
                         _check_in_view(mesh.vertices @ T_cam_world[:3, :3].T + T_cam_world[:3, 3], cam, index, name,
                                        distance)
+    return scenes
 
 
 def _check_in_view(points_cam: np.ndarray, cam: Intrinsics, index: int, name: str, distance: float) -> None:
@@ -107,91 +131,160 @@ def _check_in_view(points_cam: np.ndarray, cam: Intrinsics, index: int, name: st
                          f"to be seen; {hint}")
 
 
-def _world(params: GenerateParams, scene_index: int) -> _World:
-    """The scene and its renderable geometry, built once per process and scene."""
+@dataclass(frozen=True)
+class World:
+    """A scene and its renderable geometry; ``target_ids`` index its targets in ``geometry.object_names``."""
+
+    scene: catalog.Scene
+    geometry: renderer.SceneGeometry
+    target_ids: np.ndarray
+
+
+_WORLDS: OrderedDict[tuple[str, int], World] = OrderedDict()
+WORLDS_KEPT = 2  # per process: the shots of one scene run together, a worker seldom goes back to an earlier one
+
+
+def world(params: GenerateParams, scene_index: int) -> World:
+    """The scene and its renderable geometry, built once per process and scene (the last WORLDS_KEPT kept)."""
     key = (params.model_dump_json(), scene_index)
     if key not in _WORLDS:
-        _WORLDS.clear()
         _WORLDS[key] = _build_world(params, scene_index)
+        while len(_WORLDS) > WORLDS_KEPT:
+            _WORLDS.popitem(last=False)
+    _WORLDS.move_to_end(key)
     return _WORLDS[key]
 
 
-def _build_world(params: GenerateParams, scene_index: int) -> _World:
+@lru_cache(maxsize=1)
+def _relief(bone_foam: BoneFoamParams, seed: int) -> ReliefVolume:
+    """The foam's relief: one material, the same in every scene, drawn once per process."""
+    return bone_foam.relief(seed)
+
+
+def _build_world(params: GenerateParams, scene_index: int) -> World:
     scene = catalog.build_scene(params.scenes[scene_index], scene_index, params)
-    geometry = renderer.SceneGeometry.from_meshes(scene.placed, build_atlas(scene.textures), scene.light_dir,
-                                                  params.lights.intensities(), params.bone_foam.relief(params.seed))
+    atlas = build_atlas(catalog.scene_textures(scene, params))
+    geometry = renderer.SceneGeometry.from_meshes(scene.placed, atlas, scene.light_dir, params.lights.intensities(),
+                                                  _relief(params.bone_foam, params.seed))
     target_ids = np.array([i for i, name in enumerate(geometry.object_names) if name in scene.target_objects])
-    return _World(scene, geometry, target_ids)
+    return World(scene, geometry, target_ids)
+
+
+@dataclass(frozen=True)
+class Exposure:
+    """Images taken at a shot: image i is drawn from ``default_rng([generate.seed, *rng_key, i])`` and written
+    as ``files[i]`` into the folder of every dataset in ``datasets`` (several when they share these images byte
+    for byte: a scene's model pair); ``mask``: the file of the target mask, written beside them."""
+
+    datasets: tuple[str, ...]
+    files: tuple[str, ...]
+    rng_key: tuple[int, ...]
+    mask: str | None = None
+
+
+@dataclass(frozen=True)
+class Shot:
+    """One camera pose (T_world_cam) of scene ``scene_index``, the lens focused at ``focus_mm``: rendered once,
+    then exposed for every image taken there."""
+
+    scene_index: int
+    T_world_cam: np.ndarray
+    focus_mm: float
+    exposures: tuple[Exposure, ...]
+
+
+def plan_shots(params: GenerateParams, plans: list[DatasetPlan], trips: list[Trip]) -> list[Shot]:
+    """Every image of every dataset, grouped by the pose it is taken from (bit-identical poses of one scene and
+    focus share one render), the shots of a scene together (a worker then builds each scene once)."""
+    exposures: dict[tuple, dict[tuple, list[str]]] = {}  # shot key -> (files, rng_key, mask) -> datasets
+    poses: dict[tuple, np.ndarray] = {}
+
+    def add(plan: DatasetPlan, T_world_cam: np.ndarray, focus_mm: float, files: tuple[str, ...],
+            rng_key: tuple[int, ...], mask: str | None = None) -> None:
+        key = (plan.scene_index, T_world_cam.tobytes(), focus_mm)
+        poses.setdefault(key, T_world_cam)
+        exposures.setdefault(key, {}).setdefault((files, rng_key, mask), []).append(plan.dataset)
+
+    for dataset_index, (plan, trip) in enumerate(zip(plans, trips)):
+        for k, T_world_cam in enumerate(trip.model_views):
+            # model images depend on the scene and trajectory kind only: datasets sharing them share them byte for byte
+            add(plan, T_world_cam, trip.distance_mm, (f"model/model_{k}.png",),
+                (plan.scene_index, 1000 + k + 10 * (plan.trajectory == "line")), f"model/mask_{k}.png")
+        for s, stop in enumerate(trip.stops):
+            add(plan, stop.T_world_cam, trip.distance_mm, _image_files(s, params.images_per_stop), (dataset_index, s))
+    shots = [Shot(key[0], poses[key], key[2], tuple(Exposure(tuple(datasets), *what)
+                                                    for what, datasets in taken.items()))
+             for key, taken in exposures.items()]
+    return sorted(shots, key=lambda shot: shot.scene_index)  # stable: the datasets' order within a scene
+
+
+def _image_files(stop: int, images_per_stop: int) -> tuple[str, ...]:
+    return tuple(f"images/s{stop:02d}_i{i:02d}.png" for i in range(images_per_stop))
+
+
+def _partial(root: Path, dataset: str) -> Path:
+    """The hidden folder a dataset is written into, renamed to ``root / dataset`` when complete."""
+    return root / f".{dataset}.partial"
+
+
+def take_shot(params: GenerateParams, root: Path, shot: Shot) -> None:
+    """Render ``shot`` and write its images (and masks) into the datasets' partial folders under ``root``."""
+    scene_world = world(params, shot.scene_index)
+    cam = Intrinsics.from_params(params.camera)
+    T_cam_world = inverse(shot.T_world_cam)
+    frame = renderer.render(scene_world.geometry, cam.K, cam.width, cam.height, T_cam_world)
+    depth_mm = (T_cam_world[:3, :3] @ scene_world.scene.aim + T_cam_world[:3, 3])[2]
+    defocus = defocus_sigma_px(depth_mm, shot.focus_mm, params.camera)  # focused at the model view
+    irradiance = renderer.optics(frame.radiance, params.sensor, defocus)  # the robot is still: one image
+    for exposure in shot.exposures:
+        for i, file in enumerate(exposure.files):
+            image = renderer.expose(irradiance, params.sensor, np.random.default_rng([params.seed, *exposure.rng_key, i]))
+            _write_png(root, exposure.datasets, file, image)
+        if exposure.mask is not None:
+            mask = np.isin(frame.object_index, scene_world.target_ids).astype(np.uint8) * 255
+            _write_png(root, exposure.datasets, exposure.mask, mask)
+
+
+def _write_png(root: Path, datasets: tuple[str, ...], file: str, image: np.ndarray) -> None:
+    """Encode once, write into every dataset's partial folder."""
+    ok, encoded = cv2.imencode(".png", image, PNG_FLAGS)
+    if not ok:
+        raise OSError(f"cannot encode {file} as PNG")
+    for dataset in datasets:
+        (_partial(root, dataset) / file).write_bytes(encoded.tobytes())
 
 
 def _flat(T: np.ndarray) -> list[float]:
     return [float(v) for v in T.ravel()]
 
 
-def write_dataset(params: GenerateParams, protocol: ProtocolParams, plan: DatasetPlan, root: Path) -> dict:
-    """Render one dataset into ``root / plan.dataset`` (its trajectory spans ``protocol``'s range); returns its row
-    of the index."""
-    world = _world(params, plan.scene_index)
+def finish_dataset(params: GenerateParams, root: Path, plan: DatasetPlan, trip: Trip, scene: catalog.Scene) -> dict:
+    """Once its images are written: the dataset's frames.parquet and meta.json, then its partial folder renamed
+    to ``root / plan.dataset``; returns its row of the index."""
     spec = params.scenes[plan.scene_index]
     cam = Intrinsics.from_params(params.camera)
-    scene = world.scene
-    # the straight lines have their own model pair (IV-D), closer to the target: the robot backs away from it
-    distance_mm = spec.distance_mm if plan.trajectory == "arc" else params.lines.distance_mm
-    model_views = trajectories.model_pair(scene.aim, scene.view_dir, distance_mm, params.model_baseline_mm)
-    if plan.trajectory == "arc":
-        stops = trajectories.arc(model_views[0], scene.aim, plan.azimuth_deg, protocol.arc_span_deg,
-                                 params.arcs.n_stops)
-    else:
-        stops = trajectories.line(model_views[0], scene.aim, plan.offset_deg, protocol.line_length_mm,
-                                  params.lines.n_stops)
-
-    final = root / plan.dataset
-    tmp = root / f".{plan.dataset}.partial"
-    shutil.rmtree(tmp, ignore_errors=True)
-    (tmp / "model").mkdir(parents=True)
-    (tmp / "images").mkdir()
-
-    def shoot(T_world_cam: np.ndarray, rng_key: tuple[int, ...], n: int) -> tuple[renderer.Render, list[np.ndarray]]:
-        T_cam_world = inverse(T_world_cam)
-        frame = renderer.render(world.geometry, cam.K, cam.width, cam.height, T_cam_world)
-        depth_mm = (T_cam_world[:3, :3] @ scene.aim + T_cam_world[:3, 3])[2]
-        defocus = defocus_sigma_px(depth_mm, distance_mm, params.camera)  # focused at the model view
-        irradiance = renderer.optics(frame.radiance, params.sensor, defocus)  # the robot is still: one image
-        images = [renderer.expose(irradiance, params.sensor, np.random.default_rng([params.seed, *rng_key, i]))
-                  for i in range(n)]
-        return frame, images
-
+    tmp, final = _partial(root, plan.dataset), root / plan.dataset
     model = {"images": [], "masks": [], "T_cam_board": [], "T_cam_target": []}
-    for k, T_world_cam in enumerate(model_views):
-        # model images depend on the scene and trajectory kind only: datasets sharing them share them byte for byte
-        frame, (image,) = shoot(T_world_cam, (plan.scene_index, 1000 + k + 10 * (plan.trajectory == "line")), 1)
-        mask = np.isin(frame.object_index, world.target_ids).astype(np.uint8) * 255
-        cv2.imwrite(str(tmp / f"model/model_{k}.png"), image, PNG_FLAGS)
-        cv2.imwrite(str(tmp / f"model/mask_{k}.png"), mask, PNG_FLAGS)
+    for k, T_world_cam in enumerate(trip.model_views):
         T_cam_world = inverse(T_world_cam)
         model["images"].append(f"model/model_{k}.png")
         model["masks"].append(f"model/mask_{k}.png")
         model["T_cam_board"].append((T_cam_world @ scene.T_world_board).tolist())
         model["T_cam_target"].append((T_cam_world @ scene.T_world_target).tolist())
-
-    dataset_index = [p.dataset for p in plan_datasets(params)].index(plan.dataset)
     rows = []
-    for s, stop in enumerate(stops):
-        _, images = shoot(stop.T_world_cam, (dataset_index, s), params.images_per_stop)
+    for s, stop in enumerate(trip.stops):
         T_cam_world = inverse(stop.T_world_cam)
-        for i, image in enumerate(images):
-            file = f"images/s{s:02d}_i{i:02d}.png"
-            cv2.imwrite(str(tmp / file), image, PNG_FLAGS)
+        for i, file in enumerate(_image_files(s, params.images_per_stop)):
             rows.append({"dataset": plan.dataset, "stop": s, "image": i, "theta_deg": stop.theta_deg,
                          "x_mm": stop.x_mm, "file": file, "T_cam_board": _flat(T_cam_world @ scene.T_world_board),
                          "T_cam_target": _flat(T_cam_world @ scene.T_world_target)})
     pd.DataFrame(rows).to_parquet(tmp / "frames.parquet", index=False)
     meta = {
         "dataset": plan.dataset, "scene": spec.name, "targets": list(spec.targets), "trajectory": plan.trajectory,
-        "azimuth_deg": plan.azimuth_deg, "offset_deg": plan.offset_deg, "n_stops": len(stops),
+        "azimuth_deg": plan.azimuth_deg, "offset_deg": plan.offset_deg, "n_stops": len(trip.stops),
         "images_per_stop": params.images_per_stop, "image_size": [cam.width, cam.height], "K": cam.K.tolist(),
         "dist": [0.0] * 5, "board": scene.board.as_dict(), "model": model,
-        "model_baseline_mm": params.model_baseline_mm, "distance_mm": distance_mm,
+        "model_baseline_mm": params.model_baseline_mm, "distance_mm": trip.distance_mm,
     }
     (tmp / "meta.json").write_text(json.dumps(meta, indent=1))
     shutil.rmtree(final, ignore_errors=True)
@@ -201,19 +294,25 @@ def write_dataset(params: GenerateParams, protocol: ProtocolParams, plan: Datase
             "path": f"datasets/{plan.dataset}"}
 
 
-def generate(params: GenerateParams, protocol: ProtocolParams, root: Path, progress: bool = True) -> pd.DataFrame:
-    """Render every planned dataset under ``root`` (in parallel, ``params.n_jobs``) after :func:`check_world`;
-    returns and writes the index."""
-    check_world(params)
+def generate(params: GenerateParams, protocol: ProtocolParams, root: Path, workers: Workers,
+             progress: bool = True) -> pd.DataFrame:
+    """Render every planned dataset under ``root`` after :func:`check_world`, the shots on ``workers``; returns
+    and writes the index."""
+    scenes = check_world(params, protocol)
     root = Path(root)
     root.mkdir(parents=True, exist_ok=True)
     (root / "index.parquet").unlink(missing_ok=True)
     plans = plan_datasets(params)
-    # datasets of one scene go to the same worker in sequence, so it builds each scene once
-    plans_sorted = sorted(plans, key=lambda p: p.scene_index)
-    jobs = Parallel(n_jobs=params.n_jobs, return_as="generator")(
-        delayed(write_dataset)(params, protocol, plan, root) for plan in plans_sorted)
-    rows = list(tqdm(jobs, total=len(plans), desc="datasets", disable=not progress))
-    index = pd.DataFrame(rows).set_index("dataset").loc[[p.dataset for p in plans]].reset_index()
+    trips = [plan_trip(params, protocol, plan, scenes[plan.scene_index]) for plan in plans]
+    for plan in plans:
+        tmp = _partial(root, plan.dataset)
+        shutil.rmtree(tmp, ignore_errors=True)
+        (tmp / "model").mkdir(parents=True)
+        (tmp / "images").mkdir()
+    shots = plan_shots(params, plans, trips)
+    workers.map(partial(take_shot, params, root), shots, desc=f"camera poses of {len(plans)} datasets",
+                progress=progress)
+    index = pd.DataFrame([finish_dataset(params, root, plan, trip, scenes[plan.scene_index])
+                          for plan, trip in zip(plans, trips)])
     index.to_parquet(root / "index.parquet", index=False)
     return index

@@ -26,6 +26,8 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 N_OCTAVES = 3  # pore radii r0, 2 r0, 4 r0
+N_VOXELS = 128  # one period of the relief volume: 128 voxels of VOXEL_MM = 16 mm
+VOXEL_MM = 0.125
 # fixed, well spread rotations decorrelating the octaves (and the albedo octave) from each other
 OCTAVE_ROTATIONS = Rotation.from_rotvec(
     [[0.0, 0.0, 0.0], [0.9, 0.3, -0.4], [-0.5, 1.1, 0.6], [0.7, -0.8, 1.2]]
@@ -62,10 +64,11 @@ def _periodic_gaussian_filter(field: np.ndarray, sigma_vox: float) -> np.ndarray
     return np.fft.ifftn(np.fft.fftn(field) * np.exp(-2.0 * np.pi**2 * sigma_vox**2 * k2)).real
 
 
-def relief_volume(rng: np.random.Generator, n: int = 128, voxel_mm: float = 0.125, pore_radius_mm: float = 0.2,
-                  pore_fraction: float = 0.12, pore_depth: float = 1.0, bump_slope: float = 0.15,
-                  albedo_std: float = 0.03, albedo_mottle_mm: float = 3.0) -> ReliefVolume:
-    """The foam's height field over one period (n voxels of ``voxel_mm``).
+def relief_volume(rng: np.random.Generator, *, pore_radius_mm: float, pore_fraction: float, pore_depth: float,
+                  bump_slope: float, albedo_std: float, albedo_mottle_mm: float, n: int = N_VOXELS,
+                  voxel_mm: float = VOXEL_MM) -> ReliefVolume:
+    """The foam's height field over one period (n voxels of ``voxel_mm``); the material's values come from
+    ``generate.bone_foam`` (:meth:`~.params.BoneFoamParams.relief`).
 
     Pores: spherical pits (Gaussian profile, std = radius) at uniformly random centres, depth = pore_depth x radius
     x U(0.5, 1.5), covering about ``pore_fraction`` of a plane section (each pore's cross-section pi r^2);

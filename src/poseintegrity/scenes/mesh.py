@@ -33,8 +33,6 @@ class Material:
     foam_albedo: float | None = None
 
 
-BONE_FOAM = Material(specular=0.06, shininess=25.0, foam_albedo=0.78)  # pale, matte moulded foam, a mild lobe
-
 
 @dataclass(frozen=True)
 class Mesh:

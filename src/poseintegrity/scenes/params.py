@@ -1,4 +1,11 @@
-"""Schema of the ``generate`` section of params.yaml (stage 01, Windsor et al. section IV-D)."""
+"""Schema of the ``generate`` section of params.yaml (stage 01, Windsor et al. section IV-D).
+
+params.yaml is the only source of these values: no field has a default that could disagree with it (the one
+optional key, a scene's ``glenoid_tilt_deg``, is required with a scapula target and refused without one). Every
+number is bounded, so that a value that would crash a later step (an image of 0 pixels, a foam of billions of
+pores) or silently give something else than asked (two azimuths writing the same dataset folder, a flicker that
+turns some images black) is refused here, before any work, with its key named.
+"""
 
 from __future__ import annotations
 
@@ -11,43 +18,64 @@ import numpy as np
 from pydantic import Field, ValidationInfo, field_validator, model_validator
 
 from poseintegrity.scenes.catalog import TARGET_NAMES, TEXTURE_NAMES
-from poseintegrity.scenes.foam import ReliefVolume, relief_volume
+from poseintegrity.scenes.foam import VOXEL_MM, ReliefVolume, relief_volume
 from poseintegrity.scenes.mesh import Material
 from poseintegrity.scenes.scapula import read_mesh
-from poseintegrity.schema import KeyRule, ProjectPath, Section
+from poseintegrity.schema import KeyRule, ProjectPath, Section, Seed, distinct
 
-PositiveInt = Annotated[int, Field(gt=0)]
+MIN_IMAGE_PX = 64  # the rendered image's shorter side: below it no target keeps enough pixels to be localized
+MAX_SENSOR_PX = 4096  # a side of the sensor: larger frames take GBs of z-buffer per worker
+NAME_PATTERN = r"^[A-Za-z0-9][A-Za-z0-9_-]*$"  # scene names make folder names (no path, no hidden .partial folder)
 
 
 class CameraParams(Section):
     """IDS U3-3060CP-M (Sony IMX174, mono) with a fixed-focal lens (docs/references.md, "Camera of the Windsor et al. experiments")."""
 
-    sensor_width_px: PositiveInt = 1936
-    sensor_height_px: PositiveInt = 1216
-    pixel_um: float = Field(5.86, gt=0)
-    lens_mm: float = Field(12.0, gt=0, description="focal length of the (unpublished) lens; ours")
-    downscale: PositiveInt = Field(2, description="images are rendered at sensor size / downscale")
-    f_number: float = Field(4.0, gt=0, description="aperture; sets the depth of field (focus at the model view)")
+    sensor_width_px: int = Field(gt=0, le=MAX_SENSOR_PX)
+    sensor_height_px: int = Field(gt=0, le=MAX_SENSOR_PX)
+    pixel_um: float = Field(gt=0, le=50)
+    lens_mm: float = Field(gt=0, le=75, description="focal length of the (unpublished) lens; ours. Below every "
+                                                    "camera distance (>= 100 mm): the lens must focus")
+    downscale: int = Field(ge=1, description="images are rendered at sensor size / downscale")
+    f_number: float = Field(ge=0.5, le=64, description="aperture; sets the depth of field (focus at the model view)")
+
+    @model_validator(mode="after")
+    def _image_size(self) -> "CameraParams":
+        shorter = min(self.sensor_width_px, self.sensor_height_px) // self.downscale
+        if shorter < MIN_IMAGE_PX:
+            raise KeyRule("downscale", f"the image's shorter side would be {shorter} px "
+                                       f"({self.sensor_width_px} x {self.sensor_height_px} / {self.downscale}); "
+                                       f"at most {min(self.sensor_width_px, self.sensor_height_px) // MIN_IMAGE_PX} "
+                                       f"keeps it >= {MIN_IMAGE_PX} px")
+        return self
 
 
 class SensorParams(Section):
     """Image formation after the optics: exposure, noise, blur, flicker (8-bit output)."""
 
-    exposure: float = Field(215.0, gt=0, description="DN for a white Lambertian surface facing the ring light")
-    read_noise_dn: float = Field(1.2, ge=0)
-    shot_noise_dn_per_dn: float = Field(0.02, ge=0, description="variance of shot noise per DN of signal")
-    blur_sigma_px: float = Field(0.6, ge=0, description="optical blur, Gaussian sigma in pixels")
-    flicker: float = Field(0.006, ge=0, lt=0.5, description="std of the per-image illumination gain")
+    exposure: float = Field(gt=0, le=1000, description="DN for a white Lambertian surface facing the ring light "
+                                                       "(255 saturates; 1000 is white everywhere)")
+    read_noise_dn: float = Field(ge=0, le=50)
+    shot_noise_dn_per_dn: float = Field(ge=0, le=10, description="variance of shot noise per DN of signal")
+    blur_sigma_px: float = Field(ge=0, le=20, description="optical blur, Gaussian sigma in pixels")
+    flicker: float = Field(ge=0, le=0.1, description="std of the per-image illumination gain (above 0.1 a gain "
+                                                     "1 + flicker x N(0, 1) would sometimes be <= 0: a black image)")
 
 
 class LightParams(Section):
     """The lab's light: a ring light on the camera, a room light fixed to the scene, ambient light (radiances of a
     white surface facing each light); the background is the radiance seen past every object."""
 
-    ambient: float = Field(ge=0)
-    ring: float = Field(ge=0, description="on the lens: moves with the camera, lights what the camera sees")
-    room: float = Field(ge=0, description="directional, fixed to the scene (direction drawn per scene)")
-    background: float = Field(ge=0)
+    ambient: float = Field(ge=0, le=5)
+    ring: float = Field(ge=0, le=5, description="on the lens: moves with the camera, lights what the camera sees")
+    room: float = Field(ge=0, le=5, description="directional, fixed to the scene (direction drawn per scene)")
+    background: float = Field(ge=0, le=5)
+
+    @model_validator(mode="after")
+    def _some_light(self) -> "LightParams":
+        if self.ambient + self.ring + self.room <= 0:
+            raise ValueError("ambient, ring and room are all 0: every object would be black")
+        return self
 
     def intensities(self) -> tuple[float, float, float, float]:
         return self.ambient, self.ring, self.room, self.background
@@ -64,7 +92,7 @@ class ScapulaParams(Section):
     """The anatomical scapula phantom (:mod:`poseintegrity.scenes.scapula`)."""
 
     mesh: ProjectPath = Field(description="closed triangle mesh of a left scapula (STL, OBJ, PLY: anything trimesh reads)")
-    length_mm: float = Field(gt=0, description="the mesh is scaled so that its longest extent is this long")
+    length_mm: float = Field(ge=50, le=400, description="the mesh is scaled so that its longest extent is this long")
     glenoid_centre: tuple[float, float, float] = Field(description="glenoid centre in the mesh file's own units")
     glenoid_normal: tuple[float, float, float] = Field(description="outward normal of the glenoid, mesh frame")
     drill: DrillParams
@@ -78,8 +106,8 @@ class ScapulaParams(Section):
     @field_validator("glenoid_normal")
     @classmethod
     def _nonzero(cls, normal: tuple[float, float, float]) -> tuple[float, float, float]:
-        if not (all(math.isfinite(c) for c in normal) and math.hypot(*normal) > 1e-6):
-            raise ValueError(f"glenoid_normal must be a finite, non-zero vector, got {normal}")
+        if not math.hypot(*normal) > 1e-6:
+            raise ValueError(f"glenoid_normal must be a non-zero vector, got {normal}")
         return normal
 
 
@@ -87,37 +115,43 @@ class BoneFoamParams(Section):
     """The surface of the moulded bone-foam phantoms (:mod:`poseintegrity.scenes.foam`): physical sizes, the same
     for every phantom and offcut of the material."""
 
-    pore_radius_mm: float = Field(gt=0, le=2, description="smallest pore radius r0; octaves add 2 r0 and 4 r0")
+    pore_radius_mm: float = Field(ge=VOXEL_MM, le=2, description="smallest pore radius r0 (at least one voxel of "
+                                                                 "the relief volume); octaves add 2 r0 and 4 r0")
     pore_fraction: float = Field(gt=0, lt=1, description="share of the surface covered by pores (per octave)")
     pore_depth: float = Field(gt=0, le=3, description="pore depth / pore radius")
     bump_slope: float = Field(ge=0, le=2, description="RMS slope of the fine bumps between pores")
     albedo: float = Field(gt=0, le=1, description="mean albedo of the pale foam")
     albedo_std: float = Field(ge=0, lt=0.5, description="relative std of its albedo mottling")
-    albedo_mottle_mm: float = Field(gt=0, description="size of the mottles")
+    albedo_mottle_mm: float = Field(gt=0, le=50, description="size of the mottles")
     specular: float = Field(ge=0, le=1, description="Blinn-Phong k_s: a mild lobe")
-    shininess: float = Field(gt=0, description="Blinn-Phong exponent")
+    shininess: float = Field(gt=0, le=1000, description="Blinn-Phong exponent")
 
     def material(self) -> "Material":
         return Material(specular=self.specular, shininess=self.shininess, foam_albedo=self.albedo)
 
-    def relief(self, seed: int) -> "ReliefVolume":
-        """The foam's height field, seeded by ``generate.seed`` (one material: the same for every object)."""
+    def relief(self, seed: int, **grid) -> "ReliefVolume":
+        """The foam's height field, seeded by ``generate.seed`` (one material: the same for every object);
+        ``grid``: ``n`` / ``voxel_mm`` of :func:`~.foam.relief_volume` (tests shrink it)."""
         return relief_volume(np.random.default_rng([seed, 7]), pore_radius_mm=self.pore_radius_mm,
                              pore_fraction=self.pore_fraction, pore_depth=self.pore_depth,
                              bump_slope=self.bump_slope, albedo_std=self.albedo_std,
-                             albedo_mottle_mm=self.albedo_mottle_mm)
+                             albedo_mottle_mm=self.albedo_mottle_mm, **grid)
+
+
+Distance = Annotated[float, Field(ge=100, le=2000)]  # camera to target centre, mm
 
 
 class SceneSpec(Section):
     """One physical arrangement on the table (Fig. 4)."""
 
-    name: str = Field(min_length=1)
+    name: str = Field(pattern=NAME_PATTERN, max_length=64, description="names its dataset folders")
     targets: list[str] = Field(min_length=1)
-    distance_mm: float = Field(320.0, gt=50, description="camera to target centre at the model view")
-    elevation_deg: float = Field(50.0, gt=5, lt=90, description="of the model view above the table")
-    n_clutter: int = Field(4, ge=0, le=20)
-    glenoid_tilt_deg: tuple[float, float] = Field(
-        (0.0, 0.0), description="a scapula's glenoid normal turned from the model camera about its x, then y axis")
+    distance_mm: Distance = Field(description="camera to target centre at the model view")
+    elevation_deg: float = Field(gt=5, lt=90, description="of the model view above the table")
+    n_clutter: int = Field(ge=0, le=20)
+    glenoid_tilt_deg: tuple[Annotated[float, Field(ge=-45, le=45)], Annotated[float, Field(ge=-45, le=45)]] | None = (
+        Field(None, description="a scapula's glenoid normal turned from the model camera about its x, then y axis; "
+                                "required with a scapula target, refused without one"))
 
     @field_validator("targets")
     @classmethod
@@ -129,48 +163,59 @@ class SceneSpec(Section):
             raise ValueError("a target appears twice")
         return names
 
+    @model_validator(mode="after")
+    def _tilt_of_a_scapula(self) -> "SceneSpec":
+        scapula = any(name.startswith("scapula") for name in self.targets)
+        if scapula and self.glenoid_tilt_deg is None:
+            raise KeyRule("glenoid_tilt_deg", f"required with a scapula target ({self.targets}): how the glenoid "
+                                              "is turned from the model camera, [about x, about y] deg")
+        if not scapula and self.glenoid_tilt_deg is not None:
+            raise KeyRule("glenoid_tilt_deg", f"only a scapula has a glenoid to tilt; targets {self.targets}")
+        return self
+
+
+Stops = Annotated[int, Field(ge=1, le=100)]
+
 
 class ArcParams(Section):
     """Viewing-angle datasets: arcs about the target (IV-D)."""
 
-    azimuths_deg: list[float] = Field(default=[0.0, 90.0, 270.0], min_length=1)
-    n_stops: PositiveInt = 20
+    azimuths_deg: distinct(Annotated[float, Field(ge=0, lt=360)]) = Field(min_length=1)
+    n_stops: Stops
+
+    def dataset_ids(self, scene: str) -> list[str]:
+        """The datasets of a scene's arcs, one per azimuth (the id names its folder)."""
+        return [f"{scene}_arc{azimuth:03.0f}" for azimuth in self.azimuths_deg]
 
 
 class LineParams(Section):
     """Straight-line datasets: the camera moves along its -z axis (IV-D)."""
 
-    scene: str = Field("scene_2", description="scene holding the drilled bone-like target")
-    distance_mm: float = Field(220.0, gt=50, description="camera to target centre at the lines' own model pair")
-    offsets_deg: list[float] = Field(default=[0.0, 5.0, 10.0, 15.0])
-    n_stops: PositiveInt = 15
+    scene: str = Field(description="scene holding the drilled bone-like target")
+    distance_mm: Distance = Field(description="camera to target centre at the lines' own model pair")
+    offsets_deg: distinct(Annotated[float, Field(ge=0, le=90)]) = Field(min_length=1)
+    n_stops: Stops
 
-    @field_validator("offsets_deg")
-    @classmethod
-    def _offsets(cls, offsets: list[float]) -> list[float]:
-        if any(not 0 <= o <= 90 for o in offsets):
-            raise ValueError("offsets must lie in [0, 90] deg")
-        return offsets
+    def dataset_ids(self) -> list[str]:
+        """The datasets of the lines, one per start offset (the id names its folder)."""
+        return [f"{self.scene}_line{offset:02.0f}" for offset in self.offsets_deg]
 
 
 class GenerateParams(Section):
     """Stage 01: render the robot datasets."""
 
-    seed: int = Field(20240501, ge=0)
-    n_jobs: int = Field(2, ge=1)
-    images_per_stop: PositiveInt = 10
-    model_baseline_mm: float = Field(20.0, gt=0)
-    camera: CameraParams = CameraParams()
-    sensor: SensorParams = SensorParams()
-    arcs: ArcParams = ArcParams()
-    lines: LineParams | None = LineParams()
+    seed: Seed
+    images_per_stop: int = Field(ge=1, le=100)
+    model_baseline_mm: float = Field(gt=0, le=100)
+    camera: CameraParams
+    sensor: SensorParams
+    arcs: ArcParams
+    lines: LineParams | None = Field(description="null: no straight-line datasets")
     lights: LightParams
     scapula: ScapulaParams
     bone_foam: BoneFoamParams
     scenes: list[SceneSpec] = Field(min_length=1)
-    textures: dict[str, ProjectPath] = Field(
-        default_factory=dict, description="texture name -> image file replacing the procedural texture"
-    )
+    textures: dict[str, ProjectPath] = Field(description="texture name -> image file replacing the procedural texture")
 
     @field_validator("textures")
     @classmethod
@@ -189,9 +234,29 @@ class GenerateParams(Section):
             raise KeyRule("scenes", f"scene names must be unique, got {names}")
         if self.lines is not None and self.lines.scene not in names:
             raise KeyRule("lines.scene", f"{self.lines.scene!r} is not one of the scenes {names}")
+        self._distinct_dataset_ids()
         protocol = (info.context or {}).get("protocol")  # a robot must move past the stops it samples (IV-A)
         for key, trajectory in (("arcs", self.arcs), ("lines", self.lines)):
             if protocol is not None and trajectory is not None and trajectory.n_stops <= protocol.stops_sampled(key[:-1]):
                 raise KeyRule(f"{key}.n_stops", f"must exceed protocol.sampled_stops.{key[:-1]} "
                                                 f"({protocol.stops_sampled(key[:-1])}), got {trajectory.n_stops}")
         return self
+
+    def _distinct_dataset_ids(self) -> None:
+        """Each dataset writes the folder its id names: two equal ids would overwrite one folder and list it
+        twice in the index (azimuths 0 and 0.4 both name ``*_arc000``)."""
+        for key, ids in (("arcs.azimuths_deg", self.arcs.dataset_ids(self.scenes[0].name)),
+                         ("lines.offsets_deg", [] if self.lines is None else self.lines.dataset_ids())):
+            repeated = sorted({i for i in ids if ids.count(i) > 1})
+            if repeated:
+                raise KeyRule(key, f"two entries name the same dataset {', '.join(repeated)} (ids round to "
+                                   f"whole degrees): make them differ by at least 1 deg")
+        ids = self.dataset_ids()
+        repeated = sorted({i for i in ids if ids.count(i) > 1})
+        if repeated:
+            raise KeyRule("scenes", f"scene names give datasets of the same id: {', '.join(repeated)}")
+
+    def dataset_ids(self) -> list[str]:
+        """Every dataset, in the order of :func:`~.dataset.plan_datasets`: each scene's arcs, then the lines."""
+        return ([i for spec in self.scenes for i in self.arcs.dataset_ids(spec.name)]
+                + ([] if self.lines is None else self.lines.dataset_ids()))

@@ -1,4 +1,4 @@
-"""Textures: procedural albedo maps (bone phantom, textured blocks, table, clutter, ArUco board), image files
+"""Textures: procedural albedo maps (printed blocks, table, clutter, ArUco board), image files
 as overrides, and the mip-mapped atlas the renderer samples.
 
 Albedo maps are 8-bit grayscale (the camera is the monochrome U3-3060CP-M); 255 means a white Lambertian surface.
@@ -32,24 +32,6 @@ def fractal_noise(rng: np.random.Generator, shape: tuple[int, int], base_cells: 
 
 def to_u8(albedo: np.ndarray) -> np.ndarray:
     return np.clip(np.rint(albedo * 255), 0, 255).astype(np.uint8)
-
-
-def bone_texture(rng: np.random.Generator, size: int = 1024, hole_uv: tuple[float, float] | None = None) -> np.ndarray:
-    """Bone-phantom albedo: pale and low in contrast (std ~0.06 against ~0.2 for the printed blocks), with soft
-    mottling and sub-millimetre pores and speckles (at 1024 px over ~150 mm, 1 mm ~ 7 texels); CLAHE brings
-    them out."""
-    albedo = 0.78 + 0.035 * fractal_noise(rng, (size, size), 8, 5, 0.6)
-    n_spots = size * size // 200
-    spots = np.zeros((size, size), np.float32)
-    centres = rng.integers(0, size, (n_spots, 2))
-    radii = rng.integers(2, 7, n_spots)
-    amplitude = rng.uniform(0.03, 0.10, n_spots) * rng.choice([-1.0, 1.0], n_spots, p=[0.75, 0.25])
-    for (cx, cy), r, a in zip(centres, radii, amplitude):
-        cv2.circle(spots, (int(cx), int(cy)), int(r), float(a), -1, lineType=cv2.LINE_AA)
-    albedo -= cv2.GaussianBlur(spots, (0, 0), 1.5)
-    if hole_uv is not None:
-        cv2.circle(albedo, (int(hole_uv[0] * size), int(hole_uv[1] * size)), size // 60, 0.25, -1, cv2.LINE_AA)
-    return to_u8(albedo)
 
 
 def collage_texture(rng: np.random.Generator, shape: tuple[int, int], density: float, contrast: float,

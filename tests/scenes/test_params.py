@@ -1,0 +1,75 @@
+"""The ``generate`` section: every bad value refused before any work, its key named; params.yaml the only source."""
+
+import pytest
+
+from params_cases import refusal, with_value
+from poseintegrity.config import parse_params
+from poseintegrity.scenes import dataset
+from poseintegrity.scenes.params import GenerateParams
+
+NO_LIGHT = {"ambient": 0.0, "ring": 0.0, "room": 0.0, "background": 0.5}
+
+# (key under generate, bad value, the key the error names); after each, what it did before it was refused.
+# The tiny parameters' scenes: scene_a (a printed block), scene_b (the drilled scapula, the lines' scene).
+BAD_VALUES = [
+    ("arcs.azimuths_deg", [0, 0.4], "arcs.azimuths_deg"),  # both wrote scene_a_arc000: 3 folders, 9 index rows
+    ("arcs.azimuths_deg", [90, 90], "arcs.azimuths_deg"),  # the same arc rendered twice into one folder
+    ("arcs.azimuths_deg", [0, 360], "arcs.azimuths_deg.1"),  # the arc at 0 again, as scene_a_arc360
+    ("arcs.azimuths_deg", [-90], "arcs.azimuths_deg.0"),  # scene_a_arc-90: the arc at 270 under another name
+    ("arcs.azimuths_deg", [], "arcs.azimuths_deg"),  # no arc at all
+    ("arcs.n_stops", 1000, "arcs.n_stops"),  # accepted: hours of rendering
+    ("lines.offsets_deg", [0, 0], "lines.offsets_deg"),  # two datasets in scene_b_line00
+    ("lines.offsets_deg", [5, 5.2], "lines.offsets_deg"),  # both named scene_b_line05
+    ("lines.offsets_deg", [], "lines.offsets_deg"),
+    ("lines.n_stops", 1000, "lines.n_stops"),
+    ("lines.distance_mm", 60, "lines.distance_mm"),
+    ("images_per_stop", 100000, "images_per_stop"),  # accepted: a million images
+    ("model_baseline_mm", 1000, "model_baseline_mm"),  # stopped at rendering, blaming scenes.0.distance_mm
+    ("seed", 2**70, "seed"),
+    ("n_jobs", 2, "n_jobs"),  # gone: parallel.n_jobs is the only worker count
+    ("camera.downscale", 5000, "camera.downscale"),  # a 0 x 0 image: stopped at rendering, blaming distance_mm
+    ("camera.sensor_width_px", 100000, "camera.sensor_width_px"),  # accepted: GBs of z-buffer per worker
+    ("camera.lens_mm", 400, "camera.lens_mm"),  # focus behind the lens; stopped at rendering, blaming distance_mm
+    ("camera.f_number", 0.001, "camera.f_number"),  # accepted: a defocus blur of hundreds of pixels
+    ("sensor.exposure", 1e6, "sensor.exposure"),  # accepted: every image white
+    ("sensor.flicker", 0.45, "sensor.flicker"),  # accepted: ~1 % of the images black (gain <= 0)
+    ("sensor.blur_sigma_px", 500, "sensor.blur_sigma_px"),
+    ("lights", NO_LIGHT, "lights"),  # accepted: every object black
+    ("bone_foam.pore_radius_mm", 0.001, "bone_foam.pore_radius_mm"),  # MemoryError: 219 GiB of pore centres
+    ("bone_foam.shininess", 1e9, "bone_foam.shininess"),
+    ("scapula.length_mm", 2000, "scapula.length_mm"),
+    ("scenes.0.name", "a/b", "scenes.0.name"),  # accepted: folders a/b_arc000 inside a folder a
+    ("scenes.0.name", ".hidden", "scenes.0.name"),  # accepted: hidden folders like the unfinished .partial ones
+    ("scenes.1.name", "scene_a", "scenes"),
+    ("scenes.0.distance_mm", 5000, "scenes.0.distance_mm"),
+    ("scenes.0.glenoid_tilt_deg", [0, 10], "scenes.0.glenoid_tilt_deg"),  # a block: accepted and ignored
+    ("scenes.1.glenoid_tilt_deg", None, "scenes.1.glenoid_tilt_deg"),  # a scapula needs one (was 0, 0 by default)
+    ("scenes.1.glenoid_tilt_deg", [0, 170], "scenes.1.glenoid_tilt_deg.1"),  # accepted: the back of the bone
+    ("scenes.1.n_clutter", 50, "scenes.1.n_clutter"),
+]
+
+
+@pytest.mark.parametrize("key, value, expected", BAD_VALUES)
+def test_bad_value_names_its_key(tiny_raw, key, value, expected):
+    assert f"generate.{expected}" in refusal(tiny_raw, f"generate.{key}", value)
+
+
+def test_every_key_is_set_by_params_yaml():
+    """No field has a default that could disagree with params.yaml: leaving any key out is refused (the one
+    optional key, glenoid_tilt_deg, is required exactly where it means something)."""
+    def defaults(model):
+        for name, field in model.model_fields.items():
+            assert field.is_required() or (model.__name__, name) == ("SceneSpec", "glenoid_tilt_deg"), \
+                f"{model.__name__}.{name} has a default"
+            for sub in getattr(field.annotation, "__args__", (field.annotation,)):
+                if isinstance(sub, type) and hasattr(sub, "model_fields"):
+                    defaults(sub)
+
+    defaults(GenerateParams)
+
+
+def test_dataset_ids_are_the_plan_and_distinct(tiny_params):
+    ids = tiny_params.generate.dataset_ids()
+    assert ids == [plan.dataset for plan in dataset.plan_datasets(tiny_params.generate)]
+    assert len(set(ids)) == len(ids)
+
