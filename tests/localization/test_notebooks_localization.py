@@ -41,7 +41,10 @@ def test_stage_02_writes_tables_metrics_and_figures(executed):
     assert set(table["method"]) == {"usac_magsac"} and table["dataset"].nunique() == 3
     env = pd.read_parquet(data_dir / "artifacts" / "envelopes.parquet")
     assert list(env.columns) == ["dataset", "trajectory", "tolerance", "method", "theta_a", "censored"]
+    assert set(table.loc[table.status.isin(["bad_image", "bad_pose"]), "image"]) == {3, 4}  # of dataset "bad"
     metrics = json.loads((reports_dir / "metrics" / "artifacts.json").read_text())
+    assert metrics["flagged_frames"] == {"bad_image": 1, "bad_pose": 1}
+    assert metrics["status_counts"]["bad_image"] == metrics["status_counts"]["bad_pose"] == 1
     for key in ("min_abs_spearman", "error_ratio_low_vs_high_inliers", "n_uncensored_4mm10deg",
                 "min_theta_a_2mm3deg", "cv_theta_a_2mm3deg"):
         assert key in metrics["realism"]
@@ -56,6 +59,13 @@ def test_stage_05_writes_one_row_per_frame_and_method(executed):
     usac = pd.read_parquet(data_dir / "artifacts" / "artifacts.parquet")
     assert len(table) == len(usac) * len(PNP_METHODS)
     assert list(table.columns) == list(usac.columns)
+    same_frames = ["dataset", "stop", "image", "status", "reason", "n_keypoints", "n_matches", "board_status",
+                   "E_t_board_exact_mm"]  # stage 02's evidence, read back: the same flags, matches and ground truth
+    for method in PNP_METHODS:
+        variant = table[table.method == method].reset_index(drop=True)
+        flagged = usac.status.isin(["bad_image", "bad_pose"])
+        pd.testing.assert_frame_equal(variant.loc[flagged, same_frames], usac.loc[flagged, same_frames])
+        pd.testing.assert_frame_equal(variant[same_frames[:3] + same_frames[5:]], usac[same_frames[:3] + same_frames[5:]])
     metrics = json.loads((reports_dir / "metrics" / "pnp.json").read_text())
     assert set(metrics["methods"]) == {"usac_magsac", *PNP_METHODS}
     assert (reports_dir / "figures" / "05_theta_a_by_method.png").stat().st_size > 0

@@ -1,32 +1,72 @@
-from pathlib import Path
+"""The ``extract`` section: params.yaml is the only source of its values, and every bad value is refused before
+any work with its key named."""
+
+import copy
 
 import pytest
-from pydantic import ValidationError
 
-from poseintegrity.config import load_params
-from poseintegrity.localization.params import ExtractParams
-
-PARAMS_YAML = Path(__file__).parents[2] / "params.yaml"
+from params_cases import refusal
+from poseintegrity.config import ParamsError, parse_params
+from poseintegrity.localization.params import ClaheParams, ExtractParams, RealismParams, SiftParams
 
 
-def test_yaml_section_validates_with_paper_tolerances():
-    params = load_params(PARAMS_YAML)
-    assert params.protocol.tolerance_names == ["2mm_3deg", "4mm_10deg"]
-    assert params.protocol.pnp_method == "usac_magsac" and params.extract.pnp_methods[0] == "epnp"
+def test_tiny_section_validates_beside_the_paper_protocol(tiny_params):
+    assert tiny_params.protocol.tolerance_names == ["2mm_3deg", "4mm_10deg"]
+    assert tiny_params.protocol.pnp_method == "usac_magsac"
+    assert tiny_params.protocol.pnp_method not in tiny_params.extract.pnp_methods
 
 
-@pytest.mark.parametrize(
-    "bad, key",
-    [
-        ({"ratio_test": 1.5}, "ratio_test"),
-        ({"sift": {"sigma": -1}}, "sift.sigma"),
-        ({"pnp_methods": ["dls"]}, "pnp_methods.0"),
-        ({"n_jobs": 0}, "n_jobs"),
-        ({"ransac_typo": 3}, "ransac_typo"),
-    ],
-)
-def test_bad_values_raise_naming_the_key(bad, key):
-    with pytest.raises(ValidationError) as error:
-        ExtractParams.model_validate(bad)
-    locations = [".".join(str(part) for part in item["loc"]) for item in error.value.errors()]
-    assert key in locations
+@pytest.mark.parametrize("schema", [ExtractParams, ClaheParams, SiftParams, RealismParams])
+def test_no_field_has_a_default_that_could_disagree_with_params_yaml(schema):
+    assert [name for name, field in schema.model_fields.items() if not field.is_required()] == []
+
+
+def test_every_key_of_the_section_must_be_set(tiny_raw):
+    for key in list(tiny_raw["extract"]):
+        raw = copy.deepcopy(tiny_raw)
+        del raw["extract"][key]
+        with pytest.raises(ParamsError, match=rf"extract\.{key}: Field required"):
+            parse_params(raw)
+
+
+# (dotted key, bad value, the key the error must name)
+BAD_VALUES = [
+    ("extract.ratio_test", 1.0, "extract.ratio_test"),  # keeps every match
+    ("extract.ratio_test", 0.0, "extract.ratio_test"),
+    ("extract.ratio_test", float("nan"), "extract.ratio_test"),
+    ("extract.model_max_reprojection_px", 0.0, "extract.model_max_reprojection_px"),
+    ("extract.model_max_reprojection_px", 50.0, "extract.model_max_reprojection_px"),
+    ("extract.reprojection_threshold_px", -1.0, "extract.reprojection_threshold_px"),
+    ("extract.reprojection_threshold_px", 25.0, "extract.reprojection_threshold_px"),
+    ("extract.ransac_confidence", 1.0, "extract.ransac_confidence"),
+    ("extract.usac_max_iterations", 0, "extract.usac_max_iterations"),
+    ("extract.usac_max_iterations", 10**9, "extract.usac_max_iterations"),
+    ("extract.ransac_max_iterations", 0, "extract.ransac_max_iterations"),
+    ("extract.usac_refine_lm", "maybe", "extract.usac_refine_lm"),
+    ("extract.pnp_methods", ["dls"], "extract.pnp_methods.0"),
+    ("extract.pnp_methods", [], "extract.pnp_methods"),
+    ("extract.pnp_methods", ["epnp", "p3p", "epnp"], "extract.pnp_methods"),  # run twice
+    ("extract.pnp_methods", ["usac_magsac", "epnp"], "extract.pnp_methods"),  # protocol.pnp_method: stage 02's
+    ("extract.seed", -1, "extract.seed"),
+    ("extract.seed", 2**64, "extract.seed"),
+    ("extract.features_dir", "", "extract.features_dir"),
+    ("extract.datasets", [], "extract.datasets"),  # nothing to do: null means every dataset
+    ("extract.datasets", ["scene_a_arc000", "scene_a_arc000"], "extract.datasets"),  # extracted twice
+    ("extract.datasets", [" "], "extract.datasets"),
+    ("extract.n_jobs", 2, "extract.n_jobs"),  # gone: parallel.n_jobs is the only one
+    ("extract.ransac_typo", 3, "extract.ransac_typo"),
+    ("extract.clahe.clip_limit", 0.0, "extract.clahe.clip_limit"),
+    ("extract.clahe.tile_grid", 0, "extract.clahe.tile_grid"),
+    ("extract.sift.n_features", -1, "extract.sift.n_features"),
+    ("extract.sift.n_octave_layers", 0, "extract.sift.n_octave_layers"),
+    ("extract.sift.contrast_threshold", 0.0, "extract.sift.contrast_threshold"),
+    ("extract.sift.edge_threshold", 0.5, "extract.sift.edge_threshold"),
+    ("extract.sift.sigma", -1.0, "extract.sift.sigma"),
+    ("extract.sift.sigma", float("inf"), "extract.sift.sigma"),
+    ("extract.realism.max_nfev", 5, "extract.realism.max_nfev"),
+]
+
+
+@pytest.mark.parametrize("key, value, expected", BAD_VALUES)
+def test_bad_value_names_its_key(tiny_raw, key, value, expected):
+    assert expected in refusal(tiny_raw, key, value)

@@ -29,7 +29,7 @@ def scene(seed, n=200, outlier_fraction=0.5, noise_px=0.3):
 @pytest.mark.parametrize("method", METHODS)
 def test_every_method_recovers_a_known_pose_among_outliers(method):
     X, x, T, n_true_inliers = scene(seed=1)
-    result = solve_pnp_ransac(X, x, K, method, threshold_px=3.0, confidence=0.999, max_iterations=2000, seed=5)
+    result = solve_pnp_ransac(X, x, K, method, threshold_px=3.0, confidence=0.999, max_iterations=2000, seed=5, refine_lm=True)
     assert result.status == "ok"
     E_t_mm, E_r_deg = pose_errors(result.T_cam_model, T)
     assert E_t_mm < 1.0 and E_r_deg < 0.2
@@ -40,7 +40,7 @@ def test_every_method_recovers_a_known_pose_among_outliers(method):
 def test_inliers_are_recounted_on_the_returned_pose(method):
     """n_i equals the count of points within the threshold under the returned pose (OpenCV issue 29573)."""
     X, x, _, _ = scene(seed=2, outlier_fraction=0.6, noise_px=1.5)
-    result = solve_pnp_ransac(X, x, K, method, threshold_px=2.0, confidence=0.99, max_iterations=300, seed=3)
+    result = solve_pnp_ransac(X, x, K, method, threshold_px=2.0, confidence=0.99, max_iterations=300, seed=3, refine_lm=True)
     rvec = cv2.Rodrigues(result.T_cam_model[:3, :3])[0]
     projected, _ = cv2.projectPoints(X, rvec, result.T_cam_model[:3, 3], K, None)
     errors = np.linalg.norm(projected.reshape(-1, 2) - x, axis=1)
@@ -49,7 +49,7 @@ def test_inliers_are_recounted_on_the_returned_pose(method):
 
 def test_same_seed_repeats_exactly_and_runs_are_seeded():
     X, x, _, _ = scene(seed=3, outlier_fraction=0.7)
-    runs = [solve_pnp_ransac(X, x, K, "epnp", 2.0, 0.99, 200, seed=s) for s in (4, 4)]
+    runs = [solve_pnp_ransac(X, x, K, "epnp", 2.0, 0.99, 200, seed=s, refine_lm=True) for s in (4, 4)]
     np.testing.assert_array_equal(runs[0].T_cam_model, runs[1].T_cam_model)
     np.testing.assert_array_equal(runs[0].inliers, runs[1].inliers)
 
@@ -75,7 +75,7 @@ def test_reprojection_errors_match_opencv_and_reject_points_behind():
 @pytest.mark.parametrize("method", ["usac_magsac", "p3p"])
 def test_bad_correspondences_fail_with_a_status(X, status, method):
     x = np.random.default_rng(0).uniform(0, 900, (len(X), 2))
-    result = solve_pnp_ransac(X, x, K, method, 3.0, 0.99, 100, seed=0)
+    result = solve_pnp_ransac(X, x, K, method, 3.0, 0.99, 100, seed=0, refine_lm=True)
     assert result.status == status and result.n_inliers == 0
     assert np.all(np.isnan(result.T_cam_model))
 
@@ -84,7 +84,7 @@ def test_pure_outliers_never_crash():
     rng = np.random.default_rng(5)
     X, x = rng.uniform(-50, 50, (30, 3)), rng.uniform(0, 900, (30, 2))
     for method in METHODS:
-        result = solve_pnp_ransac(X, x, K, method, 1.0, 0.99, 200, seed=1)
+        result = solve_pnp_ransac(X, x, K, method, 1.0, 0.99, 200, seed=1, refine_lm=True)
         assert result.status in ("ok", "pnp_failed")
         assert (result.status == "ok") == np.all(np.isfinite(result.T_cam_model))
 
@@ -93,7 +93,7 @@ def test_pure_outliers_never_crash():
 @given(seed=st.integers(0, 10_000))
 def test_usac_recovers_random_poses_from_clean_points(seed):
     X, x, T, _ = scene(seed, n=60, outlier_fraction=0.0, noise_px=0.0)
-    result = solve_pnp_ransac(X, x, K, "usac_magsac", 1.0, 0.999, 200, seed=seed)
+    result = solve_pnp_ransac(X, x, K, "usac_magsac", 1.0, 0.999, 200, seed=seed, refine_lm=True)
     E_t_mm, E_r_deg = pose_errors(result.T_cam_model, T)
     assert result.n_inliers == 60 and E_t_mm < 0.01 and E_r_deg < 0.005  # MAGSAC polish stops near, not at, 0
 

@@ -3,7 +3,6 @@ import numpy as np
 
 import loc_synthetic as synthetic
 from poseintegrity.localization.features import detect_features
-from poseintegrity.localization.params import ClaheParams, SiftParams
 from poseintegrity.localization.target_model import build_target_model, triangulate
 
 
@@ -18,18 +17,19 @@ def test_triangulation_recovers_known_points():
     np.testing.assert_allclose(triangulate(synthetic.K, T_cam1_cam0, x0, x1), X, atol=1e-6)
 
 
-def model_views(rng, target_mask=True):
+def model_views(rng, params, target_mask=True):
     plane, target = synthetic.canvas(rng)
     T0 = synthetic.arc_pose(0.0, 0.0)
     T1 = synthetic.shifted(T0, np.array([20.0, 0.0, 0.0]))
-    features = tuple(detect_features(synthetic.render(plane, T), ClaheParams(), SiftParams()) for T in (T0, T1))
+    features = tuple(detect_features(synthetic.render(plane, T), params.clahe, params.sift) for T in (T0, T1))
     masks = tuple(synthetic.render(target if target_mask else 0 * target, T, cv2.INTER_NEAREST) for T in (T0, T1))
     return features, masks, (T0, T1)
 
 
-def test_model_points_lie_on_the_target_in_the_board_frame():
-    features, masks, poses = model_views(np.random.default_rng(1))
-    model = build_target_model(features, masks, poses, synthetic.K, ratio=0.8, max_reprojection_px=2.0)
+def test_model_points_lie_on_the_target_in_the_board_frame(extract_params):
+    features, masks, poses = model_views(np.random.default_rng(1), extract_params)
+    model = build_target_model(features, masks, poses, synthetic.K, extract_params.ratio_test,
+                               extract_params.model_max_reprojection_px)
     assert model.size > 200 and model.descriptors.shape == (model.size, 128)
     x_min, y_min, x_max, y_max = synthetic.TARGET_MM
     margin = 2.0
@@ -38,7 +38,8 @@ def test_model_points_lie_on_the_target_in_the_board_frame():
     assert np.median(np.abs(model.points[:, 2])) < 1.0  # the target is the plane z = 0
 
 
-def test_empty_mask_gives_an_empty_model():
-    features, masks, poses = model_views(np.random.default_rng(2), target_mask=False)
-    model = build_target_model(features, masks, poses, synthetic.K, ratio=0.8, max_reprojection_px=2.0)
+def test_empty_mask_gives_an_empty_model(extract_params):
+    features, masks, poses = model_views(np.random.default_rng(2), extract_params, target_mask=False)
+    model = build_target_model(features, masks, poses, synthetic.K, extract_params.ratio_test,
+                               extract_params.model_max_reprojection_px)
     assert model.size == 0 and model.points.shape == (0, 3) and model.descriptors.shape == (0, 128)

@@ -1,8 +1,20 @@
-"""Reader of the rendered datasets written by stage 01 (``data_dir/datasets/``).
+"""Reader of the rendered datasets written by stage 01 (``data_dir/datasets/``), checked on read.
 
-Layout: ``index.parquet`` (one row per dataset) and per dataset a folder with ``meta.json`` (camera K, ArUco
-board, model images/masks/poses) and ``frames.parquet`` (one row per image with its exact poses).
-Image paths in the tables are relative to the dataset folder (or, failing that, to ``data_dir``).
+Layout: ``index.parquet`` (one row per dataset) and per dataset a folder with ``meta.json`` (camera K, image size,
+ArUco board, model images/masks/poses) and ``frames.parquet`` (one row per image with its exact poses). Image paths
+in the tables are relative to the dataset folder (or, failing that, to ``data_dir``).
+
+What is checked before any work, each failure a :class:`DatasetError` naming the dataset and the file:
+
+- ``index.parquet`` readable, with a ``dataset`` and a ``path`` column; no dataset or folder named twice; every
+  folder it names exists; every dataset folder on disk is in it (a folder left out would be skipped silently);
+- ``meta.json`` readable and holding what stages 02 and 05 read (:class:`Meta`): the dataset's name as in the
+  index, the image size, a finite camera matrix K, the board, two model images, masks and rigid finite poses;
+- ``frames.parquet`` readable, with its columns, one row per (stop, image) and per file, finite stop positions,
+  and every image file present.
+
+A frame's own ground-truth pose is checked per frame (:func:`pose_problem`): a bad one flags that frame's rows
+(status ``bad_pose``) instead of stopping the stage, as a bad frame image does (``bad_image``, extract.py).
 """
 
 from __future__ import annotations
@@ -10,20 +22,109 @@ from __future__ import annotations
 import json
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 import pandas as pd
+import pyarrow
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
 
-from poseintegrity.localization.features import ImageReadError
+INDEX_COLUMNS = ("dataset", "path")
+FRAME_TABLE_COLUMNS = ("dataset", "stop", "image", "theta_deg", "x_mm", "file", "T_cam_board")
+RIGID_TOLERANCE = 1e-6  # |R^T R - I| and |bottom row - (0, 0, 0, 1)|: stage 01 writes poses exact to ~1e-15
+
+
+class DatasetError(RuntimeError):
+    """A dataset on disk is missing, unreadable or inconsistent (stops the stage, naming the dataset and file)."""
+
+
+def pose_problem(values: Any) -> str | None:
+    """What is wrong with a board -> camera pose given as 16 row-major numbers or a (4, 4) array; None if it is a
+    finite rigid transform (rotation orthonormal with determinant +1, bottom row 0 0 0 1)."""
+    try:
+        T = np.asarray(values, dtype=np.float64).reshape(4, 4)
+    except (TypeError, ValueError):
+        return f"is not 16 numbers (got {np.size(values) if values is not None else 'nothing'})"
+    if not np.all(np.isfinite(T)):
+        return "holds NaN or inf"
+    R = T[:3, :3]
+    if (np.abs(T[3] - [0.0, 0.0, 0.0, 1.0]).max() > RIGID_TOLERANCE
+            or np.abs(R.T @ R - np.eye(3)).max() > RIGID_TOLERANCE or np.linalg.det(R) < 0):
+        return "is not a rigid transform"
+    return None
+
+
+def _pose(values: Any, which: str) -> list[list[float]]:
+    problem = pose_problem(values)
+    if problem:
+        raise ValueError(f"{which} {problem}")
+    return np.asarray(values, dtype=np.float64).reshape(4, 4).tolist()
+
+
+class _Read(BaseModel):
+    """The part of meta.json this stage reads; stage 01 writes more (scene, targets, ...), which is ignored."""
+
+    model_config = ConfigDict(extra="ignore", frozen=True, allow_inf_nan=False)
+
+
+class BoardMeta(_Read):
+    """The ArUco GridBoard of the scene (IV-C), lengths in mm."""
+
+    dictionary: str = Field(pattern=r"^DICT_\w+$")
+    markers_x: int = Field(ge=1)
+    markers_y: int = Field(ge=1)
+    marker_length_mm: float = Field(gt=0)
+    separation_mm: float = Field(ge=0)
+    first_id: int = Field(ge=0)
+
+
+class ModelMeta(_Read):
+    """The model pair of III-B / IV-D: two images, their target masks and exact board -> camera poses."""
+
+    images: tuple[str, str]
+    masks: tuple[str, str]
+    T_cam_board: tuple[list[list[float]], list[list[float]]]
+
+    @field_validator("T_cam_board", mode="before")
+    @classmethod
+    def _rigid(cls, poses: Any) -> Any:
+        if isinstance(poses, (list, tuple)) and len(poses) == 2:
+            return [_pose(T, f"the pose of model image {i}") for i, T in enumerate(poses)]
+        return poses
+
+
+class Meta(_Read):
+    """``meta.json`` of one dataset: what stages 02 and 05 read from it."""
+
+    dataset: str = Field(min_length=1)
+    trajectory: Literal["arc", "line"]
+    image_size: tuple[int, int] = Field(description="width, height in px of every image of the dataset")
+    K: tuple[tuple[float, float, float], tuple[float, float, float], tuple[float, float, float]]
+    board: BoardMeta
+    model: ModelMeta
+
+    @field_validator("image_size")
+    @classmethod
+    def _positive(cls, size: tuple[int, int]) -> tuple[int, int]:
+        if min(size) < 1:
+            raise ValueError(f"width and height are positive, got {list(size)}")
+        return size
+
+    @field_validator("K")
+    @classmethod
+    def _camera_matrix(cls, K: tuple) -> tuple:
+        K_ = np.asarray(K)
+        if not (K_[0, 0] > 0 and K_[1, 1] > 0 and K_[1, 0] == 0 and np.array_equal(K_[2], [0.0, 0.0, 1.0])):
+            raise ValueError(f"expected [[fx, s, cx], [0, fy, cy], [0, 0, 1]] with fx, fy > 0, got {K_.tolist()}")
+        return K
 
 
 @dataclass(frozen=True)
 class Dataset:
-    """One rendered dataset.
+    """One rendered dataset, checked (module docstring).
 
-    folder : its folder; meta : ``meta.json``; frames : ``frames.parquet`` (sorted by stop, image)
-    K : (3, 3) float, pixels
+    folder : its folder; meta : ``meta.json`` as read; frames : ``frames.parquet`` (sorted by stop, image)
+    K : (3, 3) float, pixels; image_size : (width, height), px
     """
 
     data_dir: Path
@@ -31,6 +132,7 @@ class Dataset:
     meta: dict[str, Any]
     frames: pd.DataFrame
     K: np.ndarray
+    image_size: tuple[int, int]
 
     @property
     def name(self) -> str:
@@ -47,25 +149,99 @@ class Dataset:
         return first, second
 
     def check_images(self) -> None:
-        """Stop early, naming the file, if any model image, mask or frame image is missing."""
+        """:class:`DatasetError` naming the dataset and the file(s) if a model image, mask or frame image is
+        missing (their content is checked when they are read: extract.py)."""
         relatives = [*self.meta["model"]["images"], *self.meta["model"]["masks"], *self.frames["file"]]
-        for relative in relatives:
-            if not self.path(relative).is_file():
-                raise ImageReadError(f"dataset {self.name}: image file {self.path(relative)} is missing")
+        missing = [str(self.path(relative)) for relative in relatives if not self.path(relative).is_file()]
+        if missing:
+            more = f" and {len(missing) - 3} more" if len(missing) > 3 else ""
+            raise DatasetError(f"dataset {self.name}: image file(s) {', '.join(missing[:3])}{more} missing")
+
+
+def _read_parquet(path: Path, prefix: str = "") -> pd.DataFrame:
+    if not path.is_file():
+        raise DatasetError(f"{prefix}{path} is missing: run stage 01 (generate datasets) first")
+    try:
+        return pd.read_parquet(path)
+    except (OSError, ValueError, pyarrow.ArrowException) as error:
+        raise DatasetError(f"{prefix}cannot read {path}: {error}") from None
+
+
+def _missing_columns(table: pd.DataFrame, columns: tuple[str, ...]) -> list[str]:
+    return [column for column in columns if column not in table.columns]
 
 
 def load_index(data_dir: str | Path) -> pd.DataFrame:
-    """``data_dir/datasets/index.parquet``: one row per dataset."""
-    path = Path(data_dir) / "datasets" / "index.parquet"
+    """``data_dir/datasets/index.parquet``: one row per dataset, checked against the folders on disk."""
+    datasets_dir = Path(data_dir) / "datasets"
+    path = datasets_dir / "index.parquet"
+    index = _read_parquet(path)
+    if missing := _missing_columns(index, INDEX_COLUMNS):
+        raise DatasetError(f"{path} lacks the column(s) {missing}")
+    for column in INDEX_COLUMNS:
+        if repeated := sorted(set(index.loc[index[column].duplicated(), column].astype(str))):
+            raise DatasetError(f"{path} names {'dataset' if column == 'dataset' else 'folder'}(s) "
+                               f"{repeated} more than once")
+    absent = [row.dataset for row in index.itertuples() if not (Path(data_dir) / row.path).is_dir()]
+    if absent:
+        raise DatasetError(f"{path} names dataset(s) {absent} whose folder is missing")
+    listed = {(Path(data_dir) / folder).resolve() for folder in index["path"]}
+    unlisted = sorted(folder.name for folder in datasets_dir.iterdir()
+                      if folder.is_dir() and not folder.name.startswith(".") and folder.resolve() not in listed)
+    if unlisted:
+        raise DatasetError(f"dataset folder(s) {unlisted} in {datasets_dir} are missing from {path.name}: re-run "
+                           f"stage 01, or remove the folder(s)")
+    return index
+
+
+def _read_meta(path: Path, name: str | None) -> dict[str, Any]:
+    label = f"dataset {name}: " if name else ""
     if not path.is_file():
-        raise FileNotFoundError(f"dataset index {path} is missing: run stage 01 (generate datasets) first")
-    return pd.read_parquet(path)
+        raise DatasetError(f"{label}{path} is missing")
+    try:
+        meta = json.loads(path.read_text())
+    except (OSError, ValueError) as error:
+        raise DatasetError(f"{label}cannot read {path}: {error}") from None
+    try:
+        Meta.model_validate(meta)
+    except ValidationError as error:
+        lines = [f"  {'.'.join(map(str, item['loc']))}: {item['msg']}" for item in error.errors()]
+        raise DatasetError(f"{label}{path} has invalid values:\n" + "\n".join(lines)) from None
+    if name is not None and meta["dataset"] != name:
+        raise DatasetError(f"dataset {name}: {path} names the dataset {meta['dataset']!r}, the index {name!r}")
+    return meta
 
 
-def load_dataset(data_dir: str | Path, folder: str | Path) -> Dataset:
-    """A dataset from its folder (relative to ``data_dir``, as in the index's ``path`` column)."""
+def _check_frames(frames: pd.DataFrame, path: Path, name: str) -> None:
+    if missing := _missing_columns(frames, FRAME_TABLE_COLUMNS):
+        raise DatasetError(f"dataset {name}: {path} lacks the column(s) {missing}")
+    if frames[["dataset", "stop", "image", "file"]].isna().any().any():
+        raise DatasetError(f"dataset {name}: {path} has empty dataset, stop, image or file entries")
+    if others := sorted(set(frames["dataset"].astype(str)) - {name}):
+        raise DatasetError(f"dataset {name}: {path} holds rows of dataset(s) {others}")
+    for columns in (["stop", "image"], ["file"]):
+        repeated = frames[frames.duplicated(columns, keep=False)]
+        if len(repeated):
+            first = repeated.iloc[0]
+            raise DatasetError(f"dataset {name}: {path} has {len(repeated)} rows with the same {' and '.join(columns)} "
+                               f"(first: stop {first['stop']}, image {first['image']}, file {first['file']})")
+    positions = frames[["theta_deg", "x_mm"]].to_numpy(dtype=np.float64, na_value=np.nan)
+    if not np.all(np.isfinite(positions)):
+        raise DatasetError(f"dataset {name}: {path} has theta_deg / x_mm values that are not finite numbers")
+
+
+def load_dataset(data_dir: str | Path, folder: str | Path, name: str | None = None) -> Dataset:
+    """A checked dataset from its folder (relative to ``data_dir``, as in the index's ``path`` column); ``name``:
+    the index's name for it, which meta.json must repeat."""
     data_dir = Path(data_dir)
     folder = data_dir / folder
-    meta = json.loads((folder / "meta.json").read_text())
-    frames = pd.read_parquet(folder / "frames.parquet").sort_values(["stop", "image"], ignore_index=True)
-    return Dataset(data_dir, folder, meta, frames, np.asarray(meta["K"], dtype=np.float64))
+    meta = _read_meta(folder / "meta.json", name)
+    name = meta["dataset"]
+    frames_path = folder / "frames.parquet"
+    frames = _read_parquet(frames_path, f"dataset {name}: ")
+    _check_frames(frames, frames_path, name)
+    frames = frames.sort_values(["stop", "image"], ignore_index=True)
+    width, height = meta["image_size"]
+    dataset = Dataset(data_dir, folder, meta, frames, np.asarray(meta["K"], dtype=np.float64), (int(width), int(height)))
+    dataset.check_images()
+    return dataset

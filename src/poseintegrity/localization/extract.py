@@ -1,47 +1,56 @@
-"""Stage 02/05 driver: every frame of a dataset through the localization pipeline, one row per PnP method.
+"""Stage 02/05 driver: every frame of the datasets through the localization pipeline, one row per PnP method.
 
-Per dataset: M_t from the two model images (III-B); per frame (in parallel with joblib, cached features):
-CLAHE + SIFT -> ratio-test matches to M_t -> PnP-RANSAC per method -> artifacts, E_t/E_r against the exact
-renderer pose and against the ArUco board pose (IV-C).
+Before any work: the index, each dataset's meta.json and frames.parquet are checked (:mod:`dataset`), a
+:class:`~poseintegrity.localization.dataset.DatasetError` naming the dataset and file otherwise. Then, on the
+workers of the ``parallel`` section (:class:`~poseintegrity.parallel.Workers`):
+
+1. per dataset, M_t from the two model images (III-B); a model image or mask that is not the 8-bit gray image of
+   meta.json's ``image_size`` stops the stage naming it. M_t is stored beside the SIFT cache, and every frame task
+   loads it from there once per worker process (a task carries its path, not its 1-2 MB of descriptors);
+2. per frame (one task, results in frame order): its evidence (:mod:`evidence`: image check, CLAHE + SIFT, ratio-test
+   matches to M_t, ArUco board pose; cached, so stage 05 reuses stage 02's), then PnP-RANSAC per method ->
+   artifacts (III-C) and E_t/E_r against the exact renderer pose and against the ArUco board pose (IV-C).
+
+A frame whose image is unusable gives rows with status ``bad_image``, one whose ground-truth pose is not a finite
+rigid transform rows with status ``bad_pose`` (localized, but without E_t/E_r against it); the ``reason`` column
+says why (empty for every other row). Neither is evidence about localization: :func:`usable` drops them before
+envelopes and summaries.
 """
 
 from __future__ import annotations
 
 import zlib
+from dataclasses import dataclass
+from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pandas as pd
-from joblib import Parallel, delayed
-from tqdm.auto import tqdm
 
-from poseintegrity.localization.frame_artifacts import frame_artifacts
-from poseintegrity.localization.dataset import Dataset, load_dataset, load_index
+from poseintegrity.localization.dataset import Dataset, DatasetError, load_dataset, load_index, pose_problem
 from poseintegrity.localization.errors import pose_errors
-from poseintegrity.localization.features import Features, cached_features, read_gray
-from poseintegrity.localization.ground_truth import board_pose, make_board
-from poseintegrity.localization.matching import match_ratio_test
+from poseintegrity.localization.evidence import FrameEvidence, frame_evidence, model_digest
+from poseintegrity.localization.features import cached_features, read_gray, write_npz
+from poseintegrity.localization.frame_artifacts import frame_artifacts
 from poseintegrity.localization.params import ExtractParams
-from poseintegrity.localization.pnp import solve_pnp_ransac
+from poseintegrity.localization.pnp import NAN_POSE, failed, solve_pnp_ransac
 from poseintegrity.localization.target_model import TargetModel, build_target_model
+from poseintegrity.parallel import Workers
 
 FRAME_COLUMNS = ["dataset", "trajectory", "stop", "image", "theta_deg", "x_mm"]
+DATA_FLAGS = ("bad_image", "bad_pose")  # statuses of rows whose frame (not its localization) is at fault
+
+
+def usable(table: pd.DataFrame) -> pd.DataFrame:
+    """The rows of an artifacts table whose frame was usable: without the ``DATA_FLAGS`` statuses."""
+    return table[~table["status"].isin(DATA_FLAGS)]
 
 
 def frame_seed(seed: int, dataset: str, stop: int, image: int) -> int:
     """RANSAC seed of one frame, drawn from a Generator seeded by (params seed, dataset, stop, image)."""
     rng = np.random.default_rng([seed, zlib.crc32(dataset.encode()), stop, image])
     return int(rng.integers(0, 2**31 - 1))
-
-
-def correspondences(features: Features, model: TargetModel, ratio: float) -> tuple[np.ndarray, np.ndarray]:
-    """2D-3D correspondences of a frame: ratio-test matches of its descriptors to M_t (III-B).
-
-    Returns object points (k, 3, board frame, mm) and image points (k, 2, px).
-    """
-    pairs = match_ratio_test(features.descriptors, model.descriptors, ratio)
-    return model.points[pairs[:, 1]], features.points[pairs[:, 0]].astype(np.float64)
 
 
 def localize(
@@ -62,27 +71,119 @@ def localize(
     return result.T_cam_model, artifacts, status
 
 
-def _frame_rows(
-    frame: dict[str, Any], image_path: Path, cache_path: Path, model: TargetModel, board: dict[str, Any],
-    K: np.ndarray, methods: list[str], params: ExtractParams,
-) -> list[dict[str, Any]]:
-    """All rows (one per method) of one frame; runs in a joblib worker."""
-    features = cached_features(image_path, cache_path, params.clahe, params.sift)
-    T_cam_board = np.asarray(frame["T_cam_board"], dtype=np.float64).reshape(4, 4)
-    aruco = board_pose(read_gray(image_path), make_board(board), K)
+@dataclass(frozen=True)
+class ModelTask:
+    """Build M_t of one dataset and store it at ``path``."""
+
+    dataset: Dataset
+    cache_dir: Path
+    params: ExtractParams
+
+    @property
+    def path(self) -> Path:
+        return self.cache_dir / "model" / "M_t.npz"
+
+
+@dataclass(frozen=True)
+class StoredModel:
+    """Where a dataset's M_t is stored, its digest (part of every evidence key) and size."""
+
+    path: Path
+    digest: str
+    size: int
+
+
+@dataclass(frozen=True)
+class FrameTask:
+    """One frame of a dataset: everything a worker needs, M_t by reference."""
+
+    frame: dict[str, Any]  # FRAME_COLUMNS, file and T_cam_board of frames.parquet
+    image_path: Path
+    features_path: Path
+    evidence_path: Path
+    model: StoredModel
+    board: dict[str, Any]
+    K: np.ndarray
+    image_size: tuple[int, int]
+    methods: tuple[str, ...]
+    params: ExtractParams
+
+
+def dataset_model(dataset: Dataset, params: ExtractParams, cache_dir: Path) -> TargetModel:
+    """M_t of a dataset from its two model images (features cached like frames). Each image and mask must be the
+    8-bit gray image of meta.json's ``image_size``: :class:`~poseintegrity.localization.features.ImageReadError`
+    naming the dataset and the file otherwise."""
+    model = dataset.meta["model"]
+    try:
+        images = [read_gray(dataset.path(image), dataset.image_size) for image in model["images"]]
+        masks = tuple(read_gray(dataset.path(mask), dataset.image_size) for mask in model["masks"])
+    except DatasetError as error:
+        raise type(error)(f"dataset {dataset.name}, model pair: {error}") from None
+    features = tuple(
+        cached_features(dataset.path(name), cache_dir / "model" / f"{index}.npz", params.clahe, params.sift, image=image)
+        for index, (name, image) in enumerate(zip(model["images"], images))
+    )
+    return build_target_model(
+        features, masks, dataset.model_T_cam_board(), dataset.K, params.ratio_test, params.model_max_reprojection_px
+    )
+
+
+def store_model(task: ModelTask) -> StoredModel:
+    """Build M_t of a dataset (a worker task) and store it for the frame tasks (unless stored already)."""
+    model = dataset_model(task.dataset, task.params, task.cache_dir)
+    digest = model_digest(model)
+    try:
+        with np.load(task.path) as stored:
+            current = str(stored["digest"]) == digest
+    except (OSError, ValueError, KeyError):
+        current = False
+    if not current:
+        write_npz(task.path, digest=digest, points=model.points, descriptors=model.descriptors)
+    return StoredModel(task.path, digest, model.size)
+
+
+@lru_cache(maxsize=4)
+def load_model(path: Path, digest: str) -> TargetModel:
+    """M_t stored by :func:`store_model`, loaded once per worker process (``digest``: the one expected)."""
+    with np.load(path) as stored:
+        if str(stored["digest"]) != digest:
+            raise DatasetError(f"target model {path} was replaced while this stage ran (another run on the same data?)")
+        return TargetModel(stored["points"], stored["descriptors"])
+
+
+def frame_rows(task: FrameTask) -> list[dict[str, Any]]:
+    """All rows (one per method) of one frame; runs in a worker."""
+    frame, model = task.frame, task.model
+    evidence: FrameEvidence = frame_evidence(
+        task.image_path, task.features_path, task.evidence_path, load_model(model.path, model.digest), model.digest,
+        task.board, task.K, task.image_size, task.params, frame["file"],
+    )
+    truth_problem = pose_problem(frame["T_cam_board"])
+    T_cam_board = NAN_POSE if truth_problem else np.asarray(frame["T_cam_board"], dtype=np.float64).reshape(4, 4)
+    if evidence.image_problem:
+        status, reason = "bad_image", evidence.image_problem
+    elif truth_problem:
+        status, reason = "bad_pose", f"ground truth T_cam_board of frames.parquet {truth_problem}"
+    else:
+        status, reason = None, ""
+    aruco = evidence.board
     E_t_board_exact_mm, E_r_board_exact_deg = pose_errors(aruco.T_cam_board, T_cam_board)
-    seed = frame_seed(params.seed, frame["dataset"], int(frame["stop"]), int(frame["image"]))
-    object_points, image_points = correspondences(features, model, params.ratio_test)
+    seed = frame_seed(task.params.seed, frame["dataset"], int(frame["stop"]), int(frame["image"]))
     rows = []
-    for method in methods:
-        T_est, artifacts, status = localize(
-            object_points, image_points, features.n_keypoints, model.size, K, method, params, seed
-        )
+    for method in task.methods:
+        if evidence.image_problem:
+            T_est, artifacts = NAN_POSE.copy(), frame_artifacts(failed("bad_image"), evidence.object_points,
+                                                                evidence.image_points, task.K, 0, model.size)
+        else:
+            T_est, artifacts, pnp_status = localize(
+                evidence.object_points, evidence.image_points, evidence.n_keypoints, model.size, task.K, method,
+                task.params, seed,
+            )
         E_t_mm, E_r_deg = pose_errors(T_est, T_cam_board)
         E_t_board_mm, E_r_board_deg = pose_errors(T_est, aruco.T_cam_board)
         rows.append(
             {key: frame[key] for key in FRAME_COLUMNS}
-            | dict(method=method, status=status, model_size=model.size)
+            | dict(method=method, status=status or pnp_status, reason=reason, model_size=model.size)
             | artifacts
             | dict(
                 E_t_mm=E_t_mm, E_r_deg=E_r_deg, E_t_board_mm=E_t_board_mm, E_r_board_deg=E_r_board_deg,
@@ -94,51 +195,50 @@ def _frame_rows(
     return rows
 
 
-def dataset_model(dataset: Dataset, params: ExtractParams, cache_dir: Path) -> TargetModel:
-    """M_t of a dataset from its two model images (features cached like frames)."""
-    model = dataset.meta["model"]
-    features = tuple(
-        cached_features(dataset.path(image), cache_dir / "model" / f"{index}.npz", params.clahe, params.sift)
-        for index, image in enumerate(model["images"])
-    )
-    masks = tuple(read_gray(dataset.path(mask)) for mask in model["masks"])
-    return build_target_model(
-        features, masks, dataset.model_T_cam_board(), dataset.K, params.ratio_test, params.model_max_reprojection_px
-    )
+def extract_datasets(
+    datasets: list[Dataset], params: ExtractParams, methods: list[str], workers: Workers, progress: bool = True
+) -> pd.DataFrame:
+    """Artifact rows (one per frame and method, datasets in the given order, frames by stop and image) of checked
+    datasets: M_t per dataset, then every frame, on ``workers``."""
+    cache_dirs = [_cache_root(dataset.data_dir, params) / dataset.name for dataset in datasets]
+    models = workers.map(store_model, [ModelTask(d, c, params) for d, c in zip(datasets, cache_dirs)],
+                         desc="target models M_t", progress=progress)
+    tasks = [
+        FrameTask(
+            frame, dataset.path(frame["file"]), cache_dir / Path(frame["file"]).with_suffix(".npz"),
+            cache_dir / Path(frame["file"]).with_suffix(".evidence.npz"), model, dataset.meta["board"], dataset.K,
+            dataset.image_size, tuple(methods), params,
+        )
+        for dataset, cache_dir, model in zip(datasets, cache_dirs, models)
+        for frame in dataset.frames.assign(trajectory=dataset.meta["trajectory"]).to_dict("records")
+    ]
+    results = workers.map(frame_rows, tasks, desc=f"frames of {len(datasets)} dataset(s)", progress=progress)
+    return pd.DataFrame([row for rows in results for row in rows])
+
+
+def _cache_root(data_dir: Path, params: ExtractParams) -> Path:
+    return Path(data_dir) / params.features_dir  # an absolute features_dir stays as it is
 
 
 def extract_dataset(
-    data_dir: str | Path, folder: str | Path, params: ExtractParams, methods: list[str], progress: bool = True
+    data_dir: str | Path, folder: str | Path, params: ExtractParams, methods: list[str], workers: Workers,
+    progress: bool = True,
 ) -> pd.DataFrame:
-    """Artifact rows (one per frame and method) of the dataset in ``data_dir/folder``.
-
-    Raises :class:`~poseintegrity.localization.features.ImageReadError` naming the file when an image is
-    missing or unreadable; every other failure is a row status.
-    """
-    dataset = load_dataset(data_dir, folder)
-    dataset.check_images()
-    cache_dir = Path(data_dir) / params.features_dir / dataset.name
-    model = dataset_model(dataset, params, cache_dir)
-    frames = dataset.frames.assign(trajectory=dataset.meta["trajectory"]).to_dict("records")
-    tasks = (
-        delayed(_frame_rows)(
-            frame, dataset.path(frame["file"]), cache_dir / Path(frame["file"]).with_suffix(".npz"), model,
-            dataset.meta["board"], dataset.K, methods, params,
-        )
-        for frame in frames
-    )
-    results = Parallel(n_jobs=params.n_jobs, return_as="generator")(tasks)
-    rows = [row for frame_rows in tqdm(results, total=len(frames), desc=dataset.name, disable=not progress) for row in frame_rows]
-    return pd.DataFrame(rows)
+    """Artifact rows (one per frame and method) of the dataset in ``data_dir/folder`` (checked on read)."""
+    return extract_datasets([load_dataset(data_dir, folder)], params, methods, workers, progress)
 
 
-def extract_all(data_dir: str | Path, params: ExtractParams, methods: list[str], progress: bool = True) -> pd.DataFrame:
-    """Artifact rows of every dataset in ``data_dir/datasets/index.parquet`` (or of ``params.datasets``)."""
+def extract_all(
+    data_dir: str | Path, params: ExtractParams, methods: list[str], workers: Workers, progress: bool = True
+) -> pd.DataFrame:
+    """Artifact rows of every dataset of ``data_dir/datasets/index.parquet`` (or of ``params.datasets``), in index
+    order. Every dataset is checked before any work (:mod:`~poseintegrity.localization.dataset`)."""
     index = load_index(data_dir)
     if params.datasets is not None:
         unknown = sorted(set(params.datasets) - set(index["dataset"]))
         if unknown:
-            raise ValueError(f"extract.datasets names unknown datasets {unknown}; known: {sorted(index['dataset'])}")
+            raise DatasetError(f"extract.datasets names datasets {unknown} that are not in the index; "
+                               f"known: {sorted(index['dataset'])}")
         index = index[index["dataset"].isin(params.datasets)]
-    tables = [extract_dataset(data_dir, row.path, params, methods, progress) for row in index.itertuples()]
-    return pd.concat(tables, ignore_index=True)
+    datasets = [load_dataset(data_dir, row.path, row.dataset) for row in index.itertuples()]
+    return extract_datasets(datasets, params, methods, workers, progress)

@@ -17,13 +17,15 @@ from pathlib import Path
 import cv2
 import numpy as np
 
+from poseintegrity.localization.dataset import DatasetError
 from poseintegrity.localization.params import ClaheParams, SiftParams
 
 CACHE_VERSION = 1  # bump when the cached content or its layout changes
 
 
-class ImageReadError(RuntimeError):
-    """An image file of a dataset is missing or cannot be decoded (stops the stage)."""
+class ImageReadError(DatasetError):
+    """An image file of a dataset is missing, cannot be decoded, or is not what its meta.json says (an 8-bit gray
+    image of ``image_size``). Stops the stage for a model image or mask; a frame image is flagged instead."""
 
 
 @dataclass(frozen=True)
@@ -50,17 +52,29 @@ def read_image_bytes(path: str | Path) -> bytes:
         raise ImageReadError(f"cannot read image file {path}: {error.strerror}") from None
 
 
-def decode_gray(data: bytes, path: str | Path) -> np.ndarray:
-    """Decode PNG/JPEG bytes to an 8-bit grayscale (h, w) image; :class:`ImageReadError` if undecodable."""
-    image = cv2.imdecode(np.frombuffer(data, np.uint8), cv2.IMREAD_GRAYSCALE) if data else None
+def decode_gray(data: bytes, path: str | Path, size: tuple[int, int] | None = None) -> np.ndarray:
+    """Decode PNG/JPEG bytes as stored: an 8-bit single-channel (h, w) image, of ``size`` (width, height) if given.
+
+    :class:`ImageReadError` naming the file and what is wrong otherwise. The bytes are decoded unchanged, never
+    converted: IMREAD_GRAYSCALE would turn a 16-bit or colour file into a plausible 8-bit image.
+    """
+    image = cv2.imdecode(np.frombuffer(data, np.uint8), cv2.IMREAD_UNCHANGED) if data else None
     if image is None:
         raise ImageReadError(f"cannot decode image file {path} (not a readable image)")
+    if image.dtype != np.uint8 or image.ndim != 2:
+        channels = 1 if image.ndim == 2 else image.shape[2]
+        raise ImageReadError(f"image file {path} is {image.dtype.itemsize * 8}-bit with {channels} channel(s), "
+                             f"expected 8-bit gray")
+    if size is not None and (image.shape[1], image.shape[0]) != tuple(size):
+        raise ImageReadError(f"image file {path} is {image.shape[1]} x {image.shape[0]} px, its dataset's "
+                             f"meta.json image_size is {size[0]} x {size[1]} px")
     return image
 
 
-def read_gray(path: str | Path) -> np.ndarray:
-    """Read an 8-bit grayscale image: (h, w) uint8; :class:`ImageReadError` naming the file on failure."""
-    return decode_gray(read_image_bytes(path), path)
+def read_gray(path: str | Path, size: tuple[int, int] | None = None) -> np.ndarray:
+    """Read an 8-bit grayscale image (of ``size`` (width, height) if given): (h, w) uint8; :class:`ImageReadError`
+    naming the file on failure (:func:`decode_gray`)."""
+    return decode_gray(read_image_bytes(path), path, size)
 
 
 def equalize(image: np.ndarray, clahe: ClaheParams) -> np.ndarray:
@@ -88,12 +102,16 @@ def features_key(data: bytes, clahe: ClaheParams, sift: SiftParams) -> str:
     return hashlib.sha1(settings.encode() + data).hexdigest()
 
 
-def cached_features(image_path: str | Path, cache_path: str | Path, clahe: ClaheParams, sift: SiftParams) -> Features:
+def cached_features(
+    image_path: str | Path, cache_path: str | Path, clahe: ClaheParams, sift: SiftParams, data: bytes | None = None,
+    image: np.ndarray | None = None,
+) -> Features:
     """Features of ``image_path``, read from ``cache_path`` (.npz) when its key matches, else computed and stored.
 
+    ``data``: the file's bytes if already read; ``image``: the decoded image if already decoded (and checked).
     Raises :class:`ImageReadError` naming the file if the image is missing or unreadable.
     """
-    data = read_image_bytes(image_path)
+    data = read_image_bytes(image_path) if data is None else data
     key = features_key(data, clahe, sift)
     cache_path = Path(cache_path)
     if cache_path.exists():
@@ -103,11 +121,16 @@ def cached_features(image_path: str | Path, cache_path: str | Path, clahe: Clahe
                     return Features(stored["points"], stored["descriptors"].astype(np.float32))
         except (OSError, ValueError, KeyError):
             pass  # a truncated or foreign file is simply recomputed
-    features = detect_features(decode_gray(data, image_path), clahe, sift)
-    cache_path.parent.mkdir(parents=True, exist_ok=True)
-    # write-then-rename: parallel workers and interrupted runs never leave a half-written entry
-    handle, tmp_path = tempfile.mkstemp(dir=cache_path.parent, suffix=".npz")
-    with os.fdopen(handle, "wb") as stream:
-        np.savez(stream, key=key, points=features.points, descriptors=features.descriptors.astype(np.uint8))
-    os.replace(tmp_path, cache_path)
+    features = detect_features(decode_gray(data, image_path) if image is None else image, clahe, sift)
+    write_npz(cache_path, key=key, points=features.points, descriptors=features.descriptors.astype(np.uint8))
     return features
+
+
+def write_npz(path: Path, **arrays) -> None:
+    """Write an .npz cache entry by write-then-rename: parallel workers and interrupted runs never leave a
+    half-written entry."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    handle, tmp_path = tempfile.mkstemp(dir=path.parent, suffix=".npz")
+    with os.fdopen(handle, "wb") as stream:
+        np.savez(stream, **arrays)
+    os.replace(tmp_path, path)

@@ -114,7 +114,7 @@ def solve_pnp_ransac(
     confidence: float,
     max_iterations: int,
     seed: int,
-    refine_lm: bool = True,
+    refine_lm: bool,
 ) -> PnPResult:
     """Robust pose of the model from 2D-3D correspondences.
 

@@ -1,0 +1,115 @@
+"""What one frame gives before any PnP method runs, computed once and cached beside its SIFT features.
+
+Per frame, stages 02 and 05 need the same method-independent evidence: the image checked against its dataset's
+meta.json (8-bit gray, ``image_size``), its CLAHE + SIFT features (IV-C), the ratio-test 2D-3D correspondences
+to M_t (III-B) and the ArUco board pose (the ground truth of IV-C). Stage 02 computes them and stores them in one
+small ``.npz`` per frame (``<features_dir>/<dataset>/images/<image>.evidence.npz``); stage 05, which runs the other
+PnP methods on the same frames, reads them back instead of decoding the image, loading its descriptors,
+matching them and detecting the board again. The entry's key hashes everything the evidence depends on (image
+bytes, CLAHE/SIFT settings, the ratio, M_t itself, the board, K, the image size), so an entry is used only when
+recomputing it would give the same arrays; a frame image that fails its check is never cached (it is checked,
+and flagged, again).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from poseintegrity.localization.features import (
+    ImageReadError, cached_features, decode_gray, features_key, read_image_bytes, write_npz,
+)
+from poseintegrity.localization.ground_truth import BoardPose, board_pose, make_board
+from poseintegrity.localization.matching import match_ratio_test
+from poseintegrity.localization.params import ExtractParams
+from poseintegrity.localization.pnp import NAN_POSE
+from poseintegrity.localization.target_model import TargetModel
+
+EVIDENCE_VERSION = 1  # bump when the cached content or its layout changes
+
+
+@dataclass(frozen=True)
+class FrameEvidence:
+    """The method-independent evidence of one frame.
+
+    image_problem : why the image is unusable ("" if it is fine; then nothing else was computed)
+    object_points : (k, 3) float64, M_t points of the k ratio-test matches, board frame, mm
+    image_points : (k, 2) float64, the frame's keypoints of those matches, px
+    n_keypoints : SIFT keypoints in the frame
+    board : the ArUco board pose (ground truth)
+    """
+
+    image_problem: str
+    object_points: np.ndarray
+    image_points: np.ndarray
+    n_keypoints: int
+    board: BoardPose
+
+
+def bad_image(problem: str) -> FrameEvidence:
+    """The evidence of a frame whose image failed its check: no correspondences, no board."""
+    return FrameEvidence(problem, np.empty((0, 3)), np.empty((0, 2)), 0, BoardPose(NAN_POSE.copy(), 0, "bad_image"))
+
+
+def model_digest(model: TargetModel) -> str:
+    """SHA-1 of M_t's points and descriptors: the part of an evidence key that stands for the target model."""
+    return hashlib.sha1(model.points.tobytes() + model.descriptors.tobytes()).hexdigest()
+
+
+def evidence_key(features_key_: str, digest: str, params: ExtractParams, board: dict[str, Any], K: np.ndarray,
+                 image_size: tuple[int, int]) -> str:
+    """Hash of what a frame's evidence depends on beyond its features: M_t, the ratio, the board, K, image size."""
+    settings = json.dumps([EVIDENCE_VERSION, features_key_, digest, params.ratio_test, board,
+                           np.asarray(K, np.float64).tolist(), list(image_size)], sort_keys=True)
+    return hashlib.sha1(settings.encode()).hexdigest()
+
+
+def correspondences(features, model: TargetModel, ratio: float) -> tuple[np.ndarray, np.ndarray]:
+    """2D-3D correspondences of a frame: ratio-test matches of its descriptors to M_t (III-B).
+
+    Returns object points (k, 3, board frame, mm) and image points (k, 2, px).
+    """
+    pairs = match_ratio_test(features.descriptors, model.descriptors, ratio)
+    return model.points[pairs[:, 1]], features.points[pairs[:, 0]].astype(np.float64)
+
+
+def _load(path: Path, key: str) -> FrameEvidence | None:
+    try:
+        with np.load(path) as stored:
+            if str(stored["key"]) != key:
+                return None
+            board = BoardPose(stored["board_T_cam_board"], int(stored["board_n_markers"]), str(stored["board_status"]))
+            return FrameEvidence("", stored["object_points"], stored["image_points"], int(stored["n_keypoints"]), board)
+    except (OSError, ValueError, KeyError):
+        return None  # missing, truncated or foreign: recomputed
+
+
+def frame_evidence(
+    image_path: Path, features_path: Path, evidence_path: Path, model: TargetModel, digest: str,
+    board: dict[str, Any], K: np.ndarray, image_size: tuple[int, int], params: ExtractParams, name: str,
+) -> FrameEvidence:
+    """The evidence of one frame: from ``evidence_path`` when its key matches, else computed (the SIFT features
+    from ``features_path``, the SIFT cache) and stored. A missing file raises :class:`ImageReadError`; an image that
+    cannot be decoded or is not 8-bit gray of ``image_size`` (width, height) gives :func:`bad_image` evidence,
+    naming the file by ``name`` (as frames.parquet does: the table is the same whichever folder holds the data)."""
+    data = read_image_bytes(image_path)
+    features_key_ = features_key(data, params.clahe, params.sift)
+    key = evidence_key(features_key_, digest, params, board, K, image_size)
+    if evidence_path.exists() and (cached := _load(evidence_path, key)) is not None:
+        return cached
+    try:
+        image = decode_gray(data, name, image_size)
+    except ImageReadError as error:
+        return bad_image(str(error))
+    features = cached_features(image_path, features_path, params.clahe, params.sift, data=data, image=image)
+    object_points, image_points = correspondences(features, model, params.ratio_test)
+    aruco = board_pose(image, make_board(board), K)
+    write_npz(evidence_path, key=key, object_points=object_points, image_points=image_points,
+              n_keypoints=features.n_keypoints, board_T_cam_board=aruco.T_cam_board,
+              board_n_markers=aruco.n_markers, board_status=aruco.status)
+    return FrameEvidence("", object_points, image_points, features.n_keypoints, aruco)
