@@ -102,7 +102,7 @@ def test_fit_statuses_have_a_row_per_model_and_predictor():
             for s in FIT_STATUSES} <= keys
     metrics = {"fits": {"fit_status": {"emg": {"ok": 0.975, "at_bound": 0.025, "non_physical": 0.0, "fallback": 0.0}}},
                "predictors": {"fit_status": {"next_step": {"non_physical": 0.125}}, "live": {"n_flagged_fits": 2}}}
-    text = render_summary(metrics)
+    text = render_summary(metrics, [])
     assert "| EMG (eq. 1): share of fits ok | 97.5% | - | >= 0.99 |" in text
     assert "| ... at a bound | 2.5% | - | - |" in text
     assert "| ... non-physical | 12.5% | - | - |" in text  # next step's rows

@@ -86,7 +86,7 @@ def realism_metrics(
     gap = (loose.loc[both_uncensored, "theta_a"] - strict.loc[both_uncensored, "theta_a"]).to_dict()
     last_sampled = per_stop["theta"].groupby("dataset").nth(sampled - 1).droplevel("stop")
     within_sampling = sorted(d for d, row in strict.iterrows() if d in last_sampled and row["theta_a"] <= last_sampled[d])
-    rmse = base_function_rmse(rows, sampled, realism.max_nfev)
+    rmse = base_function_rmse(rows, sampled, protocol.range_end("arc"), realism.max_nfev)
     others = {name: value for name, value in rmse.items() if name != "emg"}
     decay_arc, decay_line = decay_ratios(rows, "arc", sampled), decay_ratios(rows, "line", sampled)
     n_arcs = int(arcs["dataset"].nunique())
@@ -148,15 +148,16 @@ def realism_metrics(
     return metrics
 
 
-def base_function_rmse(rows: pd.DataFrame, sampled_stops: int, max_nfev: int) -> dict[str, float]:
+def base_function_rmse(rows: pd.DataFrame, sampled_stops: int, theta_end: float, max_nfev: int) -> dict[str, float]:
     """R1: per least-squares base function (eq. 1 and the other decays of Fig. 2), the mean over arc datasets of
-    the RMSE over every image when fitted to the images of the first ``sampled_stops`` stops."""
+    the RMSE over every image when fitted to the images of the first ``sampled_stops`` stops (``theta_end``: the
+    arcs' range end, deg, up to which each fit's curve is checked)."""
     sums: dict[str, list[float]] = {name: [] for name in BASE_FUNCTIONS}
     for _, frames in rows[rows["trajectory"] == "arc"].groupby("dataset"):
         theta, n_i = frames["theta_deg"].to_numpy(float), frames["n_inliers"].to_numpy(float)
         fitted_stops = np.isin(frames["stop"], np.sort(frames["stop"].unique())[:sampled_stops])
         for name, base in BASE_FUNCTIONS.items():
-            model = base.fit(theta[fitted_stops], n_i[fitted_stops], max_nfev)
+            model = base.fit(theta[fitted_stops], n_i[fitted_stops], theta_end=theta_end, max_nfev=max_nfev)
             sums[name].append(float(np.sqrt(np.mean((model.predict(theta) - n_i) ** 2))))
     return {name: _nanmean(values) for name, values in sums.items()}
 
