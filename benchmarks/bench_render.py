@@ -14,7 +14,8 @@ import numpy as np
 
 from poseintegrity.config import load_params
 from poseintegrity.scenes import dataset, renderer, trajectories
-from poseintegrity.scenes.camera import Intrinsics, inverse
+from poseintegrity.poses import inverse
+from poseintegrity.scenes.camera import Intrinsics
 
 cv2.setNumThreads(1)
 everything = load_params("params.yaml")

@@ -1,7 +1,7 @@
 import numpy as np
 
 import loc_synthetic as synthetic
-from poseintegrity.localization.errors import pose_errors
+from poseintegrity.poses import pose_errors
 from poseintegrity.localization.ground_truth import board_pose, make_board
 
 

@@ -5,7 +5,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
-from poseintegrity.localization.errors import pose_errors
+from poseintegrity.poses import pose_errors
 from poseintegrity.localization.pnp import METHODS, reprojection_errors, solve_pnp_ransac
 
 K = np.array([[700.0, 0.0, 480.0], [0.0, 700.0, 300.0], [0.0, 0.0, 1.0]])

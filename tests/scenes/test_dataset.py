@@ -60,7 +60,8 @@ def test_images_of_a_stop_differ_only_by_noise(tiny_root):
 def test_board_ground_truth_agrees_with_opencv_aruco_pose(tiny_root):
     """T_cam_board of the renderer and the pose OpenCV recovers from the rendered board agree (half resolution)."""
     from poseintegrity.scenes import trajectories
-    from poseintegrity.scenes.camera import Intrinsics, inverse
+    from poseintegrity.poses import inverse
+    from poseintegrity.scenes.camera import Intrinsics
     params, _ = tiny_root
     params = params.model_copy(update={"camera": params.camera.model_copy(update={"downscale": 2})})
     world = dataset.world(params, 1)

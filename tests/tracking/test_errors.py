@@ -2,8 +2,8 @@ import numpy as np
 import pandas as pd
 from scipy.spatial.transform import Rotation
 
-from poseintegrity.tracking.errors import EULER_SEQUENCE, axis_errors, error_columns, pose_errors, rms_summary
-from poseintegrity.tracking.geometry import pose_matrix
+from poseintegrity.poses import pose_errors, pose_matrix
+from poseintegrity.tracking.errors import EULER_SEQUENCE, axis_errors, error_columns, rms_summary
 
 
 def _poses(rotvecs, positions):

@@ -27,7 +27,7 @@ from poseintegrity.localization.features import (
 from poseintegrity.localization.ground_truth import BoardPose, board_pose, make_board
 from poseintegrity.localization.matching import match_ratio_test
 from poseintegrity.localization.params import ExtractParams
-from poseintegrity.localization.pnp import NAN_POSE
+from poseintegrity.poses import NAN_POSE
 from poseintegrity.localization.target_model import TargetModel
 
 EVIDENCE_VERSION = 1  # bump when the cached content or its layout changes

@@ -29,12 +29,12 @@ import numpy as np
 import pandas as pd
 
 from poseintegrity.localization.dataset import Dataset, DatasetError, load_dataset, load_index, pose_problem
-from poseintegrity.localization.errors import pose_errors
 from poseintegrity.localization.evidence import FrameEvidence, frame_evidence, model_digest
 from poseintegrity.localization.features import cached_features, read_gray, write_npz
 from poseintegrity.localization.frame_artifacts import frame_artifacts
 from poseintegrity.localization.params import ExtractParams
-from poseintegrity.localization.pnp import NAN_POSE, failed, solve_pnp_ransac
+from poseintegrity.localization.pnp import failed, solve_pnp_ransac
+from poseintegrity.poses import NAN_POSE, pose_errors
 from poseintegrity.localization.target_model import TargetModel, build_target_model
 from poseintegrity.parallel import Workers
 
@@ -167,7 +167,7 @@ def frame_rows(task: FrameTask) -> list[dict[str, Any]]:
     else:
         status, reason = None, ""
     aruco = evidence.board
-    E_t_board_exact_mm, E_r_board_exact_deg = pose_errors(aruco.T_cam_board, T_cam_board)
+    E_t_board_exact_mm, E_r_board_exact_deg = map(float, pose_errors(aruco.T_cam_board, T_cam_board))
     seed = frame_seed(task.params.seed, frame["dataset"], int(frame["stop"]), int(frame["image"]))
     rows = []
     for method in task.methods:
@@ -179,8 +179,8 @@ def frame_rows(task: FrameTask) -> list[dict[str, Any]]:
                 evidence.object_points, evidence.image_points, evidence.n_keypoints, model.size, task.K, method,
                 task.params, seed,
             )
-        E_t_mm, E_r_deg = pose_errors(T_est, T_cam_board)
-        E_t_board_mm, E_r_board_deg = pose_errors(T_est, aruco.T_cam_board)
+        E_t_mm, E_r_deg = map(float, pose_errors(T_est, T_cam_board))
+        E_t_board_mm, E_r_board_deg = map(float, pose_errors(T_est, aruco.T_cam_board))
         rows.append(
             {key: frame[key] for key in FRAME_COLUMNS}
             | dict(method=method, status=status or pnp_status, reason=reason, model_size=model.size)

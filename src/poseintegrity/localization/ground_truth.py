@@ -12,7 +12,7 @@ from typing import Any
 import cv2
 import numpy as np
 
-from poseintegrity.localization.pnp import NAN_POSE, pose_from_rvec_tvec
+from poseintegrity.poses import NAN_POSE, pose_from_rvec_tvec
 
 
 @dataclass(frozen=True)

@@ -25,6 +25,8 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
+from poseintegrity.poses import NAN_POSE, pose_from_rvec_tvec
+
 # names of docs/references.md, "OpenCV 5" (OpenCV 5 renumbered the flags: never use the integers)
 CLASSIC_FLAGS = {
     "epnp": cv2.SOLVEPNP_EPNP,
@@ -35,7 +37,6 @@ CLASSIC_FLAGS = {
 }
 METHODS = ("usac_magsac", *CLASSIC_FLAGS)
 MIN_CORRESPONDENCES = 4  # a unique pose needs 4 points; P3P with 3 leaves up to 4 solutions
-NAN_POSE = np.full((4, 4), np.nan)
 
 
 @dataclass(frozen=True)
@@ -61,14 +62,6 @@ class PnPResult:
 def failed(status: str) -> PnPResult:
     """The documented failed value: NaN pose, no inliers, a reason."""
     return PnPResult(NAN_POSE.copy(), np.empty(0, dtype=np.intp), 0, status)
-
-
-def pose_from_rvec_tvec(rvec: np.ndarray, tvec: np.ndarray) -> np.ndarray:
-    """(4, 4) pose from OpenCV's Rodrigues vector (3,) and translation (3,)."""
-    T = np.eye(4)
-    T[:3, :3] = cv2.Rodrigues(np.asarray(rvec, dtype=np.float64).reshape(3))[0]
-    T[:3, 3] = np.asarray(tvec, dtype=np.float64).reshape(3)
-    return T
 
 
 def reprojection_errors(object_points: np.ndarray, image_points: np.ndarray, K: np.ndarray, T_cam_model: np.ndarray) -> np.ndarray:

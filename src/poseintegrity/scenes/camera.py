@@ -11,6 +11,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from poseintegrity.poses import pose_matrix
+
 if TYPE_CHECKING:
     from poseintegrity.scenes.params import CameraParams
 
@@ -58,17 +60,5 @@ def look_at(eye: np.ndarray, target: np.ndarray, up: np.ndarray = np.array([0.0,
     if np.linalg.norm(x) < 1e-9:  # looking straight along `up`: any horizontal x will do
         x = np.cross(z, np.array([0.0, 1.0, 0.0]))
     x = x / np.linalg.norm(x)
-    return rigid(np.column_stack([x, np.cross(z, x), z]), eye)
+    return pose_matrix(np.column_stack([x, np.cross(z, x), z]), eye)
 
-
-def rigid(R: np.ndarray, t) -> np.ndarray:
-    """The 4x4 homogeneous transform with rotation R (3, 3) and translation t (3,)."""
-    T = np.eye(4)
-    T[:3, :3] = R
-    T[:3, 3] = t
-    return T
-
-
-def inverse(T: np.ndarray) -> np.ndarray:
-    """Inverse of a rigid 4x4 transform."""
-    return rigid(T[:3, :3].T, -T[:3, :3].T @ T[:3, 3])

@@ -25,7 +25,7 @@ from scipy.spatial.transform import Rotation
 
 from poseintegrity.scenes import mesh as meshes
 from poseintegrity.scenes import textures as tex
-from poseintegrity.scenes.camera import rigid
+from poseintegrity.poses import pose_matrix
 from poseintegrity.scenes.scapula import scapula_mesh
 
 if TYPE_CHECKING:
@@ -130,11 +130,11 @@ def _held_phantom(name: str, params: "GenerateParams", spec: "SceneSpec", view_d
     R = np.column_stack([inferior, np.cross(normal, inferior), normal])
     phantom = target_mesh(name, params)
     lowest = float((phantom.vertices @ R.T)[:, 2].min())
-    T = rigid(R, side + np.array([0.0, 0.0, PHANTOM_CLEARANCE_MM - lowest]))
+    T = pose_matrix(R, side + np.array([0.0, 0.0, PHANTOM_CLEARANCE_MM - lowest]))
     placed = phantom.transformed(T)
     # the rod holding it: from the table up to its lowest vertex
     foot = placed.vertices[placed.vertices[:, 2].argmin()]
-    stand = meshes.cylinder(STAND_RADIUS_MM, foot[2] + 2.0, "clutter_c").transformed(rigid(np.eye(3), [*foot[:2], 0]))
+    stand = meshes.cylinder(STAND_RADIUS_MM, foot[2] + 2.0, "clutter_c").transformed(pose_matrix(np.eye(3), [*foot[:2], 0]))
     return T, [(name, placed), (f"{name}_stand", stand)]
 
 
@@ -155,7 +155,7 @@ def build_scene(spec: "SceneSpec", index: int, params: "GenerateParams") -> Scen
         else:
             # a corner towards the model camera, so that two printed sides are in view (a 3D point set)
             R = Rotation.from_euler("z", yaw + np.pi / 4 + rng.uniform(-0.25, 0.25)).as_matrix()
-            T = rigid(R, side + np.array([0.0, 0.0, BLOCK_SIZE_MM[2] / 2]))
+            T = pose_matrix(R, side + np.array([0.0, 0.0, BLOCK_SIZE_MM[2] / 2]))
             placed.append((name, target_mesh(name, params).transformed(T)))
         target_poses.append(T)
     aim = np.mean([T[:3, 3] for T in target_poses], axis=0)
@@ -175,13 +175,13 @@ def build_scene(spec: "SceneSpec", index: int, params: "GenerateParams") -> Scen
     height = max(aim[2] - BOARD_BELOW_AIM_MM, 0.0)
     if height > 0:
         pedestal = meshes.box((bw + 2 * m, bh + 2 * m, height), "clutter_b", n_sub=4)
-        placed.append(("board_pedestal", pedestal.transformed(rigid(R_world_board @ np.diag([1.0, -1.0, -1.0]),
+        placed.append(("board_pedestal", pedestal.transformed(pose_matrix(R_world_board @ np.diag([1.0, -1.0, -1.0]),
                                                                     [*board_centre, height / 2]))))
     origin = np.append(board_centre, height + 0.4) - R_world_board @ np.array([bw / 2, bh / 2, 0.0])
-    T_world_board = rigid(R_world_board, origin)
+    T_world_board = pose_matrix(R_world_board, origin)
     # plane() faces +z with texture v along -y; flip about x so it faces -z (the board's printed side) with v along +y
     board_mesh = meshes.plane(bw + 2 * m, bh + 2 * m, 12, 9, "aruco_board", material=meshes.Material(0.02, 10.0))
-    board_mesh = board_mesh.transformed(rigid(np.diag([1.0, -1.0, -1.0]), [bw / 2, bh / 2, 0.0]))
+    board_mesh = board_mesh.transformed(pose_matrix(np.diag([1.0, -1.0, -1.0]), [bw / 2, bh / 2, 0.0]))
     placed.append(("aruco_board", board_mesh.transformed(T_world_board)))
     placed += _clutter(spec, params, rng, aim, toward_cam, board_centre)
 
@@ -223,18 +223,18 @@ def _clutter(spec: "SceneSpec", params: "GenerateParams", rng: np.random.Generat
             if rng.random() < 0.5:
                 size = (2 * radius, rng.uniform(0.6, 1.2) * radius, rng.uniform(30, 90))
                 obj = meshes.box(size, None, n_sub=8, material=foam)
-                T = rigid(Rotation.from_euler("z", rng.uniform(0, np.pi)).as_matrix(), [*xy, size[2] / 2])
+                T = pose_matrix(Rotation.from_euler("z", rng.uniform(0, np.pi)).as_matrix(), [*xy, size[2] / 2])
             else:
                 obj = meshes.cylinder(0.45 * radius, rng.uniform(80, 160), None, n_seg=48, material=foam)
-                T = rigid(np.eye(3), [*xy, 0.0])
+                T = pose_matrix(np.eye(3), [*xy, 0.0])
         elif kind < 2 / 3:
             texture = PRINTED_CLUTTER[rng.integers(len(PRINTED_CLUTTER))]
             size = (2 * radius, rng.uniform(0.5, 1.5) * radius, rng.uniform(25, 140))
             obj = meshes.box(size, texture, n_sub=4)
-            T = rigid(Rotation.from_euler("z", rng.uniform(0, np.pi)).as_matrix(), [*xy, size[2] / 2])
+            T = pose_matrix(Rotation.from_euler("z", rng.uniform(0, np.pi)).as_matrix(), [*xy, size[2] / 2])
         else:
             texture = PRINTED_CLUTTER[rng.integers(len(PRINTED_CLUTTER))]
             obj = meshes.cylinder(0.8 * radius, rng.uniform(40, 160), texture, n_seg=40)
-            T = rigid(np.eye(3), [*xy, 0.0])
+            T = pose_matrix(np.eye(3), [*xy, 0.0])
         placed.append((f"clutter_{len(placed)}", obj.transformed(T)))
     return placed

@@ -30,7 +30,8 @@ import pandas as pd
 from poseintegrity.parallel import Workers
 from poseintegrity.protocol import ProtocolParams
 from poseintegrity.scenes import catalog, renderer, trajectories
-from poseintegrity.scenes.camera import Intrinsics, defocus_sigma_px, inverse
+from poseintegrity.poses import inverse
+from poseintegrity.scenes.camera import Intrinsics, defocus_sigma_px
 from poseintegrity.scenes.foam import ReliefVolume
 from poseintegrity.scenes.params import BoneFoamParams, GenerateParams
 from poseintegrity.scenes.textures import build_atlas

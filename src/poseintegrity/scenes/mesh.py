@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from poseintegrity.scenes.camera import rigid
+from poseintegrity.poses import pose_matrix
 
 if TYPE_CHECKING:
     import trimesh
@@ -139,7 +139,7 @@ def box(size: tuple[float, float, float], texture: str | None, n_sub: int = 6, m
         R, (a, b), d = rot[name]
         u0, v0 = (k % 3) / 3, (k // 3) / 2
         face = plane(a, b, n_sub, n_sub, texture, (u0, v0, u0 + 1 / 3, v0 + 1 / 2), material)
-        faces.append(face.transformed(rigid(R, R @ [0, 0, d])))
+        faces.append(face.transformed(pose_matrix(R, R @ [0, 0, d])))
     return merge(faces)
 
 

@@ -9,7 +9,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from poseintegrity.scenes.camera import look_at, rigid
+from poseintegrity.poses import pose_matrix
+from poseintegrity.scenes.camera import look_at
 
 
 @dataclass(frozen=True)
@@ -34,7 +35,7 @@ def model_pair(aim: np.ndarray, view_dir: np.ndarray, distance_mm: float, baseli
 def _rotate_about(T_world_cam: np.ndarray, centre: np.ndarray, rotation: Rotation) -> np.ndarray:
     """The camera pose rotated rigidly about the point ``centre`` (world frame)."""
     R = rotation.as_matrix()
-    return rigid(R @ T_world_cam[:3, :3], centre + R @ (T_world_cam[:3, 3] - centre))
+    return pose_matrix(R @ T_world_cam[:3, :3], centre + R @ (T_world_cam[:3, 3] - centre))
 
 
 def arc_axis(T_world_cam: np.ndarray, azimuth_deg: float) -> np.ndarray:

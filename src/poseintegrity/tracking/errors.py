@@ -17,18 +17,10 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from poseintegrity.tracking.geometry import rotation_angle_deg
+from poseintegrity import poses
 
-NAN_POSE = np.full((4, 4), np.nan)
 EULER_SEQUENCE = "YXZ"  # Unity: R = R_y R_x R_z (intrinsic y, x, z)
 EULER_AXES = ("y", "x", "z")
-
-
-def pose_errors(T_est: np.ndarray, T_true: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Position error norm (k,) mm and geodesic rotation error (k,) deg of poses (k, 4, 4); NaN where T_est is NaN."""
-    pos = np.linalg.norm(T_est[:, :3, 3] - T_true[:, :3, 3], axis=1) * 1000.0
-    rot = rotation_angle_deg(np.nan_to_num(T_est[:, :3, :3]), T_true[:, :3, :3])
-    return pos, np.where(np.isnan(pos), np.nan, rot)
 
 
 def axis_errors(T_est: np.ndarray, T_true: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -47,10 +39,10 @@ def axis_errors(T_est: np.ndarray, T_true: np.ndarray) -> tuple[np.ndarray, np.n
 def error_columns(T_est: np.ndarray, T_true: np.ndarray) -> dict[str, np.ndarray]:
     """Per-pose error columns for a table: pos_err_mm, rot_err_deg (ours) and dx/dy/dz_mm, dyaw/dpitch/droll_deg
     (the paper's element-wise differences; yaw about y, pitch about x, roll about z in Unity's convention)."""
-    pos, rot = pose_errors(T_est, T_true)
+    pos_m, rot = poses.pose_errors(T_est, T_true)
     d_pos, d_euler = axis_errors(T_est, T_true)
     return {
-        "pos_err_mm": pos, "rot_err_deg": rot,
+        "pos_err_mm": pos_m * 1000.0, "rot_err_deg": rot,
         "dx_mm": d_pos[:, 0], "dy_mm": d_pos[:, 1], "dz_mm": d_pos[:, 2],
         "dyaw_deg": d_euler[:, 0], "dpitch_deg": d_euler[:, 1], "droll_deg": d_euler[:, 2],
     }

@@ -27,7 +27,8 @@ from poseintegrity.tracking.detection import detect_markers
 from poseintegrity.tracking.detection_sweep import small_blob_sweep, sweep_summary
 from poseintegrity.tracking.errors import rms, rms_summary
 from poseintegrity.tracking.frames import draw_phantoms, intrinsics, render_frame, unit_plane_lut
-from poseintegrity.tracking.geometry import MARKER_DIAMETER_M, pose_matrix, transform_points
+from poseintegrity.poses import pose_matrix
+from poseintegrity.tracking.geometry import MARKER_DIAMETER_M, transform_points
 from poseintegrity.tracking.kabsch import kabsch, pose_from_points
 from poseintegrity.tracking.motion import sample_sensors, simulate_trajectory
 from poseintegrity.parallel import Workers

@@ -61,24 +61,9 @@ def skew(v: np.ndarray) -> np.ndarray:
     return S
 
 
-def pose_matrix(R: np.ndarray, t: np.ndarray) -> np.ndarray:
-    """4x4 homogeneous matrix from a rotation R (..., 3, 3) and translation t (..., 3) in metres."""
-    T = np.zeros(R.shape[:-2] + (4, 4))
-    T[..., :3, :3] = R
-    T[..., :3, 3] = t
-    T[..., 3, 3] = 1.0
-    return T
-
-
 def transform_points(T_a_b: np.ndarray, points_b: np.ndarray) -> np.ndarray:
     """Map points from frame b into frame a.
 
     T_a_b : (..., 4, 4); points_b : (..., n, 3) metres.  Returns (..., n, 3) metres in frame a.
     """
     return points_b @ np.swapaxes(T_a_b[..., :3, :3], -1, -2) + T_a_b[..., None, :3, 3]
-
-
-def rotation_angle_deg(R_a: np.ndarray, R_b: np.ndarray) -> np.ndarray:
-    """Geodesic angle between rotations, degrees.  R_a, R_b : (..., 3, 3).  Returns (...)."""
-    cos = (np.einsum("...ij,...ij->...", R_a, R_b) - 1.0) / 2.0
-    return np.degrees(np.arccos(np.clip(cos, -1.0, 1.0)))

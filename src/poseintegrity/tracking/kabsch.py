@@ -9,7 +9,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from poseintegrity.tracking.geometry import pose_matrix
+from poseintegrity.poses import pose_matrix
 
 
 def kabsch(points_world: np.ndarray, points_body: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

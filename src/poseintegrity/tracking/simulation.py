@@ -16,9 +16,10 @@ from tqdm.auto import tqdm
 
 from poseintegrity.tracking.correspondence import match_markers
 from poseintegrity.tracking.detection import detect_markers
-from poseintegrity.tracking.errors import NAN_POSE, error_columns
+from poseintegrity.tracking.errors import error_columns
 from poseintegrity.tracking.frames import draw_phantoms, intrinsics, render_frame
-from poseintegrity.tracking.geometry import MARKER_DIAMETER_M, pose_matrix, transform_points
+from poseintegrity.poses import NAN_POSE, pose_matrix
+from poseintegrity.tracking.geometry import MARKER_DIAMETER_M, transform_points
 from poseintegrity.tracking.kabsch import pose_from_points
 from poseintegrity.tracking.motion import (
     SensorTimeline,

@@ -27,7 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from poseintegrity.tracking.correspondence import match_markers
-from poseintegrity.tracking.errors import NAN_POSE
+from poseintegrity.poses import NAN_POSE
 from poseintegrity.tracking.geometry import transform_points
 from poseintegrity.tracking.kabsch import pose_from_points
 from poseintegrity.tracking.params import FilterParams, MatchingParams
