@@ -6,6 +6,7 @@ import shutil
 from pathlib import Path
 
 import pandas as pd
+import papermill
 import pytest
 
 from poseintegrity import config
@@ -17,7 +18,6 @@ pytestmark = pytest.mark.notebook
 
 @pytest.fixture(scope="module")
 def executed(synthetic_data_dir, tmp_path_factory):
-    papermill = pytest.importorskip("papermill")
     work = tmp_path_factory.mktemp("notebooks")
     data_dir, reports_dir = work / "data", work / "reports"
     shutil.copytree(synthetic_data_dir / "datasets", data_dir / "datasets")
