@@ -85,6 +85,26 @@ def test_a_failing_task_raises_its_exception_in_the_caller(request, backend):
         workers.map(explode_on_three, range(6), progress=False)
 
 
+def opencv_threads(_: int) -> int:
+    import cv2
+
+    return cv2.getNumThreads()
+
+
+@pytest.mark.parametrize("backend", ["local", "dask"])
+def test_tasks_run_with_one_opencv_thread_and_the_caller_keeps_its_own(request, backend):
+    import cv2
+
+    params = (ParallelParams(backend="dask", address=request.getfixturevalue("cluster").scheduler_address)
+              if backend == "dask" else ParallelParams(n_jobs=2))
+    caller = cv2.getNumThreads()
+    with Workers(params) as workers:
+        assert workers.map(opencv_threads, range(4), progress=False) == [1, 1, 1, 1]
+    with Workers(ParallelParams(n_jobs=1)) as workers:  # in this process: limited while the task runs, then restored
+        assert workers.map(opencv_threads, range(2), progress=False) == [1, 1]
+    assert cv2.getNumThreads() == caller
+
+
 def test_empty_task_list_returns_without_starting_anything():
     assert Workers(ParallelParams(backend="local", n_jobs=2)).map(abs, []) == []
 

@@ -14,8 +14,9 @@ tasks does not change::
 ``map`` returns a list with one result per task, in the order of the tasks, whatever order they finish in. A
 task and its function must be picklable, and a task draws random numbers only from a generator seeded by the
 task itself (e.g. ``np.random.default_rng(task.seed)``): then both backends return byte-identical results
-(tests/test_parallel.py). Both run one task at a time per worker process with one BLAS/OpenMP thread, so that
-float reductions run in the same order whichever backend runs them. (The local backend with ``n_jobs: 1`` runs
+(tests/test_parallel.py). Both run one task at a time per worker process with one BLAS/OpenMP thread and one
+OpenCV thread (:func:`run_single_threaded`), so that float reductions run in the same order whichever backend runs
+them, and two workers on two cores do not start four threads each. (The local backend with ``n_jobs: 1`` runs
 the tasks one after the other in the calling process, where tracebacks and debuggers work as usual.)
 
 Dask workers on other machines must see the same files at the same paths and run the same environment (README,
@@ -27,10 +28,12 @@ from __future__ import annotations
 import hashlib
 import time
 from collections.abc import Callable, Sequence
+from functools import partial
 from pathlib import Path
 from typing import Literal, TypeVar
 from urllib.parse import urlsplit
 
+import cv2
 import joblib
 from pydantic import Field, ValidationInfo, field_validator
 from tqdm import tqdm
@@ -134,6 +137,19 @@ def _check_workers(client, address: str, expected_digest: str) -> None:
                               f"this machine; start every worker from the same checkout")
 
 
+def run_single_threaded(function: Callable[[Task], Result], task: Task) -> Result:
+    """``function(task)`` with OpenCV's own thread pool limited to one thread (joblib and Dask limit BLAS and
+    OpenMP, not OpenCV's pthreads pool): with one task per core, SIFT runs 5-8 % faster per frame than with every
+    worker starting a thread per core (benchmarks/bench_parallel.py). The previous setting is restored, so the
+    in-process ``n_jobs: 1`` path leaves the caller's OpenCV as it was."""
+    previous = cv2.getNumThreads()
+    cv2.setNumThreads(1)
+    try:
+        return function(task)
+    finally:
+        cv2.setNumThreads(previous)
+
+
 class Workers:
     """The worker processes of one :class:`ParallelParams`, open from construction to :meth:`close` (or the end
     of a ``with`` block).
@@ -197,7 +213,7 @@ class Workers:
         results = []
         with joblib.parallel_config(backend="loky", inner_max_num_threads=1):
             for result in joblib.Parallel(n_jobs=self.params.n_jobs, return_as="generator")(
-                    joblib.delayed(function)(task) for task in tasks):
+                    joblib.delayed(run_single_threaded)(function, task) for task in tasks):
                 results.append(result)
                 meter.update()
         return results
@@ -206,7 +222,7 @@ class Workers:
         from distributed import as_completed
 
         # pure=False: every task runs, even two equal ones (Dask would otherwise compute a key's result once)
-        futures = self._client.map(function, tasks, pure=False)
+        futures = self._client.map(partial(run_single_threaded, function), tasks, pure=False)
         position = {future.key: index for index, future in enumerate(futures)}
         results = [None] * len(tasks)
         try:
