@@ -57,6 +57,19 @@ def test_images_of_a_stop_differ_only_by_noise(tiny_root):
     assert np.abs(a - c).mean() > 2 * np.abs(a - b).mean()  # another stop is another view
 
 
+@pytest.mark.parametrize("flags", ["IMAGE_PNG_FLAGS", "MASK_PNG_FLAGS"])
+def test_png_files_hold_exactly_the_pixels_exposed(tmp_path, flags):
+    """The encoder settings are lossless on a noisy camera image and a flat mask, whatever they compress."""
+    folder = dataset._partial(tmp_path, "d")
+    folder.mkdir()
+    noisy = renderer.expose(np.full((64, 96), 0.6, np.float32), TINY.generate.sensor, np.random.default_rng(0))
+    mask = np.zeros((64, 96), np.uint8)
+    mask[10:40, 20:70] = 255
+    for name, image in (("noisy.png", noisy), ("mask.png", mask)):
+        dataset._write_png(tmp_path, ("d",), name, image, getattr(dataset, flags))
+        assert (cv2.imread(str(folder / name), cv2.IMREAD_UNCHANGED) == image).all()
+
+
 def test_board_ground_truth_agrees_with_opencv_aruco_pose(tiny_root):
     """T_cam_board of the renderer and the pose OpenCV recovers from the rendered board agree (half resolution)."""
     from poseintegrity.scenes import trajectories

@@ -38,6 +38,26 @@ def test_trilinear_gradient_is_the_derivative_of_its_value_and_periodic(relief):
     assert foam.trilinear_gradient(relief.height, 3.0, 4.0, 5.0)[0] == pytest.approx(relief.height[3, 4, 5])
 
 
+def test_trilinear_value_matches_scipy_periodic_interpolation_across_the_wrap(relief):
+    """Points on both sides of the period's edges and far outside it (negative too): scipy's order-1
+    map_coordinates with grid-wrap is the reference for the bit-mask wrapping."""
+    from scipy.ndimage import map_coordinates
+
+    n = relief.height.shape[0]
+    points = np.random.default_rng(4).uniform(-2.5 * n, 2.5 * n, (300, 3))
+    points[:6] = [[-0.5, 0.2, 0.3], [n - 0.5, 3.2, n - 0.25], [-n - 0.7, -0.1, 2 * n - 0.9], [0.0, -1e-9, 0.5],
+                  [n - 1e-9, n, -n], [-3 * n + 0.25, 7.5, -0.75]]
+    values = [foam.trilinear_gradient(relief.height, *p)[0] for p in points]
+    reference = map_coordinates(relief.height.astype(np.float64), points.T, order=1, mode="grid-wrap")
+    np.testing.assert_allclose(values, reference, atol=1e-6)
+
+
+@pytest.mark.parametrize("shape", [(12, 12, 12), (16, 16, 8), (1, 1, 1)])
+def test_a_relief_volume_is_a_cube_of_a_power_of_two_voxels(shape):
+    with pytest.raises(ValueError, match="power of two"):
+        foam.ReliefVolume(np.zeros(shape, np.float32), 0.125, 0.2, 0.0, 1.0)
+
+
 @pytest.mark.parametrize("footprint", [0.05, 0.3, 0.7])
 def test_relief_gradient_is_the_gradient_of_the_octave_sum(relief, footprint):
     rng = np.random.default_rng(1)

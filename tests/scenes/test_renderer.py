@@ -130,6 +130,29 @@ def test_expose_is_seeded_and_models_noise():
     assert a.std() == pytest.approx(np.sqrt(4.0 + 1 / 12), rel=0.05)  # read noise + rounding
 
 
+def numpy_expose(irradiance, sensor, rng):
+    """The sensor model written as whole-array numpy float32 operations, in expose's order of draws."""
+    gain = sensor.exposure * (1.0 + sensor.flicker * rng.standard_normal())
+    dn = irradiance * np.float32(gain)
+    noise = rng.standard_normal(dn.shape, dtype=np.float32)
+    dn += noise * np.sqrt(np.float32(sensor.read_noise_dn**2) + np.float32(sensor.shot_noise_dn_per_dn)
+                          * np.maximum(dn, 0))
+    return np.clip(np.rint(dn), 0, 255).astype(np.uint8)
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_expose_equals_the_numpy_sensor_model_bit_for_bit(seed):
+    """Below zero, above full scale, exact half-DN ties (rounded to even) and everything between."""
+    sensor = GENERATE.sensor.model_copy(update={"flicker": 0.0, "read_noise_dn": 0.0, "shot_noise_dn_per_dn": 0.0})
+    ties = np.arange(-2.5, 258.5, 0.5, dtype=np.float32) / np.float32(sensor.exposure)
+    assert (renderer.expose(ties[None], sensor, np.random.default_rng(seed))
+            == numpy_expose(ties[None], sensor, np.random.default_rng(seed))).all()
+    irradiance = np.random.default_rng(seed).uniform(-0.2, 1.6, (97, 131)).astype(np.float32)
+    image = renderer.expose(irradiance, GENERATE.sensor, np.random.default_rng([seed, 9]))
+    assert (image == numpy_expose(irradiance, GENERATE.sensor, np.random.default_rng([seed, 9]))).all()
+    assert 0 < (image == 0).mean() < 1 and 0 < (image == 255).mean() < 1  # both clips were exercised
+
+
 def test_smooth_surfaces_follow_the_lambert_and_blinn_phong_model():
     """A tilted foam plane without relief: radiance = albedo (ambient + ring n.v + room n.l) + k_s (ring (n.v)^s +
     room (n.h)^s) per pixel, with v towards the camera (the ring light) and l the room light."""

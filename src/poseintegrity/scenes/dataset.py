@@ -36,7 +36,12 @@ from poseintegrity.scenes.foam import ReliefVolume
 from poseintegrity.scenes.params import BoneFoamParams, GenerateParams
 from poseintegrity.scenes.textures import build_atlas
 
-PNG_FLAGS = [cv2.IMWRITE_PNG_COMPRESSION, 3]
+# Camera images are noisy: deflate's string matching finds almost nothing in them, so they are Huffman-coded only,
+# after PNG's "average" filter (the prediction residuals are what is compressible): ~3 x faster to encode and ~12 %
+# smaller than zlib level 3 with adaptive filters. Masks are flat: there string matching is what compresses.
+IMAGE_PNG_FLAGS = [cv2.IMWRITE_PNG_STRATEGY, cv2.IMWRITE_PNG_STRATEGY_HUFFMAN_ONLY,
+                   cv2.IMWRITE_PNG_FILTER, cv2.IMWRITE_PNG_FILTER_AVG]
+MASK_PNG_FLAGS = [cv2.IMWRITE_PNG_COMPRESSION, 3]
 MIN_TARGET_IN_VIEW = 0.5  # share of a target's vertices that must project inside the model images
 MIN_TARGET_AREA = 0.005  # share of the image its projected bounding box must cover (not a speck)
 
@@ -240,15 +245,15 @@ def take_shot(params: GenerateParams, root: Path, shot: Shot) -> None:
     for exposure in shot.exposures:
         for i, file in enumerate(exposure.files):
             image = renderer.expose(irradiance, params.sensor, np.random.default_rng([params.seed, *exposure.rng_key, i]))
-            _write_png(root, exposure.datasets, file, image)
+            _write_png(root, exposure.datasets, file, image, IMAGE_PNG_FLAGS)
         if exposure.mask is not None:
             mask = np.isin(frame.object_index, scene_world.target_ids).astype(np.uint8) * 255
-            _write_png(root, exposure.datasets, exposure.mask, mask)
+            _write_png(root, exposure.datasets, exposure.mask, mask, MASK_PNG_FLAGS)
 
 
-def _write_png(root: Path, datasets: tuple[str, ...], file: str, image: np.ndarray) -> None:
-    """Encode once, write into every dataset's partial folder."""
-    ok, encoded = cv2.imencode(".png", image, PNG_FLAGS)
+def _write_png(root: Path, datasets: tuple[str, ...], file: str, image: np.ndarray, flags: list[int]) -> None:
+    """Encode once (OpenCV ``flags``), write into every dataset's partial folder."""
+    ok, encoded = cv2.imencode(".png", image, flags)
     if not ok:
         raise OSError(f"cannot encode {file} as PNG")
     for dataset in datasets:

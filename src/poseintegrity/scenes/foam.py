@@ -20,6 +20,7 @@ A low-frequency octave of the same volume modulates the albedo by a few per cent
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numba
 import numpy as np
@@ -38,7 +39,8 @@ OCTAVE_ROTATIONS = Rotation.from_rotvec(
 class ReliefVolume:
     """One period of the foam's height field, sampled on a periodic n^3 grid.
 
-    height : (n, n, n) float32, mm, zero mean;  voxel_mm : grid spacing;  pore_radius_mm : r0 (octave 0)
+    height : (n, n, n) float32, mm, zero mean; n a power of two (sampling wraps by a bit mask)
+    voxel_mm : grid spacing;  pore_radius_mm : r0 (octave 0)
     albedo_std : std of the albedo modulation (a fraction, e.g. 0.03)
     albedo_scale : the albedo octave samples the volume at p / (albedo_scale voxel): mottles ~albedo_scale r0 wide
     """
@@ -49,7 +51,12 @@ class ReliefVolume:
     albedo_std: float
     albedo_scale: float
 
-    @property
+    def __post_init__(self):
+        n = self.height.shape[0]
+        if self.height.shape != (n, n, n) or n < 2 or n & (n - 1):
+            raise ValueError(f"the relief volume must be n^3 voxels with n a power of two, got {self.height.shape}")
+
+    @cached_property  # the std of 128^3 voxels costs as much as rasterising a frame: once, not per render
     def albedo_gain(self) -> float:
         """albedo_std / std(height): scales the albedo octave's heights to albedo fractions (0 for a flat volume)."""
         std = float(self.height.std())
@@ -94,13 +101,13 @@ def relief_volume(rng: np.random.Generator, *, pore_radius_mm: float, pore_fract
 
 @numba.njit(cache=True, nogil=True, fastmath=True, error_model="numpy")
 def trilinear_gradient(volume, x, y, z):
-    """Value and gradient (per voxel) of a periodic (n, n, n) volume, trilinearly interpolated at voxel
+    """Value and gradient (per voxel) of a periodic (n, n, n) volume (n a power of two), trilinearly interpolated at voxel
     coordinates (x, y, z). Returns (value, d/dx, d/dy, d/dz)."""
-    n = volume.shape[0]
+    wrap = volume.shape[0] - 1  # n is a power of two: i & (n - 1) is i mod n, also for negative i
     fx, fy, fz = np.floor(x), np.floor(y), np.floor(z)
     tx, ty, tz = x - fx, y - fy, z - fz
-    i0, j0, k0 = int(fx) % n, int(fy) % n, int(fz) % n
-    i1, j1, k1 = (i0 + 1) % n, (j0 + 1) % n, (k0 + 1) % n
+    i0, j0, k0 = int(fx) & wrap, int(fy) & wrap, int(fz) & wrap
+    i1, j1, k1 = (i0 + 1) & wrap, (j0 + 1) & wrap, (k0 + 1) & wrap
     c000, c100 = volume[i0, j0, k0], volume[i1, j0, k0]
     c010, c110 = volume[i0, j1, k0], volume[i1, j1, k0]
     c001, c101 = volume[i0, j0, k1], volume[i1, j0, k1]

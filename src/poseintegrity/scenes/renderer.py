@@ -281,13 +281,24 @@ def expose(irradiance: np.ndarray, sensor: SensorParams, rng: np.random.Generato
     """The sensor: (h, w) irradiance -> (h, w) uint8 image.
 
     DN = exposure x flicker gain x irradiance, plus Gaussian noise of variance read_noise^2 + shot_noise x DN
-    (the Poisson-Gaussian model of a CMOS sensor), rounded and clipped to 8 bit.
+    (the Poisson-Gaussian model of a CMOS sensor), rounded and clipped to 8 bit. The draws: the flicker gain, then
+    one float32 standard normal per pixel (row-major); the arithmetic is float32.
     """
     gain = sensor.exposure * (1.0 + sensor.flicker * rng.standard_normal())
-    dn = irradiance * np.float32(gain)
-    noise = rng.standard_normal(dn.shape, dtype=np.float32)
-    noise *= np.sqrt(np.float32(sensor.read_noise_dn**2) + np.float32(sensor.shot_noise_dn_per_dn) * np.maximum(dn, 0))
-    dn += noise
-    np.rint(dn, out=dn)
-    np.clip(dn, 0, 255, out=dn)
-    return dn.astype(np.uint8)
+    noise = rng.standard_normal(irradiance.shape, dtype=np.float32)
+    image = np.empty(irradiance.shape, np.uint8)
+    _sensor(np.ascontiguousarray(irradiance, np.float32).reshape(-1), np.float32(gain),
+            np.float32(sensor.read_noise_dn**2), np.float32(sensor.shot_noise_dn_per_dn), noise.reshape(-1),
+            image.reshape(-1))
+    return image
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")  # no fastmath: IEEE float32, no reassociation or FMA
+def _sensor(irradiance, gain, read_variance, shot_noise, noise, out):
+    """One pass over (n,) float32 pixels: out = clip(rint(dn + noise sqrt(read_variance + shot_noise max(dn, 0))),
+    0, 255) with dn = gain irradiance; rint rounds half to even (as numpy)."""
+    zero = np.float32(0.0)
+    for i in range(irradiance.shape[0]):
+        dn = irradiance[i] * gain
+        dn = np.rint(dn + noise[i] * np.sqrt(read_variance + shot_noise * max(dn, zero)))
+        out[i] = np.uint8(min(max(dn, zero), np.float32(255.0)))
