@@ -140,7 +140,7 @@ def _check_workers(client, address: str, expected_digest: str) -> None:
 def run_single_threaded(function: Callable[[Task], Result], task: Task) -> Result:
     """``function(task)`` with OpenCV's own thread pool limited to one thread (joblib and Dask limit BLAS and
     OpenMP, not OpenCV's pthreads pool): with one task per core, SIFT runs 5-8 % faster per frame than with every
-    worker starting a thread per core (benchmarks/bench_parallel.py). The previous setting is restored, so the
+    worker starting a thread per core (benchmarks/bench_opencv_threads.py). The previous setting is restored, so the
     in-process ``n_jobs: 1`` path leaves the caller's OpenCV as it was."""
     previous = cv2.getNumThreads()
     cv2.setNumThreads(1)
