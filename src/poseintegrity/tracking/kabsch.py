@@ -18,21 +18,35 @@ def kabsch(points_world: np.ndarray, points_body: np.ndarray) -> tuple[np.ndarra
     points_world : (..., n, 3) float, metres, measured points r^i.
     points_body : (..., n, 3) or (n, 3) float, metres, known points y^i in the same order.
     Returns R : (..., 3, 3) proper rotation and t : (..., 3) metres with ``R @ y + t ~= r``.
+    R is the proper rotation maximising tr(R P^T Q) (Alg. 4's R = V diag(1, 1, d) U^T of the SVD of
+    H = P^T Q), found as the top eigenvector of Horn's 4x4 quaternion matrix (Horn 1987) by compiled Jacobi
+    sweeps: one call costs microseconds instead of a LAPACK SVD and numpy's per-call overhead.
     Fewer than 3 non-collinear points give one of the equally good rotations (no error is raised).
     """
-    r_bar = points_world.mean(axis=-2)
-    y_bar = points_body.mean(axis=-2)
-    P = points_body - y_bar[..., None, :]  # (n, 3) centred known points
-    Q = points_world - r_bar[..., None, :]  # (n, 3) centred measured points
-    H = np.swapaxes(P, -1, -2) @ Q  # cross-covariance
-    U, _, Vt = np.linalg.svd(H)
-    V = np.swapaxes(Vt, -1, -2)
-    d = np.sign(np.linalg.det(V @ np.swapaxes(U, -1, -2)))  # handedness
-    d = np.where(d == 0, 1.0, d)
-    V = V.copy()
-    V[..., :, 2] *= d[..., None]
-    R = V @ np.swapaxes(U, -1, -2)  # R = V diag(1, 1, d) U^T
-    t = r_bar - np.einsum("...ij,...j->...i", R, y_bar)
+    points_world = np.asarray(points_world, dtype=np.float64)
+    points_body = np.broadcast_to(np.asarray(points_body, dtype=np.float64), points_world.shape)
+    batch, n = points_world.shape[:-2], points_world.shape[-2]
+    R, t = _kabsch_kernel(np.ascontiguousarray(points_world.reshape(-1, n, 3)), np.ascontiguousarray(points_body.reshape(-1, n, 3)))
+    return R.reshape(batch + (3, 3)), t.reshape(batch + (3,))
+
+
+@numba.njit(cache=True)
+def _kabsch_kernel(points_world, points_body):  # pragma: no cover - compiled
+    """R (b, 3, 3) and t = r_bar - R y_bar (b, 3) of Alg. 4 for b problems of n points (b, n, 3)."""
+    b, n = points_world.shape[0], points_world.shape[1]
+    R = np.empty((b, 3, 3))
+    t = np.empty((b, 3))
+    for k in range(b):
+        r_bar = np.zeros(3)
+        y_bar = np.zeros(3)
+        for i in range(n):
+            r_bar += points_world[k, i]
+            y_bar += points_body[k, i]
+        r_bar /= n
+        y_bar /= n
+        R[k] = horn_rotation(centred_cross_covariance(points_world[k], points_body[k] - y_bar))
+        for a in range(3):
+            t[k, a] = r_bar[a] - (R[k, a, 0] * y_bar[0] + R[k, a, 1] * y_bar[1] + R[k, a, 2] * y_bar[2])
     return R, t
 
 
@@ -119,23 +133,3 @@ def centred_cross_covariance(points_world, ell):  # pragma: no cover - compiled
             for c in range(3):
                 H[a, c] += ell[i, a] * (points_world[i, c] - r_bar[c])
     return H
-
-
-@numba.njit(cache=True)
-def _horn_rotations(points_world, ell):  # pragma: no cover - compiled
-    out = np.empty((points_world.shape[0], 3, 3))
-    for k in range(points_world.shape[0]):
-        out[k] = horn_rotation(centred_cross_covariance(points_world[k], ell))
-    return out
-
-
-def kabsch_rotations(points_world: np.ndarray, points_body: np.ndarray) -> np.ndarray:
-    """The rotation of Alg. 4 for a batch, computed without LAPACK for the sigma points of the filter.
-
-    points_world : (b, n, 3) metres; points_body : (n, 3) metres.  Returns R : (b, 3, 3).
-    Same optimum as :func:`kabsch` (the proper rotation minimising sum |R y^i + t - r^i|^2), found as the
-    top eigenvector of Horn's 4x4 quaternion matrix (Horn 1987) by Jacobi sweeps: 37 sigma points cost a
-    few microseconds instead of 37 LAPACK SVD calls.
-    """
-    ell = points_body - points_body.mean(axis=0)
-    return _horn_rotations(np.ascontiguousarray(points_world, dtype=np.float64), np.ascontiguousarray(ell, dtype=np.float64))

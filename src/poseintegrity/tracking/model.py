@@ -14,7 +14,7 @@ import numba
 import numpy as np
 
 from poseintegrity.tracking.geometry import skew
-from poseintegrity.tracking.kabsch import centred_cross_covariance, horn_rotation, kabsch
+from poseintegrity.tracking.kabsch import centred_cross_covariance, horn_rotation
 
 
 def state_dim(n_markers: int) -> int:
@@ -137,7 +137,8 @@ def measurement_noise_std(observed: np.ndarray, gyro: bool, sigma_r: float, sigm
 
 
 def process_model_reference(x: np.ndarray, dt: float, markers_body: np.ndarray) -> np.ndarray:
-    """f of eq. 10 for one state, written plainly with the SVD Kabsch of Alg. 4.
+    """f of eq. 10 for one state, written plainly with the SVD Kabsch of Alg. 4 (independent of the compiled
+    Horn rotation of :func:`process_model`).
 
     x : (N,) state; dt : s; markers_body : (n, 3) geometry, metres.  Returns (N,).
     The compiled :func:`process_model` is tested against it, and it is the ``fx`` given to filterpy.
@@ -145,7 +146,10 @@ def process_model_reference(x: np.ndarray, dt: float, markers_body: np.ndarray) 
     n = markers_body.shape[0]
     r = x[: 3 * n].reshape(n, 3)
     omega, c_dot = x[3 * n : 3 * n + 3], x[3 * n + 3 :]
-    R, _ = kabsch(r, markers_body)
-    a = centred(markers_body) @ R.T  # R ell^i
+    ell = centred(markers_body)
+    U, _, Vt = np.linalg.svd(ell.T @ (r - r.mean(axis=0)))  # H = P^T Q (Alg. 4)
+    d = 1.0 if np.linalg.det(Vt.T @ U.T) >= 0 else -1.0  # handedness
+    R = Vt.T @ np.diag([1.0, 1.0, d]) @ U.T  # R = V diag(1, 1, d) U^T
+    a = ell @ R.T  # R ell^i
     r_next = r + dt * (c_dot + np.cross(omega, a))
     return np.concatenate([r_next.ravel(), omega, c_dot])
