@@ -13,7 +13,6 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from poseintegrity.tracking.geometry import skew
 from poseintegrity.tracking.kabsch import centred_cross_covariance, horn_rotation
 
 
@@ -88,10 +87,19 @@ def process_noise_sqrt(x: np.ndarray, dt: float, ell: np.ndarray, sigma_c: float
     marker/omega block is -(dt^3 / 2) sigma_alpha^2 [a_i]x (eq. 26 is its transpose).  P_proc has rank
     7 < N, so it has no Cholesky factor; the rectangular B feeds the QR of Alg. 5 directly.
     """
+    x, ell = np.ascontiguousarray(x, dtype=np.float64), np.ascontiguousarray(ell, dtype=np.float64)
+    return noise_sqrt_kernel(x, float(dt), ell, float(sigma_c), float(sigma_alpha))
+
+
+@numba.njit(cache=True)
+def noise_sqrt_kernel(x, dt, ell, sigma_c, sigma_alpha):  # pragma: no cover - compiled
+    """Compiled :func:`process_noise_sqrt`: a_i = R ell^i with R by Alg. 4 from the markers of x (N,),
+    and the centripetal term (dt^2 / 2) [omega]x^2 a_i, then B (N, 7)."""
     n = ell.shape[0]
     R = horn_rotation(centred_cross_covariance(x[: 3 * n].reshape(n, 3), ell))
     a = ell @ R.T  # (n, 3)
-    W = skew(x[3 * n : 3 * n + 3])  # [omega]x
+    w0, w1, w2 = x[3 * n], x[3 * n + 1], x[3 * n + 2]
+    W = np.array([[0.0, -w2, w1], [w2, 0.0, -w0], [-w1, w0, 0.0]])  # [omega]x
     half_dt2 = 0.5 * dt * dt
     return _noise_sqrt_kernel(a, half_dt2 * a @ (W @ W).T, dt, sigma_c, sigma_alpha)
 
