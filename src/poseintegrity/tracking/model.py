@@ -13,7 +13,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from poseintegrity.tracking.kabsch import centred_cross_covariance, horn_rotation
+from poseintegrity.tracking.kabsch import centred_cross_covariance, horn_rotation, horn_rotation_from
 
 
 def state_dim(n_markers: int) -> int:
@@ -41,15 +41,17 @@ def _process_model_kernel(X, dt, ell):  # pragma: no cover - compiled
     X_next = X.copy()
     r = np.empty((n, 3))
     R_first = np.empty((3, 3))
+    V_first = np.eye(4)
     for k in range(X.shape[1]):  # one sigma point per column
         if k > 0 and _same_rows(X, k, 3 * n):  # it differs from the first only in omega or c_dot: same markers, same R_k
             R = R_first
         else:
             for i in range(n):
                 r[i] = X[3 * i : 3 * i + 3, k]
-            R = horn_rotation(centred_cross_covariance(r, ell))  # R_k by Alg. 4, recomputed every step
+            # R_k by Alg. 4, recomputed every step; the Jacobi sweeps of the other columns start from column 0's
+            R, V = horn_rotation_from(centred_cross_covariance(r, ell), V_first)
             if k == 0:
-                R_first = R
+                R_first, V_first = R, V
         w = X[3 * n : 3 * n + 3, k]
         v = X[3 * n + 3 : 3 * n + 6, k]
         for i in range(n):
@@ -133,10 +135,8 @@ def measurement_rows(observed: np.ndarray, gyro: bool) -> np.ndarray:
     Returns (3 * observed.sum() + 3 * gyro,) int.
     """
     n = observed.shape[0]
-    rows = [np.arange(3 * i, 3 * i + 3) for i in np.flatnonzero(observed)]
-    if gyro:
-        rows.append(np.arange(3 * n, 3 * n + 3))
-    return np.concatenate(rows) if rows else np.zeros(0, dtype=int)
+    rows = (3 * np.flatnonzero(observed)[:, None] + np.arange(3)).ravel()
+    return np.concatenate([rows, np.arange(3 * n, 3 * n + 3)]) if gyro else rows
 
 
 def measurement_noise_std(observed: np.ndarray, gyro: bool, sigma_r: float, sigma_omega: float) -> np.ndarray:
