@@ -36,7 +36,8 @@ def _same_rows(X, k, rows):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True)
-def _process_model_kernel(X, dt, ell):  # pragma: no cover - compiled
+def process_model_kernel(X, dt, ell):  # pragma: no cover - compiled
+    """Compiled :func:`process_model`; returns (X_next (N, b), R_k of column 0 (3, 3))."""
     n = ell.shape[0]
     X_next = X.copy()
     r = np.empty((n, 3))
@@ -61,7 +62,7 @@ def _process_model_kernel(X, dt, ell):  # pragma: no cover - compiled
             X_next[3 * i + 0, k] += dt * (v[0] + w[1] * a2 - w[2] * a1)  # r + dt (c_dot + [w]x R ell)
             X_next[3 * i + 1, k] += dt * (v[1] + w[2] * a0 - w[0] * a2)
             X_next[3 * i + 2, k] += dt * (v[2] + w[0] * a1 - w[1] * a0)
-    return X_next
+    return X_next, R_first
 
 
 def process_model(X: np.ndarray, dt: float, ell: np.ndarray) -> np.ndarray:
@@ -72,7 +73,7 @@ def process_model(X: np.ndarray, dt: float, ell: np.ndarray) -> np.ndarray:
     on its own marker positions, so the rigid body constraint holds:
     r^i <- r^i + dt (c_dot + [omega]x R ell^i); omega and c_dot are unchanged.
     """
-    return _process_model_kernel(np.ascontiguousarray(X, dtype=np.float64), float(dt), np.ascontiguousarray(ell, dtype=np.float64))
+    return process_model_kernel(np.ascontiguousarray(X, dtype=np.float64), float(dt), np.ascontiguousarray(ell, dtype=np.float64))[0]
 
 
 def process_noise_sqrt(x: np.ndarray, dt: float, ell: np.ndarray, sigma_c: float, sigma_alpha: float) -> np.ndarray:
@@ -90,20 +91,27 @@ def process_noise_sqrt(x: np.ndarray, dt: float, ell: np.ndarray, sigma_c: float
     7 < N, so it has no Cholesky factor; the rectangular B feeds the QR of Alg. 5 directly.
     """
     x, ell = np.ascontiguousarray(x, dtype=np.float64), np.ascontiguousarray(ell, dtype=np.float64)
-    return noise_sqrt_kernel(x, float(dt), ell, float(sigma_c), float(sigma_alpha))
+    R = horn_rotation(centred_cross_covariance(x[: 3 * ell.shape[0]].reshape(-1, 3), ell))  # Alg. 4
+    return noise_sqrt_kernel(R, x, float(dt), ell, float(sigma_c), float(sigma_alpha))
 
 
 @numba.njit(cache=True)
-def noise_sqrt_kernel(x, dt, ell, sigma_c, sigma_alpha):  # pragma: no cover - compiled
-    """Compiled :func:`process_noise_sqrt`: a_i = R ell^i with R by Alg. 4 from the markers of x (N,),
-    and the centripetal term (dt^2 / 2) [omega]x^2 a_i, then B (N, 7)."""
+def noise_sqrt_kernel(R, x, dt, ell, sigma_c, sigma_alpha):  # pragma: no cover - compiled
+    """Compiled :func:`process_noise_sqrt` given R (3, 3) of the markers of x (N,) by Alg. 4: a_i = R ell^i and
+    the centripetal term (dt^2 / 2) [omega]x^2 a_i, then B (N, 7)."""
     n = ell.shape[0]
-    R = horn_rotation(centred_cross_covariance(x[: 3 * n].reshape(n, 3), ell))
-    a = ell @ R.T  # (n, 3)
-    w0, w1, w2 = x[3 * n], x[3 * n + 1], x[3 * n + 2]
-    W = np.array([[0.0, -w2, w1], [w2, 0.0, -w0], [-w1, w0, 0.0]])  # [omega]x
+    w = x[3 * n : 3 * n + 3]
+    a = np.empty((n, 3))
+    centripetal = np.empty((n, 3))
     half_dt2 = 0.5 * dt * dt
-    return _noise_sqrt_kernel(a, half_dt2 * a @ (W @ W).T, dt, sigma_c, sigma_alpha)
+    for i in range(n):
+        for j in range(3):
+            a[i, j] = R[j, 0] * ell[i, 0] + R[j, 1] * ell[i, 1] + R[j, 2] * ell[i, 2]
+        wa = (w[1] * a[i, 2] - w[2] * a[i, 1], w[2] * a[i, 0] - w[0] * a[i, 2], w[0] * a[i, 1] - w[1] * a[i, 0])  # [omega]x a_i
+        centripetal[i, 0] = half_dt2 * (w[1] * wa[2] - w[2] * wa[1])  # (dt^2 / 2) [omega]x^2 a_i
+        centripetal[i, 1] = half_dt2 * (w[2] * wa[0] - w[0] * wa[2])
+        centripetal[i, 2] = half_dt2 * (w[0] * wa[1] - w[1] * wa[0])
+    return _noise_sqrt_kernel(a, centripetal, dt, sigma_c, sigma_alpha)
 
 
 @numba.njit(cache=True)

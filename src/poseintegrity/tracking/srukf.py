@@ -18,7 +18,7 @@ import numba
 import numpy as np
 
 from poseintegrity.tracking.cholesky import lower_factor, rank1_update
-from poseintegrity.tracking.model import _process_model_kernel, noise_sqrt_kernel
+from poseintegrity.tracking.model import noise_sqrt_kernel, process_model_kernel
 from poseintegrity.tracking.unscented import UnscentedMarkerFilter, _sigma_points_kernel, health_code
 
 _NO_NOISE_SQRT = np.zeros((0, 0))  # "B of eq. 30 at the current state" for the kernels
@@ -94,8 +94,8 @@ def _time_update_steps(x, S, n_steps, dt, ell, Wm, Wc, gamma, B_fixed, sigma_c, 
     failed = 0
     root_weight = np.sqrt(Wc[1])
     for _ in range(n_steps):
-        X_f = _process_model_kernel(_sigma_points_kernel(x, S, gamma), dt, ell)  # X_{k|k-1} = f(X_{k-1}), eq. 10
-        B = noise_sqrt_kernel(x, dt, ell, sigma_c, sigma_alpha) if B_fixed.shape[0] == 0 else B_fixed  # eq. 30
+        X_f, R = process_model_kernel(_sigma_points_kernel(x, S, gamma), dt, ell)  # X_{k|k-1} = f(X_{k-1}), eq. 10
+        B = noise_sqrt_kernel(R, x, dt, ell, sigma_c, sigma_alpha) if B_fixed.shape[0] == 0 else B_fixed  # eq. 30 (R of x: column 0)
         x = _weighted_mean(X_f, Wm)  # x_k^- = X_{k|k-1} w_m
         dev = X_f - x.reshape(N, 1)
         # S_k^- = qr{[sqrt(Wc[1]) (X_{k|k-1}[:, 1:] - x^-)  sqrt(P_proc)]}; B is the (rectangular) sqrt(P_proc)
