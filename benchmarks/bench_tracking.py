@@ -8,6 +8,10 @@
 3. Frame synthesis (render_frame, the same frame) against drawing its IR sensor noise alone (512 x 512 float32
    normals), the floor of any synthesis that draws this noise: stage 06 renders ~90 000 frames, and after the
    in-place IR and whole-millimetre depth (same bits) the noise draw is most of a frame.
+4. A whole filter run (run_filter over a simulated recording with gyro, the stage-06 workload) against the same
+   run with the SR-UKF computed one numpy / LAPACK call per step (benchmarks/srukf_reference.py, the
+   implementation before the fused kernels), and the same run with the plain covariance-form UKF; the largest
+   position difference of the two SR-UKF runs (rounding only) and whether their flags are identical.
 
 Run: .venv/bin/python benchmarks/bench_tracking.py (from the repository root)
 """
@@ -28,6 +32,12 @@ from poseintegrity.tracking.evaluation import detect_match_kabsch  # noqa: E402
 from poseintegrity.tracking.frames import draw_phantoms, intrinsics, render_frame  # noqa: E402
 from poseintegrity.tracking.geometry import MARKER_DIAMETER_M  # noqa: E402
 from poseintegrity.tracking.peers import filter_speed  # noqa: E402
+from poseintegrity.tracking.simulation import run_filter, simulate  # noqa: E402
+from poseintegrity.tracking.srukf import SquareRootUKF  # noqa: E402
+from poseintegrity.tracking.ukf import UnscentedKalmanFilter  # noqa: E402
+from srukf_reference import StepwiseSquareRootUKF  # noqa: E402
+
+RUN_DURATION_S = 20.0  # a third of the accuracy recording; a run costs the same per second of recording
 
 
 def per_call_ms(fn, repeats):
@@ -67,6 +77,20 @@ def main():
     noise = per_call_ms(lambda: rng.standard_normal(shape, dtype=np.float32), 300)
     print("frame synthesis, one 512 x 512 IR + depth frame (4 markers, one round phantom)")
     print(f"  render_frame      {synthesis:8.3f} ms; its IR noise draw alone {noise:8.3f} ms; synthesis / noise = {synthesis / noise:.2f} (floor 1)")
+
+    [sim] = simulate(params, np.random.default_rng(7), duration_s=RUN_DURATION_S)
+    run_filter(sim, params, use_gyro=True)  # compile
+    runs, seconds = {}, {}
+    for name, cls in [("fused kernels", SquareRootUKF), ("stepwise SR-UKF", StepwiseSquareRootUKF), ("plain UKF", UnscentedKalmanFilter)]:
+        start = time.perf_counter()
+        runs[name], _ = run_filter(sim, params, use_gyro=True, filter_cls=cls)
+        seconds[name] = time.perf_counter() - start
+    fused, stepwise = runs["fused kernels"], runs["stepwise SR-UKF"]
+    print(f"whole filter run, {RUN_DURATION_S:.0f} s recording with gyro ({len(fused)} events, {RUN_DURATION_S / params.filter.dt:.0f} filter steps)")
+    for name in runs:
+        print(f"  {name:16s} {seconds[name]:7.2f} s   run / fused = {seconds[name] / seconds['fused kernels']:5.1f}")
+    diff = np.nanmax(np.abs(fused[["x_mm", "y_mm", "z_mm"]].to_numpy() - stepwise[["x_mm", "y_mm", "z_mm"]].to_numpy()))
+    print(f"  fused vs stepwise: max |position difference| {diff:.2e} mm, flags identical: {fused.flag.equals(stepwise.flag)}")
 
 
 if __name__ == "__main__":

@@ -9,31 +9,50 @@ from __future__ import annotations
 
 import numba
 import numpy as np
-from scipy.linalg.lapack import dgeqrf
 
 
 def tril_from_qr(A: np.ndarray) -> np.ndarray:
     """Lower-triangular S with ``S @ S.T == A @ A.T`` from a QR decomposition of ``A.T``.
 
-    A : (N, p) float, p >= N, full row rank.  Returns (N, N) float with a non-negative diagonal
-    (column signs of the QR factor are flipped, which leaves ``S @ S.T`` unchanged).
+    A : (N, p) float, p >= N.  Returns (N, N) float with a non-negative diagonal.
     """
-    qr, _, _, info = dgeqrf(A.T)  # qr{[...]} of Alg. 5: LAPACK's Householder QR, R in the upper triangle
-    if info != 0:
-        raise np.linalg.LinAlgError(f"QR factorisation failed (LAPACK dgeqrf info {info})")
-    return _signed_transpose_of_r(qr, A.shape[0])
+    return lower_factor(np.ascontiguousarray(A, dtype=np.float64))
 
 
 @numba.njit(cache=True)
-def _signed_transpose_of_r(qr, N):  # pragma: no cover - compiled
-    """S = R^T diag(signs) (N, N) from the upper triangle R of qr[:N], signs = -1 where R's diagonal is negative.
-    Every entry is R^T's times its column's sign, so the zeros above the diagonal keep that sign (-0.0), as
-    ``triu(qr)[:N].T * signs`` gives them."""
-    S = np.empty((N, N))
+def lower_factor(A):  # pragma: no cover - compiled
+    """qr{A^T} of Alg. 5 as an LQ decomposition A = L Q by Householder reflections on the rows of A
+    (Golub and Van Loan, *Matrix Computations*, alg. 5.2.1, transposed): A (N, p) -> S = L (N, N) with the
+    column signs that make its diagonal non-negative (S S^T = L L^T = A A^T).  A row that is already zero
+    beyond the diagonal is left as it is, as LAPACK's dgeqrf does."""
+    N, p = A.shape
+    W = A.copy()
+    for k in range(N):
+        tail2 = 0.0
+        for j in range(k + 1, p):
+            tail2 += W[k, j] * W[k, j]
+        if not (tail2 > 0.0):  # nothing to annihilate (or non-finite: left to the health check)
+            if not np.isfinite(tail2):
+                W[k, k] = np.nan
+            continue
+        norm2 = W[k, k] * W[k, k] + tail2
+        beta = -np.sqrt(norm2) if W[k, k] >= 0.0 else np.sqrt(norm2)  # new diagonal, sign as in LAPACK's dlarfg
+        v0 = W[k, k] - beta  # v = [v0, W[k, k+1:]], H = I - 2 v v^T / (v^T v)
+        scale = 2.0 / (v0 * v0 + tail2)
+        for i in range(k + 1, N):
+            dot = W[i, k] * v0
+            for j in range(k + 1, p):
+                dot += W[i, j] * W[k, j]
+            dot *= scale
+            W[i, k] -= dot * v0
+            for j in range(k + 1, p):
+                W[i, j] -= dot * W[k, j]
+        W[k, k] = beta
+    S = np.zeros((N, N))
     for j in range(N):
-        sign = -1.0 if qr[j, j] < 0 else 1.0
-        for i in range(N):
-            S[i, j] = (qr[j, i] if i >= j else 0.0) * sign
+        sign = -1.0 if W[j, j] < 0.0 else 1.0
+        for i in range(j, N):
+            S[i, j] = W[i, j] * sign
     return S
 
 
@@ -58,6 +77,17 @@ def _rank1_sweep(S, X, sign):  # pragma: no cover - compiled
     return True
 
 
+@numba.njit(cache=True)
+def rank1_update(S, X, gamma):  # pragma: no cover - compiled
+    """Compiled :func:`cholupdate`: S (N, N), X (N, p) C-contiguous, gamma float -> (S_new, ok)."""
+    if gamma == 0.0:
+        return S.copy(), True
+    S_new = S.copy()
+    if _rank1_sweep(S_new, X * np.sqrt(abs(gamma)), 1.0 if gamma > 0 else -1.0):
+        return S_new, True
+    return S.copy(), False
+
+
 def cholupdate(S: np.ndarray, X: np.ndarray, gamma: float) -> tuple[np.ndarray, bool]:
     """Cholesky factor of ``S S^T + gamma * X X^T`` (``cholupdate(S, x, gamma)`` of Alg. 5).
 
@@ -66,11 +96,6 @@ def cholupdate(S: np.ndarray, X: np.ndarray, gamma: float) -> tuple[np.ndarray, 
     Returns (S_new, ok).  A downdate that would lose positive definiteness (or any non-finite value)
     fails: then ``ok`` is False and S_new is an unchanged copy of S; the caller decides the recovery.
     """
-    S_new = np.array(S, dtype=np.float64, order="C", copy=True)
-    X = np.asarray(X, dtype=np.float64).reshape(S.shape[0], -1) * np.sqrt(abs(gamma))
-    if gamma == 0.0:
-        return S_new, True
-    ok = _rank1_sweep(S_new, np.ascontiguousarray(X), 1.0 if gamma > 0 else -1.0)
-    if not ok:
-        return np.array(S, dtype=np.float64, copy=True), False
-    return S_new, True
+    S = np.ascontiguousarray(S, dtype=np.float64)
+    X = np.ascontiguousarray(np.asarray(X, dtype=np.float64).reshape(S.shape[0], -1))
+    return rank1_update(S, X, float(gamma))

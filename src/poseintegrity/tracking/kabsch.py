@@ -18,21 +18,39 @@ def kabsch(points_world: np.ndarray, points_body: np.ndarray) -> tuple[np.ndarra
     points_world : (..., n, 3) float, metres, measured points r^i.
     points_body : (..., n, 3) or (n, 3) float, metres, known points y^i in the same order.
     Returns R : (..., 3, 3) proper rotation and t : (..., 3) metres with ``R @ y + t ~= r``.
+    R is the proper rotation maximising tr(R P^T Q) (Alg. 4's R = V diag(1, 1, d) U^T of the SVD of
+    H = P^T Q), found as the top eigenvector of Horn's 4x4 quaternion matrix (Horn 1987) by compiled Jacobi
+    sweeps: one call costs microseconds instead of a LAPACK SVD and numpy's per-call overhead.
     Fewer than 3 non-collinear points give one of the equally good rotations (no error is raised).
     """
-    r_bar = points_world.mean(axis=-2)
-    y_bar = points_body.mean(axis=-2)
-    P = points_body - y_bar[..., None, :]  # (n, 3) centred known points
-    Q = points_world - r_bar[..., None, :]  # (n, 3) centred measured points
-    H = np.swapaxes(P, -1, -2) @ Q  # cross-covariance
-    U, _, Vt = np.linalg.svd(H)
-    V = np.swapaxes(Vt, -1, -2)
-    d = np.sign(np.linalg.det(V @ np.swapaxes(U, -1, -2)))  # handedness
-    d = np.where(d == 0, 1.0, d)
-    V = V.copy()
-    V[..., :, 2] *= d[..., None]
-    R = V @ np.swapaxes(U, -1, -2)  # R = V diag(1, 1, d) U^T
-    t = r_bar - np.einsum("...ij,...j->...i", R, y_bar)
+    points_world = np.asarray(points_world, dtype=np.float64)
+    points_body = np.asarray(points_body, dtype=np.float64)
+    batch, n = points_world.shape[:-2], points_world.shape[-2]
+    if points_body.ndim > 2:  # one body per problem; else the same (n, 3) body for all
+        points_body = np.broadcast_to(points_body, points_world.shape)
+    R, t = _kabsch_kernel(np.ascontiguousarray(points_world.reshape(-1, n, 3)), np.ascontiguousarray(points_body.reshape(-1, n, 3)))
+    return R.reshape(batch + (3, 3)), t.reshape(batch + (3,))
+
+
+@numba.njit(cache=True)
+def _kabsch_kernel(points_world, points_body):  # pragma: no cover - compiled
+    """R (b, 3, 3) and t = r_bar - R y_bar (b, 3) of Alg. 4 for b problems of n points: points_world (b, n, 3),
+    points_body (b, n, 3) or (1, n, 3) for one body shared by all."""
+    b, n = points_world.shape[0], points_world.shape[1]
+    R = np.empty((b, 3, 3))
+    t = np.empty((b, 3))
+    for k in range(b):
+        body = points_body[k if points_body.shape[0] > 1 else 0]
+        r_bar = np.zeros(3)
+        y_bar = np.zeros(3)
+        for i in range(n):
+            r_bar += points_world[k, i]
+            y_bar += body[i]
+        r_bar /= n
+        y_bar /= n
+        R[k] = horn_rotation(centred_cross_covariance(points_world[k], body - y_bar))
+        for a in range(3):
+            t[k, a] = r_bar[a] - (R[k, a, 0] * y_bar[0] + R[k, a, 1] * y_bar[1] + R[k, a, 2] * y_bar[2])
     return R, t
 
 
@@ -51,19 +69,33 @@ def kabsch_residuals(points_world: np.ndarray, points_body: np.ndarray) -> np.nd
 @numba.njit(cache=True)
 def horn_rotation(H):  # pragma: no cover - compiled
     """Proper rotation maximising tr(R H) for a 3x3 cross-covariance H = P^T Q (Alg. 4), by Horn's method."""
-    M = np.empty((4, 4))
-    M[0, 0] = H[0, 0] + H[1, 1] + H[2, 2]
-    M[1, 1] = H[0, 0] - H[1, 1] - H[2, 2]
-    M[2, 2] = -H[0, 0] + H[1, 1] - H[2, 2]
-    M[3, 3] = -H[0, 0] - H[1, 1] + H[2, 2]
-    M[0, 1] = M[1, 0] = H[1, 2] - H[2, 1]
-    M[0, 2] = M[2, 0] = H[2, 0] - H[0, 2]
-    M[0, 3] = M[3, 0] = H[0, 1] - H[1, 0]
-    M[1, 2] = M[2, 1] = H[0, 1] + H[1, 0]
-    M[1, 3] = M[3, 1] = H[2, 0] + H[0, 2]
-    M[2, 3] = M[3, 2] = H[1, 2] + H[2, 1]
-    V = np.eye(4)
-    scale = 1e-30 * (1.0 + M[0, 0] ** 2 + M[1, 1] ** 2 + M[2, 2] ** 2 + M[3, 3] ** 2)
+    return horn_rotation_from(H, np.eye(4))[0]
+
+
+@numba.njit(cache=True)
+def horn_rotation_from(H, V0):  # pragma: no cover - compiled
+    """:func:`horn_rotation` with the Jacobi sweeps started from the eigenvectors V0 (4, 4, orthogonal) of a
+    nearby H (the sigma points of the filter are micrometres apart: one or two sweeps instead of five).
+    Returns (R (3, 3), V (4, 4) the eigenvectors of this H's quaternion matrix)."""
+    N = np.empty((4, 4))
+    N[0, 0] = H[0, 0] + H[1, 1] + H[2, 2]
+    N[1, 1] = H[0, 0] - H[1, 1] - H[2, 2]
+    N[2, 2] = -H[0, 0] + H[1, 1] - H[2, 2]
+    N[3, 3] = -H[0, 0] - H[1, 1] + H[2, 2]
+    N[0, 1] = N[1, 0] = H[1, 2] - H[2, 1]
+    N[0, 2] = N[2, 0] = H[2, 0] - H[0, 2]
+    N[0, 3] = N[3, 0] = H[0, 1] - H[1, 0]
+    N[1, 2] = N[2, 1] = H[0, 1] + H[1, 0]
+    N[1, 3] = N[3, 1] = H[2, 0] + H[0, 2]
+    N[2, 3] = N[3, 2] = H[1, 2] + H[2, 1]
+    scale = 1e-30 * (1.0 + N[0, 0] ** 2 + N[1, 1] ** 2 + N[2, 2] ** 2 + N[3, 3] ** 2)
+    V = V0.copy()
+    M = np.zeros((4, 4))  # Horn's matrix in the starting basis, V^T N V (exactly N for V = I)
+    for a in range(4):
+        for b in range(4):
+            for i in range(4):
+                for j in range(4):
+                    M[a, b] += V[i, a] * N[i, j] * V[j, b]
     for _sweep in range(30):  # cyclic Jacobi eigen-decomposition of the symmetric 4x4 M
         off = 0.0
         for p in range(3):
@@ -102,7 +134,7 @@ def horn_rotation(H):  # pragma: no cover - compiled
     R[2, 0] = 2.0 * (x * z - w * y)
     R[2, 1] = 2.0 * (y * z + w * x)
     R[2, 2] = w * w - x * x - y * y + z * z
-    return R
+    return R, V
 
 
 @numba.njit(cache=True)
@@ -119,23 +151,3 @@ def centred_cross_covariance(points_world, ell):  # pragma: no cover - compiled
             for c in range(3):
                 H[a, c] += ell[i, a] * (points_world[i, c] - r_bar[c])
     return H
-
-
-@numba.njit(cache=True)
-def _horn_rotations(points_world, ell):  # pragma: no cover - compiled
-    out = np.empty((points_world.shape[0], 3, 3))
-    for k in range(points_world.shape[0]):
-        out[k] = horn_rotation(centred_cross_covariance(points_world[k], ell))
-    return out
-
-
-def kabsch_rotations(points_world: np.ndarray, points_body: np.ndarray) -> np.ndarray:
-    """The rotation of Alg. 4 for a batch, computed without LAPACK for the sigma points of the filter.
-
-    points_world : (b, n, 3) metres; points_body : (n, 3) metres.  Returns R : (b, 3, 3).
-    Same optimum as :func:`kabsch` (the proper rotation minimising sum |R y^i + t - r^i|^2), found as the
-    top eigenvector of Horn's 4x4 quaternion matrix (Horn 1987) by Jacobi sweeps: 37 sigma points cost a
-    few microseconds instead of 37 LAPACK SVD calls.
-    """
-    ell = points_body - points_body.mean(axis=0)
-    return _horn_rotations(np.ascontiguousarray(points_world, dtype=np.float64), np.ascontiguousarray(ell, dtype=np.float64))

@@ -13,8 +13,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from poseintegrity.tracking.geometry import skew
-from poseintegrity.tracking.kabsch import centred_cross_covariance, horn_rotation, kabsch
+from poseintegrity.tracking.kabsch import centred_cross_covariance, horn_rotation, horn_rotation_from
 
 
 def state_dim(n_markers: int) -> int:
@@ -37,20 +36,23 @@ def _same_rows(X, k, rows):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True)
-def _process_model_kernel(X, dt, ell):  # pragma: no cover - compiled
+def process_model_kernel(X, dt, ell):  # pragma: no cover - compiled
+    """Compiled :func:`process_model`; returns (X_next (N, b), R_k of column 0 (3, 3))."""
     n = ell.shape[0]
     X_next = X.copy()
     r = np.empty((n, 3))
     R_first = np.empty((3, 3))
+    V_first = np.eye(4)
     for k in range(X.shape[1]):  # one sigma point per column
         if k > 0 and _same_rows(X, k, 3 * n):  # it differs from the first only in omega or c_dot: same markers, same R_k
             R = R_first
         else:
             for i in range(n):
                 r[i] = X[3 * i : 3 * i + 3, k]
-            R = horn_rotation(centred_cross_covariance(r, ell))  # R_k by Alg. 4, recomputed every step
+            # R_k by Alg. 4, recomputed every step; the Jacobi sweeps of the other columns start from column 0's
+            R, V = horn_rotation_from(centred_cross_covariance(r, ell), V_first)
             if k == 0:
-                R_first = R
+                R_first, V_first = R, V
         w = X[3 * n : 3 * n + 3, k]
         v = X[3 * n + 3 : 3 * n + 6, k]
         for i in range(n):
@@ -60,7 +62,7 @@ def _process_model_kernel(X, dt, ell):  # pragma: no cover - compiled
             X_next[3 * i + 0, k] += dt * (v[0] + w[1] * a2 - w[2] * a1)  # r + dt (c_dot + [w]x R ell)
             X_next[3 * i + 1, k] += dt * (v[1] + w[2] * a0 - w[0] * a2)
             X_next[3 * i + 2, k] += dt * (v[2] + w[0] * a1 - w[1] * a0)
-    return X_next
+    return X_next, R_first
 
 
 def process_model(X: np.ndarray, dt: float, ell: np.ndarray) -> np.ndarray:
@@ -71,7 +73,7 @@ def process_model(X: np.ndarray, dt: float, ell: np.ndarray) -> np.ndarray:
     on its own marker positions, so the rigid body constraint holds:
     r^i <- r^i + dt (c_dot + [omega]x R ell^i); omega and c_dot are unchanged.
     """
-    return _process_model_kernel(np.ascontiguousarray(X, dtype=np.float64), float(dt), np.ascontiguousarray(ell, dtype=np.float64))
+    return process_model_kernel(np.ascontiguousarray(X, dtype=np.float64), float(dt), np.ascontiguousarray(ell, dtype=np.float64))[0]
 
 
 def process_noise_sqrt(x: np.ndarray, dt: float, ell: np.ndarray, sigma_c: float, sigma_alpha: float) -> np.ndarray:
@@ -88,12 +90,28 @@ def process_noise_sqrt(x: np.ndarray, dt: float, ell: np.ndarray, sigma_c: float
     marker/omega block is -(dt^3 / 2) sigma_alpha^2 [a_i]x (eq. 26 is its transpose).  P_proc has rank
     7 < N, so it has no Cholesky factor; the rectangular B feeds the QR of Alg. 5 directly.
     """
+    x, ell = np.ascontiguousarray(x, dtype=np.float64), np.ascontiguousarray(ell, dtype=np.float64)
+    R = horn_rotation(centred_cross_covariance(x[: 3 * ell.shape[0]].reshape(-1, 3), ell))  # Alg. 4
+    return noise_sqrt_kernel(R, x, float(dt), ell, float(sigma_c), float(sigma_alpha))
+
+
+@numba.njit(cache=True)
+def noise_sqrt_kernel(R, x, dt, ell, sigma_c, sigma_alpha):  # pragma: no cover - compiled
+    """Compiled :func:`process_noise_sqrt` given R (3, 3) of the markers of x (N,) by Alg. 4: a_i = R ell^i and
+    the centripetal term (dt^2 / 2) [omega]x^2 a_i, then B (N, 7)."""
     n = ell.shape[0]
-    R = horn_rotation(centred_cross_covariance(x[: 3 * n].reshape(n, 3), ell))
-    a = ell @ R.T  # (n, 3)
-    W = skew(x[3 * n : 3 * n + 3])  # [omega]x
+    w = x[3 * n : 3 * n + 3]
+    a = np.empty((n, 3))
+    centripetal = np.empty((n, 3))
     half_dt2 = 0.5 * dt * dt
-    return _noise_sqrt_kernel(a, half_dt2 * a @ (W @ W).T, dt, sigma_c, sigma_alpha)
+    for i in range(n):
+        for j in range(3):
+            a[i, j] = R[j, 0] * ell[i, 0] + R[j, 1] * ell[i, 1] + R[j, 2] * ell[i, 2]
+        wa = (w[1] * a[i, 2] - w[2] * a[i, 1], w[2] * a[i, 0] - w[0] * a[i, 2], w[0] * a[i, 1] - w[1] * a[i, 0])  # [omega]x a_i
+        centripetal[i, 0] = half_dt2 * (w[1] * wa[2] - w[2] * wa[1])  # (dt^2 / 2) [omega]x^2 a_i
+        centripetal[i, 1] = half_dt2 * (w[2] * wa[0] - w[0] * wa[2])
+        centripetal[i, 2] = half_dt2 * (w[0] * wa[1] - w[1] * wa[0])
+    return _noise_sqrt_kernel(a, centripetal, dt, sigma_c, sigma_alpha)
 
 
 @numba.njit(cache=True)
@@ -125,10 +143,8 @@ def measurement_rows(observed: np.ndarray, gyro: bool) -> np.ndarray:
     Returns (3 * observed.sum() + 3 * gyro,) int.
     """
     n = observed.shape[0]
-    rows = [np.arange(3 * i, 3 * i + 3) for i in np.flatnonzero(observed)]
-    if gyro:
-        rows.append(np.arange(3 * n, 3 * n + 3))
-    return np.concatenate(rows) if rows else np.zeros(0, dtype=int)
+    rows = (3 * np.flatnonzero(observed)[:, None] + np.arange(3)).ravel()
+    return np.concatenate([rows, np.arange(3 * n, 3 * n + 3)]) if gyro else rows
 
 
 def measurement_noise_std(observed: np.ndarray, gyro: bool, sigma_r: float, sigma_omega: float) -> np.ndarray:
@@ -137,7 +153,8 @@ def measurement_noise_std(observed: np.ndarray, gyro: bool, sigma_r: float, sigm
 
 
 def process_model_reference(x: np.ndarray, dt: float, markers_body: np.ndarray) -> np.ndarray:
-    """f of eq. 10 for one state, written plainly with the SVD Kabsch of Alg. 4.
+    """f of eq. 10 for one state, written plainly with the SVD Kabsch of Alg. 4 (independent of the compiled
+    Horn rotation of :func:`process_model`).
 
     x : (N,) state; dt : s; markers_body : (n, 3) geometry, metres.  Returns (N,).
     The compiled :func:`process_model` is tested against it, and it is the ``fx`` given to filterpy.
@@ -145,7 +162,10 @@ def process_model_reference(x: np.ndarray, dt: float, markers_body: np.ndarray) 
     n = markers_body.shape[0]
     r = x[: 3 * n].reshape(n, 3)
     omega, c_dot = x[3 * n : 3 * n + 3], x[3 * n + 3 :]
-    R, _ = kabsch(r, markers_body)
-    a = centred(markers_body) @ R.T  # R ell^i
+    ell = centred(markers_body)
+    U, _, Vt = np.linalg.svd(ell.T @ (r - r.mean(axis=0)))  # H = P^T Q (Alg. 4)
+    d = 1.0 if np.linalg.det(Vt.T @ U.T) >= 0 else -1.0  # handedness
+    R = Vt.T @ np.diag([1.0, 1.0, d]) @ U.T  # R = V diag(1, 1, d) U^T
+    a = ell @ R.T  # R ell^i
     r_next = r + dt * (c_dot + np.cross(omega, a))
     return np.concatenate([r_next.ravel(), omega, c_dot])

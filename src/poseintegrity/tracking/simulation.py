@@ -163,21 +163,28 @@ def run_filter(
     """
     tracker = MarkerTracker(sim.markers_body, filter_params or params.filter, params.matching, use_gyro, filter_cls)
     tl, traj = sim.timeline, sim.trajectory
-    events = sorted([(i, 1, g) for g, i in enumerate(tl.gyro_index)] + [(i, 0, f) for f, i in enumerate(tl.frame_index)])
-    rows, poses, grid = [], [], []
-    for grid_index, is_gyro, k in events:
-        t = traj.t[grid_index]
-        if is_gyro:
-            flag, n_matched, T = tracker.gyro(t, tl.gyro[k]), -1, tracker.pose()
+    # events in time order (grid index), a frame before a gyro sample of the same instant
+    grid = np.concatenate([tl.frame_index, tl.gyro_index]).astype(np.int64)
+    is_gyro = np.repeat([False, True], [len(tl.frame_index), len(tl.gyro_index)])
+    k = np.concatenate([np.arange(len(tl.frame_index)), np.arange(len(tl.gyro_index))])
+    order = np.lexsort((k, is_gyro, grid))
+    grid, is_gyro, k = grid[order], is_gyro[order], k[order]
+    t = traj.t[grid]
+    flags, n_matched, poses = [], np.full(len(grid), -1), np.empty((len(grid), 4, 4))
+    for e in range(len(grid)):
+        if is_gyro[e]:
+            flags.append(tracker.gyro(t[e], tl.gyro[k[e]]))
+            poses[e] = tracker.pose()
         else:
-            result = tracker.frame(t, sim.points[k])
-            flag, n_matched, T = result.flag, int((result.assignment >= 0).sum()), result.T_filtered
-        rows.append({"t": t, "kind": "gyro" if is_gyro else "frame", "frame": -1 if is_gyro else k, "flag": flag, "n_matched": n_matched,
-                     "in_occlusion": any(a <= t < a + d for a, d in sim.occlusions)})
-        poses.append(T)
-        grid.append(grid_index)
-    df = pd.DataFrame(rows)
-    poses, grid = np.stack(poses), np.array(grid)
+            result = tracker.frame(t[e], sim.points[k[e]])
+            flags.append(result.flag)
+            n_matched[e] = int((result.assignment >= 0).sum())
+            poses[e] = result.T_filtered
+    in_occlusion = np.zeros(len(grid), dtype=bool)
+    for start, duration in sim.occlusions:
+        in_occlusion |= (start <= t) & (t < start + duration)
+    df = pd.DataFrame({"t": t, "kind": np.where(is_gyro, "gyro", "frame").astype(object), "frame": np.where(is_gyro, -1, k),
+                       "flag": flags, "n_matched": n_matched, "in_occlusion": in_occlusion})
     truth = pose_matrix(traj.rotation(grid), traj.position[grid])
     for name, column in error_columns(poses, truth).items():
         df[name] = column

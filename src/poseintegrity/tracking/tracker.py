@@ -98,13 +98,10 @@ class MarkerTracker:
             self.n_restarts += 1
             self.t = t
             return "restart"
-        n_steps = int(np.ceil((t - self.t) / self.params.dt - 1e-9))
-        for _ in range(max(n_steps, 0)):
-            if not self.filter.predict((t - self.t) / n_steps if n_steps else 0.0):
-                self.t = t
-                return "diverged"
+        n_steps = max(int(np.ceil((t - self.t) / self.params.dt - 1e-9)), 0)
+        ok = self.filter.predict_steps(n_steps, (t - self.t) / n_steps if n_steps else 0.0)
         self.t = t
-        return ""
+        return "" if ok else "diverged"
 
     def gyro(self, t: float, omega_body: np.ndarray) -> str:
         """A gyro sample at t: omega_body (3,) rad/s in the body frame.  Returns "ok" or a flag."""
@@ -122,14 +119,12 @@ class MarkerTracker:
 
     def innovation_ok(self, points: np.ndarray, observed: np.ndarray) -> np.ndarray:
         """(n,) bool: observed markers whose point (n, 3 rows in geometry order) passes the innovation gate."""
-        S = self.filter.sqrt_covariance()
+        i = np.flatnonzero(observed)
+        rows = self.filter.sqrt_covariance()[: 3 * self.filter.n].reshape(self.filter.n, 3, -1)[i]  # (k, 3, N)
+        cov = rows @ np.swapaxes(rows, 1, 2) + self.params.sigma_r**2 * np.eye(3)  # predicted marker + measurement noise (eq. 16)
+        nu = points[i] - self.filter.markers()[i]  # (k, 3)
         ok = np.zeros(self.filter.n, dtype=bool)
-        predicted = self.filter.markers()
-        for i in np.flatnonzero(observed):
-            rows = S[3 * i : 3 * i + 3]
-            cov = rows @ rows.T + self.params.sigma_r**2 * np.eye(3)  # predicted marker + measurement noise (eq. 16)
-            nu = points[i] - predicted[i]
-            ok[i] = nu @ np.linalg.solve(cov, nu) <= self.params.innovation_gate_chi2
+        ok[i] = np.einsum("ki,ki->k", nu, np.linalg.solve(cov, nu[:, :, None])[:, :, 0]) <= self.params.innovation_gate_chi2
         return ok
 
     def frame(self, t: float, points: np.ndarray) -> FrameResult:

@@ -31,7 +31,9 @@ class UnscentedKalmanFilter(UnscentedMarkerFilter):
         dev = X_f - x_prior[:, None]
         self.P = (dev * self.Wc) @ dev.T + B @ B.T  # P^- = sum Wc (X - x^-)(X - x^-)^T + P_proc
 
-    def _measurement_update(self, X: np.ndarray, Y: np.ndarray, z: np.ndarray, noise_std: np.ndarray) -> None:
+    def _measurement_update(self, rows: np.ndarray, z: np.ndarray, noise_std: np.ndarray) -> int:
+        X = self.sigma_points()
+        Y = X[rows]  # Y = h(X): rows of X (eq. 4)
         y_prior = Y @ self.Wm
         dy = Y - y_prior[:, None]
         P_yy = (dy * self.Wc) @ dy.T + np.diag(noise_std**2)
@@ -40,3 +42,4 @@ class UnscentedKalmanFilter(UnscentedMarkerFilter):
         self.x = self.x + K @ (z - y_prior)
         self.P = self.P - K @ P_yy @ K.T
         self.P = 0.5 * (self.P + self.P.T)
+        return self._health_code()

@@ -46,6 +46,21 @@ def _sigma_points_kernel(x, S, gamma):  # pragma: no cover - compiled
     return X
 
 
+DIVERGENCE_REASONS = ("", "non-finite state or covariance", "runaway covariance")  # by health_code
+
+
+@numba.njit(cache=True)
+def health_code(x, P_diag, n_position_rows, max_position_std):  # pragma: no cover - compiled
+    """Divergence test of the filters: 0 healthy, 1 NaN/inf in x (N,) or P_diag (N,), 2 a marker standard
+    deviation sqrt(max P_diag[:n_position_rows]) above max_position_std (m); see ``DIVERGENCE_REASONS``."""
+    for i in range(x.shape[0]):
+        if not (np.isfinite(x[i]) and np.isfinite(P_diag[i])):
+            return 1
+    if np.sqrt(P_diag[:n_position_rows].max()) > max_position_std:
+        return 2
+    return 0
+
+
 class UnscentedMarkerFilter:
     """Base of the marker-position filters; use :class:`SquareRootUKF` or :class:`UnscentedKalmanFilter`.
 
@@ -90,7 +105,9 @@ class UnscentedMarkerFilter:
     def _time_update(self, X_f: np.ndarray, x_prior: np.ndarray, B: np.ndarray) -> None:
         raise NotImplementedError
 
-    def _measurement_update(self, X: np.ndarray, Y: np.ndarray, z: np.ndarray, noise_std: np.ndarray) -> None:
+    def _measurement_update(self, rows: np.ndarray, z: np.ndarray, noise_std: np.ndarray) -> int:
+        """Fuse z (m,) measuring the state rows (m,) int (Y = h(X): rows of X, eq. 4) with noise std (m,);
+        returns the :func:`health_code` of the result."""
         raise NotImplementedError
 
     # -- the filter ------------------------------------------------------------------------------
@@ -114,11 +131,18 @@ class UnscentedMarkerFilter:
         current state (:func:`~poseintegrity.tracking.model.process_noise_sqrt`).  A fixed B is how the filter
         runs an additive-noise model for the comparison with pykalman.
         """
-        X_f = process_model(self.sigma_points(), dt, self.ell)  # X_{k|k-1} = f(X_{k-1})
-        B = process_noise_sqrt(self.x, dt, self.ell, self.settings.sigma_c, self.settings.sigma_alpha) if noise_sqrt is None else noise_sqrt
-        self.x = X_f @ self.Wm  # x_k^- = X_{k|k-1} w_m
-        self._time_update(X_f, self.x, B)
-        return self._check_health()
+        return self.predict_steps(1, dt, noise_sqrt)
+
+    def predict_steps(self, n_steps: int, dt: float, noise_sqrt: np.ndarray | None = None) -> bool:
+        """n_steps time updates of dt seconds each (see :meth:`predict`); stops at the first divergence."""
+        for _ in range(n_steps):
+            X_f = process_model(self.sigma_points(), dt, self.ell)  # X_{k|k-1} = f(X_{k-1})
+            B = process_noise_sqrt(self.x, dt, self.ell, self.settings.sigma_c, self.settings.sigma_alpha) if noise_sqrt is None else noise_sqrt
+            self.x = X_f @ self.Wm  # x_k^- = X_{k|k-1} w_m
+            self._time_update(X_f, self.x, B)
+            if not self._check_health():
+                return False
+        return True
 
     def update(self, z: np.ndarray, observed: np.ndarray, gyro: bool) -> bool:
         """Measurement update with whatever arrived (Alg. 5, "Measurement Update"; partial updates).
@@ -134,10 +158,8 @@ class UnscentedMarkerFilter:
         rows = measurement_rows(np.asarray(observed, bool), gyro)
         if rows.size == 0:
             return True
-        X = self.sigma_points()
         noise_std = measurement_noise_std(np.asarray(observed, bool), gyro, self.settings.sigma_r, self.settings.sigma_omega)
-        self._measurement_update(X, X[rows], np.asarray(z, float), noise_std)  # Y = h(X): rows of X (eq. 4)
-        return self._check_health()
+        return self._record_health(self._measurement_update(rows, np.asarray(z, dtype=np.float64), noise_std))
 
     def markers(self) -> np.ndarray:
         """Estimated marker centres (n, 3), metres, world frame."""
@@ -147,17 +169,19 @@ class UnscentedMarkerFilter:
         """T_world_body (4, 4) of the marker geometry, from the estimated markers by Kabsch (Alg. 4)."""
         return pose_from_points(self.markers(), self.markers_body)
 
+    def _health_code(self) -> int:
+        """:func:`health_code` of the current state and covariance."""
+        return health_code(self.x, self.covariance_diagonal(), 3 * self.n, self.settings.max_position_std)
+
     def _check_health(self) -> bool:
         """Divergence test: NaN/inf anywhere or a marker standard deviation above max_position_std."""
-        P_diag = self.covariance_diagonal()
-        bad = ""
-        if not (np.all(np.isfinite(self.x)) and np.all(np.isfinite(P_diag))):
-            bad = "non-finite state or covariance"
-        elif np.sqrt(P_diag[: 3 * self.n].max()) > self.settings.max_position_std:
-            bad = "runaway covariance"
-        if bad:
+        return self._record_health(self._health_code())
+
+    def _record_health(self, code: int) -> bool:
+        """False and the filter stopped (``initialized`` False, counted, ``last_reason``) if code is not 0."""
+        if code:
             self.initialized = False
             self.n_divergences += 1
-            self.last_reason = bad
+            self.last_reason = DIVERGENCE_REASONS[code]
             return False
         return True
