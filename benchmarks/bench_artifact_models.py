@@ -3,7 +3,8 @@
     1. one EMG fit (eq. 1) on 4 stops x 10 images          target: median <= 5 ms
        reference: a plain curve_fit of alpha * scipy.stats.exponnorm.pdf(theta - mu, K) (lm, no bounds)
     2. the MLP recipes (pretrain + fine-tune; scratch)      target: pretrained <= 2 s
-       reference: a 500 x 500 float64 numpy matmul
+       reference: the same recipe trained by torch.optim.LBFGS on the torch net (the implementation before the
+       numba port of lbfgs.py), from the same initial weights
     3. the whole Fig. 2 experiment at paper scale           target: <= 5 min on 2 cores
        (21 arcs + 4 lines of synthetic eq. 1 data, k = 3 .. all, all models, on the workers of ``parallel``),
        with the fit statuses it reports (fits.json)
@@ -18,10 +19,13 @@ import time
 from pathlib import Path
 
 import numpy as np
+import torch
 from scipy.optimize import curve_fit
 from scipy.stats import exponnorm
 
 from poseintegrity.artifact_models import EMG, emg, fig2_rmse, fit_mlp, fits_metrics, status_counts
+from poseintegrity.artifact_models.mlp import initial_weights
+from poseintegrity.artifact_models.params import MLPParams
 from poseintegrity.artifact_models.synthetic import synthetic_artifacts
 from poseintegrity.config import load_section
 from poseintegrity.parallel import Workers, worker_count
@@ -31,6 +35,41 @@ from timing import paired_medians  # benchmarks/timing.py
 def report(label: str, seconds: float, reference: float, target: float | None = None) -> None:
     verdict = "" if target is None else ("  [meets target]" if seconds <= target else "  [MISSES target]")
     print(f"  {label:<42s} {seconds * 1e3:10.2f} ms   {seconds / reference:8.2f} x reference{verdict}")
+
+
+def torch_recipe(theta: np.ndarray, n: np.ndarray, theta_end: float, mlp: MLPParams, seed: int, pretrain: bool
+                 ) -> torch.nn.Sequential:  # fmt: skip
+    """Reference: fit_mlp's training done by torch.optim.LBFGS on an nn.Sequential (the code before lbfgs.py)."""
+    widths = [1] + [mlp.hidden_units] * mlp.hidden_layers
+    layers = [m for i, o in zip(widths[:-1], widths[1:], strict=True) for m in (torch.nn.Linear(i, o), torch.nn.Tanh())]
+    net = torch.nn.Sequential(*layers, torch.nn.Linear(mlp.hidden_units, 1)).double()
+    x0 = initial_weights(mlp.hidden_layers, mlp.hidden_units, torch.Generator().manual_seed(seed))
+    torch.nn.utils.vector_to_parameters(torch.as_tensor(x0), net.parameters())
+    n_scale = max(float(n.max()), 1.0)
+
+    def train(t: np.ndarray, counts: np.ndarray, max_iter: int) -> None:
+        u = torch.as_tensor(2.0 * t / theta_end - 1.0).reshape(-1, 1)
+        y = torch.as_tensor(counts / n_scale).reshape(-1, 1)
+        optimizer = torch.optim.LBFGS(net.parameters(), lr=1.0, max_iter=max_iter, tolerance_grad=1e-12,
+                                      tolerance_change=mlp.tolerance_change, history_size=20,
+                                      line_search_fn="strong_wolfe")  # fmt: skip
+
+        def closure() -> torch.Tensor:
+            optimizer.zero_grad()
+            loss = torch.mean((net(u) - y) ** 2)
+            loss.backward()
+            return loss
+
+        optimizer.step(closure)
+
+    if not pretrain:
+        train(theta, n, mlp.max_iter_scratch)
+        return net
+    grid = np.linspace(0.0, theta_end, mlp.n_pretrain_points)
+    train(grid, EMG.f(grid, *EMG.initial_guess(theta, n)[0]), mlp.max_iter_pretrain)
+    train(np.concatenate([theta, np.full(mlp.n_artificial, theta_end)]),
+          np.concatenate([n, np.zeros(mlp.n_artificial)]), mlp.max_iter_finetune)  # fmt: skip
+    return net
 
 
 def main() -> None:
@@ -59,14 +98,14 @@ def main() -> None:
     report("EMG.fit (bounded trf, analytic Jacobian)", seconds, reference, 5e-3)
 
     print("2. MLP recipes, 4 stops x 10 images (params.fit.mlp)")
-    a, b = rng.random((500, 500)), rng.random((500, 500))
+    torch.set_num_threads(1)
     for pretrain, target in ((True, 2.0), (False, None)):
         reference, seconds = paired_medians(
-            lambda: a @ b,
+            lambda: torch_recipe(theta, n, theta_end, params.mlp, 0, pretrain),
             lambda: fit_mlp(theta, n, theta_end=theta_end, mlp=params.mlp, rng=rng, pretrain=pretrain),
             7,
         )
-        report("reference: 500 x 500 numpy matmul", reference, reference)
+        report("reference: torch.optim.LBFGS on nn.Sequential", reference, reference)
         report("mlp_pretrained (pretrain + fine-tune)" if pretrain else "mlp_scratch", seconds, reference, target)
 
     if args.skip_stage:

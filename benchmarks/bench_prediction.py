@@ -7,6 +7,9 @@
        its lower-bound variant, MLP and next-step on the paper's path, long range + static on the others)
        reference: the same datasets' long range predictor with the per-threshold reference of 1.
        Prints the fit statuses of the sweep's rows (predictors.json shares them).
+    3. leave-one-scene-out folds (stage 04's LOSO) on a random prediction table of the paper's shape
+       (7 scenes x 3 arcs, 97 thresholds, 6 predictors, 2 tolerances, 2 target rates)
+       reference: loso_folds once per target rate (each rate recomputing the training curves, as before)
 
 Usage: PYTHONPATH=src .venv/bin/python benchmarks/bench_prediction.py [--params params.yaml]
 (the ``fit``, ``predict``, ``protocol`` and ``parallel`` sections of --params)
@@ -20,13 +23,15 @@ import time
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 
 from poseintegrity.artifact_models import emg, fit_model
 from poseintegrity.artifact_models.series import dataset_series
 from poseintegrity.artifact_models.synthetic import synthetic_artifacts
 from poseintegrity.config import load_section
 from poseintegrity.parallel import Workers, worker_count
-from poseintegrity.prediction import boundaries, fit_status_shares, sweep
+from poseintegrity.prediction import boundaries, fit_status_shares, loso, loso_folds, sweep
+from poseintegrity.prediction.metrics import with_metrics
 from timing import paired_medians  # benchmarks/timing.py
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
@@ -84,6 +89,35 @@ def main() -> None:
         print(f"     {predictor:<20s} " + "  ".join(f"{k} {v:.4g}" for k, v in entry.items()))
     if args.save:
         table.to_parquet(args.save, index=False)
+
+    print("3. leave-one-scene-out folds")
+    predictions = random_predictions(np.random.default_rng(2), n_t)
+    predictors = tuple(predictions["predictor"].unique())
+
+    def per_rate() -> pd.DataFrame:
+        return pd.concat([loso_folds(group, (rate,), conservative_high=predictor != "static")
+                          for (predictor, _), group in predictions.groupby(["predictor", "tolerance"])
+                          for rate in predict.loso_target_rates], ignore_index=True)  # fmt: skip
+
+    def all_rates() -> pd.DataFrame:
+        return loso(predictions, predict.loso_target_rates, predictors, "usac_magsac")
+
+    reference, subject = paired_medians(per_rate, all_rates, repeats=3)
+    print(f"   loso_folds per target rate (reference)      {reference * 1e3:8.1f} ms")
+    print(f"   loso (one training curve for all rates)     {subject * 1e3:8.1f} ms   {subject / reference:6.3f} x reference")
+
+
+def random_predictions(rng: np.random.Generator, n_t: np.ndarray) -> pd.DataFrame:
+    """A prediction table of stage 04's shape for one method and the arcs: theta_p falling with n_t, theta_a fixed."""
+    rows = []
+    for predictor in ("long_range", "mlp", "next_step", "static", "long_range_relative", "next_step_relative"):
+        for tolerance in ("2mm_3deg", "4mm_10deg"):
+            for dataset in (f"scene_{s}_arc{a}" for s in range(7) for a in range(3)):
+                theta_p = np.sort(rng.uniform(0.0, 45.0, n_t.size))[::-1]
+                rows.append(pd.DataFrame({"predictor": predictor, "method": "usac_magsac", "trajectory": "arc",
+                                          "tolerance": tolerance, "dataset": dataset, "operating_point": n_t,
+                                          "theta_p": theta_p, "theta_a": rng.uniform(10.0, 45.0)}))  # fmt: skip
+    return with_metrics(pd.concat(rows, ignore_index=True))
 
 
 if __name__ == "__main__":

@@ -1,4 +1,4 @@
-"""The torch MLP of IV-E: architecture, seeding, scaling invariants, the two recipes of III-D and their status."""
+"""The MLP of IV-E: architecture, seeding, scaling invariants, the two recipes of III-D and their status."""
 
 from __future__ import annotations
 
@@ -9,7 +9,8 @@ from torch import nn
 
 from poseintegrity.artifact_models import EMG, emg, fit_mlp
 from poseintegrity.artifact_models.fitted import FALLBACK, NEGATIVE_COUNT, NON_PHYSICAL, OK
-from poseintegrity.artifact_models.mlp import mlp_network
+from poseintegrity.artifact_models.mlp import initial_weights
+from poseintegrity.artifact_models.mlp_net import n_parameters
 
 THETA4 = np.repeat(2.25 * np.arange(1, 5), 10)  # first 4 stops of an arc, deg
 N4 = np.maximum(np.round(emg(THETA4, 3000.0, 9.0, 1.0) + np.random.default_rng(5).normal(0, 4, THETA4.size)), 0)
@@ -24,12 +25,24 @@ def fit(tiny_fit, protocol):
     return train
 
 
-def test_network_is_three_hidden_layers_of_ten_tanh_neurons():
-    net = mlp_network(3, 10, torch.Generator().manual_seed(0))
-    linear = [m for m in net if isinstance(m, nn.Linear)]
-    assert [(m.in_features, m.out_features) for m in linear] == [(1, 10), (10, 10), (10, 10), (10, 1)]
-    assert sum(isinstance(m, nn.Tanh) for m in net) == 3
-    assert sum(p.numel() for p in net.parameters()) == 251
+def torch_network(generator: torch.Generator) -> nn.Sequential:
+    """Reference: the 3 x 10 tanh net of IV-E as torch layers, initialised by nn.init.uniform_ from ``generator``."""
+    net = nn.Sequential(*[m for i, o in ((1, 10), (10, 10), (10, 10)) for m in (nn.Linear(i, o), nn.Tanh())],
+                        nn.Linear(10, 1)).double()  # fmt: skip
+    with torch.no_grad():
+        for layer in net:
+            if isinstance(layer, nn.Linear):
+                bound = 1.0 / np.sqrt(layer.in_features)
+                nn.init.uniform_(layer.weight, -bound, bound, generator=generator)
+                nn.init.uniform_(layer.bias, -bound, bound, generator=generator)
+    return net
+
+
+def test_network_is_three_hidden_layers_of_ten_tanh_neurons_initialised_like_torch_linear_layers():
+    net = torch_network(torch.Generator().manual_seed(7))
+    weights = initial_weights(3, 10, torch.Generator().manual_seed(7))
+    assert weights.shape == (n_parameters(3, 10),) == (sum(p.numel() for p in net.parameters()),) == (251,)
+    np.testing.assert_array_equal(weights, nn.utils.parameters_to_vector(net.parameters()).detach().numpy())
 
 
 @pytest.mark.parametrize("pretrain", [False, True])

@@ -21,7 +21,7 @@ def test_scene_of_dataset_ids():
     assert scene_of("other") == "other"
 
 
-def _folds() -> pd.DataFrame:
+def _table() -> pd.DataFrame:
     # scenes a, b are safe at n_t = 10 (theta_p 5 < theta_a 6); scene c needs n_t = 20 (theta_p 3 < theta_a 4)
     rows = []
     for scene, theta_a in (("a", 6.0), ("b", 6.0), ("c", 4.0)):
@@ -29,7 +29,19 @@ def _folds() -> pd.DataFrame:
             rows.append(dict(predictor="long_range", method="m", trajectory="arc", tolerance="t",
                              dataset=f"{scene}_arc0", operating_point=n_t, theta_p=theta_p, theta_a=theta_a,
                              spl=min(theta_p, theta_a), incursion=float(theta_p > theta_a)))  # fmt: skip
-    return loso_folds(pd.DataFrame(rows), 0.0, conservative_high=True)
+    return pd.DataFrame(rows)
+
+
+def _folds() -> pd.DataFrame:
+    return loso_folds(_table(), (0.0,), conservative_high=True)
+
+
+def test_several_target_rates_give_the_folds_of_each_rate_in_turn():
+    table = _table()
+    one_by_one = pd.concat([loso_folds(table, (rate,), conservative_high=True) for rate in (0.0, 0.5)],
+                           ignore_index=True)  # fmt: skip
+    pd.testing.assert_frame_equal(loso_folds(table, (0.0, 0.5), conservative_high=True), one_by_one)
+    assert set(one_by_one.loc[one_by_one.target_rate == 0.5, "operating_point"]) == {10.0}  # 1/2 allowed: the SPL 5
 
 
 def test_loso_chooses_on_other_scenes_and_scores_the_held_out_one():

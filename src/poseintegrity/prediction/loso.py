@@ -28,32 +28,34 @@ def scene_of(dataset: str) -> str:
     return re.split(r"_(?:arc|line)", dataset, maxsplit=1)[0]
 
 
-def loso_folds(table: pd.DataFrame, target_rate: float, conservative_high: bool) -> pd.DataFrame:
-    """One row per held-out scene for one predictor / tolerance / method / trajectory of a prediction table.
+def loso_folds(table: pd.DataFrame, target_rates: tuple[float, ...], conservative_high: bool) -> pd.DataFrame:
+    """One row per target rate and held-out scene (rates in the given order, scenes sorted) for one predictor /
+    tolerance / method / trajectory of a prediction table; each scene's training curve serves every rate.
 
     table : rows of one curve family with columns dataset, operating_point, theta_p, spl, incursion (and the
         curve keys). Needs at least two scenes; with one scene the result is empty.
     """
     scenes = table["dataset"].map(scene_of)
-    rows = []
+    rows: dict[float, list[dict]] = {rate: [] for rate in target_rates}
     for scene in sorted(scenes.unique()):
         train, test = table[scenes != scene], table[scenes == scene]
         if train.empty:
             continue
         curve = operating_curves(train)
-        _, point = best_operating_point(curve, target_rate, conservative_high)
-        feasible = bool(np.isfinite(point))
-        if not feasible:  # nothing that safe on the training scenes: the most conservative operating point
-            points = curve["operating_point"]
-            point = float(points.max() if conservative_high else points.min())
-        held = test[(test["operating_point"] == point) & test["theta_p"].notna()]
-        rows.append(
-            dict(predictor=str(table["predictor"].iloc[0]), tolerance=str(table["tolerance"].iloc[0]),
-                 target_rate=target_rate, scene=scene, operating_point=point, feasible=feasible,
-                 heldout_incursions=float(held["incursion"].sum()), heldout_n=int(len(held)),
-                 heldout_spl_sum=float(held["spl"].sum()))
-        )  # fmt: skip
-    return pd.DataFrame(rows, columns=FOLD_COLUMNS)
+        for rate in target_rates:
+            _, point = best_operating_point(curve, rate, conservative_high)
+            feasible = bool(np.isfinite(point))
+            if not feasible:  # nothing that safe on the training scenes: the most conservative operating point
+                points = curve["operating_point"]
+                point = float(points.max() if conservative_high else points.min())
+            held = test[(test["operating_point"] == point) & test["theta_p"].notna()]
+            rows[rate].append(
+                dict(predictor=str(table["predictor"].iloc[0]), tolerance=str(table["tolerance"].iloc[0]),
+                     target_rate=rate, scene=scene, operating_point=point, feasible=feasible,
+                     heldout_incursions=float(held["incursion"].sum()), heldout_n=int(len(held)),
+                     heldout_spl_sum=float(held["spl"].sum()))
+            )  # fmt: skip
+    return pd.DataFrame([row for rate in target_rates for row in rows[rate]], columns=FOLD_COLUMNS)
 
 
 def loso(
@@ -63,9 +65,8 @@ def loso(
     """LOSO folds for every predictor, tolerance and target rate on one PnP method and trajectory type."""
     rows = table[(table["method"] == method) & (table["trajectory"] == trajectory)]
     folds = [
-        loso_folds(group, rate, conservative_high=predictor != "static")
+        loso_folds(group, tuple(target_rates), conservative_high=predictor != "static")
         for (predictor, _), group in rows[rows["predictor"].isin(predictors)].groupby(["predictor", "tolerance"])
-        for rate in target_rates
     ]
     return pd.concat(folds, ignore_index=True) if folds else pd.DataFrame(columns=FOLD_COLUMNS)
 
