@@ -5,9 +5,10 @@
    square-root UKF (pykalman.sqrt.AdditiveUnscentedKalmanFilter.filter_update) on the additive-noise model.
 2. Detection + correspondence + Kabsch on one 512 x 512 frame (4 markers, one round phantom), in frames
    per second on one core, beside a bare OpenCV threshold + findContours on the same frame.  Target: >= 300.
-3. Frame synthesis (render_frame, the same frame) against drawing its IR sensor noise alone (512 x 512 float32
-   normals), the floor of any synthesis that draws this noise: stage 06 renders ~90 000 frames, and after the
-   in-place IR and whole-millimetre depth (same bits) the noise draw is most of a frame.
+3. Frame synthesis (render_frame, the same frame; stage 06 renders ~80 000) against the previous synthesis
+   (:func:`reference_render_frame` below: numpy ray casting and a float32 normal drawn for every pixel, the
+   same depth and reflections to the bit, and the same distribution of the IR noise), and against its former
+   floor, drawing the 512 x 512 float32 normals alone.
 4. A whole filter run (run_filter over a simulated recording with gyro, the stage-06 workload) against the same
    run with the SR-UKF computed one numpy / LAPACK call per step (benchmarks/srukf_reference.py, the
    implementation before the fused kernels), and the same run with the plain covariance-form UKF; the largest
@@ -38,6 +39,58 @@ from poseintegrity.tracking.ukf import UnscentedKalmanFilter  # noqa: E402
 from srukf_reference import StepwiseSquareRootUKF  # noqa: E402
 
 RUN_DURATION_S = 20.0  # a third of the accuracy recording; a run costs the same per second of recording
+
+
+def reference_render_frame(markers_cam, phantoms, camera, frames, marker_radius_m, rng):
+    """The previous render_frame: per-patch numpy ray casting and IR noise drawn as a float32 normal per pixel."""
+    H, W, s = camera.height, camera.width, frames.supersampling
+    K = intrinsics(camera)
+    offsets = (np.arange(s) + 0.5) / s - 0.5
+    du, dv = (g.ravel() for g in np.meshgrid(offsets, offsets))
+
+    def grid(u0, v0, u1, v1):
+        return np.broadcast_arrays(np.arange(u0, u1, dtype=float)[None, :, None] + du, np.arange(v0, v1, dtype=float)[:, None, None] + dv)
+
+    def to_mm(x):
+        return np.clip(np.rint(x), 0, 65535).astype(np.uint16)
+
+    brightness = np.zeros((H, W), dtype=np.float32)
+    depth = np.full((H, W), to_mm(frames.background_depth_mm), dtype=np.uint16)
+    frame_bias = rng.normal(0.0, frames.frame_depth_bias_std_mm)
+    for c in markers_cam[np.argsort(-markers_cam[:, 2])]:
+        u_c, v_c = K[0, 0] * c[0] / c[2] + K[0, 2], K[1, 1] * c[1] / c[2] + K[1, 2]
+        rho = camera.focal_px * marker_radius_m / np.sqrt(c[2] ** 2 - marker_radius_m**2) + 2.0
+        u0, u1, v0, v1 = max(int(u_c - rho), 0), min(int(u_c + rho) + 2, W), max(int(v_c - rho), 0), min(int(v_c + rho) + 2, H)
+        uu, vv = grid(u0, v0, u1, v1)
+        rays = np.stack([(uu - K[0, 2]) / K[0, 0], (vv - K[1, 2]) / K[1, 1], np.ones_like(uu)], axis=-1)
+        rays /= np.linalg.norm(rays, axis=-1, keepdims=True)
+        proj = rays @ c
+        disc = marker_radius_m**2 - (c @ c - proj**2)
+        hit = disc > 0
+        near = np.where(hit, (proj - np.sqrt(np.where(hit, disc, 0.0))) * 1000.0, np.inf).min(axis=-1)
+        cover = hit.mean(axis=-1)
+        bias = frame_bias + rng.normal(0.0, frames.depth_bias_std_mm)
+        noisy = to_mm(near + bias + rng.normal(0.0, frames.depth_noise_mm, near.shape))
+        patch = (slice(v0, v1), slice(u0, u1))
+        depth[patch] = np.where(cover > 0, np.minimum(depth[patch], noisy), depth[patch])
+        brightness[patch] = np.maximum(brightness[patch], (frames.marker_ir + rng.normal(0.0, frames.marker_ir_std)) * cover)
+    for p in phantoms:
+        extent = p.radius_px * p.elongation + 2.0
+        u0, u1 = max(int(p.u - extent), 0), min(int(p.u + extent) + 2, W)
+        v0, v1 = max(int(p.v - extent), 0), min(int(p.v + extent) + 2, H)
+        uu, vv = grid(u0, v0, u1, v1)
+        a = ((uu - p.u) * np.cos(p.angle) + (vv - p.v) * np.sin(p.angle)) / (p.radius_px * p.elongation)
+        b = (-(uu - p.u) * np.sin(p.angle) + (vv - p.v) * np.cos(p.angle)) / p.radius_px
+        cover = (a * a + b * b <= 1.0).mean(axis=-1)
+        patch = (slice(v0, v1), slice(u0, u1))
+        noisy = to_mm(p.depth_mm + rng.normal(0.0, frames.depth_noise_mm, cover.shape))
+        depth[patch] = np.where(cover > 0, np.minimum(depth[patch], noisy), depth[patch])
+        brightness[patch] = np.maximum(brightness[patch], (frames.marker_ir + rng.normal(0.0, frames.marker_ir_std)) * cover)
+    ir = rng.standard_normal((H, W), dtype=np.float32)
+    ir *= np.float32(frames.ir_noise_std)
+    ir += np.float32(frames.ir_background)
+    ir += brightness
+    return np.clip(np.rint(ir, out=ir), 0, 65535, out=ir).astype(np.uint16), depth
 
 
 def per_call_ms(fn, repeats):
@@ -72,11 +125,16 @@ def main():
     print(f"  threshold+contours{bare:8.3f} ms = {1000 / bare:7.0f} frames/s (reference); chain / reference = {chain / bare:.1f}")
 
     phantoms = draw_phantoms(1, params.camera, params.frames, 1.0, rng)
-    synthesis = per_call_ms(lambda: render_frame(markers, phantoms, params.camera, params.frames, MARKER_DIAMETER_M / 2, rng), 300)
+    args = (markers, phantoms, params.camera, params.frames, MARKER_DIAMETER_M / 2)
+    (_, depth), (_, ref_depth) = render_frame(*args, np.random.default_rng(1)), reference_render_frame(*args, np.random.default_rng(1))
+    assert np.array_equal(depth, ref_depth)  # the same draws in the same order up to the IR noise
+    synthesis = per_call_ms(lambda: render_frame(*args, rng), 300)
+    reference = per_call_ms(lambda: reference_render_frame(*args, rng), 300)
     shape = (params.camera.height, params.camera.width)
     noise = per_call_ms(lambda: rng.standard_normal(shape, dtype=np.float32), 300)
     print("frame synthesis, one 512 x 512 IR + depth frame (4 markers, one round phantom)")
-    print(f"  render_frame      {synthesis:8.3f} ms; its IR noise draw alone {noise:8.3f} ms; synthesis / noise = {synthesis / noise:.2f} (floor 1)")
+    print(f"  render_frame      {synthesis:8.3f} ms; previous synthesis {reference:8.3f} ms: {reference / synthesis:.1f}x faster")
+    print(f"  float32 normals for every pixel alone {noise:8.3f} ms = {noise / synthesis:.1f} x render_frame")
 
     [sim] = simulate(params, np.random.default_rng(7), duration_s=RUN_DURATION_S)
     run_filter(sim, params, use_gyro=True)  # compile

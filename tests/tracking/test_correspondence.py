@@ -108,3 +108,45 @@ def test_too_few_points_only_phantoms_and_duplicates():
     duplicated = np.vstack([G, G[:1]]) + [0, 0, 0.5]
     assignment = match_markers(duplicated, G, None, MATCHING)
     assert assignment[0] in (0, 4) and list(assignment[1:]) == [1, 2, 3]
+
+
+def reference_voting(points, geometry, tolerance_m):
+    """Alg. 2 as written, a loop over the geometry pairs and then over the points (see match_voting)."""
+    m, rows = len(geometry), np.flatnonzero(np.isfinite(points).all(axis=1))
+    assignment, outlier = np.full(m, -1), np.ones(len(points), dtype=bool)
+    X = points[rows]
+    n = len(X)
+    if n < 2:
+        return assignment, outlier
+    D, Y = np.linalg.norm(X[:, None] - X[None], axis=-1), np.linalg.norm(geometry[:, None] - geometry[None], axis=-1)
+    k_idx, l_idx = np.triu_indices(n, 1)
+    V = np.zeros((m, n), dtype=int)
+    for i, j in zip(*np.triu_indices(m, 1)):
+        diff = np.abs(D[k_idx, l_idx] - Y[i, j])
+        best = int(np.argmin(diff))
+        if diff[best] <= tolerance_m:
+            for a in (i, j):
+                V[a, k_idx[best]] += 1
+                V[a, l_idx[best]] += 1
+    outlier[rows] = V.sum(axis=0) == 0
+    for k in range(n):
+        i = int(np.argmax(V[:, k]))
+        if V[i, k] >= m - 1 and np.sum(V[:, k] == V[i, k]) == 1 and np.sum(V[i] == V[i, k]) == 1 and V[i].argmax() == k:
+            assignment[i] = rows[k]
+    return assignment, outlier
+
+
+@settings(deadline=None, max_examples=300)
+@given(seed=st.integers(0, 2**32 - 1), n_missing=st.integers(0, 3), n_near=st.integers(0, 3), noise=st.sampled_from([0.0, 0.0005, 0.002, 0.006]))
+def test_voting_equals_the_loop_of_alg_2(seed, n_missing, n_near, noise):
+    """Phantoms near the body (they may take votes), missing markers, noise up to the tolerance, a NaN row."""
+    rng = np.random.default_rng(seed)
+    points, _, markers = _scene(seed, n_missing, 0, noise)
+    points = np.vstack([points, markers.mean(0) + rng.normal(0, 0.04, (n_near, 3))])
+    if rng.random() < 0.2:
+        points[rng.integers(len(points))] = np.nan
+    points = points[rng.permutation(len(points))]
+    assignment, outlier = match_voting(points, G, tolerance_m=TOL)
+    expected, expected_outlier = reference_voting(points, G, TOL)
+    np.testing.assert_array_equal(assignment, expected)
+    np.testing.assert_array_equal(outlier, expected_outlier)

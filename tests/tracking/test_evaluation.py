@@ -71,8 +71,26 @@ def test_the_stress_recording_is_rendered_once_for_both_detectors():
     np.testing.assert_array_equal(split.T_true, unsplit.T_true)
     duration = split.trajectory.t[-1]
     [alone] = simulate(TINY, experiment_rng(TINY, f"stress_{run.label}"), np.array(TINY.markers_body), TINY.evaluation.success_omega_std,
-                       duration, [TINY.detection.model_copy(update={"split_touching": False})])
+                       duration, [TINY.detection.model_copy(update={"split_touching": False})], n_frames=TINY.evaluation.success_frames)
     assert all(np.array_equal(a, b) for a, b in zip(alone.points, unsplit.points)) and len(alone.points) == len(unsplit.points)
+
+
+def test_a_recording_cut_to_its_first_frames_is_the_start_of_the_whole_one():
+    """success_recording renders only the counted frames: the motion and timeline are drawn for the whole
+    duration, so the frames, their detections and a filter run over them are the start of the uncut ones."""
+    n = 30
+    [whole] = simulate(TINY, np.random.default_rng(5), duration_s=2.5)
+    [cut] = simulate(TINY, np.random.default_rng(5), duration_s=2.5, n_frames=n)
+    assert len(cut.points) == n < len(whole.points)
+    assert all(np.array_equal(a, b) for a, b in zip(cut.points, whole.points[:n]))
+    np.testing.assert_array_equal(cut.T_true, whole.T_true[:n])
+    last = cut.timeline.frame_index[-1]
+    assert cut.timeline.gyro_index.max() == last  # the gyro samples up to the last frame and none after it
+    np.testing.assert_array_equal(cut.timeline.gyro, whole.timeline.gyro[whole.timeline.gyro_index <= last])
+    cut_run, _ = run_filter(cut, TINY, use_gyro=True)
+    whole_run, _ = run_filter(whole, TINY, use_gyro=True)
+    pd.testing.assert_frame_equal(cut_run, whole_run.iloc[: len(cut_run)])
+    assert cut_run.frame.max() == n - 1 and (whole_run.iloc[len(cut_run) :].frame.max()) > n - 1
 
 
 def test_each_filter_run_is_made_once_and_shared_by_the_experiments_that_need_it():

@@ -15,6 +15,7 @@ or -1 if it was not found.  Measured points are (n, 3) metres; rows with NaN are
 
 from __future__ import annotations
 
+from functools import lru_cache
 from itertools import combinations, permutations
 
 import numpy as np
@@ -28,6 +29,15 @@ from poseintegrity.tracking.params import MatchingParams
 def _finite_rows(points: np.ndarray) -> np.ndarray:
     points = np.asarray(points, dtype=float).reshape(-1, 3)
     return np.flatnonzero(np.all(np.isfinite(points), axis=1))
+
+
+@lru_cache(maxsize=32)
+def _pairs(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """The index pairs (k, l), k < l, of n points, row-major (np.triu_indices(n, 1)), read-only."""
+    pairs = np.triu_indices(n, 1)
+    for index in pairs:
+        index.flags.writeable = False
+    return pairs
 
 
 def is_consistent(points: np.ndarray, geometry: np.ndarray, assignment: np.ndarray, tolerance_m: float) -> bool:
@@ -97,26 +107,22 @@ def match_voting(points: np.ndarray, geometry: np.ndarray, *, tolerance_m: float
         return assignment, outlier
     D = pairwise_distances(X)  # D[k, l] = |r^k - r^l|
     Y = pairwise_distances(geometry)  # offline in the paper
-    k_idx, l_idx = np.triu_indices(n, 1)
+    k_idx, l_idx = _pairs(n)
+    g_i, g_j = _pairs(m)
+    diff = np.abs(D[k_idx, l_idx][None, :] - Y[g_i, g_j][:, None])  # (geometry pairs, measured pairs)
+    best = np.argmin(diff, axis=1)  # per geometry pair (i, j) the closest measured pair (k, l)
+    votes = diff[np.arange(len(g_i)), best] <= tolerance_m
+    k, l = k_idx[best[votes]], l_idx[best[votes]]
     V = np.zeros((m, n), dtype=int)
-    for i, j in zip(*np.triu_indices(m, 1)):
-        diff = np.abs(D[k_idx, l_idx] - Y[i, j])
-        best = int(np.argmin(diff))
-        if diff[best] > tolerance_m:
-            continue
-        k, l = k_idx[best], l_idx[best]
-        V[i, k] += 1
-        V[i, l] += 1
-        V[j, k] += 1
-        V[j, l] += 1
+    for a, b in ((g_i[votes], k), (g_i[votes], l), (g_j[votes], k), (g_j[votes], l)):  # V[i, k], V[i, l], V[j, k], V[j, l] += 1
+        np.add.at(V, (a, b), 1)
     outlier[rows] = V.sum(axis=0) == 0
-    for k in range(n):
-        column = V[:, k]
-        i = int(np.argmax(column))
-        if column[i] >= m - 1 and np.sum(column == column[i]) == 1:
-            claimants = np.flatnonzero(V[i] == column[i])
-            if claimants.size == 1 and V[i].argmax() == k:
-                assignment[i] = rows[k]
+    i = np.argmax(V, axis=0)  # per point k its best geometry marker
+    top = V[i, np.arange(n)]
+    unique_in_column = (V == top).sum(axis=0) == 1
+    unique_in_row = ((V[i] == top[:, None]).sum(axis=1) == 1) & (np.argmax(V[i], axis=1) == np.arange(n))  # no other point claims i
+    confident = (top >= m - 1) & unique_in_column & unique_in_row
+    assignment[i[confident]] = rows[confident]
     return assignment, outlier
 
 

@@ -60,9 +60,9 @@ def validate_frame(ir: np.ndarray, depth_mm: np.ndarray, unproject: np.ndarray) 
     if lut is not None and (not np.all(np.isfinite(lut)) or not np.any(lut)):
         return "unit-plane lookup table is all zero or not finite: it cannot unproject pixels"
     sample = np.asarray(depth_mm[grid], dtype=float)
-    valid = sample[np.isfinite(sample) & (sample > 0)]
-    if valid.size and np.median(valid) < MIN_METRES_DEPTH_MM:
-        return f"depth looks like metres, not millimetres (median of valid depth {np.median(valid):.3g} < {MIN_METRES_DEPTH_MM:g})"
+    median = small_median(sample[np.isfinite(sample) & (sample > 0)])
+    if median < MIN_METRES_DEPTH_MM:  # False for NaN: no valid depth
+        return f"depth looks like metres, not millimetres (median of valid depth {median:.3g} < {MIN_METRES_DEPTH_MM:g})"
     return ""
 
 

@@ -264,18 +264,20 @@ def success_runs(params: TrackParams) -> list[SuccessRun]:
 
 
 def success_recording(params: TrackParams, run: SuccessRun, keep: bool = False) -> dict[str, tuple[pd.DataFrame, Simulation | None]]:
-    """The recording of one :class:`SuccessRun` (success_frames_duration seconds) and its no-filter tables,
-    by run name (``a_markers4``, ``b_markers3_no_split``, ...): {name: (no-filter table, recording if keep
-    else None)} (a recording of motion (a) holds ~50 MB of ground truth: only the one filtered later is kept)."""
+    """The recording of one :class:`SuccessRun` and its no-filter tables, by run name (``a_markers4``,
+    ``b_markers3_no_split``, ...): {name: (no-filter table, recording if keep else None)} (a recording of motion
+    (a) holds ~50 MB of ground truth: only the one filtered later is kept).  The motion and its timeline are
+    drawn for success_frames_duration seconds, and only the evaluation.success_frames frames that are counted
+    are rendered (and filtered later, for the kept one)."""
     geometry = np.array(params.markers_body)
     body = geometry if run.dropped < 0 else np.delete(geometry, run.dropped, axis=0)
-    duration = success_frames_duration(params)
+    duration, n_frames = success_frames_duration(params), params.evaluation.success_frames
     if run.motion == "a":
-        sims = {f"a_{run.label}": simulate_hand(params, experiment_rng(params, f"hand_{run.label}"), body, duration)}
+        sims = {f"a_{run.label}": simulate_hand(params, experiment_rng(params, f"hand_{run.label}"), body, duration, n_frames)}
     else:
         no_split = params.detection.model_copy(update={"split_touching": False})
         split, unsplit = simulate(params, experiment_rng(params, f"stress_{run.label}"), body, params.evaluation.success_omega_std,
-                                  duration, [params.detection, no_split])
+                                  duration, [params.detection, no_split], n_frames=n_frames)
         sims = {f"b_{run.label}": split, f"b_{run.label}_no_split": unsplit}
     return {name: (run_no_filter(sim, params), sim if keep else None) for name, sim in sims.items()}
 

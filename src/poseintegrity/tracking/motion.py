@@ -165,6 +165,14 @@ class SensorTimeline:
     gyro_index: np.ndarray
     gyro: np.ndarray
 
+    def first_frames(self, n: int) -> SensorTimeline:
+        """The timeline up to its n-th marker frame (n >= 1): the first n frames and the gyro samples up to the
+        last of them (each frame's samples lie after the frame before it).  The whole timeline if it is shorter."""
+        if n >= len(self.frame_index):
+            return self
+        keep = self.gyro_index <= self.frame_index[n - 1]
+        return SensorTimeline(self.frame_index[:n], self.occluded[:n], self.n_phantoms[:n], self.gyro_index[keep], self.gyro[keep])
+
 
 def sample_sensors(trajectory: Trajectory, n_markers: int, motion: MotionParams, rng: np.random.Generator) -> SensorTimeline:
     """Draw frame times, occlusions, phantom counts and gyro samples for a trajectory (II-F)."""

@@ -97,10 +97,13 @@ def record(
 
 
 def simulate(params: TrackParams, rng: np.random.Generator, markers_body: np.ndarray | None = None, omega_std: float | None = None,
-             duration_s: float | None = None, detections: Sequence[DetectionParams] | None = None, sink=None) -> list[Simulation]:
+             duration_s: float | None = None, detections: Sequence[DetectionParams] | None = None, sink=None,
+             n_frames: int | None = None) -> list[Simulation]:
     """The accuracy recording (params.motion), or motion (b), the stress test, with omega_std and no deliberate
     occlusion when omega_std is given.  markers_body : (m, 3) geometry (default params.markers_body).
-    One :class:`Simulation` per detector of ``detections`` (default: params.detection alone), see :func:`record`."""
+    One :class:`Simulation` per detector of ``detections`` (default: params.detection alone), see :func:`record`.
+    n_frames : render only the first n_frames marker frames of the duration_s timeline (all if None); the
+    motion and the timeline are drawn for the whole duration, so those frames are the same either way."""
     markers_body = np.array(params.markers_body) if markers_body is None else markers_body
     update = {} if duration_s is None else {"duration_s": duration_s}
     if omega_std is not None:
@@ -108,19 +111,24 @@ def simulate(params: TrackParams, rng: np.random.Generator, markers_body: np.nda
     params = params.model_copy(update={"motion": params.motion.model_copy(update=update)})
     trajectory = simulate_trajectory(params.motion, rng, omega_std=omega_std)
     timeline = sample_sensors(trajectory, len(markers_body), params.motion, rng)
+    if n_frames is not None:
+        timeline = timeline.first_frames(n_frames)
     return record(params, trajectory, timeline, markers_body, rng, detections or [params.detection], sink,
                   label="stress" if omega_std else "recording")
 
 
-def simulate_hand(params: TrackParams, rng: np.random.Generator, markers_body: np.ndarray, duration_s: float) -> Simulation:
+def simulate_hand(params: TrackParams, rng: np.random.Generator, markers_body: np.ndarray, duration_s: float, n_frames: int | None = None) -> Simulation:
     """Motion (a), paper-like (:class:`~poseintegrity.tracking.params.HandMotionParams`): full turns about every
-    axis, large translations, brief per-marker occlusions in place of the i.i.d. P_o and the deliberate occlusion."""
+    axis, large translations, brief per-marker occlusions in place of the i.i.d. P_o and the deliberate occlusion.
+    n_frames : as in :func:`simulate`."""
     motion = params.motion.model_copy(update={"duration_s": duration_s, "p_occlusion": 0.0, "occlusions": []})
     params = params.model_copy(update={"motion": motion})
     trajectory = simulate_hand_motion(motion, params.hand, rng)
     timeline = sample_sensors(trajectory, len(markers_body), motion, rng)
     hidden = brief_occlusions(trajectory.t[timeline.frame_index], len(markers_body), params.hand, rng)
     timeline = replace(timeline, occluded=timeline.occluded | hidden)
+    if n_frames is not None:
+        timeline = timeline.first_frames(n_frames)
     return record(params, trajectory, timeline, markers_body, rng, [params.detection], label="hand motion")[0]
 
 
