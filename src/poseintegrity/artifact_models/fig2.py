@@ -10,12 +10,12 @@ Input: the artifacts table of stage 02, one row per image and PnP method, with a
 
 from __future__ import annotations
 
-import zlib
 from functools import partial
 
 import numpy as np
 import pandas as pd
 
+from poseintegrity.seeding import keyed_rng
 from poseintegrity.artifact_models.fitted import FIT_STATUSES, OK, FittedModel
 from poseintegrity.artifact_models.models import fit_model
 from poseintegrity.artifact_models.params import FitParams
@@ -29,20 +29,15 @@ COLUMNS = ["trajectory", "dataset", "k", "model", "rmse", "status", "reason", "n
 def fit_first_stops(series: Series, k: int, params: FitParams) -> dict[str, FittedModel]:
     """Every model of ``params.models`` fitted to the first k stops of ``series``, checked up to its range end.
 
-    Each fit draws from ``np.random.default_rng([seed, crc32(trajectory/dataset), k, crc32(model)])``:
+    Each fit draws from ``keyed_rng(seed, "trajectory/dataset", k, model)``:
     the same for any number of workers, any order of work, any other datasets in the table and any other models.
     """
     theta, n_inliers = series.first_stops(k)
-    key = [params.seed, _crc32(f"{series.trajectory}/{series.dataset}"), k]
     return {
         name: fit_model(name, theta, n_inliers, theta_end=series.theta_end, params=params,
-                        rng=np.random.default_rng([*key, _crc32(name)]))
+                        rng=keyed_rng(params.seed, f"{series.trajectory}/{series.dataset}", k, name))
         for name in params.models
     }  # fmt: skip
-
-
-def _crc32(text: str) -> int:
-    return zlib.crc32(text.encode())
 
 
 def rmse(model: FittedModel, theta: np.ndarray, n_inliers: np.ndarray) -> float:

@@ -19,7 +19,6 @@ envelopes and summaries.
 
 from __future__ import annotations
 
-import zlib
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
@@ -28,6 +27,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from poseintegrity.seeding import keyed_rng
 from poseintegrity.localization.dataset import Dataset, DatasetError, load_dataset, load_index, pose_problem
 from poseintegrity.localization.evidence import FrameEvidence, frame_evidence, model_digest
 from poseintegrity.localization.features import cached_features, read_gray, write_npz
@@ -49,7 +49,7 @@ def usable(table: pd.DataFrame) -> pd.DataFrame:
 
 def frame_seed(seed: int, dataset: str, stop: int, image: int) -> int:
     """RANSAC seed of one frame, drawn from a Generator seeded by (params seed, dataset, stop, image)."""
-    rng = np.random.default_rng([seed, zlib.crc32(dataset.encode()), stop, image])
+    rng = keyed_rng(seed, dataset, stop, image)
     return int(rng.integers(0, 2**31 - 1))
 
 

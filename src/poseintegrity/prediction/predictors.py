@@ -27,12 +27,12 @@ what the robot would have done (a "fallback" fit predicts with its line, the oth
 
 from __future__ import annotations
 
-import zlib
 from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 
+from poseintegrity.seeding import keyed_rng
 from poseintegrity.artifact_models import FIT_STATUSES, FitParams, FittedModel, fit_model
 from poseintegrity.artifact_models.fitted import OK
 from poseintegrity.artifact_models.series import Series
@@ -116,7 +116,7 @@ def stop_positions(series: Series) -> tuple[np.ndarray, np.ndarray]:
 
 def fit_rng(seed: int, method: str, series: Series, k: int) -> np.random.Generator:
     """The Generator of one fit: the same for any number of workers, order of work and other datasets in the table."""
-    return np.random.default_rng([seed, zlib.crc32(f"{method}/{series.trajectory}/{series.dataset}".encode()), k])
+    return keyed_rng(seed, f"{method}/{series.trajectory}/{series.dataset}", k)
 
 
 def fit_stops(

@@ -15,7 +15,6 @@ z up, millimetres.
 
 from __future__ import annotations
 
-import zlib
 from dataclasses import dataclass
 from functools import lru_cache
 from typing import TYPE_CHECKING
@@ -23,6 +22,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from poseintegrity.seeding import keyed_rng
 from poseintegrity.scenes import mesh as meshes
 from poseintegrity.scenes import textures as tex
 from poseintegrity.poses import pose_matrix
@@ -40,16 +40,11 @@ PHANTOM_CLEARANCE_MM = 20.0  # lowest point of a held phantom above the table
 BOARD_BELOW_AIM_MM = 60.0  # the board's pedestal brings it this far below the aim point (never below the table)
 
 
-def rng_for(seed: int, *key: str | int) -> np.random.Generator:
-    """A Generator keyed by ``generate.seed`` and names/indices: the same draw in every process and run."""
-    return np.random.default_rng([seed, *(zlib.crc32(k.encode()) if isinstance(k, str) else k for k in key)])
-
-
 @lru_cache(maxsize=len(TEXTURE_NAMES))
 def procedural_texture(name: str, seed: int) -> np.ndarray:
     """The albedo map of a texture name, the same in every scene and process: drawn once per process (most of a
     scene's layout time went into drawing the same textures again), read-only."""
-    texture = _draw_texture(name, rng_for(seed, "texture", name))
+    texture = _draw_texture(name, keyed_rng(seed, "texture", name))
     texture.flags.writeable = False
     return texture
 
@@ -140,7 +135,7 @@ def _held_phantom(name: str, params: "GenerateParams", spec: "SceneSpec", view_d
 
 def build_scene(spec: "SceneSpec", index: int, params: "GenerateParams") -> Scene:
     """Lay out scene ``spec`` (index = its position in params, seeds the arrangement with ``params.seed``)."""
-    rng = rng_for(params.seed, "scene", index)
+    rng = keyed_rng(params.seed, "scene", index)
     yaw = np.deg2rad(rng.uniform(-20, 20))  # direction of the model camera around the target
     elev = np.deg2rad(spec.elevation_deg)
     view_dir = np.array([np.sin(yaw) * np.cos(elev), -np.cos(yaw) * np.cos(elev), np.sin(elev)])

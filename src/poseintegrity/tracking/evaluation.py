@@ -1,7 +1,7 @@
 """Section III on our simulation: one small function per experiment, each named after what it measures, and
 :func:`run_study` that runs them all.
 
-Each experiment draws from its own generator, ``numpy.random.default_rng([params.seed, crc32(name)])``, so the
+Each experiment draws from its own generator, ``keyed_rng(params.seed, name)`` (:mod:`poseintegrity.seeding`), so the
 experiments do not depend on each other's order and the per-frame tables are bit-identical for one seed
 (timings are the only non-deterministic outputs and are kept apart).  That lets :func:`run_study` run them as
 independent tasks on :class:`~poseintegrity.parallel.Workers`: first the recordings (render + detect + the
@@ -13,7 +13,6 @@ calling process, alone on the machine.
 from __future__ import annotations
 
 import time
-import zlib
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from functools import partial
@@ -22,6 +21,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from poseintegrity.seeding import keyed_rng
 from poseintegrity.tracking.correspondence import match_brute_force, match_markers, match_voting
 from poseintegrity.tracking.detection import detect_markers
 from poseintegrity.tracking.detection_sweep import small_blob_sweep, sweep_summary
@@ -44,8 +44,8 @@ from poseintegrity.tracking.ukf import UnscentedKalmanFilter
 from poseintegrity.tracking.unscented import UnscentedMarkerFilter
 
 def experiment_rng(params: TrackParams, name: str) -> np.random.Generator:
-    """The generator of one experiment: default_rng([params.seed, crc32(name)])."""
-    return np.random.default_rng([params.seed, zlib.crc32(name.encode())])
+    """The generator of one experiment: keyed_rng(params.seed, name)."""
+    return keyed_rng(params.seed, name)
 
 
 def normalized_lag_ms(t_ref: np.ndarray, ref: np.ndarray, t_sig: np.ndarray, sig: np.ndarray, lag_max_ms: float) -> float:
