@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from poseintegrity.tracking.cholesky import cholupdate, tril_from_qr
+from poseintegrity.tracking.cholesky import cholupdate, lower_factor
 
 
 def _spd(rng, n):
@@ -26,9 +26,9 @@ def test_failed_downdate_is_reported_and_leaves_factor_unchanged():
     np.testing.assert_array_equal(S, L)
 
 
-def test_tril_from_qr_gives_a_factor_of_a_rectangular_square_root():
+def test_lower_factor_gives_a_factor_of_a_rectangular_square_root():
     rng = np.random.default_rng(2)
     A = rng.normal(size=(5, 12))
-    S = tril_from_qr(A)
+    S = lower_factor(A)
     np.testing.assert_allclose(S @ S.T, A @ A.T, atol=1e-12)
     assert np.allclose(S, np.tril(S)) and np.all(np.diag(S) >= 0)

@@ -11,14 +11,6 @@ import numba
 import numpy as np
 
 
-def tril_from_qr(A: np.ndarray) -> np.ndarray:
-    """Lower-triangular S with ``S @ S.T == A @ A.T`` from a QR decomposition of ``A.T``.
-
-    A : (N, p) float, p >= N.  Returns (N, N) float with a non-negative diagonal.
-    """
-    return lower_factor(np.ascontiguousarray(A, dtype=np.float64))
-
-
 @numba.njit(cache=True)
 def lower_factor(A):  # pragma: no cover - compiled
     """qr{A^T} of Alg. 5 as an LQ decomposition A = L Q by Householder reflections on the rows of A

@@ -90,10 +90,16 @@ def record(
         for found, detection in zip(points, detections):
             found.append(detect_markers(ir, depth_mm, K, detection, T_world_cam=T_wc))
     occlusions = [tuple(o) for o in params.motion.occlusions]
-    in_occlusion = np.zeros(len(idx), dtype=bool)
+    return [Simulation(trajectory, timeline, markers_body, t, T_true, found, inside_occlusions(t, occlusions), occlusions)
+            for found in points]
+
+
+def inside_occlusions(t: np.ndarray, occlusions: Sequence[tuple[float, float]]) -> np.ndarray:
+    """(k,) bool: which times t (k,) s fall inside one of the occlusion windows [start_s, start_s + duration_s)."""
+    inside = np.zeros(len(t), dtype=bool)
     for start, duration in occlusions:
-        in_occlusion |= (t >= start) & (t < start + duration)
-    return [Simulation(trajectory, timeline, markers_body, t, T_true, found, in_occlusion, occlusions) for found in points]
+        inside |= (t >= start) & (t < start + duration)
+    return inside
 
 
 def simulate(params: TrackParams, rng: np.random.Generator, markers_body: np.ndarray | None = None, omega_std: float | None = None,
@@ -188,11 +194,8 @@ def run_filter(
             flags.append(result.flag)
             n_matched[e] = int((result.assignment >= 0).sum())
             poses[e] = result.T_filtered
-    in_occlusion = np.zeros(len(grid), dtype=bool)
-    for start, duration in sim.occlusions:
-        in_occlusion |= (start <= t) & (t < start + duration)
     df = pd.DataFrame({"t": t, "kind": np.where(is_gyro, "gyro", "frame").astype(object), "frame": np.where(is_gyro, -1, k),
-                       "flag": flags, "n_matched": n_matched, "in_occlusion": in_occlusion})
+                       "flag": flags, "n_matched": n_matched, "in_occlusion": inside_occlusions(t, sim.occlusions)})
     truth = pose_matrix(traj.rotation(grid), traj.position[grid])
     for name, column in error_columns(poses, truth).items():
         df[name] = column
