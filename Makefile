@@ -17,11 +17,16 @@ export MALLOC_TRIM_THRESHOLD_ := 1073741824
 help: ## list the targets
 	@grep -E '^[a-z]+:.*## ' $(MAKEFILE_LIST) | sed 's/:.*## /\t/'
 
+# uv installs the pinned lock in ~20 s where pip takes ~2 min (most of it byte-compiling every module of every
+# package). torch alone goes through pip, which takes the CPU build lying on this machine's disk; uv does not look
+# there and would download PyPI's multi-GB CUDA build.
 $(VENV)/.installed: requirements.lock pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV) || python3 -m venv $(VENV)
-	$(BIN)/python -m pip install --quiet --upgrade pip
-	$(BIN)/python -m pip install --quiet -r requirements.lock
-	$(BIN)/python -m pip install --quiet --no-deps --no-build-isolation -e .
+	$(BIN)/python -m pip install --quiet $$(grep '^uv==' requirements.lock)
+	grep -v '^torch==' requirements.lock > $(VENV)/requirements-uv.txt
+	$(BIN)/uv pip install --quiet --python $(BIN)/python -r $(VENV)/requirements-uv.txt
+	$(BIN)/python -m pip install --quiet --no-deps --no-compile $$(grep '^torch==' requirements.lock)
+	$(BIN)/uv pip install --quiet --python $(BIN)/python --no-deps -e .
 	$(BIN)/python -m ipykernel install --sys-prefix --name python3 > /dev/null
 	touch $@
 
