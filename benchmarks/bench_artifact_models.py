@@ -43,7 +43,7 @@ def torch_recipe(theta: np.ndarray, n: np.ndarray, theta_end: float, mlp: MLPPar
     widths = [1] + [mlp.hidden_units] * mlp.hidden_layers
     layers = [m for i, o in zip(widths[:-1], widths[1:], strict=True) for m in (torch.nn.Linear(i, o), torch.nn.Tanh())]
     net = torch.nn.Sequential(*layers, torch.nn.Linear(mlp.hidden_units, 1)).double()
-    x0 = initial_weights(mlp.hidden_layers, mlp.hidden_units, torch.Generator().manual_seed(seed))
+    x0 = initial_weights(mlp.hidden_layers, mlp.hidden_units, seed)
     torch.nn.utils.vector_to_parameters(torch.as_tensor(x0), net.parameters())
     n_scale = max(float(n.max()), 1.0)
 

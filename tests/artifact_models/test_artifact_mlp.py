@@ -40,7 +40,7 @@ def torch_network(generator: torch.Generator) -> nn.Sequential:
 
 def test_network_is_three_hidden_layers_of_ten_tanh_neurons_initialised_like_torch_linear_layers():
     net = torch_network(torch.Generator().manual_seed(7))
-    weights = initial_weights(3, 10, torch.Generator().manual_seed(7))
+    weights = initial_weights(3, 10, 7)
     assert weights.shape == (n_parameters(3, 10),) == (sum(p.numel() for p in net.parameters()),) == (251,)
     np.testing.assert_array_equal(weights, nn.utils.parameters_to_vector(net.parameters()).detach().numpy())
 

@@ -10,41 +10,19 @@
     fig2.py            the Fig. 2 experiment on the stage-02 artifacts table
 """
 
-from poseintegrity.artifact_models.base_functions import BASE_FUNCTIONS, EMG, BaseFunction, emg, emg_pdf
-from poseintegrity.artifact_models.fig2 import (
-    at_sampled_stops,
-    fig2_rmse,
-    fit_first_stops,
-    fits_metrics,
-    mean_rmse,
-    status_counts,
-)
-from poseintegrity.artifact_models.fitted import FIT_STATUSES, FallbackLine, FittedModel
-from poseintegrity.artifact_models.mlp import fit_mlp
-from poseintegrity.artifact_models.models import MODEL_NAMES, fit_model
-from poseintegrity.artifact_models.params import FitParams, MLPParams
-from poseintegrity.artifact_models.series import Series, dataset_series
+import lazy_loader
 
-__all__ = [
-    "BASE_FUNCTIONS",
-    "EMG",
-    "FIT_STATUSES",
-    "MODEL_NAMES",
-    "BaseFunction",
-    "FallbackLine",
-    "FitParams",
-    "FittedModel",
-    "MLPParams",
-    "Series",
-    "at_sampled_stops",
-    "dataset_series",
-    "emg",
-    "emg_pdf",
-    "fig2_rmse",
-    "fit_first_stops",
-    "fit_mlp",
-    "fit_model",
-    "fits_metrics",
-    "mean_rmse",
-    "status_counts",
-]
+# Names resolve on first use, so that importing one module of the package (its params schema, say) does not
+# import all of them: the stage runner and every worker process import only what they run.
+__getattr__, __dir__, __all__ = lazy_loader.attach(
+    __name__,
+    submod_attrs={
+        "base_functions": ["BASE_FUNCTIONS", "EMG", "BaseFunction", "emg", "emg_pdf"],
+        "fig2": ["at_sampled_stops", "fig2_rmse", "fit_first_stops", "fits_metrics", "mean_rmse", "status_counts"],
+        "fitted": ["FIT_STATUSES", "FallbackLine", "FittedModel"],
+        "mlp": ["fit_mlp"],
+        "models": ["MODEL_NAMES", "fit_model"],
+        "params": ["FitParams", "MLPParams"],
+        "series": ["Series", "dataset_series"],
+    },
+)

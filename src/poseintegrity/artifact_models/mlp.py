@@ -19,7 +19,6 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 import numpy as np
-import torch
 
 from poseintegrity.artifact_models.base_functions import EMG
 from poseintegrity.artifact_models.fitted import FittedModel, too_few_samples, valid_samples
@@ -31,14 +30,17 @@ PARAM_NAMES = ("loss", "evaluations")  # FittedModel.params of an MLP: final sca
 DISTINCT_THETA = 2  # distinct theta both recipes need (the EMG starting curve of the pretraining needs 2)
 
 
-def initial_weights(hidden_layers: int, hidden_units: int, generator: torch.Generator) -> np.ndarray:
+def initial_weights(hidden_layers: int, hidden_units: int, seed: int) -> np.ndarray:
     """Initial parameters of 1 -> (Linear, tanh) x hidden_layers -> Linear -> 1 (IV-E: 3 x 10, tanh), flat float64
     in the layout of mlp_net.py: (n_params,).
 
     Weights and biases ~ U(-1/sqrt(fan_in), 1/sqrt(fan_in)) (torch's default bound of nn.Linear), drawn from
-    ``generator`` in the order of nn.init.uniform_ on each layer's weight then bias (hence the same numbers as those
-    layers would get); the global torch RNG is never touched.
+    a torch generator seeded with ``seed``, in the order of nn.init.uniform_ on each layer's weight then bias (hence
+    the same numbers as those layers would get); the global torch RNG is never touched.
     """
+    import torch  # only here: the 2 s import is not paid by every process that reads the fit params
+
+    generator = torch.Generator().manual_seed(seed)
     widths = [1] + [hidden_units] * hidden_layers + [1]
     parts = []
     for fan_in, fan_out in zip(widths[:-1], widths[1:], strict=True):
@@ -105,9 +107,8 @@ def fit_mlp(
     reason = too_few_samples(theta, DISTINCT_THETA)
     if reason is not None:
         return FittedModel.failed(name, PARAM_NAMES, reason, theta, n_inliers)
-    generator = torch.Generator().manual_seed(int(rng.integers(0, 2**63 - 1)))
     curve = MLPCurve(
-        initial_weights(mlp.hidden_layers, mlp.hidden_units, generator),
+        initial_weights(mlp.hidden_layers, mlp.hidden_units, int(rng.integers(0, 2**63 - 1))),
         hidden_layers=mlp.hidden_layers,
         hidden_units=mlp.hidden_units,
         theta_max=float(theta_end),

@@ -7,14 +7,18 @@ board) -> frame_artifacts (n_i and friends), realism checks -> envelope (theta_a
 datasets on the workers of poseintegrity.parallel.
 """
 
-from poseintegrity.localization.dataset import DatasetError
-from poseintegrity.localization.envelope import actual_envelope, envelopes
-from poseintegrity.localization.extract import DATA_FLAGS, extract_all, extract_dataset, usable
-from poseintegrity.localization.params import ExtractParams
-from poseintegrity.localization.pnp import METHODS, solve_pnp_ransac
-from poseintegrity.localization.target_model import TargetModel, build_target_model
+import lazy_loader
 
-__all__ = [
-    "DATA_FLAGS", "DatasetError", "ExtractParams", "METHODS", "TargetModel", "actual_envelope", "build_target_model",
-    "envelopes", "extract_all", "extract_dataset", "solve_pnp_ransac", "usable",
-]
+# Names resolve on first use, so that importing one module of the package (its params schema, say) does not
+# import all of them: the stage runner and every worker process import only what they run.
+__getattr__, __dir__, __all__ = lazy_loader.attach(
+    __name__,
+    submod_attrs={
+        "dataset": ["DatasetError"],
+        "envelope": ["actual_envelope", "envelopes"],
+        "extract": ["DATA_FLAGS", "extract_all", "extract_dataset", "usable"],
+        "params": ["ExtractParams"],
+        "pnp": ["METHODS", "solve_pnp_ransac"],
+        "target_model": ["TargetModel", "build_target_model"],
+    },
+)

@@ -9,82 +9,28 @@
     supervisor.py   NextStepSupervisor: the next-step predictor as a component of a robot loop
 """
 
-from poseintegrity.prediction.loso import loso, loso_folds, loso_summary, pooled, scene_of
-from poseintegrity.prediction.metrics import (
-    best_operating_point,
-    incursion,
-    operating_curves,
-    relative_improvement,
-    safe_path_length,
-    with_metrics,
-)
-from poseintegrity.prediction.params import PredictorModels, PredictParams, UncertaintyParams
-from poseintegrity.prediction.predictors import (
-    NO_FIT,
-    Boundaries,
-    boundaries,
-    envelope_prediction,
-    long_range,
-    next_step,
-    next_step_stops,
-    relative_thresholds,
-    static_baseline,
-)
-from poseintegrity.prediction.supervisor import Decision, NextStepSupervisor
-from poseintegrity.prediction.sweeps import (
-    FITTED_PREDICTORS,
-    PAPER_PREDICTORS,
-    RELATIVE_PREDICTORS,
-    attach_envelopes,
-    best_table,
-    fit_status_shares,
-    headline_metrics,
-    live_trials,
-    predict_dataset,
-    sweep,
-    with_pnp_variants,
-)
-from poseintegrity.prediction.uncertainty import Interval, bootstrap_interval, covariance_interval, prediction_interval
+import lazy_loader
 
-__all__ = [
-    "FITTED_PREDICTORS",
-    "NO_FIT",
-    "PAPER_PREDICTORS",
-    "RELATIVE_PREDICTORS",
-    "Boundaries",
-    "Decision",
-    "Interval",
-    "NextStepSupervisor",
-    "PredictParams",
-    "PredictorModels",
-    "UncertaintyParams",
-    "attach_envelopes",
-    "best_operating_point",
-    "best_table",
-    "bootstrap_interval",
-    "boundaries",
-    "covariance_interval",
-    "envelope_prediction",
-    "fit_status_shares",
-    "headline_metrics",
-    "incursion",
-    "live_trials",
-    "long_range",
-    "loso",
-    "loso_folds",
-    "loso_summary",
-    "next_step",
-    "next_step_stops",
-    "operating_curves",
-    "pooled",
-    "prediction_interval",
-    "predict_dataset",
-    "relative_thresholds",
-    "relative_improvement",
-    "safe_path_length",
-    "scene_of",
-    "static_baseline",
-    "sweep",
-    "with_metrics",
-    "with_pnp_variants",
-]
+# Names resolve on first use, so that importing one module of the package (its params schema, say) does not
+# import all of them: the stage runner and every worker process import only what they run.
+__getattr__, __dir__, __all__ = lazy_loader.attach(
+    __name__,
+    submod_attrs={
+        "loso": ["loso", "loso_folds", "loso_summary", "pooled", "scene_of"],
+        "metrics": [
+            "best_operating_point", "incursion", "operating_curves", "relative_improvement", "safe_path_length",
+            "with_metrics",
+        ],
+        "params": ["PredictorModels", "PredictParams", "UncertaintyParams"],
+        "predictors": [
+            "NO_FIT", "Boundaries", "boundaries", "envelope_prediction", "long_range", "next_step",
+            "next_step_stops", "relative_thresholds", "static_baseline",
+        ],
+        "supervisor": ["Decision", "NextStepSupervisor"],
+        "sweeps": [
+            "FITTED_PREDICTORS", "PAPER_PREDICTORS", "RELATIVE_PREDICTORS", "attach_envelopes", "best_table",
+            "fit_status_shares", "headline_metrics", "live_trials", "predict_dataset", "sweep", "with_pnp_variants",
+        ],
+        "uncertainty": ["Interval", "bootstrap_interval", "covariance_interval", "prediction_interval"],
+    },
+)

@@ -20,37 +20,21 @@ Module map (paper section -> module):
     III   results        :mod:`evaluation`
 """
 
-from poseintegrity.tracking.correspondence import match_brute_force, match_frobenius, match_gated, match_markers, match_voting
-from poseintegrity.tracking.detection import detect_markers, validate_frame
-from poseintegrity.tracking.kabsch import kabsch, pose_from_points
-from poseintegrity.tracking.params import TrackParams
-from poseintegrity.tracking.recording import Recording, RecordingError, RecordingWriter, read_recording, track_recording
-from poseintegrity.tracking.srukf import SquareRootUKF
-from poseintegrity.tracking.tools import MultiToolTracker, ToolError, read_tools, write_tools
-from poseintegrity.tracking.tracker import MarkerTracker
-from poseintegrity.tracking.ukf import UnscentedKalmanFilter
+import lazy_loader
 
-__all__ = [
-    "MarkerTracker",
-    "MultiToolTracker",
-    "Recording",
-    "RecordingError",
-    "RecordingWriter",
-    "SquareRootUKF",
-    "ToolError",
-    "TrackParams",
-    "UnscentedKalmanFilter",
-    "detect_markers",
-    "kabsch",
-    "match_brute_force",
-    "match_frobenius",
-    "match_gated",
-    "match_markers",
-    "match_voting",
-    "pose_from_points",
-    "read_recording",
-    "read_tools",
-    "track_recording",
-    "validate_frame",
-    "write_tools",
-]
+# Names resolve on first use, so that importing one module of the package (its params schema, say) does not
+# import all of them: the stage runner and every worker process import only what they run.
+__getattr__, __dir__, __all__ = lazy_loader.attach(
+    __name__,
+    submod_attrs={
+        "correspondence": ["match_brute_force", "match_frobenius", "match_gated", "match_markers", "match_voting"],
+        "detection": ["detect_markers", "validate_frame"],
+        "kabsch": ["kabsch", "pose_from_points"],
+        "params": ["TrackParams"],
+        "recording": ["Recording", "RecordingError", "RecordingWriter", "read_recording", "track_recording"],
+        "srukf": ["SquareRootUKF"],
+        "tools": ["MultiToolTracker", "ToolError", "read_tools", "write_tools"],
+        "tracker": ["MarkerTracker"],
+        "ukf": ["UnscentedKalmanFilter"],
+    },
+)
