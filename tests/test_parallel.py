@@ -105,6 +105,22 @@ def test_tasks_run_with_one_opencv_thread_and_the_caller_keeps_its_own(request, 
     assert cv2.getNumThreads() == caller
 
 
+def task_location(_: int) -> bool:
+    return parallel.in_worker_task()
+
+
+@pytest.mark.parametrize("backend", ["local", "dask"])
+def test_tasks_know_whether_they_run_in_a_worker_process(request, backend):
+    """A task's own progress bar is off in worker processes, on in the caller's (n_jobs: 1)."""
+    params = (ParallelParams(backend="dask", address=request.getfixturevalue("cluster").scheduler_address)
+              if backend == "dask" else ParallelParams(n_jobs=2))
+    with Workers(params) as workers:
+        assert workers.map(task_location, range(3), progress=False) == [True, True, True]
+    with Workers(ParallelParams(n_jobs=1)) as workers:
+        assert workers.map(task_location, range(2), progress=False) == [False, False]
+    assert not parallel.in_worker_task()
+
+
 def test_empty_task_list_returns_without_starting_anything():
     assert Workers(ParallelParams(backend="local", n_jobs=2)).map(abs, []) == []
 

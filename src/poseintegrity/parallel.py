@@ -26,6 +26,7 @@ Dask workers on other machines must see the same files at the same paths and run
 from __future__ import annotations
 
 import hashlib
+import os
 import time
 from collections.abc import Callable, Sequence
 from functools import partial
@@ -137,17 +138,31 @@ def _check_workers(client, address: str, expected_digest: str) -> None:
                               f"this machine; start every worker from the same checkout")
 
 
-def run_single_threaded(function: Callable[[Task], Result], task: Task) -> Result:
+_in_worker_task = False
+
+
+def in_worker_task() -> bool:
+    """True while a task of :meth:`Workers.map` runs in a worker process (not in the caller's own process, as
+    with ``n_jobs: 1``). A task's own progress bar is then off: the workers share the terminal, their bars would
+    interleave, and the map already prints a progress line for the tasks."""
+    return _in_worker_task
+
+
+def run_single_threaded(function: Callable[[Task], Result], task: Task, caller_pid: int) -> Result:
     """``function(task)`` with OpenCV's own thread pool limited to one thread (joblib and Dask limit BLAS and
     OpenMP, not OpenCV's pthreads pool): with one task per core, SIFT runs 5-8 % faster per frame than with every
     worker starting a thread per core (benchmarks/bench_opencv_threads.py). The previous setting is restored, so the
-    in-process ``n_jobs: 1`` path leaves the caller's OpenCV as it was."""
-    previous = cv2.getNumThreads()
+    in-process ``n_jobs: 1`` path leaves the caller's OpenCV as it was. ``caller_pid``: the process that mapped
+    the task (:func:`in_worker_task` is True in any other)."""
+    global _in_worker_task
+    previous = cv2.getNumThreads(), _in_worker_task
     cv2.setNumThreads(1)
+    _in_worker_task = os.getpid() != caller_pid
     try:
         return function(task)
     finally:
-        cv2.setNumThreads(previous)
+        cv2.setNumThreads(previous[0])
+        _in_worker_task = previous[1]
 
 
 class Workers:
@@ -213,7 +228,7 @@ class Workers:
         results = []
         with joblib.parallel_config(backend="loky", inner_max_num_threads=1):
             for result in joblib.Parallel(n_jobs=self.params.n_jobs, return_as="generator")(
-                    joblib.delayed(run_single_threaded)(function, task) for task in tasks):
+                    joblib.delayed(run_single_threaded)(function, task, os.getpid()) for task in tasks):
                 results.append(result)
                 meter.update()
         return results
@@ -222,7 +237,7 @@ class Workers:
         from distributed import as_completed
 
         # pure=False: every task runs, even two equal ones (Dask would otherwise compute a key's result once)
-        futures = self._client.map(partial(run_single_threaded, function), tasks, pure=False)
+        futures = self._client.map(partial(run_single_threaded, function, caller_pid=os.getpid()), tasks, pure=False)
         position = {future.key: index for index, future in enumerate(futures)}
         results = [None] * len(tasks)
         try:

@@ -18,6 +18,7 @@ from poseintegrity.tracking.correspondence import match_markers
 from poseintegrity.tracking.detection import detect_markers
 from poseintegrity.tracking.errors import error_columns
 from poseintegrity.tracking.frames import draw_phantoms, intrinsics, render_frame
+from poseintegrity.parallel import in_worker_task
 from poseintegrity.poses import NAN_POSE, pose_matrix
 from poseintegrity.tracking.geometry import MARKER_DIAMETER_M, transform_points
 from poseintegrity.tracking.kabsch import pose_from_points
@@ -81,7 +82,7 @@ def record(
     K = intrinsics(params.camera)
     t = trajectory.t[idx]
     points: list[list[np.ndarray]] = [[] for _ in detections]
-    for f in tqdm(range(len(idx)), desc=label, leave=False, mininterval=5):
+    for f in tqdm(range(len(idx)), desc=label, leave=False, mininterval=5, disable=in_worker_task()):
         markers_cam = transform_points(T_cw, transform_points(T_true[f], markers_body))[~timeline.occluded[f]]
         phantoms = draw_phantoms(int(timeline.n_phantoms[f]), params.camera, params.frames, params.motion.phantom_round_fraction, rng)
         ir, depth_mm = render_frame(markers_cam, phantoms, params.camera, params.frames, MARKER_DIAMETER_M / 2, rng)
