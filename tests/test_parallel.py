@@ -77,10 +77,16 @@ def explode_on_three(value: int) -> int:
     return value
 
 
+def two_workers(request, backend: str) -> ParallelParams:
+    """Two worker processes: local, or the module's Dask cluster (started only by the tests that ask for it)."""
+    if backend == "dask":
+        return ParallelParams(backend="dask", address=request.getfixturevalue("cluster").scheduler_address)
+    return ParallelParams(n_jobs=2)
+
+
 @pytest.mark.parametrize("backend", ["local", "dask"])
 def test_a_failing_task_raises_its_exception_in_the_caller(request, backend):
-    params = (ParallelParams(backend="dask", address=request.getfixturevalue("cluster").scheduler_address)
-              if backend == "dask" else ParallelParams(n_jobs=2))
+    params = two_workers(request, backend)
     with Workers(params) as workers, pytest.raises(ValueError, match="task 3 failed"):
         workers.map(explode_on_three, range(6), progress=False)
 
@@ -95,8 +101,7 @@ def opencv_threads(_: int) -> int:
 def test_tasks_run_with_one_opencv_thread_and_the_caller_keeps_its_own(request, backend):
     import cv2
 
-    params = (ParallelParams(backend="dask", address=request.getfixturevalue("cluster").scheduler_address)
-              if backend == "dask" else ParallelParams(n_jobs=2))
+    params = two_workers(request, backend)
     caller = cv2.getNumThreads()
     with Workers(params) as workers:
         assert workers.map(opencv_threads, range(4), progress=False) == [1, 1, 1, 1]
@@ -112,8 +117,7 @@ def task_location(_: int) -> bool:
 @pytest.mark.parametrize("backend", ["local", "dask"])
 def test_tasks_know_whether_they_run_in_a_worker_process(request, backend):
     """A task's own progress bar is off in worker processes, on in the caller's (n_jobs: 1)."""
-    params = (ParallelParams(backend="dask", address=request.getfixturevalue("cluster").scheduler_address)
-              if backend == "dask" else ParallelParams(n_jobs=2))
+    params = two_workers(request, backend)
     with Workers(params) as workers:
         assert workers.map(task_location, range(3), progress=False) == [True, True, True]
     with Workers(ParallelParams(n_jobs=1)) as workers:
