@@ -8,7 +8,7 @@ tolerance (``predict.tolerance_fig6_fig7``, ``predict.live_tolerance``) is check
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import Literal, get_args
 
 from pydantic import Field, field_validator
 
@@ -16,6 +16,8 @@ from poseintegrity.schema import Section
 
 Trajectory = Literal["arc", "line"]
 PnPMethod = Literal["usac_magsac", "epnp", "p3p", "ap3p", "sqpnp", "iterative"]
+FailedFrameRule = Literal["fail_fraction", "capped", "infinite"]
+FAILED_FRAME_RULES: tuple[str, ...] = get_args(FailedFrameRule)  # localization/envelope.py says what each means
 
 
 def tolerance_name(tolerance: tuple[float, float]) -> str:
@@ -32,6 +34,17 @@ class SampledStops(Section):
     line: int = Field(ge=2, le=100)
 
 
+class EnvelopeParams(Section):
+    """How theta_a treats a frame without a pose (IV-E leaves it open; localization/envelope.py). Stage 02 computes
+    theta_a under every rule; ``failed_frames`` is the one of the paper's tables."""
+
+    failed_frames: FailedFrameRule = Field(description="the headline rule")
+    max_failed_fraction: float = Field(gt=0, lt=1, description="fail_fraction: a stop fails when more of its frames "
+                                                               "than this have no pose")
+    cap_factor: float = Field(ge=1, le=1000, description="capped: a frame without a pose counts as this many times "
+                                                         "the tolerance (>= 1: a failed frame is never a pass)")
+
+
 class ProtocolParams(Section):
     """Windsor et al. IV: trajectories, PnP method, tolerances, sampled stops. Lengths in mm, angles in deg."""
 
@@ -41,6 +54,7 @@ class ProtocolParams(Section):
     tolerances: list[tuple[float, float]] = Field(
         min_length=1, description="(E_t mm, E_r deg) error tolerances of IV-E (paper: 2 mm/3 deg, 4 mm/10 deg)")
     sampled_stops: SampledStops
+    envelope: EnvelopeParams
 
     @field_validator("tolerances")
     @classmethod

@@ -2,10 +2,12 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from poseintegrity.localization.envelope import actual_envelope, envelopes
+from poseintegrity.localization.envelope import actual_envelope, envelopes, headline, stop_criteria
+from poseintegrity.protocol import FAILED_FRAME_RULES, EnvelopeParams
 
 THETA = np.array([0.0, 2.25, 4.5, 6.75])  # IV-D: the first stop is the model view
 TOLERANCE = np.array([2.0, 3.0])
+RULES = EnvelopeParams(failed_frames="fail_fraction", max_failed_fraction=0.5, cap_factor=10.0)
 
 
 def test_linear_interpolation_between_the_last_passing_and_first_failing_stop():
@@ -29,24 +31,73 @@ def test_never_failing_dataset_is_censored_at_the_end():
     assert actual_envelope(THETA, errors, TOLERANCE) == (6.75, True)
 
 
-def test_failed_frames_count_as_infinite_error_at_their_stop():
+def test_an_infinite_criterion_crosses_at_the_previous_stop_and_nan_never_fails():
     errors = np.array([[0.5, 0.1], [0.5, 0.1], [np.inf, np.inf], [0.5, 0.1]])
     assert actual_envelope(THETA, errors, TOLERANCE) == (2.25, False)
+    unscored = np.array([[0.5, 0.1], [np.nan, np.nan], [0.5, 0.1], [0.5, 0.1]])
+    assert actual_envelope(THETA, unscored, TOLERANCE) == (6.75, True)
 
 
-def test_table_envelopes_use_theta_for_arcs_and_x_for_lines():
+def stop(errors_mm: list[float], failed: int) -> list[tuple[str, float]]:
+    """Frames of one stop: posed frames with these E_t (E_r 0), then ``failed`` frames without a pose."""
+    return [("ok", e) for e in errors_mm] + [("pnp_failed", np.nan)] * failed
+
+
+def frames_of(stops: list[list[tuple[str, float]]]) -> pd.DataFrame:
+    return pd.DataFrame([dict(stop=s, status=status, E_t_mm=e, E_r_deg=0.0 if status == "ok" else np.nan)
+                         for s, rows in enumerate(stops) for status, e in rows])
+
+
+# stop 1 has 1 frame of 10 without a pose, stop 2 has 6 of 10, stop 3 all: posed errors stay small
+FAILING = frames_of([stop([0.5] * 10, 0), stop([0.5] * 9, 1), stop([0.5] * 4, 6), stop([], 10)])
+
+
+def test_fail_fraction_rule_interpolates_the_share_of_frames_without_a_pose():
+    criteria, bounds = stop_criteria(FAILING, (2.0, 3.0), "fail_fraction", RULES)
+    np.testing.assert_allclose(criteria[:, 2], [0.0, 0.1, 0.6, 1.0])
+    np.testing.assert_allclose(bounds, [2.0, 3.0, 0.5])
+    assert np.isnan(criteria[3, 0])  # nothing to average where no frame has a pose
+    # the share crosses 0.5 at 2.25 + (0.5 - 0.1) / (0.6 - 0.1) * 2.25 = 4.05, between the stops
+    assert actual_envelope(THETA, criteria, bounds) == (pytest.approx(4.05), False)
+
+
+def test_capped_rule_counts_a_missing_pose_as_cap_factor_times_the_tolerance():
+    criteria, bounds = stop_criteria(FAILING, (2.0, 3.0), "capped", RULES)
+    np.testing.assert_allclose(criteria[:, 0], [0.5, 0.9 * 0.5 + 0.1 * 20.0, 0.4 * 0.5 + 0.6 * 20.0, 20.0])
+    # E_t: 0.5 -> 2.45 crosses 2 mm at 2.25 * (1.5 / 1.95); E_r: 0 -> 3.0 never exceeds 3 deg at stop 1
+    assert actual_envelope(THETA, criteria, bounds)[0] == pytest.approx(2.25 * 1.5 / 1.95)
+
+
+def test_infinite_rule_snaps_to_the_stop_before_any_frame_without_a_pose():
+    criteria, bounds = stop_criteria(FAILING, (2.0, 3.0), "infinite", RULES)
+    assert actual_envelope(THETA, criteria, bounds) == (0.0, False)
+
+
+def test_a_frame_without_ground_truth_is_left_out_of_the_mean():
+    frames = frames_of([stop([0.5, 0.5], 0), stop([0.5, np.nan], 0), stop([3.0, 3.0], 0)])
+    criteria, _ = stop_criteria(frames, (2.0, 3.0), "infinite", RULES)
+    np.testing.assert_allclose(criteria[:, 0], [0.5, 0.5, 3.0])
+
+
+def test_table_envelopes_use_theta_for_arcs_and_x_for_lines_under_every_rule():
     rows = []
     for dataset, trajectory in (("arc", "arc"), ("line", "line")):
-        for stop, E_t in enumerate([0.5, 1.5, 2.5]):
+        for s, E_t in enumerate([0.5, 1.5, 2.5]):
             for image, offset in enumerate([-0.1, 0.1]):  # stop means 0.5, 1.5, 2.5 mm
-                rows.append(dict(dataset=dataset, trajectory=trajectory, stop=stop, image=image,
-                                 theta_deg=10.0 * stop if trajectory == "arc" else 0.0,
-                                 x_mm=20.0 * stop if trajectory == "line" else 0.0,
+                rows.append(dict(dataset=dataset, trajectory=trajectory, stop=s, image=image, status="ok",
+                                 theta_deg=10.0 * s if trajectory == "arc" else 0.0,
+                                 x_mm=20.0 * s if trajectory == "line" else 0.0,
                                  method="usac_magsac", E_t_mm=E_t + offset, E_r_deg=0.0))
-    rows[-1]["E_t_mm"] = np.nan  # one failed frame in the last line stop: infinite error
-    table = envelopes(pd.DataFrame(rows), [(2.0, 3.0), (4.0, 10.0)]).set_index(["dataset", "tolerance"])
-    assert table.loc[("arc", "2mm_3deg"), "theta_a"] == pytest.approx(15.0)
-    assert not table.loc[("arc", "2mm_3deg"), "censored"]
-    assert table.loc[("arc", "4mm_10deg"), ["theta_a", "censored"]].tolist() == [20.0, True]
-    assert table.loc[("line", "2mm_3deg"), "theta_a"] == pytest.approx(20.0)  # previous stop: infinite mean
-    assert list(table.reset_index().columns) == ["dataset", "tolerance", "trajectory", "method", "theta_a", "censored"]
+    rows[-1].update(status="pnp_failed", E_t_mm=np.nan, E_r_deg=np.nan)  # half the last line stop has no pose
+    table = envelopes(pd.DataFrame(rows), [(2.0, 3.0), (4.0, 10.0)], RULES)
+    assert set(table["rule"]) == set(FAILED_FRAME_RULES) and len(table) == 2 * 2 * len(FAILED_FRAME_RULES)
+    ours = headline(table, RULES).set_index(["dataset", "tolerance"])
+    assert ours.loc[("arc", "2mm_3deg"), "theta_a"] == pytest.approx(15.0)
+    assert not ours.loc[("arc", "2mm_3deg"), "censored"]
+    assert ours.loc[("arc", "4mm_10deg"), ["theta_a", "censored"]].tolist() == [20.0, True]
+    # line: the one posed frame of the last stop has 2.4 mm, crossing 2 mm at 20 + 0.5 / 0.9 * 20
+    assert ours.loc[("line", "2mm_3deg"), "theta_a"] == pytest.approx(20.0 + 20.0 * 0.5 / 0.9)
+    snapped = table[(table.rule == "infinite") & (table.dataset == "line")].set_index("tolerance")
+    assert snapped.loc["2mm_3deg", "theta_a"] == pytest.approx(20.0)  # the previous stop
+    assert list(ours.reset_index().columns) == ["dataset", "tolerance", "trajectory", "method", "theta_a",
+                                                "censored"]

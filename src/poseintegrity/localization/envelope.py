@@ -1,18 +1,28 @@
-"""Actual localization envelope theta_a (paper IV-E).
+"""Actual localization envelope theta_a (Windsor et al. IV-E).
 
-theta_a is the viewing-angle change (or, for straight-line datasets, the camera translation x_i) at which the
-mean localization error over a stop's images first exceeds the tolerance, linearly interpolated between stops.
+IV-E: theta_a is "the viewing angle change at which the mean localization error exceeds a specified error
+threshold, calculated using linear interpolation between discrete sampled points" (for straight-line datasets the
+camera translation x_i, V-A). The error is measured against the ground truth, the ArUco board (IV-C): a frame
+whose board was not detected has no error to average and is left out of the stop's mean.
 
-Rules (ours, the paper leaves them open):
-- a tolerance is a pair (E_t mm, E_r deg); a stop fails when its mean E_t or its mean E_r exceeds its bound;
-- theta_a is the earliest crossing, taking each error linearly interpolated between the last passing stop and
-  the first failing one (equivalently: the first crossing of max(E_t / tol_t, E_r / tol_r) along the
-  piecewise-linear error curves);
-- the first stop is the trajectory start (theta = 0, the model view, IV-D; x = 0 on lines): a dataset whose first
-  stop already fails has theta_a = the first stop's position (no safe motion at all);
-- a frame without a pose (failed localization) has infinite error, so its stop fails and theta_a is the
-  previous stop;
-- a dataset whose mean errors never exceed the tolerance is censored at its last stop (``censored`` True).
+The paper leaves open what a frame *without a pose* (PnP-RANSAC returned none) adds to a stop's mean. That is a
+named choice, ``protocol.envelope.failed_frames``; stage 02 computes theta_a under every rule (column ``rule``) and
+stage 04 reports Tables I-III under each, so that the choice is seen:
+
+- ``fail_fraction`` (the headline): the mean error is taken over the frames with a pose, and the share of frames
+  without one is a criterion of its own, bounded by ``max_failed_fraction``. Both are interpolated like the errors.
+  A robot that cannot localize in most frames at a stop has lost the target even if the few poses it gets are good;
+  one unlucky frame among ten does not end the envelope.
+- ``capped``: a frame without a pose counts as an error of ``cap_factor`` times the tolerance (per bound), so a stop
+  fails once about 1 / cap_factor of its frames have no pose; interpolated like any error.
+- ``infinite``: a frame without a pose is an infinite error, so one such frame fails its stop and theta_a is the
+  previous stop, never a point between stops (the rule of our first reproduction; it snaps theta_a to the stops).
+
+Rules common to all: a tolerance is a pair (E_t mm, E_r deg) and a stop fails when any criterion exceeds its bound;
+theta_a is the earliest crossing, each criterion linearly interpolated between the last passing stop and the first
+failing one (a criterion that is infinite at the failing stop crosses at the previous stop); a dataset whose first
+stop (the model view, IV-D; x = 0 on lines) already fails has theta_a = that stop; one that never fails is censored
+at its last stop (``censored`` True).
 """
 
 from __future__ import annotations
@@ -20,51 +30,86 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from poseintegrity.protocol import tolerance_name
+from poseintegrity.protocol import FAILED_FRAME_RULES, EnvelopeParams, tolerance_name
+
+COLUMNS = ["dataset", "trajectory", "tolerance", "method", "rule", "theta_a", "censored"]
 
 
-def actual_envelope(theta: np.ndarray, mean_errors: np.ndarray, tolerance: np.ndarray) -> tuple[float, bool]:
-    """theta_a and whether it is censored.
+def actual_envelope(theta: np.ndarray, criteria: np.ndarray, bounds: np.ndarray) -> tuple[float, bool]:
+    """theta_a and whether it is censored (IV-E).
 
     theta : (m,) increasing stop positions (deg or mm), the first one the trajectory start
-    mean_errors : (m, b) mean error per stop for each of the b bounds (inf: a stop with failed frames)
-    tolerance : (b,) the bounds
+    criteria : (m, b) per stop, each criterion (mean E_t, mean E_r, share of frames without a pose, ...); inf fails
+               the stop and crosses at the previous one; NaN (nothing to average) never fails a stop
+    bounds : (b,) the bound of each criterion
     """
     theta = np.asarray(theta, dtype=float)
-    errors = np.asarray(mean_errors, dtype=float)
-    exceeded = np.any(errors > tolerance, axis=1)
+    values = np.asarray(criteria, dtype=float)
+    bounds = np.asarray(bounds, dtype=float)
+    with np.errstate(invalid="ignore"):
+        exceeded = np.any(values > bounds, axis=1)
     if not exceeded.any():
         return float(theta[-1]), True
     k = int(np.argmax(exceeded))  # first failing stop
     if k == 0:
         return float(theta[0]), False
     crossings = []
-    for e_prev, e_next, bound in zip(errors[k - 1], errors[k], tolerance):
-        if e_next > bound:
-            fraction = 0.0 if np.isinf(e_next) else (bound - e_prev) / (e_next - e_prev)
+    for before, after, bound in zip(values[k - 1], values[k], bounds):
+        if after > bound:
+            interpolable = np.isfinite(before) and np.isfinite(after)
+            fraction = (bound - before) / (after - before) if interpolable else 0.0
             crossings.append(theta[k - 1] + fraction * (theta[k] - theta[k - 1]))
     return float(min(crossings)), False
 
 
-def envelopes(table: pd.DataFrame, tolerances: list[tuple[float, float]]) -> pd.DataFrame:
-    """theta_a per dataset, tolerance and method from an artifacts table.
+def stop_criteria(frames: pd.DataFrame, tolerance: tuple[float, float], rule: str,
+                  envelope: EnvelopeParams) -> tuple[np.ndarray, np.ndarray]:
+    """Per stop of one dataset and PnP method: the criteria of ``rule`` and their bounds.
 
-    Uses ``theta_deg`` for arcs and ``x_mm`` for lines; columns: dataset, trajectory, tolerance, method,
-    theta_a (deg for arcs, mm for lines), censored.
+    frames : usable artifact rows (``status`` "ok" = a pose; ``E_t_mm``, ``E_r_deg`` against the ground truth,
+             NaN where the board was not detected or there is no pose), with ``stop``
+    Returns criteria (m, b) in stop order and bounds (b,): mean E_t, mean E_r, and for ``fail_fraction`` the share
+    of frames without a pose.
+    """
+    if rule not in FAILED_FRAME_RULES:
+        raise ValueError(f"unknown failed-frame rule {rule!r}; expected one of {FAILED_FRAME_RULES}")
+    tol = np.asarray(tolerance, dtype=float)
+    posed = (frames["status"] == "ok").to_numpy()
+    errors = frames[["E_t_mm", "E_r_deg"]].to_numpy(dtype=float, copy=True)
+    if rule == "infinite":
+        errors[~posed] = np.inf
+    elif rule == "capped":
+        errors[~posed] = envelope.cap_factor * tol
+    else:
+        errors[~posed] = np.nan
+    per_frame = pd.DataFrame(errors, columns=["E_t", "E_r"]).assign(stop=frames["stop"].to_numpy(),
+                                                                     failed=~posed)
+    per_stop = per_frame.groupby("stop", sort=True).agg(E_t=("E_t", "mean"), E_r=("E_r", "mean"),
+                                                         failed=("failed", "mean"))
+    if rule == "fail_fraction":
+        return per_stop[["E_t", "E_r", "failed"]].to_numpy(), np.append(tol, envelope.max_failed_fraction)
+    return per_stop[["E_t", "E_r"]].to_numpy(), tol
+
+
+def envelopes(table: pd.DataFrame, tolerances: list[tuple[float, float]], envelope: EnvelopeParams) -> pd.DataFrame:
+    """theta_a per dataset, tolerance, PnP method and failed-frame rule from an artifacts table (columns
+    :data:`COLUMNS`; theta_a in deg for arcs (``theta_deg``), mm for lines (``x_mm``)).
+
+    table : usable artifact rows (:func:`~poseintegrity.localization.extract.usable`)
     """
     rows = []
-    errors = table.assign(
-        E_t=table["E_t_mm"].fillna(np.inf), E_r=table["E_r_deg"].fillna(np.inf)
-    )  # a failed frame has infinite error
-    for (dataset, trajectory, method), frames in errors.groupby(["dataset", "trajectory", "method"], sort=True):
+    for (dataset, trajectory, method), frames in table.groupby(["dataset", "trajectory", "method"], sort=True):
         position = "x_mm" if trajectory == "line" else "theta_deg"
-        per_stop = frames.groupby("stop").agg(position=(position, "mean"), E_t=("E_t", "mean"), E_r=("E_r", "mean"))
+        theta = frames.groupby("stop", sort=True)[position].mean().to_numpy()
         for tolerance in tolerances:
-            theta_a, censored = actual_envelope(
-                per_stop["position"].to_numpy(), per_stop[["E_t", "E_r"]].to_numpy(), np.asarray(tolerance)
-            )
-            rows.append(
-                dict(dataset=dataset, trajectory=trajectory, tolerance=tolerance_name(tolerance), method=method,
-                     theta_a=theta_a, censored=censored)
-            )
-    return pd.DataFrame(rows, columns=["dataset", "trajectory", "tolerance", "method", "theta_a", "censored"])
+            for rule in FAILED_FRAME_RULES:
+                criteria, bounds = stop_criteria(frames, tolerance, rule, envelope)
+                theta_a, censored = actual_envelope(theta, criteria, bounds)
+                rows.append(dict(dataset=dataset, trajectory=trajectory, tolerance=tolerance_name(tolerance),
+                                 method=method, rule=rule, theta_a=theta_a, censored=censored))
+    return pd.DataFrame(rows, columns=COLUMNS)
+
+
+def headline(envelope_table: pd.DataFrame, envelope: EnvelopeParams) -> pd.DataFrame:
+    """The rows of ``protocol.envelope.failed_frames``, the rule of the paper's tables (without the rule column)."""
+    return envelope_table[envelope_table["rule"] == envelope.failed_frames].drop(columns="rule")

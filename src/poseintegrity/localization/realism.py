@@ -14,6 +14,7 @@ import pandas as pd
 from scipy.stats import spearmanr
 
 from poseintegrity.artifact_models.base_functions import BASE_FUNCTIONS
+from poseintegrity.localization.envelope import headline
 from poseintegrity.localization.params import RealismParams
 from poseintegrity.protocol import ProtocolParams, tolerance_name
 
@@ -23,7 +24,8 @@ def realism_metrics(
 ) -> dict[str, Any]:
     """Properties of the rendered world that the paper's real datasets had (issues 3 and 10, "Realism").
 
-    table : artifacts rows; envelope_table : :func:`envelope.envelopes` rows. Only the rows of
+    table : artifacts rows; envelope_table : :func:`envelope.envelopes` rows, of which those of the headline rule
+    ``protocol.envelope.failed_frames`` are used. Only the rows of
     ``protocol.pnp_method`` are used; the sampled stops are ``protocol.sampled_stops.arc`` (IV-A: 4).
     Keys (bars in ``passed``):
     - ``min_abs_spearman``: weakest decay of mean n_i with theta over the arc datasets, as min over datasets of
@@ -52,8 +54,21 @@ def realism_metrics(
     - R4 (Table III) medians of n_i at theta_a in [10, 35] at both tolerances, 90th percentiles <= 50
     - R5 (V-A) ``median_decay_ratio_arc``: median over arcs of mean n_i at the 4th (sampled) stop over the
       first stop's (bar: <= 0.75); ``median_decay_ratio_line`` the same on lines (bar: larger than on arcs)
+    - R6 (Tables I-II: the static baseline's 7.0 deg at zero incursion is the smallest arc theta_a)
+      ``min_theta_a_2mm3deg`` in [6.75, 9.0] deg: the hardest arc fails just past the sampled stops
+    - R7 (Tables I-II: next step's mean SPL 13.9-14.4 deg cannot exceed the mean theta_a, 7.0 is the smallest)
+      ``arc_theta_a_mean_over_min_2mm3deg`` >= 2.0
+    - R8 (V-A: +46.2 % for a line predictor needs the lines' envelopes that unalike) ``line_x_a_mean_over_min_2mm3deg``
+      >= 1.4
+    - R9 (V-A: 2 mm/3 deg is "the accuracy limit of our pose estimation pipeline") ``median_E_t_mm_first_stops``,
+      the median E_t against the ArUco ground truth of the frames with a pose at the sampled stops of the arcs,
+      in [0.3, 1.5] mm
+    - R10 (IV-E: theta_a is interpolated between stops) ``share_theta_a_on_stop_2mm3deg``: the share of uncensored
+      arcs whose theta_a lies within 0.01 deg of a stop, <= 0.5
+    ``n_bars_passed`` / ``n_bars`` count the bars of ``passed``.
     """
     method, sampled = protocol.pnp_method, protocol.sampled_stops.arc
+    envelope_table = headline(envelope_table, protocol.envelope)
     rows = table[table["method"] == method]
     arcs = rows[rows["trajectory"] == "arc"]
     per_stop = arcs.groupby(["dataset", "stop"]).agg(theta=("theta_deg", "mean"), n_i=("n_inliers", "mean"))
@@ -89,6 +104,12 @@ def realism_metrics(
     rmse = base_function_rmse(rows, sampled, protocol.range_end("arc"), realism.max_nfev)
     others = {name: value for name, value in rmse.items() if name != "emg"}
     decay_arc, decay_line = decay_ratios(rows, "arc", sampled), decay_ratios(rows, "line", sampled)
+    lines = envelope_table[(envelope_table["method"] == method) & (envelope_table["trajectory"] == "line")
+                           & (envelope_table["tolerance"] == tolerance_name((2.0, 3.0)))]
+    stop_theta = per_stop["theta"].groupby("dataset").apply(np.asarray).to_dict()
+    first_stops = arcs[arcs["stop"].isin(np.sort(arcs["stop"].unique())[:sampled]) & (arcs["status"] == "ok")]
+    uncensored = strict[~strict["censored"]]
+    on_stop = [bool(np.min(np.abs(stop_theta[d] - row["theta_a"])) <= 0.01) for d, row in uncensored.iterrows()]
     n_arcs = int(arcs["dataset"].nunique())
     metrics = dict(
         method=method,
@@ -126,6 +147,10 @@ def realism_metrics(
         decay_ratio_line=decay_line,
         median_decay_ratio_arc=_nanmedian(list(decay_arc.values())),
         median_decay_ratio_line=_nanmedian(list(decay_line.values())),
+        arc_theta_a_mean_over_min_2mm3deg=_mean_over_min(strict["theta_a"]),
+        line_x_a_mean_over_min_2mm3deg=_mean_over_min(lines["theta_a"]),
+        median_E_t_mm_first_stops=float(first_stops["E_t_mm"].median()),
+        share_theta_a_on_stop_2mm3deg=float(np.mean(on_stop)) if on_stop else float("nan"),
     )
     median_at_failure = (metrics["median_inliers_at_theta_a_2mm3deg"], metrics["median_inliers_at_theta_a_4mm10deg"])
     p90_at_failure = (metrics["p90_inliers_at_theta_a_2mm3deg"], metrics["p90_inliers_at_theta_a_4mm10deg"])
@@ -144,7 +169,14 @@ def realism_metrics(
         r4_inliers_at_failure=bool(all(10 <= m <= 35 for m in median_at_failure) and all(q <= 50 for q in p90_at_failure)),
         r5_early_decay=bool(metrics["median_decay_ratio_arc"] <= 0.75
                             and metrics["median_decay_ratio_line"] > metrics["median_decay_ratio_arc"]),
+        r6_hardest_arc=bool(6.75 <= metrics["min_theta_a_2mm3deg"] <= 9.0),
+        r7_arc_spread=bool(metrics["arc_theta_a_mean_over_min_2mm3deg"] >= 2.0),
+        r8_line_spread=bool(metrics["line_x_a_mean_over_min_2mm3deg"] >= 1.4),
+        r9_pipeline_accuracy=bool(0.3 <= metrics["median_E_t_mm_first_stops"] <= 1.5),
+        r10_interpolated=bool(metrics["share_theta_a_on_stop_2mm3deg"] <= 0.5),
     )
+    metrics["n_bars"] = len(metrics["passed"])
+    metrics["n_bars_passed"] = int(sum(metrics["passed"].values()))
     return metrics
 
 
@@ -193,6 +225,11 @@ def _nanmean(values: list[float]) -> float:
     """Mean of the finite values; NaN when there are none."""
     finite = [value for value in values if np.isfinite(value)]
     return float(np.mean(finite)) if finite else float("nan")
+
+
+def _mean_over_min(values: pd.Series) -> float:
+    """mean / min of positive envelopes; NaN for an empty series or a zero minimum (no envelope at all)."""
+    return float(values.mean() / values.min()) if len(values) and values.min() > 0 else float("nan")
 
 
 def _cv(values: pd.Series) -> float:

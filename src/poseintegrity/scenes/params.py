@@ -15,7 +15,7 @@ from typing import Annotated
 
 import cv2
 import numpy as np
-from pydantic import Field, ValidationInfo, field_validator, model_validator
+from pydantic import Field, ValidationError, ValidationInfo, field_validator, model_validator
 
 from poseintegrity.scenes.catalog import TARGET_NAMES, TEXTURE_NAMES
 from poseintegrity.scenes.foam import VOXEL_MM, ReliefVolume, relief_volume
@@ -201,8 +201,25 @@ class LineParams(Section):
         return [f"{self.scene}_line{offset:02.0f}" for offset in self.offsets_deg]
 
 
+WORLDS = ("main", "validation")  # the main world, calibrated to the paper; a second one nothing was tuned on
+
+
+class ValidationWorld(Section):
+    """A second world for the generalisation check (issue: "a headline that survives a world nobody tuned on"):
+    its own seed (so its own textures, foam relief, layouts, room-light directions, robot, calibration session and
+    sensor noise), its own scenes (targets, distances, elevations, clutter), straight lines and lighting, and fewer
+    images per stop; camera, sensor, robot model, materials and protocol are the main world's. Its scene names must
+    differ from the main world's (they name the dataset folders of both)."""
+
+    seed: Seed
+    images_per_stop: int = Field(ge=1, le=100)
+    lights: LightParams
+    scenes: list[SceneSpec] = Field(min_length=1)
+    lines: LineParams | None = Field(description="null: no straight-line datasets in this world")
+
+
 class GenerateParams(Section):
-    """Stage 01: render the robot datasets."""
+    """Stage 01: render the robot datasets of the main world and, if given, of the validation world."""
 
     seed: Seed
     images_per_stop: int = Field(ge=1, le=100)
@@ -216,6 +233,7 @@ class GenerateParams(Section):
     bone_foam: BoneFoamParams
     scenes: list[SceneSpec] = Field(min_length=1)
     textures: dict[str, ProjectPath] = Field(description="texture name -> image file replacing the procedural texture")
+    validation: ValidationWorld | None = Field(description="the second world; null: the main world only")
 
     @field_validator("textures")
     @classmethod
@@ -255,6 +273,40 @@ class GenerateParams(Section):
         repeated = sorted({i for i in ids if ids.count(i) > 1})
         if repeated:
             raise KeyRule("scenes", f"scene names give datasets of the same id: {', '.join(repeated)}")
+
+    @model_validator(mode="after")
+    def _validation_world(self, info: ValidationInfo) -> "GenerateParams":
+        """The validation world must itself be valid (scene names, the lines' scene, stops), and name datasets the
+        main world does not."""
+        if self.validation is None:
+            return self
+        try:
+            other = self.world("validation", info.context)
+        except ValidationError as error:
+            item = error.errors()[0]
+            rule = item.get("ctx", {}).get("error")
+            key = ".".join(map(str, (*item["loc"], *(rule.key.split(".") if isinstance(rule, KeyRule) else ()))))
+            raise KeyRule(f"validation.{key}", str(rule) if rule is not None else item["msg"]) from None
+        shared = sorted(set(self.dataset_ids()) & set(other.dataset_ids()))
+        if shared:
+            raise KeyRule("validation.scenes", f"the validation world names datasets the main world has too: "
+                                               f"{', '.join(shared[:4])}; give its scenes other names")
+        return self
+
+    def world(self, name: str, context: dict | None = None) -> "GenerateParams":
+        """The params of one world (:data:`WORLDS`), without a validation world of its own: "main" is these params,
+        "validation" these with ``validation``'s keys in place of the main world's."""
+        if name not in WORLDS or (name == "validation" and self.validation is None):
+            available = [w for w in WORLDS if w == "main" or self.validation is not None]
+            raise ValueError(f"unknown world {name!r}; these params have {available}")
+        if name == "main":
+            return self.model_copy(update={"validation": None})
+        fields = self.model_dump() | self.validation.model_dump() | {"validation": None}
+        return GenerateParams.model_validate(fields, context=context)
+
+    def worlds(self) -> dict[str, "GenerateParams"]:
+        """Every world's params, the main world first."""
+        return {name: self.world(name) for name in WORLDS if name == "main" or self.validation is not None}
 
     def dataset_ids(self) -> list[str]:
         """Every dataset, in the order of :func:`~.dataset.plan_datasets`: each scene's arcs, then the lines."""
