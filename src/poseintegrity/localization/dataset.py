@@ -97,6 +97,7 @@ class Meta(_Read):
     """``meta.json`` of one dataset: what stages 02 and 05 read from it."""
 
     dataset: str = Field(min_length=1)
+    world: str = Field(min_length=1, description="the world the dataset belongs to (main, validation, ...)")
     trajectory: Literal["arc", "line"]
     image_size: tuple[int, int] = Field(description="width, height in px of every image of the dataset")
     K: tuple[tuple[float, float, float], tuple[float, float, float], tuple[float, float, float]]

@@ -40,7 +40,7 @@ from poseintegrity.poses import NAN_POSE, pose_errors
 from poseintegrity.localization.target_model import TargetModel, build_target_model
 from poseintegrity.parallel import Workers
 
-FRAME_COLUMNS = ["dataset", "trajectory", "stop", "image", "theta_deg", "x_mm"]
+FRAME_COLUMNS = ["world", "dataset", "trajectory", "stop", "image", "theta_deg", "x_mm"]
 DATA_FLAGS = ("bad_image", "bad_pose")  # statuses of rows whose frame (not its localization) is at fault
 
 
@@ -212,7 +212,8 @@ def extract_datasets(
             dataset.image_size, tuple(methods), params,
         )
         for dataset, cache_dir, model in zip(datasets, cache_dirs, models)
-        for frame in dataset.frames.assign(trajectory=dataset.meta["trajectory"]).to_dict("records")
+        for frame in dataset.frames.assign(world=dataset.meta["world"], trajectory=dataset.meta["trajectory"])
+            .to_dict("records")
     ]
     results = workers.map(frame_rows, tasks, desc=f"frames of {len(datasets)} dataset(s)", progress=progress)
     return pd.DataFrame([row for rows in results for row in rows])
