@@ -1,5 +1,5 @@
 """The robot carrying the camera: UR5e kinematics against independent references, its error model's invariants,
-placement, and the ``generate.robot`` params' refusals."""
+placement, the ring-down, and the ``generate.robot`` params' refusals."""
 
 import math
 
@@ -10,7 +10,7 @@ from scipy.spatial.transform import Rotation
 from params_cases import refusal, with_value
 from poseintegrity.config import ParamsError, load_params, parse_params
 from poseintegrity.poses import pose_errors
-from poseintegrity.scenes import kinematics, robot, trajectories
+from poseintegrity.scenes import kinematics, ringdown, robot, trajectories
 from poseintegrity.scenes.kinematics import UR5E
 from poseintegrity.seeding import keyed_rng
 from repository import ROOT
@@ -213,6 +213,34 @@ def test_a_camera_under_the_table_is_unreachable(placed):
     assert T_world_cam[2, 3] < 0
     with pytest.raises(robot.ReachError, match="above the table"):
         placed.joints(T_world_cam)
+
+
+# --- ring-down ---
+
+def test_ring_down_decays_by_its_logarithmic_decrement():
+    vibration = ringdown.ring_down(ROBOT.ring_down, keyed_rng(4, "ring"))
+    period = 2 * np.pi / vibration.omega_d
+    t = np.linspace(0.0, 1.0, 200_001)
+    angle = vibration.angle(t)
+    peaks = t[1:-1][(angle[1:-1] > angle[:-2]) & (angle[1:-1] > angle[2:])]
+    assert np.diff(peaks) == pytest.approx(period, rel=1e-3)
+    zeta = ROBOT.ring_down.damping_ratio
+    ratio = vibration.angle(peaks[1:]) / vibration.angle(peaks[:-1])
+    np.testing.assert_allclose(ratio, np.exp(-2 * np.pi * zeta / np.sqrt(1 - zeta**2)), rtol=1e-4)
+    assert np.abs(angle).max() <= np.radians(ROBOT.ring_down.amplitude_deg) + 1e-15
+
+
+def test_ring_down_rate_is_the_derivative_and_the_exposure_samples_it():
+    vibration = ringdown.ring_down(ROBOT.ring_down, keyed_rng(5, "ring"))
+    t, h = np.array([0.05, 0.1, 0.2]), 1e-7
+    np.testing.assert_allclose(vibration.angular_rate(t), (vibration.angle(t + h) - vibration.angle(t - h)) / (2 * h),
+                               rtol=1e-5)
+    exposure = vibration.exposure(0.1, 0.11, 5)
+    np.testing.assert_allclose(exposure.mid, vibration.rotation(0.105))
+    np.testing.assert_allclose(exposure.path[[0, -1]], vibration.rotation(np.array([0.1, 0.11])))
+    np.testing.assert_allclose(np.linalg.norm(exposure.path, axis=1), np.abs(vibration.angle(exposure.times_s)))
+    with pytest.raises(ValueError, match="t0_s"):
+        vibration.exposure(0.2, 0.1, 5)
 
 
 # --- params ---
