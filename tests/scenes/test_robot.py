@@ -117,6 +117,19 @@ def test_rotation_vector_is_scipys_at_every_angle():
                                        rtol=1e-9, atol=1e-15 if angle < 1 else 1e-7)
 
 
+def test_a_pose_has_eight_ik_solutions_one_per_branch():
+    """A UR arm reaches a generic pose in 8 ways (shoulder, elbow, wrist each either way): the seeds of the first
+    solution find them all, each on its own branch."""
+    T = kinematics.forward(UR5E, np.radians([20.0, -100.0, 95.0, -60.0, 80.0, 30.0]))
+    solutions = []
+    for seed in robot._seeds(T[:3, 3]):
+        q = kinematics.inverse(UR5E, T, seed)
+        if q is not None and not any(np.allclose(q, other, atol=1e-6) for other in solutions):
+            solutions.append(q)
+    assert len(solutions) == 8
+    assert len({kinematics.branch(UR5E, q) for q in solutions}) == 8
+
+
 def test_inverse_of_a_pose_out_of_reach_is_none():
     far = np.eye(4)
     far[:3, 3] = [2000.0, 0.0, 300.0]

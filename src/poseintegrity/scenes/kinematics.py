@@ -86,6 +86,14 @@ def jacobian(dh: DH, q: np.ndarray) -> np.ndarray:
     return np.vstack([np.cross(z, frames[-1, :3, 3] - o).T, z.T])
 
 
+def branch(dh: DH, q: np.ndarray) -> tuple[int, int, int]:
+    """Which of a UR arm's 8 IK branches q (6,) is on: the signs of the three factors of its Jacobian's
+    determinant (:func:`manipulability`): shoulder (the wrist's reach from joint 1's axis), elbow (sin q3), wrist
+    (sin q5). A continuous motion changes branch only through a singularity, where a factor vanishes."""
+    reach = dh.a[1] * np.cos(q[1]) + dh.a[2] * np.cos(q[1] + q[2]) + dh.d[4] * np.sin(q[1] + q[2] + q[3])
+    return int(np.sign(reach)), int(np.sign(np.sin(q[2]))), int(np.sign(np.sin(q[4])))
+
+
 def manipulability(dh: DH, q: np.ndarray) -> float:
     """|det J| / (|a2| |a3| (|a2| + |a3|)): Yoshikawa's manipulability of the square Jacobian, scaled to ~[0, 1].
     For a UR arm det J = a2 a3 sin(q3) sin(q5) (a2 cos q2 + a3 cos(q2 + q3) + d5 sin(q2 + q3 + q4)), the last

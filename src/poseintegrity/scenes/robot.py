@@ -27,9 +27,6 @@ from poseintegrity.scenes.trajectories import Stop
 if TYPE_CHECKING:
     from poseintegrity.scenes.params import PlacementParams, RobotParams
 
-MAX_JOINT_STEP_RAD = np.radians(30.0)  # between consecutive poses of a path (stops 2.25 deg / 10 mm apart move a
-# joint by a few deg away from singularities): a larger step is a jump to another IK branch, which a real arm's
-# linear moves never make
 ISO_9283_CYCLES = 30  # visits per pose of the ISO 9283 repeatability test
 
 
@@ -166,10 +163,9 @@ class PlacedRobot:
         q = kinematics.inverse(self.robot.nominal, self._flange_target(T_world_cam), q_seed)
         if q is None:
             raise ReachError(f"no IK solution {where} from the previous pose")
-        step = np.max(np.abs(kinematics.wrap(q - q_seed)))
-        if step > MAX_JOINT_STEP_RAD:
-            raise ReachError(f"the IK solution {where} is {np.degrees(step):.0f} deg from the previous pose's "
-                             f"(another branch)")
+        if kinematics.branch(self.robot.nominal, q) != kinematics.branch(self.robot.nominal, q_seed):
+            raise ReachError(f"the IK solution {where} is on another branch than the previous pose's: the arm "
+                             f"would pass a singularity between them")
         reason = self._check(q)
         if reason is not None:
             raise ReachError(f"{where}: {reason}")
