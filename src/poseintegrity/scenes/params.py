@@ -368,6 +368,29 @@ class GenerateParams(Section):
             raise KeyRule("scenes", f"scene names give datasets of the same id: {', '.join(repeated)}")
 
     @model_validator(mode="after")
+    def _robot_error_below_stop_spacing(self, info: ValidationInfo) -> "GenerateParams":
+        """The robot's expected pose error (:meth:`RobotParams.error_budget`, RMS) must stay below the spacing of
+        the stops (IV-D: 2.25 deg along the arcs, 10 mm along the lines), or a stop's recorded theta or x would be
+        the robot's error rather than the protocol's step. Names the key that adds the most."""
+        protocol = (info.context or {}).get("protocol")
+        if protocol is None:
+            return self
+        orientation, position = self.robot.error_budget()
+        checks = [(orientation, "orientation", "deg", protocol.arc_span_deg / self.arcs.n_stops,
+                   "protocol.arc_span_deg / arcs.n_stops")]
+        if self.lines is not None:
+            checks.append((position, "position", "mm", protocol.line_length_mm / self.lines.n_stops,
+                           "protocol.line_length_mm / lines.n_stops"))
+        for budget, kind, unit, spacing, spacing_keys in checks:
+            rms = math.sqrt(sum(budget.values()))
+            if rms >= spacing:
+                largest = max(budget, key=budget.get)
+                raise KeyRule(f"robot.{largest}", f"the robot's expected {kind} error of a stop, {rms:.3g} {unit} "
+                                                  f"(first order, mostly from this key), is not below the stops' "
+                                                  f"spacing {spacing:.3g} {unit} ({spacing_keys})")
+        return self
+
+    @model_validator(mode="after")
     def _validation_world(self, info: ValidationInfo) -> "GenerateParams":
         """The validation world must itself be valid (scene names, the lines' scene, stops), and name datasets the
         main world does not."""
@@ -405,26 +428,3 @@ class GenerateParams(Section):
         """Every dataset, in the order of :func:`~.dataset.plan_datasets`: each scene's arcs, then the lines."""
         return ([i for spec in self.scenes for i in self.arcs.dataset_ids(spec.name)]
                 + ([] if self.lines is None else self.lines.dataset_ids()))
-
-    @model_validator(mode="after")
-    def _robot_error_below_stop_spacing(self, info: ValidationInfo) -> "GenerateParams":
-        """The robot's expected pose error (:meth:`RobotParams.error_budget`, RMS) must stay below the spacing of
-        the stops (IV-D: 2.25 deg along the arcs, 10 mm along the lines), or a stop's recorded theta or x would be
-        the robot's error rather than the protocol's step. Names the key that adds the most."""
-        protocol = (info.context or {}).get("protocol")
-        if protocol is None:
-            return self
-        orientation, position = self.robot.error_budget()
-        checks = [(orientation, "orientation", "deg", protocol.arc_span_deg / self.arcs.n_stops,
-                   "protocol.arc_span_deg / arcs.n_stops")]
-        if self.lines is not None:
-            checks.append((position, "position", "mm", protocol.line_length_mm / self.lines.n_stops,
-                           "protocol.line_length_mm / lines.n_stops"))
-        for budget, kind, unit, spacing, spacing_keys in checks:
-            rms = math.sqrt(sum(budget.values()))
-            if rms >= spacing:
-                largest = max(budget, key=budget.get)
-                raise KeyRule(f"robot.{largest}", f"the robot's expected {kind} error of a stop, {rms:.3g} {unit} "
-                                                  f"(first order, mostly from this key), is not below the stops' "
-                                                  f"spacing {spacing:.3g} {unit} ({spacing_keys})")
-        return self
