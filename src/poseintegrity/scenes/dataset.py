@@ -1,22 +1,33 @@
-"""Stage 01: write the robot datasets of Windsor et al. IV-D to disk.
+"""Stage 01: write the robot datasets of Windsor et al. IV-D to disk, for every world of ``generate``.
 
-Layout of ``<root>/<dataset>/``: ``meta.json`` (scene, targets, trajectory, intrinsics, board, model pair),
-``frames.parquet`` (one row per image: stop, image, theta_deg, x_mm, file, T_cam_board, T_cam_target as
-row-major 16-float lists), ``model/`` (the two model images and their target masks) and ``images/``.
-A dataset is written into a hidden temporary folder and renamed when complete, so an interrupted run leaves
-nothing that looks finished; ``<root>/index.parquet`` is written last.
+Layout of ``<root>/<dataset>/``: ``meta.json`` (world, scene, targets, trajectory, board, model pair),
+``camera.yaml`` (the camera as the world's calibration estimated it: the pipeline's only intrinsics),
+``frames.parquet`` (one row per image: stop, image, theta_deg and x_mm as the robot recorded them, file, and the
+exact T_cam_board / T_cam_target of the image as row-major 16-float lists, a diagnostic), ``model/`` (the two model
+images and their target masks) and ``images/``. A dataset is written into a hidden temporary folder and renamed when
+complete, so an interrupted run leaves nothing that looks finished; ``<root>/index.parquet`` is written last.
 
-The work is split into :class:`Shot` tasks, one per distinct camera pose of a scene, run by
-:class:`poseintegrity.parallel.Workers`: a shot renders its pose once and writes every image taken there. Poses
-that several datasets share are rendered once: a scene's model pair serves all its arcs (and the lines theirs),
-and an arc's first stop is its model view (IV-D: the robot returns to it). Every image draws its noise from its
-own generator, keyed by ``generate.seed`` and what the image is, so the files do not depend on the backend, the
-worker count or the order the shots run in.
+How an image comes about:
+
+1. The robot (:mod:`.robot`) is commanded to the protocol's poses (:mod:`.trajectories`) and lands slightly off them:
+   each visit of a pose has its own actual pose. The model pair is visited once per scene and trajectory kind and
+   serves all its datasets; the robot returns to the first model view to start each arc (a new visit).
+2. Once the robot reports a stop, the camera takes a burst of ``images_per_stop`` exposures (``capture``) while
+   the arm rings down (:mod:`.ringdown`): each image sees the stop's view turned by a small rotation, and blurred
+   along its path during the exposure.
+3. The view is rendered once per visit on the lens' ideal canvas (:mod:`.renderer`), blurred by the lens and the
+   depth of field (:mod:`.optics`), warped per image by its ring-down rotation and distorted by the lens onto the
+   sensor, then exposed (sensor noise).
+
+The work is split into :class:`Shot` tasks, one per visit, run by :class:`poseintegrity.parallel.Workers`. Every
+random draw comes from a generator keyed by the world's seed and what it is for, so the files do not depend on the
+backend, the worker count or the order the shots run in.
 """
 
 from __future__ import annotations
 
 import json
+import math
 import shutil
 from collections import OrderedDict
 from dataclasses import dataclass
@@ -26,15 +37,20 @@ from pathlib import Path
 import cv2
 import numpy as np
 import pandas as pd
+from scipy.spatial.transform import Rotation
 
 from poseintegrity.parallel import Workers
+from poseintegrity.poses import inverse, pose_matrix
 from poseintegrity.protocol import ProtocolParams
-from poseintegrity.scenes import catalog, renderer, trajectories
-from poseintegrity.poses import inverse
-from poseintegrity.scenes.camera import Intrinsics, defocus_sigma_px
+from poseintegrity.scenes import catalog, optics, renderer, trajectories
+from poseintegrity.scenes.camera import Intrinsics
 from poseintegrity.scenes.foam import ReliefVolume
-from poseintegrity.scenes.params import BoneFoamParams, GenerateParams
+from poseintegrity.scenes.params import BoneFoamParams, CaptureParams, GenerateParams
+from poseintegrity.scenes.ringdown import Exposure as RingExposure
+from poseintegrity.scenes.ringdown import RingDown, ring_down
+from poseintegrity.scenes.robot import PlacedRobot, Robot, accuracy, trip_path
 from poseintegrity.scenes.textures import build_atlas
+from poseintegrity.seeding import keyed_rng
 
 # Camera images are noisy: deflate's string matching finds almost nothing in them, so they are Huffman-coded only,
 # after PNG's "average" filter (the prediction residuals are what is compressible): ~3 x faster to encode and ~12 %
@@ -50,6 +66,7 @@ MIN_TARGET_AREA = 0.005  # share of the image its projected bounding box must co
 class DatasetPlan:
     """One dataset to render: ``trajectory`` is "arc" (``azimuth_deg``) or "line" (``offset_deg``)."""
 
+    world: str
     dataset: str
     scene_index: int
     trajectory: str
@@ -57,22 +74,22 @@ class DatasetPlan:
     offset_deg: float
 
 
-def plan_datasets(params: GenerateParams) -> list[DatasetPlan]:
-    """Arcs: every scene x every azimuth; lines: every offset on ``lines.scene`` (IV-D). The ids are
-    :meth:`GenerateParams.dataset_ids` (validated distinct)."""
-    plans = [DatasetPlan(dataset, i, "arc", az, 0.0) for i, spec in enumerate(params.scenes)
+def plan_datasets(params: GenerateParams, world: str = "main") -> list[DatasetPlan]:
+    """Arcs: every scene x every azimuth; lines: every offset on ``lines.scene`` (IV-D), of one world's params.
+    The ids are :meth:`GenerateParams.dataset_ids` (validated distinct)."""
+    plans = [DatasetPlan(world, dataset, i, "arc", az, 0.0) for i, spec in enumerate(params.scenes)
              for dataset, az in zip(params.arcs.dataset_ids(spec.name), params.arcs.azimuths_deg)]
     if params.lines is not None:
         i = [s.name for s in params.scenes].index(params.lines.scene)
-        plans += [DatasetPlan(dataset, i, "line", 0.0, off)
+        plans += [DatasetPlan(world, dataset, i, "line", 0.0, off)
                   for dataset, off in zip(params.lines.dataset_ids(), params.lines.offsets_deg)]
     return plans
 
 
 @dataclass(frozen=True)
 class Trip:
-    """Where the camera of one dataset goes: its model pair (T_world_cam, the first is where the trajectory
-    starts) at ``distance_mm`` from the aim point, and the stops of its trajectory."""
+    """Where the camera of one dataset is commanded to go: its model pair (T_world_cam, the first is where the
+    trajectory starts) at ``distance_mm`` from the aim point, and the stops of its trajectory."""
 
     distance_mm: float
     model_views: list[np.ndarray]
@@ -80,7 +97,7 @@ class Trip:
 
 
 def plan_trip(params: GenerateParams, protocol: ProtocolParams, plan: DatasetPlan, scene: catalog.Scene) -> Trip:
-    """The model pair and stops of ``plan`` in ``scene``; the trajectory spans ``protocol``'s range."""
+    """The commanded model pair and stops of ``plan`` in ``scene``; the trajectory spans ``protocol``'s range."""
     # the straight lines have their own model pair (IV-D), closer to the target: the robot backs away from it
     distance_mm = params.scenes[plan.scene_index].distance_mm if plan.trajectory == "arc" else params.lines.distance_mm
     model_views = trajectories.model_pair(scene.aim, scene.view_dir, distance_mm, params.model_baseline_mm)
@@ -94,15 +111,21 @@ def plan_trip(params: GenerateParams, protocol: ProtocolParams, plan: DatasetPla
 
 
 class WorldError(ValueError):
-    """A scene cannot give the datasets: its target would leave (or vanish from) the model view."""
+    """A scene cannot give the datasets: its target would leave (or vanish from) the model view, or the robot
+    cannot reach its poses."""
 
 
-def check_world(params: GenerateParams, protocol: ProtocolParams) -> list[catalog.Scene]:
-    """Lay out every scene and stop before any rendering, naming the key, when one cannot be rendered as the
-    protocol needs; returns the scenes. Every scene is built (an unreadable mesh or a hole outside the bone raises
+def scenes_key(world: str) -> str:
+    """The params key of a world's scenes, as an error names it."""
+    return "generate.scenes" if world == "main" else f"generate.{world}.scenes"
+
+
+def check_world(params: GenerateParams, protocol: ProtocolParams, world: str = "main") -> list[catalog.Scene]:
+    """Lay out every scene before any rendering, naming the key, when one cannot be rendered as the protocol
+    needs; returns the scenes. Every scene is built (an unreadable mesh or a hole outside the bone raises
     :class:`~.scapula.MeshError` here); each target must lie mostly inside both model views of its arcs and, for
     the lines' scene, of the lines' model pair (a mesh scaled far too large or too small, or a distance that puts
-    the target out of the picture)."""
+    the target out of the picture). The robot's reach is checked by :func:`drive`."""
     cam = Intrinsics.from_params(params.camera)
     scenes = [catalog.build_scene(spec, index, params) for index, spec in enumerate(params.scenes)]
     for index, scene in enumerate(scenes):
@@ -114,27 +137,79 @@ def check_world(params: GenerateParams, protocol: ProtocolParams) -> list[catalo
                 T_cam_world = inverse(T_world_cam)
                 for name, mesh in scene.placed:
                     if name in scene.target_objects:
-                        _check_in_view(mesh.vertices @ T_cam_world[:3, :3].T + T_cam_world[:3, 3], cam, index, name,
-                                       distance)
+                        _check_in_view(mesh.vertices @ T_cam_world[:3, :3].T + T_cam_world[:3, 3], cam,
+                                       f"{scenes_key(world)}.{index}", name, distance)
     return scenes
 
 
-def _check_in_view(points_cam: np.ndarray, cam: Intrinsics, index: int, name: str, distance: float) -> None:
+def _check_in_view(points_cam: np.ndarray, cam: Intrinsics, key: str, name: str, distance: float) -> None:
     """WorldError unless most of points_cam (n, 3, mm) project inside the image and their extent is not a speck."""
     z = points_cam[:, 2]
     safe = np.where(z > renderer.NEAR_MM, z, np.nan)
     u = cam.K[0, 0] * points_cam[:, 0] / safe + cam.K[0, 2]
     v = cam.K[1, 1] * points_cam[:, 1] / safe + cam.K[1, 2]
     inside = (u >= 0) & (u <= cam.width - 1) & (v >= 0) & (v <= cam.height - 1)
-    hint = (f"check generate.scenes.{index}.distance_mm ({distance:g} mm)"
+    hint = (f"check {key}.distance_mm ({distance:g} mm)"
             + (" and generate.scapula.length_mm" if name.startswith("scapula") else ""))
     if inside.mean() < MIN_TARGET_IN_VIEW:
-        raise WorldError(f"generate.scenes.{index}: only {inside.mean():.0%} of target {name} lies inside the "
+        raise WorldError(f"{key}: only {inside.mean():.0%} of target {name} lies inside the "
                          f"{cam.width} x {cam.height} model image: it leaves the view; {hint}")
     area = np.ptp(u[inside]) * np.ptp(v[inside]) / (cam.width * cam.height)
     if area < MIN_TARGET_AREA:
-        raise WorldError(f"generate.scenes.{index}: target {name} covers {area:.2%} of the model image: too small "
+        raise WorldError(f"{key}: target {name} covers {area:.2%} of the model image: too small "
                          f"to be seen; {hint}")
+
+
+@dataclass(frozen=True)
+class Visit:
+    """The camera at one stop of the robot (or one model view): its actual T_world_cam (4, 4) when the controller
+    reported the stop, and how the arm rings down from there."""
+
+    T_world_cam: np.ndarray
+    ring_down: RingDown
+
+
+@dataclass(frozen=True)
+class Route:
+    """Where the camera of one dataset really was: the visits of its model pair and of its stops."""
+
+    model: tuple[Visit, ...]
+    stops: tuple[Visit, ...]
+
+
+def _visits(placed: PlacedRobot, path: list[np.ndarray], params: GenerateParams, *key) -> tuple[Visit, ...]:
+    """One visit to each commanded pose of ``path`` in order, its repeatability and ring-downs drawn by ``key``."""
+    actual = placed.moves(path, keyed_rng(params.seed, "visit", *key))
+    return tuple(Visit(T, ring_down(params.robot.ring_down, keyed_rng(params.seed, "ring", *key, k)))
+                 for k, T in enumerate(actual))
+
+
+def drive(params: GenerateParams, plans: list[DatasetPlan], trips: list[Trip], scenes: list[catalog.Scene],
+          world: str = "main") -> tuple[list[Route], dict[str, dict[str, float]]]:
+    """The world's robot (drawn from its seed) placed in each scene where it reaches every commanded pose, then
+    driven: the routes of ``plans`` (same order) and, per scene, how far it lands from what was commanded
+    (:func:`.robot.accuracy`). A scene the robot cannot serve raises :class:`WorldError` naming it."""
+    robot = Robot.from_params(params.robot, keyed_rng(params.seed, "robot"))
+    routes: dict[str, Route] = {}
+    summary = {}
+    for scene_index, scene in enumerate(scenes):
+        mine = [(plan, trip) for plan, trip in zip(plans, trips) if plan.scene_index == scene_index]
+        if not mine:
+            continue
+        try:
+            placed = robot.placed([trip_path(trip) for _, trip in mine], scene.aim, scene.name)
+        except ValueError as error:
+            raise WorldError(f"{scenes_key(world)}.{scene_index}: {error}") from None
+        first_trip = {plan.trajectory: trip for plan, trip in reversed(mine)}  # arcs share one model pair, lines one
+        model = {kind: _visits(placed, trip.model_views, params, "model", scene_index, kind)
+                 for kind, trip in first_trip.items()}
+        for plan, trip in mine:
+            stops = _visits(placed, trip_path(trip), params, plan.dataset)[len(trip.model_views):]
+            routes[plan.dataset] = Route(model[plan.trajectory], stops)
+        summary[scene.name] = accuracy(placed, [t for p, t in mine if p.trajectory == "arc"],
+                                       [t for p, t in mine if p.trajectory == "line"],
+                                       keyed_rng(params.seed, "accuracy", scene_index))
+    return [routes[plan.dataset] for plan in plans], summary
 
 
 @dataclass(frozen=True)
@@ -161,9 +236,9 @@ def world(params: GenerateParams, scene_index: int) -> World:
     return _WORLDS[key]
 
 
-@lru_cache(maxsize=1)
+@lru_cache(maxsize=2)
 def _relief(bone_foam: BoneFoamParams, seed: int) -> ReliefVolume:
-    """The foam's relief: one material, the same in every scene, drawn once per process."""
+    """The foam's relief: one material, the same in every scene of a world, drawn once per process."""
     return bone_foam.relief(seed)
 
 
@@ -176,22 +251,47 @@ def _build_world(params: GenerateParams, scene_index: int) -> World:
     return World(scene, geometry, target_ids)
 
 
+def exposure_times(capture: CaptureParams, image: int) -> tuple[float, float]:
+    """(start, end) of image ``image``'s exposure, s after the robot reported its stop."""
+    start = (capture.delay_ms + image * capture.interval_ms) / 1000.0
+    return start, start + capture.exposure_ms / 1000.0
+
+
+def image_motion(visit: Visit, capture: CaptureParams, image: int, f_px: float) -> RingExposure:
+    """The ring-down during image ``image``'s exposure: its rotation at mid-exposure and a path sampled so that
+    consecutive samples move the image by at most ``capture.blur_step_px`` (f_px |delta r| bounds the motion of a
+    pixel under a small rotation r); one sample, the mid-exposure rotation, when it moves less."""
+    t0, t1 = exposure_times(capture, image)
+    ends = visit.ring_down.rotation(np.array([t0, t1]))
+    extent_px = f_px * float(np.linalg.norm(ends[1] - ends[0]))
+    if extent_px <= capture.blur_step_px:
+        mid = visit.ring_down.rotation(0.5 * (t0 + t1))
+        return RingExposure(mid, mid[None], np.array([0.5 * (t0 + t1)]))
+    return visit.ring_down.exposure(t0, t1, math.ceil(extent_px / capture.blur_step_px) + 1)
+
+
+def image_pose(visit: Visit, motion: RingExposure) -> np.ndarray:
+    """Actual T_world_cam (4, 4) of an image: the visit's pose turned by its mid-exposure rotation (camera frame)."""
+    return visit.T_world_cam @ pose_matrix(Rotation.from_rotvec(motion.mid).as_matrix(), np.zeros(3))
+
+
 @dataclass(frozen=True)
 class Exposure:
-    """Images taken at a shot: image i is drawn from ``default_rng([generate.seed, *rng_key, i])`` and written
-    as ``files[i]`` into the folder of every dataset in ``datasets`` (several when they share these images byte
-    for byte: a scene's model pair); ``mask``: the file of the target mask, written beside them."""
+    """An image taken at a shot: its noise drawn from ``keyed_rng(generate.seed, "image", *rng_key)`` after turning the view by the
+    ring-down path ``rotations`` (k, 3), written as ``file`` into the folder of every dataset in ``datasets``;
+    ``mask``: the file of the target mask, written beside it (model images)."""
 
     datasets: tuple[str, ...]
-    files: tuple[str, ...]
-    rng_key: tuple[int, ...]
+    file: str
+    rng_key: tuple
+    rotations: np.ndarray
     mask: str | None = None
 
 
 @dataclass(frozen=True)
 class Shot:
-    """One camera pose (T_world_cam) of scene ``scene_index``, the lens focused at ``focus_mm``: rendered once,
-    then exposed for every image taken there."""
+    """One visit of the camera (T_world_cam at the reported stop) in scene ``scene_index``, the lens focused at
+    ``focus_mm``: rendered once, then exposed for every image taken there."""
 
     scene_index: int
     T_world_cam: np.ndarray
@@ -199,29 +299,30 @@ class Shot:
     exposures: tuple[Exposure, ...]
 
 
-def plan_shots(params: GenerateParams, plans: list[DatasetPlan], trips: list[Trip]) -> list[Shot]:
-    """Every image of every dataset, grouped by the pose it is taken from (bit-identical poses of one scene and
-    focus share one render), the shots of a scene together (a worker then builds each scene once)."""
-    exposures: dict[tuple, dict[tuple, list[str]]] = {}  # shot key -> (files, rng_key, mask) -> datasets
-    poses: dict[tuple, np.ndarray] = {}
-
-    def add(plan: DatasetPlan, T_world_cam: np.ndarray, focus_mm: float, files: tuple[str, ...],
-            rng_key: tuple[int, ...], mask: str | None = None) -> None:
-        key = (plan.scene_index, T_world_cam.tobytes(), focus_mm)
-        poses.setdefault(key, T_world_cam)
-        exposures.setdefault(key, {}).setdefault((files, rng_key, mask), []).append(plan.dataset)
-
-    for dataset_index, (plan, trip) in enumerate(zip(plans, trips)):
-        for k, T_world_cam in enumerate(trip.model_views):
-            # model images depend on the scene and trajectory kind only: datasets sharing them share them byte for byte
-            add(plan, T_world_cam, trip.distance_mm, (f"model/model_{k}.png",),
-                (plan.scene_index, 1000 + k + 10 * (plan.trajectory == "line")), f"model/mask_{k}.png")
-        for s, stop in enumerate(trip.stops):
-            add(plan, stop.T_world_cam, trip.distance_mm, _image_files(s, params.images_per_stop), (dataset_index, s))
-    shots = [Shot(key[0], poses[key], key[2], tuple(Exposure(tuple(datasets), *what)
-                                                    for what, datasets in taken.items()))
-             for key, taken in exposures.items()]
-    return sorted(shots, key=lambda shot: shot.scene_index)  # stable: the datasets' order within a scene
+def plan_shots(params: GenerateParams, plans: list[DatasetPlan], trips: list[Trip], routes: list[Route]) -> list[Shot]:
+    """Every image of every dataset, one shot per visit (a scene's model pair once for all datasets sharing it), the
+    shots of a scene together (a worker then builds each scene once)."""
+    f_px = Intrinsics.from_params(params.camera).K[0, 0]
+    shots: dict[tuple, Shot] = {}
+    for plan, trip, route in zip(plans, trips, routes):
+        for k, visit in enumerate(route.model):
+            key = (plan.scene_index, "model", plan.trajectory, k)
+            if key in shots:  # the scene's other datasets of this kind share the images
+                shot = shots[key]
+                shots[key] = Shot(shot.scene_index, shot.T_world_cam, shot.focus_mm,
+                                  tuple(Exposure((*e.datasets, plan.dataset), e.file, e.rng_key, e.rotations, e.mask)
+                                        for e in shot.exposures))
+                continue
+            motion = image_motion(visit, params.capture, 0, f_px)
+            shots[key] = Shot(plan.scene_index, visit.T_world_cam, trip.distance_mm, (Exposure(
+                (plan.dataset,), f"model/model_{k}.png", ("model", plan.scene_index, plan.trajectory, k),
+                motion.path, f"model/mask_{k}.png"),))
+        for s, visit in enumerate(route.stops):
+            exposures = tuple(Exposure((plan.dataset,), file, (plan.dataset, s, i),
+                                       image_motion(visit, params.capture, i, f_px).path)
+                              for i, file in enumerate(_image_files(s, params.images_per_stop)))
+            shots[(plan.dataset, s)] = Shot(plan.scene_index, visit.T_world_cam, trip.distance_mm, exposures)
+    return sorted(shots.values(), key=lambda shot: shot.scene_index)  # stable: the datasets' order within a scene
 
 
 def _image_files(stop: int, images_per_stop: int) -> tuple[str, ...]:
@@ -233,21 +334,41 @@ def _partial(root: Path, dataset: str) -> Path:
     return root / f".{dataset}.partial"
 
 
+def _rotation_warp(K: np.ndarray, rotation: np.ndarray, map_x: np.ndarray, map_y: np.ndarray
+                   ) -> tuple[np.ndarray, np.ndarray]:
+    """Sampling maps of the view turned by ``rotation`` (3,) rad (camera frame): the canvas pixel p' an output
+    pixel sees through (map_x, map_y) is where the unturned camera saw that ray, p = K R K^-1 p' (pure rotation)."""
+    H = K @ Rotation.from_rotvec(rotation).as_matrix() @ np.linalg.inv(K)
+    w = H[2, 0] * map_x + H[2, 1] * map_y + H[2, 2]
+    return ((H[0, 0] * map_x + H[0, 1] * map_y + H[0, 2]) / w).astype(np.float32), (
+        (H[1, 0] * map_x + H[1, 1] * map_y + H[1, 2]) / w).astype(np.float32)
+
+
+@lru_cache(maxsize=1)
+def _identity_maps(width: int, height: int) -> tuple[np.ndarray, np.ndarray]:
+    x, y = np.meshgrid(np.arange(width, dtype=np.float32), np.arange(height, dtype=np.float32))
+    return x, y
+
+
 def take_shot(params: GenerateParams, root: Path, shot: Shot) -> None:
     """Render ``shot`` and write its images (and masks) into the datasets' partial folders under ``root``."""
     scene_world = world(params, shot.scene_index)
     cam = Intrinsics.from_params(params.camera)
-    T_cam_world = inverse(shot.T_world_cam)
-    frame = renderer.render(scene_world.geometry, cam.K, cam.width, cam.height, T_cam_world)
-    depth_mm = (T_cam_world[:3, :3] @ scene_world.scene.aim + T_cam_world[:3, 3])[2]
-    defocus = defocus_sigma_px(depth_mm, shot.focus_mm, params.camera)  # focused at the model view
-    irradiance = renderer.optics(frame.radiance, params.sensor, defocus)  # the robot is still: one image
+    frame = renderer.render(scene_world.geometry, cam.K, cam.width, cam.height, inverse(shot.T_world_cam))
+    irradiance = optics.lens(frame.radiance, frame.depth_mm, shot.focus_mm, params.sensor.blur_sigma_px, params.camera)
+    map_x, map_y = _identity_maps(cam.width, cam.height)
     for exposure in shot.exposures:
-        for i, file in enumerate(exposure.files):
-            image = renderer.expose(irradiance, params.sensor, np.random.default_rng([params.seed, *exposure.rng_key, i]))
-            _write_png(root, exposure.datasets, file, image, IMAGE_PNG_FLAGS)
+        sensor = np.zeros_like(irradiance)
+        for rotation in exposure.rotations:  # the exposure integrates the view along the ring-down's path
+            sensor += cv2.remap(irradiance, *_rotation_warp(cam.K, rotation, map_x, map_y), cv2.INTER_LINEAR,
+                                borderMode=cv2.BORDER_REPLICATE)
+        sensor /= len(exposure.rotations)
+        image = renderer.expose(sensor, params.sensor, keyed_rng(params.seed, "image", *exposure.rng_key))
+        _write_png(root, exposure.datasets, exposure.file, image, IMAGE_PNG_FLAGS)
         if exposure.mask is not None:
-            mask = np.isin(frame.object_index, scene_world.target_ids).astype(np.uint8) * 255
+            middle = exposure.rotations[len(exposure.rotations) // 2]
+            target = np.isin(frame.object_index, scene_world.target_ids).astype(np.uint8) * 255
+            mask = cv2.remap(target, *_rotation_warp(cam.K, middle, map_x, map_y), cv2.INTER_NEAREST)
             _write_png(root, exposure.datasets, exposure.mask, mask, MASK_PNG_FLAGS)
 
 
@@ -264,61 +385,88 @@ def _flat(T: np.ndarray) -> list[float]:
     return [float(v) for v in T.ravel()]
 
 
-def finish_dataset(params: GenerateParams, root: Path, plan: DatasetPlan, trip: Trip, scene: catalog.Scene) -> dict:
+def finish_dataset(params: GenerateParams, root: Path, plan: DatasetPlan, trip: Trip, route: Route,
+                   scene: catalog.Scene) -> dict:
     """Once its images are written: the dataset's frames.parquet and meta.json, then its partial folder renamed
     to ``root / plan.dataset``; returns its row of the index."""
     spec = params.scenes[plan.scene_index]
     cam = Intrinsics.from_params(params.camera)
+    f_px = cam.K[0, 0]
     tmp, final = _partial(root, plan.dataset), root / plan.dataset
-    model = {"images": [], "masks": [], "T_cam_board": [], "T_cam_target": []}
-    for k, T_world_cam in enumerate(trip.model_views):
-        T_cam_world = inverse(T_world_cam)
-        model["images"].append(f"model/model_{k}.png")
-        model["masks"].append(f"model/mask_{k}.png")
-        model["T_cam_board"].append((T_cam_world @ scene.T_world_board).tolist())
-        model["T_cam_target"].append((T_cam_world @ scene.T_world_target).tolist())
+    model_poses = [image_pose(visit, image_motion(visit, params.capture, 0, f_px)) for visit in route.model]
+    T_cam1_cam0 = inverse(trip.model_views[1]) @ trip.model_views[0]  # what the robot says it did (III-B)
+    model = {
+        "images": [f"model/model_{k}.png" for k in range(len(route.model))],
+        "masks": [f"model/mask_{k}.png" for k in range(len(route.model))],
+        "T_cam1_cam0": T_cam1_cam0.tolist(),
+        "exact_T_cam_board": [(inverse(T) @ scene.T_world_board).tolist() for T in model_poses],
+    }
     rows = []
-    for s, stop in enumerate(trip.stops):
-        T_cam_world = inverse(stop.T_world_cam)
+    for s, (stop, visit) in enumerate(zip(trip.stops, route.stops)):
         for i, file in enumerate(_image_files(s, params.images_per_stop)):
+            T_cam_world = inverse(image_pose(visit, image_motion(visit, params.capture, i, f_px)))
             rows.append({"dataset": plan.dataset, "stop": s, "image": i, "theta_deg": stop.theta_deg,
                          "x_mm": stop.x_mm, "file": file, "T_cam_board": _flat(T_cam_world @ scene.T_world_board),
                          "T_cam_target": _flat(T_cam_world @ scene.T_world_target)})
     pd.DataFrame(rows).to_parquet(tmp / "frames.parquet", index=False)
     meta = {
-        "dataset": plan.dataset, "scene": spec.name, "targets": list(spec.targets), "trajectory": plan.trajectory,
-        "azimuth_deg": plan.azimuth_deg, "offset_deg": plan.offset_deg, "n_stops": len(trip.stops),
-        "images_per_stop": params.images_per_stop, "image_size": [cam.width, cam.height], "K": cam.K.tolist(),
-        "dist": [0.0] * 5, "board": scene.board.as_dict(), "model": model,
+        "dataset": plan.dataset, "world": plan.world, "scene": spec.name, "targets": list(spec.targets),
+        "trajectory": plan.trajectory, "azimuth_deg": plan.azimuth_deg, "offset_deg": plan.offset_deg,
+        "n_stops": len(trip.stops), "images_per_stop": params.images_per_stop, "image_size": [cam.width, cam.height],
+        "K": cam.K.tolist(), "dist": [0.0] * 5, "board": scene.board.as_dict(), "model": model,
         "model_baseline_mm": params.model_baseline_mm, "distance_mm": trip.distance_mm,
     }
     (tmp / "meta.json").write_text(json.dumps(meta, indent=1))
     shutil.rmtree(final, ignore_errors=True)
     tmp.rename(final)
-    return {"dataset": plan.dataset, "scene": spec.name, "trajectory": plan.trajectory,
+    return {"dataset": plan.dataset, "world": plan.world, "scene": spec.name, "trajectory": plan.trajectory,
             "azimuth_deg": plan.azimuth_deg, "offset_deg": plan.offset_deg, "n_frames": len(rows),
             "path": f"datasets/{plan.dataset}"}
 
 
+@dataclass(frozen=True)
+class WorldPlan:
+    """Everything one world renders: its params, scenes, datasets, their commanded trips and actual routes."""
+
+    name: str
+    params: GenerateParams
+    scenes: list[catalog.Scene]
+    plans: list[DatasetPlan]
+    trips: list[Trip]
+    routes: list[Route]
+    robot_accuracy: dict[str, dict[str, float]]
+
+
+def plan_world(params: GenerateParams, protocol: ProtocolParams, name: str) -> WorldPlan:
+    """Check one world (:func:`check_world`), plan its datasets and drive its robot (:func:`drive`): every error
+    comes here, before any rendering."""
+    scenes = check_world(params, protocol, name)
+    plans = plan_datasets(params, name)
+    trips = [plan_trip(params, protocol, plan, scenes[plan.scene_index]) for plan in plans]
+    routes, robot_accuracy = drive(params, plans, trips, scenes, name)
+    return WorldPlan(name, params, scenes, plans, trips, routes, robot_accuracy)
+
+
 def generate(params: GenerateParams, protocol: ProtocolParams, root: Path, workers: Workers,
-             progress: bool = True) -> pd.DataFrame:
-    """Render every planned dataset under ``root`` after :func:`check_world`, the shots on ``workers``; returns
-    and writes the index."""
-    scenes = check_world(params, protocol)
+             progress: bool = True) -> tuple[pd.DataFrame, dict[str, dict]]:
+    """Render every world's datasets under ``root`` (every world planned and checked first), the shots on
+    ``workers``; returns and writes the index, and returns each world's robot accuracy per scene."""
+    worlds = [plan_world(world_params, protocol, name) for name, world_params in params.worlds().items()]
     root = Path(root)
     root.mkdir(parents=True, exist_ok=True)
     (root / "index.parquet").unlink(missing_ok=True)
-    plans = plan_datasets(params)
-    trips = [plan_trip(params, protocol, plan, scenes[plan.scene_index]) for plan in plans]
-    for plan in plans:
-        tmp = _partial(root, plan.dataset)
-        shutil.rmtree(tmp, ignore_errors=True)
-        (tmp / "model").mkdir(parents=True)
-        (tmp / "images").mkdir()
-    shots = plan_shots(params, plans, trips)
-    workers.map(partial(take_shot, params, root), shots, desc=f"camera poses of {len(plans)} datasets",
-                progress=progress)
-    index = pd.DataFrame([finish_dataset(params, root, plan, trip, scenes[plan.scene_index])
-                          for plan, trip in zip(plans, trips)])
+    rows = []
+    for w in worlds:
+        for plan in w.plans:
+            tmp = _partial(root, plan.dataset)
+            shutil.rmtree(tmp, ignore_errors=True)
+            (tmp / "model").mkdir(parents=True)
+            (tmp / "images").mkdir()
+        shots = plan_shots(w.params, w.plans, w.trips, w.routes)
+        workers.map(partial(take_shot, w.params, root), shots,
+                    desc=f"camera poses of {len(w.plans)} datasets ({w.name} world)", progress=progress)
+        rows += [finish_dataset(w.params, root, plan, trip, route, w.scenes[plan.scene_index])
+                 for plan, trip, route in zip(w.plans, w.trips, w.routes)]
+    index = pd.DataFrame(rows)
     index.to_parquet(root / "index.parquet", index=False)
-    return index
+    return index, {w.name: w.robot_accuracy for w in worlds}

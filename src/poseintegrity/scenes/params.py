@@ -63,6 +63,25 @@ class SensorParams(Section):
                                                      "1 + flicker x N(0, 1) would sometimes be <= 0: a black image)")
 
 
+class CaptureParams(Section):
+    """How the images of a stop are taken once the robot reports it has stopped (IV-D: "stopping every 2.25 deg to
+    capture 10 images"): a burst of exposures while the arm rings down (:mod:`.ringdown`). Ours: the paper gives no
+    timing."""
+
+    delay_ms: float = Field(ge=0, le=5000, description="from the reported stop to the first exposure's start")
+    interval_ms: float = Field(gt=0, le=5000, description="between exposure starts (the frame period of the burst)")
+    exposure_ms: float = Field(gt=0, le=200, description="shutter time; with the ring light a few ms suffice")
+    blur_step_px: float = Field(gt=0, le=5, description="motion blur: sub-exposures no further apart in the image than "
+                                                        "this (1 sub-exposure when the image moves less)")
+
+    @model_validator(mode="after")
+    def _one_at_a_time(self) -> "CaptureParams":
+        if self.exposure_ms > self.interval_ms:
+            raise KeyRule("exposure_ms", f"a camera exposes one frame at a time: must be <= interval_ms "
+                                         f"({self.interval_ms:g}), got {self.exposure_ms:g}")
+        return self
+
+
 class LightParams(Section):
     """The lab's light: a ring light on the camera, a room light fixed to the scene, ambient light (radiances of a
     white surface facing each light); the background is the radiance seen past every object."""
@@ -318,6 +337,7 @@ class GenerateParams(Section):
     model_baseline_mm: float = Field(gt=0, le=100)
     camera: CameraParams
     sensor: SensorParams
+    capture: CaptureParams
     robot: RobotParams
     arcs: ArcParams
     lines: LineParams | None = Field(description="null: no straight-line datasets")
