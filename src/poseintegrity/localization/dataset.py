@@ -79,18 +79,17 @@ class BoardMeta(_Read):
 
 
 class ModelMeta(_Read):
-    """The model pair of III-B / IV-D: two images, their target masks and exact board -> camera poses."""
+    """The model pair of III-B / IV-D: two images, their target masks and the relative camera pose the robot
+    reports between them (camera 0 -> camera 1, mm)."""
 
     images: tuple[str, str]
     masks: tuple[str, str]
-    T_cam_board: tuple[list[list[float]], list[list[float]]]
+    T_cam1_cam0: list[list[float]]
 
-    @field_validator("T_cam_board", mode="before")
+    @field_validator("T_cam1_cam0", mode="before")
     @classmethod
-    def _rigid(cls, poses: Any) -> Any:
-        if isinstance(poses, (list, tuple)) and len(poses) == 2:
-            return [_pose(T, f"the pose of model image {i}") for i, T in enumerate(poses)]
-        return poses
+    def _rigid(cls, pose: Any) -> Any:
+        return _pose(pose, "the model pair's relative pose")
 
 
 class Meta(_Read):
@@ -144,10 +143,9 @@ class Dataset:
         in_folder = self.folder / relative
         return in_folder if in_folder.exists() or not (self.data_dir / relative).exists() else self.data_dir / relative
 
-    def model_T_cam_board(self) -> tuple[np.ndarray, np.ndarray]:
-        """Exact board -> camera poses (4, 4, mm) of the two model images."""
-        first, second = (np.asarray(T, dtype=np.float64).reshape(4, 4) for T in self.meta["model"]["T_cam_board"])
-        return first, second
+    def model_baseline(self) -> np.ndarray:
+        """T_cam1_cam0 (4, 4, mm): camera 0 -> camera 1 of the model pair, as the robot reports it."""
+        return np.asarray(self.meta["model"]["T_cam1_cam0"], dtype=np.float64).reshape(4, 4)
 
     def check_images(self) -> None:
         """:class:`DatasetError` naming the dataset and the file(s) if a model image, mask or frame image is

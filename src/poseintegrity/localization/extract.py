@@ -34,6 +34,7 @@ from poseintegrity.localization.dataset import Dataset, DatasetError, load_datas
 from poseintegrity.localization.evidence import FrameEvidence, frame_evidence, model_digest
 from poseintegrity.localization.features import cached_features, read_gray, write_npz
 from poseintegrity.localization.frame_artifacts import frame_artifacts
+from poseintegrity.localization.ground_truth import board_pose, make_board
 from poseintegrity.localization.params import ExtractParams
 from poseintegrity.localization.pnp import failed, solve_pnp_ransac
 from poseintegrity.poses import NAN_POSE, pose_errors
@@ -125,9 +126,13 @@ def dataset_model(dataset: Dataset, params: ExtractParams, cache_dir: Path) -> T
         cached_features(dataset.path(name), cache_dir / "model" / f"{index}.npz", params.clahe, params.sift, image=image)
         for index, (name, image) in enumerate(zip(model["images"], images))
     )
-    return build_target_model(
-        features, masks, dataset.model_T_cam_board(), dataset.K, params.ratio_test, params.model_max_reprojection_px
-    )
+    anchor = board_pose(images[0], make_board(dataset.meta["board"]), dataset.K)  # IV-C: M_t in the board frame
+    if anchor.status != "ok":
+        raise DatasetError(f"dataset {dataset.name}: the ArUco board is not found in model image "
+                           f"{model['images'][0]} ({anchor.status}), so the target model cannot be placed in the "
+                           f"board frame (IV-C)")
+    return build_target_model(features, masks, dataset.model_baseline(), anchor.T_cam_board, dataset.K,
+                              params.ratio_test, params.model_max_reprojection_px)
 
 
 def store_model(task: ModelTask) -> StoredModel:

@@ -1,10 +1,11 @@
 """Static sparse feature model of the target, M_t (paper III-B).
 
-Two model images taken with a known relative camera pose (IV-D: 20 mm apart along the camera x axis) ->
-CLAHE + SIFT -> ratio-test matches -> ``cv2.triangulatePoints`` -> keep points on the target (the paper trims
-by hand; we keep keypoints inside the renderer's target mask in both images) -> coordinates in the board
-frame, so that the model origin coincides with the ArUco board origin (IV-C) and a PnP pose of the model
-is directly an estimate of T_cam_board.
+Two model images taken with a relative camera pose the robot reports (IV-D: 20 mm apart along the camera x axis;
+the robot really moved slightly otherwise) -> CLAHE + SIFT -> ratio-test matches -> ``cv2.triangulatePoints`` ->
+keep points on the target (the paper trims by hand; we keep keypoints inside the renderer's target mask in both
+images) -> coordinates in the board frame, through the ArUco board's pose in the first model image (IV-C: "the
+origin of the model reference frame was transformed to be coincident with the origin of the ArUco board"), so that
+a PnP pose of the model is directly an estimate of T_cam_board.
 """
 
 from __future__ import annotations
@@ -59,7 +60,8 @@ def _inside(mask: np.ndarray, x: np.ndarray) -> np.ndarray:
 def build_target_model(
     features: tuple[Features, Features],
     masks: tuple[np.ndarray, np.ndarray],
-    T_cam_board: tuple[np.ndarray, np.ndarray],
+    T_cam1_cam0: np.ndarray,
+    T_cam0_board: np.ndarray,
     K: np.ndarray,
     ratio: float,
     max_reprojection_px: float,
@@ -68,7 +70,8 @@ def build_target_model(
 
     features : CLAHE + SIFT features of model image 0 and 1
     masks : (h, w) uint8 target masks of both images (nonzero = target)
-    T_cam_board : (4, 4) board -> camera poses of both model images, mm
+    T_cam1_cam0 : (4, 4) camera 0 -> camera 1, mm: the model baseline as the robot reports it
+    T_cam0_board : (4, 4) board -> camera 0, mm: the ArUco board's pose in model image 0
     A point is kept when it lies in front of both cameras, reprojects within ``max_reprojection_px`` in both
     images and its keypoints lie inside both masks. An empty model (no texture, no overlap) is returned
     as such; every frame then fails with ``too_few_matches``.
@@ -77,7 +80,6 @@ def build_target_model(
     pairs = match_ratio_test(features[0].descriptors, features[1].descriptors, ratio)
     x0 = features[0].points[pairs[:, 0]].astype(np.float64)
     x1 = features[1].points[pairs[:, 1]].astype(np.float64)
-    T_cam1_cam0 = T_cam_board[1] @ np.linalg.inv(T_cam_board[0])
     X_cam0 = triangulate(K, T_cam1_cam0, x0, x1)
     finite = np.all(np.isfinite(X_cam0), axis=1)
     X_cam0 = np.where(finite[:, None], X_cam0, 0.0)
@@ -90,7 +92,7 @@ def build_target_model(
         & _inside(masks[0], x0)
         & _inside(masks[1], x1)
     )
-    T_board_cam0 = np.linalg.inv(T_cam_board[0])
+    T_board_cam0 = np.linalg.inv(T_cam0_board)
     points = X_cam0[keep] @ T_board_cam0[:3, :3].T + T_board_cam0[:3, 3]
     descriptors = features[0].descriptors[pairs[keep, 0]]
     return TargetModel(points.reshape(-1, 3), descriptors.reshape(-1, 128).astype(np.float32))
