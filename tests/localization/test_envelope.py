@@ -84,7 +84,7 @@ def test_table_envelopes_use_theta_for_arcs_and_x_for_lines_under_every_rule():
     for dataset, trajectory in (("arc", "arc"), ("line", "line")):
         for s, E_t in enumerate([0.5, 1.5, 2.5]):
             for image, offset in enumerate([-0.1, 0.1]):  # stop means 0.5, 1.5, 2.5 mm
-                rows.append(dict(dataset=dataset, trajectory=trajectory, stop=s, image=image, status="ok",
+                rows.append(dict(world="main", dataset=dataset, trajectory=trajectory, stop=s, image=image, status="ok",
                                  theta_deg=10.0 * s if trajectory == "arc" else 0.0,
                                  x_mm=20.0 * s if trajectory == "line" else 0.0,
                                  method="usac_magsac", E_t_mm=E_t + offset, E_r_deg=0.0))
@@ -99,5 +99,5 @@ def test_table_envelopes_use_theta_for_arcs_and_x_for_lines_under_every_rule():
     assert ours.loc[("line", "2mm_3deg"), "theta_a"] == pytest.approx(20.0 + 20.0 * 0.5 / 0.9)
     snapped = table[(table.rule == "infinite") & (table.dataset == "line")].set_index("tolerance")
     assert snapped.loc["2mm_3deg", "theta_a"] == pytest.approx(20.0)  # the previous stop
-    assert list(ours.reset_index().columns) == ["dataset", "tolerance", "trajectory", "method", "theta_a",
+    assert list(ours.reset_index().columns) == ["dataset", "tolerance", "world", "trajectory", "method", "theta_a",
                                                 "censored"]

@@ -32,7 +32,7 @@ import pandas as pd
 
 from poseintegrity.protocol import FAILED_FRAME_RULES, EnvelopeParams, tolerance_name
 
-COLUMNS = ["dataset", "trajectory", "tolerance", "method", "rule", "theta_a", "censored"]
+COLUMNS = ["world", "dataset", "trajectory", "tolerance", "method", "rule", "theta_a", "censored"]
 
 
 def actual_envelope(theta: np.ndarray, criteria: np.ndarray, bounds: np.ndarray) -> tuple[float, bool]:
@@ -98,14 +98,15 @@ def envelopes(table: pd.DataFrame, tolerances: list[tuple[float, float]], envelo
     table : usable artifact rows (:func:`~poseintegrity.localization.extract.usable`)
     """
     rows = []
-    for (dataset, trajectory, method), frames in table.groupby(["dataset", "trajectory", "method"], sort=True):
+    for (world, dataset, trajectory, method), frames in table.groupby(["world", "dataset", "trajectory", "method"],
+                                                                      sort=True):
         position = "x_mm" if trajectory == "line" else "theta_deg"
         theta = frames.groupby("stop", sort=True)[position].mean().to_numpy()
         for tolerance in tolerances:
             for rule in FAILED_FRAME_RULES:
                 criteria, bounds = stop_criteria(frames, tolerance, rule, envelope)
                 theta_a, censored = actual_envelope(theta, criteria, bounds)
-                rows.append(dict(dataset=dataset, trajectory=trajectory, tolerance=tolerance_name(tolerance),
+                rows.append(dict(world=world, dataset=dataset, trajectory=trajectory, tolerance=tolerance_name(tolerance),
                                  method=method, rule=rule, theta_a=theta_a, censored=censored))
     return pd.DataFrame(rows, columns=COLUMNS)
 

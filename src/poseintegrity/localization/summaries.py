@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import numpy as np
 import pandas as pd
 
 
@@ -23,6 +24,31 @@ def method_summary(table: pd.DataFrame, envelope_table: pd.DataFrame) -> pd.Data
     theta_a.columns = [f"mean_theta_a_{trajectory}_{tolerance}" for trajectory, tolerance in theta_a.columns]
     censored = envelope_table.groupby("method")["censored"].sum().rename("n_censored")
     return summary.join(theta_a).join(censored).reset_index()
+
+
+def envelope_rule_summary(envelope_table: pd.DataFrame, table: pd.DataFrame, method: str) -> pd.DataFrame:
+    """How the failed-frame rules of theta_a (localization/envelope.py) differ: per world, rule, trajectory and
+    tolerance, for ``method``: datasets, censored ones, the smallest and mean theta_a, mean / smallest, and the
+    share of the uncensored envelopes that end within 0.01 (deg or mm) of a stop (a rule that snaps to stops).
+
+    table : the artifact rows the envelopes came from (their stop positions)
+    """
+    rows = table[table["method"] == method]
+    positions = (rows.assign(position=rows["theta_deg"].where(rows["trajectory"] == "arc", rows["x_mm"]))
+                 .groupby("dataset")["position"].unique())
+    out = []
+    keys = ["world", "rule", "trajectory", "tolerance"]
+    for (world, rule, trajectory, tolerance), group in envelope_table[envelope_table["method"] == method].groupby(keys):
+        uncensored = group[~group["censored"]]
+        on_stop = [float(np.min(np.abs(positions[d] - a))) <= 0.01 for d, a in zip(uncensored["dataset"],
+                                                                                   uncensored["theta_a"])]
+        out.append(dict(world=world, rule=rule, trajectory=trajectory, tolerance=tolerance, n=len(group),
+                        n_censored=int(group["censored"].sum()), min_theta_a=float(group["theta_a"].min()),
+                        mean_theta_a=float(group["theta_a"].mean()),
+                        mean_over_min=float(group["theta_a"].mean() / group["theta_a"].min())
+                        if group["theta_a"].min() > 0 else np.nan,
+                        share_on_stop=float(np.mean(on_stop)) if on_stop else np.nan))
+    return pd.DataFrame(out)
 
 
 def board_summary(table: pd.DataFrame) -> dict[str, float]:
