@@ -1,4 +1,4 @@
-"""Pinhole camera of the eye-in-hand rig and camera placement helpers.
+"""The eye-in-hand camera as stage 01 renders it (true intrinsics and lens) and camera placement helpers.
 
 Frames: OpenCV camera frame (x right, y down, z forward); lengths in millimetres; ``T_a_b`` is a 4x4 matrix
 mapping coordinates of frame b into frame a.
@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from poseintegrity.lens import Camera
 from poseintegrity.poses import pose_matrix
 
 if TYPE_CHECKING:
@@ -19,7 +20,7 @@ if TYPE_CHECKING:
 
 @dataclass(frozen=True)
 class Intrinsics:
-    """Pinhole intrinsics of the rendered images (no distortion).
+    """Pinhole intrinsics of the rendered images, the true ones (the pipeline only sees a calibration's estimate).
 
     width, height : image size in pixels; K : (3, 3) float, pixels.
     """
@@ -30,23 +31,23 @@ class Intrinsics:
 
     @classmethod
     def from_params(cls, camera: "CameraParams") -> "Intrinsics":
-        """IDS U3-3060CP: f_px = f_mm / pixel pitch (docs/references.md, "Camera of the Windsor et al. experiments"), principal point at the centre, downscaled."""
+        """IDS U3-3060CP: f_px = f_mm / pixel pitch (docs/references.md, "Camera of the Windsor et al. experiments"),
+        the principal point ``principal_point_offset_px`` from the sensor's centre, downscaled."""
         scale = 1.0 / camera.downscale
         f_px = camera.lens_mm / (camera.pixel_um * 1e-3) * scale
         width = camera.sensor_width_px // camera.downscale
         height = camera.sensor_height_px // camera.downscale
-        # pixel centres at integer coordinates: the optical axis meets the image centre at (w - 1) / 2
-        K = np.array([[f_px, 0.0, (width - 1) / 2], [0.0, f_px, (height - 1) / 2], [0.0, 0.0, 1.0]])
+        # pixel centres at integer coordinates: the sensor's centre is at (w - 1) / 2
+        cx = (width - 1) / 2 + camera.principal_point_offset_px[0] * scale
+        cy = (height - 1) / 2 + camera.principal_point_offset_px[1] * scale
+        K = np.array([[f_px, 0.0, cx], [0.0, f_px, cy], [0.0, 0.0, 1.0]])
         return cls(width, height, K)
 
 
-def defocus_sigma_px(depth_mm: float, focus_mm: float, camera: "CameraParams") -> float:
-    """Gaussian sigma (rendered pixels) of the defocus blur of a point at ``depth_mm`` when the lens is focused
-    at ``focus_mm``: the thin-lens circle of confusion c = f^2 / N * |d - d_f| / (d (d_f - f)), taken as a
-    Gaussian of sigma c / 2 (the lens is focused once, at the model view, and never refocused)."""
-    f = camera.lens_mm
-    c_mm = f**2 / camera.f_number * abs(depth_mm - focus_mm) / (depth_mm * (focus_mm - f))
-    return 0.5 * c_mm / (camera.pixel_um * 1e-3) / camera.downscale
+def true_camera(camera: "CameraParams") -> Camera:
+    """The camera stage 01 renders through: the true intrinsics and the lens' true distortion."""
+    cam = Intrinsics.from_params(camera)
+    return Camera(cam.K, np.asarray(camera.distortion, dtype=float), cam.width, cam.height)
 
 
 def look_at(eye: np.ndarray, target: np.ndarray, up: np.ndarray = np.array([0.0, 0.0, 1.0])) -> np.ndarray:

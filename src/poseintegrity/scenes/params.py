@@ -22,6 +22,7 @@ from poseintegrity.scenes.foam import VOXEL_MM, ReliefVolume, relief_volume
 from poseintegrity.scenes.kinematics import UR5E
 from poseintegrity.scenes.mesh import Material
 from poseintegrity.scenes.scapula import read_mesh
+from poseintegrity.lens import LensError, check_folding
 from poseintegrity.schema import KeyRule, ProjectPath, Section, Seed, distinct
 
 MIN_IMAGE_PX = 64  # the rendered image's shorter side: below it no target keeps enough pixels to be localized
@@ -39,6 +40,11 @@ class CameraParams(Section):
                                                     "camera distance (>= 100 mm): the lens must focus")
     downscale: int = Field(ge=1, description="images are rendered at sensor size / downscale")
     f_number: float = Field(ge=0.5, le=64, description="aperture; sets the depth of field (focus at the model view)")
+    principal_point_offset_px: tuple[Annotated[float, Field(ge=-100, le=100)], Annotated[float, Field(ge=-100, le=100)]] = (
+        Field(description="where the optical axis meets the sensor, from its centre, full-resolution px (a lens is "
+                          "mounted a few px off; 100 px would be a visibly decentred lens)"))
+    distortion: tuple[float, float, float, float, float] = Field(
+        description="k1, k2, p1, p2, k3 of the lens (Brown-Conrady as OpenCV models it, poseintegrity.lens)")
 
     @model_validator(mode="after")
     def _image_size(self) -> "CameraParams":
@@ -48,6 +54,17 @@ class CameraParams(Section):
                                        f"({self.sensor_width_px} x {self.sensor_height_px} / {self.downscale}); "
                                        f"at most {min(self.sensor_width_px, self.sensor_height_px) // MIN_IMAGE_PX} "
                                        f"keeps it >= {MIN_IMAGE_PX} px")
+        return self
+
+    @model_validator(mode="after")
+    def _lens_does_not_fold(self) -> "CameraParams":
+        from poseintegrity.scenes.camera import Intrinsics  # camera.py imports this module for type hints only
+
+        cam = Intrinsics.from_params(self)
+        try:
+            check_folding(cam.K, np.array(self.distortion), cam.width, cam.height)
+        except LensError as error:
+            raise KeyRule("distortion", str(error)) from None
         return self
 
 
