@@ -69,7 +69,7 @@ class PredictParams(Section):
 
     @model_validator(mode="after")
     def _check(self, info: ValidationInfo) -> PredictParams:
-        from poseintegrity.artifact_models.models import BASE_FUNCTIONS, distinct_theta_needed  # no import cycle
+        from poseintegrity.artifact_models.models import LEAST_SQUARES, distinct_theta_needed  # no import cycle
 
         protocol = (info.context or {}).get("protocol")
         for key in ("tolerance_fig6_fig7", "live_tolerance"):
@@ -93,9 +93,9 @@ class PredictParams(Section):
             if fewest is not None and distinct_theta_needed(model) > fewest:
                 raise KeyRule(f"models.{predictor}", f"model {model!r} needs {distinct_theta_needed(model)} stops, "
                                                      f"more than protocol.sampled_stops gives ({fewest})")
-        if self.uncertainty.method == "covariance" and self.models.long_range not in BASE_FUNCTIONS:
+        if self.uncertainty.method == "covariance" and self.models.long_range not in LEAST_SQUARES:
             raise KeyRule("uncertainty.method", f"covariance needs a least squares long_range model (one of "
-                                                f"{sorted(BASE_FUNCTIONS)}), got {self.models.long_range!r}: use "
+                                                f"{sorted(LEAST_SQUARES)}), got {self.models.long_range!r}: use "
                                                 f"bootstrap")
         return self
 
