@@ -104,3 +104,25 @@ def test_tail_fits_refuse_a_dataset_that_is_no_arc(tables, tiny_predict, tiny_fi
     artifacts, _ = tables
     with pytest.raises(ValueError, match="scene_2_line01"):
         tail_fits(artifacts, pd.DataFrame(), ["scene_2_line01"], tiny_predict, tiny_fit, protocol)
+
+
+def test_the_tail_figure_shows_both_fits_and_every_theta_a(tiny_predict, tiny_fit, protocol):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from poseintegrity.report.figures import tail_figure
+
+    theta = np.repeat(2.25 * np.arange(20), 3)
+    artifacts = pd.DataFrame({"dataset": "scene_1_arc00", "trajectory": "arc", "stop": np.repeat(np.arange(20), 3),
+                              "image": np.arange(60), "theta_deg": theta, "x_mm": 0.0, "method": protocol.pnp_method,
+                              "n_inliers": cliff(theta)})  # fmt: skip
+    table = pd.DataFrame({"dataset": "scene_1_arc00", "method": protocol.pnp_method,
+                          "tolerance": protocol.tolerance_names, "theta_a": [15.0, 17.0]})
+    tails = tail_fits(artifacts, table, ["scene_1_arc00"], tiny_predict, tiny_fit, protocol)
+    (ax,) = tail_figure(tails, 30).axes
+    labels = ax.get_legend_handles_labels()[1]
+    assert labels[:2] == ["all images", "first 4 stops"]
+    assert {"eq. 1 (EMG, sigma = 1)", "free-width EMG (ours)"} <= {label.split(" (at")[0] for label in labels}
+    assert [line.get_xdata()[0] for line in ax.get_lines() if line.get_linestyle() == ":"] == [15.0, 17.0]
+    (note,) = tail_figure([], 30).axes
+    assert "no arc overshoots" in note.texts[0].get_text()

@@ -92,8 +92,9 @@ def emg_jacobian(theta: np.ndarray, alpha: float, K: float, mu: float) -> np.nda
 def emg_free_width(theta: np.ndarray, alpha: float, K: float, mu: float, sigma: float) -> np.ndarray:
     """Eq. (1) with a free Gaussian width (ours): alpha * exponnorm.pdf((theta - mu) / sigma, K) / sigma.
 
-    scipy's exponnorm with ``loc=mu, scale=sigma``: a Gaussian of width sigma (theta units) convolved with an
-    exponential of decay length K sigma; alpha stays the area. sigma = 1 is eq. 1 to the bit (the same operations).
+    scipy's exponnorm with ``loc=mu, scale=sigma`` (docs/references.md, "SciPy"): a Gaussian of width sigma (theta
+    units) convolved with an exponential of decay length K sigma; alpha stays the area. sigma = 1 is eq. 1 to the bit
+    (the same operations).
     theta : (m,) -> (m,) inliers
     """
     return alpha / sigma * emg_pdf((np.asarray(theta, dtype=float) - mu) / sigma, K)
