@@ -107,3 +107,24 @@ def test_fit_statuses_have_a_row_per_model_and_predictor():
     assert "| ... at a bound | 2.5% | - | - |" in text
     assert "| ... non-physical | 12.5% | - | - |" in text  # next step's rows
     assert "| simulated live trials that went by a flagged fit | 2 | - | - |" in text
+
+
+def test_free_width_rows_and_tail_counts_stand_beside_the_papers_rows():
+    """Ours (predictors on the free-width EMG, the tail diagnosis) are rows of their own, labelled ours; the paper's
+    rows keep their labels and paper values."""
+    metrics = {"predictors": {
+        "long_range": {"2mm_3deg": {"max_mean_spl_zero_incursion": 11.0, "best_n_t": 60.0}},
+        "long_range_free_width": {"2mm_3deg": {"max_mean_spl_zero_incursion": 12.5, "best_n_t": 25.0},
+                                  "relative_improvement_vs_long_range": 0.125},
+        "tails": {"long_range": {"2mm_3deg": {"n_overshooting": 2, "datasets": ["scene_1_arc00", "scene_4_arc17"]}},
+                  "long_range_free_width": {"2mm_3deg": {"n_overshooting": 0, "datasets": []}}}}}
+    text = render_summary(metrics, [])
+    assert "| long range (EMG, eq. 1), 2 mm/3 deg: max mean SPL at zero incursion (deg) | 11 | 12.3 | - |" in text
+    assert ("| ours: long range on the free-width EMG, 2 mm/3 deg: max mean SPL at zero incursion (deg) | 12.5 | - | - |"
+            in text)
+    assert "| ours: long range on the free-width EMG over long range on eq. 1 (mean of both tolerances) | +12.5% |" in text
+    assert ("| ours: arcs whose long range theta_p on eq. 1 overshoots theta_a at every n_t up to predict.tail_n_t_max, "
+            "2 mm/3 deg | 2 | - | - |") in text
+    assert "| ... which arcs | scene_1_arc00, scene_4_arc17 | - | - |" in text
+    assert "| ... which arcs | none | - | - |" in text  # the free-width EMG: an empty list
+    assert "| ... which arcs | not run | - | - |" in text  # 4 mm/10 deg: no metrics

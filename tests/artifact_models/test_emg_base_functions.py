@@ -17,16 +17,6 @@ THETA = np.repeat(2.25 * np.arange(1, 21), 10)  # an arc dataset: 20 stops x 10 
 FIRST4 = np.repeat(2.25 * np.arange(4), 10)  # the 4 stops an arc robot samples (IV-A), from the model view
 
 
-@pytest.fixture(scope="module")
-def fit_base(tiny_fit, protocol):
-    """base.fit with the tiny ``fit`` budget on an arc (range end from the protocol)."""
-    def run(base, theta, n, **changes):
-        budget = {"theta_end": protocol.range_end("arc"), "max_nfev": tiny_fit.max_nfev, **changes}
-        return base.fit(theta, n, **budget)
-
-    return run
-
-
 @pytest.mark.parametrize("K", [0.01, 0.05, 0.3, 1.0, 3.0, 10.0, 100.0, 1000.0])
 def test_emg_pdf_matches_scipy_exponnorm(K):
     x = np.linspace(-8.0, 60.0, 1361)

@@ -85,6 +85,13 @@ BAD_VALUES = [
     ("predict.n_static", 1, "predict.n_static"),
     ("predict.n_grid", 8, "predict.n_grid"),
     ("predict.models.long_range", "spline", "predict.models.long_range"),
+    ("predict.models.long_range_free_width", "emg_wide", "predict.models.long_range_free_width"),
+    ("predict.models.next_step_free_width", None, "predict.models.next_step_free_width"),
+    ("predict.tail_n_t_max", 200, "predict.tail_n_t_max"),  # beyond the swept n_t_max (30 in the tiny params)
+    ("predict.tail_n_t_max", 2, "predict.tail_n_t_max"),  # below n_t_min
+    ("predict.tail_n_t_shown", [4, 60], "predict.tail_n_t_shown.1"),  # not a swept threshold
+    ("predict.tail_n_t_shown", [4, 4], "predict.tail_n_t_shown"),  # distinct
+    ("predict.tail_n_t_shown", [], "predict.tail_n_t_shown"),
     ("predict.loso_target_rates", [1.5], "predict.loso_target_rates.0"),
     ("predict.loso_target_rates", [0.0, -0.1], "predict.loso_target_rates.1"),
     ("predict.loso_target_rates", [0.0, 0.0], "predict.loso_target_rates"),  # distinct
@@ -112,6 +119,20 @@ def test_a_model_needing_more_stops_than_sampled_is_refused(tiny_raw):
     """With 2 sampled stops on arcs, eq. 1 (3 parameters) could never be fitted by the long range predictor."""
     tiny_raw["protocol"]["sampled_stops"]["arc"] = 2
     tiny_raw["fit"].update(models=["exponential", "mlp_pretrained"], k_min=2)  # 2-parameter models only
-    tiny_raw["predict"]["models"].update(long_range="exponential", next_step="exponential")
+    tiny_raw["predict"]["models"].update(long_range="exponential", next_step="exponential",
+                                         long_range_free_width="exponential", next_step_free_width="exponential")
     assert "predict.models.long_range" in refusal(tiny_raw, "predict.models.long_range", "emg")
     assert "predict.models.next_step" in refusal(tiny_raw, "predict.models.next_step", "gaussian")
+
+
+def test_the_free_width_emg_fits_the_stops_sampled_and_no_fewer(tiny_raw):
+    """It needs 4 stops: the 4 (arcs) and 5 (lines) of the paper's protocol suffice, 3 on arcs do not."""
+    from poseintegrity.config import parse_params
+
+    assert parse_params(tiny_raw).predict.models.long_range_free_width == "emg_free_width"  # 4 and 5 stops: valid
+    tiny_raw["protocol"]["sampled_stops"]["arc"] = 3
+    tiny_raw["fit"].update(models=["emg", "exponential"])
+    tiny_raw["predict"]["models"].update(long_range_free_width="emg", next_step_free_width="emg")
+    for key in ("predict.models.long_range_free_width", "predict.models.next_step_free_width"):
+        message = refusal(tiny_raw, key, "emg_free_width")
+        assert key in message and "needs 4 stops" in message

@@ -12,12 +12,13 @@ import pytest
 from pred_synthetic import scene_tables
 
 from artifact_models.tiny import TINY_PARAMS
-from poseintegrity.prediction import FITTED_PREDICTORS, NO_FIT
+from poseintegrity.prediction import FITTED_PREDICTORS, FREE_WIDTH_PREDICTORS, NO_FIT
 
 ROOT = Path(__file__).resolve().parents[2]
 NOTEBOOK = ROOT / "notebooks" / "04_predictor_sweeps.ipynb"
 FIGURES = ["04_fig5_long_range.png", "04_fig6_pnp.png", "04_fig7_straight_line.png", "04_fig8_next_step.png",
-           "04_loso.png", "04_relative_thresholds.png", "04_uncertainty.png"]  # fmt: skip
+           "04_free_width.png", "04_loso.png", "04_relative_thresholds.png", "04_tails.png",
+           "04_uncertainty.png"]  # fmt: skip
 
 
 @pytest.mark.notebook
@@ -35,9 +36,14 @@ def test_notebook_runs_on_tiny_params(tmp_path, tiny):
     )  # fmt: skip
 
     metrics = json.loads((tmp_path / "reports" / "metrics" / "predictors.json").read_text())
-    for predictor in ("static", "long_range", "mlp", "next_step"):
+    for predictor in ("static", "long_range", "mlp", "next_step", *FREE_WIDTH_PREDICTORS):
         assert set(protocol.tolerance_names) <= set(metrics[predictor])
-    assert {"straight_line", "pnp", "loso", "live", "fit_status"} <= set(metrics)
+    assert {"straight_line", "pnp", "loso", "live", "fit_status", "tails"} <= set(metrics)
+    tails = pd.read_parquet(tmp_path / "data" / "predictions" / "tails.parquet")
+    for predictor, entry in metrics["tails"].items():  # the table the notebook shows is the one the metrics count
+        for tolerance, counted in entry.items():
+            listed = tails[(tails.predictor == predictor) & (tails.tolerance == tolerance)]
+            assert counted == {"n_overshooting": len(listed), "datasets": sorted(listed.dataset)}
     table = pd.read_parquet(tmp_path / "data" / "predictions" / "predictions.parquet")
     for predictor in FITTED_PREDICTORS:
         rows = table[(table.predictor == predictor) & (table.tolerance == protocol.tolerance_names[0])]

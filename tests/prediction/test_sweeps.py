@@ -14,6 +14,7 @@ from poseintegrity.artifact_models.series import dataset_series
 from poseintegrity.parallel import Workers
 from poseintegrity.prediction import (
     FITTED_PREDICTORS,
+    FREE_WIDTH_PREDICTORS,
     NO_FIT,
     PAPER_PREDICTORS,
     attach_envelopes,
@@ -44,13 +45,14 @@ def test_every_predictor_every_dataset_every_operating_point(swept, tables, tiny
     counts = theta_p.groupby(["method", "dataset", "predictor"]).size().unstack("predictor")
     paper = counts.loc["usac_magsac"]
     assert set(paper.columns) == {"static", "long_range", "long_range_lower", "mlp", "next_step",
-                                  "long_range_relative", "next_step_relative"}
-    assert (paper[["long_range", "long_range_lower", "mlp", "next_step"]] == tiny_predict.thresholds.size).all().all()
+                                  "long_range_relative", "next_step_relative", *FREE_WIDTH_PREDICTORS}
+    absolute = ["long_range", "long_range_lower", "mlp", "next_step", *FREE_WIDTH_PREDICTORS]
+    assert (paper[absolute] == tiny_predict.thresholds.size).all().all()
     relative = tiny_predict.relative_thresholds
     assert (relative[0], relative[-1]) == (tiny_predict.relative_min, tiny_predict.relative_max)
     assert (paper[["long_range_relative", "next_step_relative"]] == relative.size).all().all()
     assert (paper["static"] == tiny_predict.n_static).all()
-    assert counts.loc["epnp"][["mlp", "next_step", "long_range_relative"]].isna().all().all()  # Fig. 6: long range
+    assert counts.loc["epnp"][["mlp", "next_step", "long_range_relative", *FREE_WIDTH_PREDICTORS]].isna().all().all()
     assert len(paper) == tables[0]["dataset"].nunique()
 
 
@@ -208,3 +210,33 @@ def test_envelopes_that_do_not_fit_the_protocol_are_refused(swept, tables, proto
     theta_p, _, _ = swept
     with pytest.raises(ValueError, match=message):
         attach_envelopes(theta_p, spoil(tables[1]), protocol)
+
+
+def test_free_width_variants_have_rows_of_their_own_beside_the_papers(swept, tiny_predict, protocol):
+    """The free-width rows flow through the curves, Tables I-III and predictors.json under their own names; the
+    paper's figures are what they are without them."""
+    theta_p, table, curves = swept
+    free = theta_p[theta_p.predictor.isin(FREE_WIDTH_PREDICTORS)]
+    assert set(free.model) == {"emg_free_width"} and set(theta_p[theta_p.predictor == "long_range"].model) == {"emg"}
+    best = best_table(curves)
+    paper_arcs = best[(best.method == protocol.pnp_method) & (best.trajectory == "arc")]
+    for predictor in FREE_WIDTH_PREDICTORS:
+        assert set(paper_arcs[paper_arcs.predictor == predictor].tolerance) == set(protocol.tolerance_names)
+    folds = loso(table, tiny_predict.loso_target_rates, PAPER_PREDICTORS, protocol.pnp_method)
+    live = live_trials(table, best, tiny_predict, protocol)
+    metrics = headline_metrics(table, curves, folds, live, tiny_predict, protocol)
+    paper_only = table[~table.predictor.isin(FREE_WIDTH_PREDICTORS)]
+    without = headline_metrics(paper_only, operating_curves(paper_only), folds, live, tiny_predict, protocol)
+    for predictor in (*PAPER_PREDICTORS, "long_range_lower", "long_range_relative", "next_step_relative"):
+        assert json_ready(metrics[predictor]) == json_ready(without[predictor])
+    for ours, paper in (("long_range_free_width", "long_range"), ("next_step_free_width", "next_step")):
+        for tolerance in protocol.tolerance_names:
+            row = paper_arcs[(paper_arcs.predictor == ours) & (paper_arcs.tolerance == tolerance)].iloc[0]
+            entry = metrics[ours][tolerance]
+            assert entry["max_mean_spl_zero_incursion"] == pytest.approx(row.max_mean_spl, nan_ok=True)
+            assert entry["best_n_t"] == pytest.approx(row.best_operating_point, nan_ok=True)
+        mean_ours, mean_paper = (metrics[p]["mean_max_mean_spl_zero_incursion"] for p in (ours, paper))
+        assert metrics[ours][f"relative_improvement_vs_{paper}"] == pytest.approx(
+            (mean_ours - mean_paper) / mean_paper, nan_ok=True)
+    assert set(metrics["tails"]) == {"long_range", "long_range_free_width"}
+    assert set(metrics["tails"]["long_range"]) == set(protocol.tolerance_names)

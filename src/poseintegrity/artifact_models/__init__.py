@@ -3,7 +3,8 @@
     params.py          the ``fit`` section of params.yaml (FitParams)
     fitted.py          FittedModel: what every fitter returns (status ok / at_bound / non_physical / fallback, reason,
                        fallback line)
-    base_functions.py  eq. 1 (scaled EMG) and four other decays, fitted by bounded least squares
+    base_functions.py  eq. 1 (scaled EMG) and four other decays, fitted by bounded least squares; beside them (ours)
+                       eq. 1 with a free Gaussian width (emg_free_width)
     mlp.py             the 3 x 10 tanh MLP (IV-E), from scratch or EMG-pretrained + fine-tuned (III-D)
     models.py          fit_model(name, ...): one entry point for all of them
     series.py          Series: one dataset's samples (theta, n_inliers per image, in stop order)
@@ -17,7 +18,10 @@ import lazy_loader
 __getattr__, __dir__, __all__ = lazy_loader.attach(
     __name__,
     submod_attrs={
-        "base_functions": ["BASE_FUNCTIONS", "EMG", "BaseFunction", "emg", "emg_pdf"],
+        "base_functions": [
+            "BASE_FUNCTIONS", "EMG", "EMG_FREE_WIDTH", "LEAST_SQUARES", "BaseFunction", "emg", "emg_free_width",
+            "emg_pdf",
+        ],
         "fig2": ["at_sampled_stops", "fig2_rmse", "fit_first_stops", "fits_metrics", "mean_rmse", "status_counts"],
         "fitted": ["FIT_STATUSES", "FallbackLine", "FittedModel"],
         "mlp": ["fit_mlp"],

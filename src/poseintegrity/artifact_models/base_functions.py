@@ -9,10 +9,17 @@ exponentially modified Gaussian (EMG) of eq. 1. Every base function here is ampl
     logistic     a / (1 + exp((theta - t50) / s))
     power_law    a / (1 + (theta / t50)^p)                       (Hill / log-logistic; tail ~ theta^-p)
 
+and, beside them (ours, not the paper's; not in Fig. 2's comparison set :data:`BASE_FUNCTIONS`):
+
+    emg_free_width  alpha * exponnorm.pdf((theta - mu) / sigma, K) / sigma   (eq. 1 with its Gaussian width sigma
+                 fitted; sigma = 1 is eq. 1. With sigma fixed at 1 theta unit eq. 1 is a shifted exponential past
+                 its peak: it cannot bend down into a cliff after a shoulder, a broad Gaussian part can)
+
 Starting values and bounds are derived from the samples (see :class:`DecaySummary` and each ``_start_*``):
 a decay length tau0 from a log-linear fit of the per-theta mean counts sets every scale parameter,
 bounds are multiples of the sampled span, and the amplitude starts at its linear least squares
 value given the starting shape. All theta units are those of the data (deg for arcs, mm for lines).
+The free-width EMG is fitted from two starts (:class:`FreeWidthEMG`) and keeps the one of least cost.
 A fit whose parameters end at a bound is flagged "at_bound" (fitted.py): the samples wanted a curve outside them.
 """
 
@@ -22,7 +29,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import least_squares
+from scipy.optimize import OptimizeResult, least_squares
 from scipy.special import erfc, erfcx
 
 from poseintegrity.artifact_models.fitted import (
@@ -62,19 +69,47 @@ def emg(theta: np.ndarray, alpha: float, K: float, mu: float) -> np.ndarray:
     return alpha * emg_pdf(np.asarray(theta, dtype=float) - mu, K)
 
 
+def emg_pdf_derivatives(x: np.ndarray, K: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(g, dg/dx, dg/dK) of g = exponnorm.pdf(x, K) = :func:`emg_pdf`, each (m,) for x : (m,).
+
+    With phi the standard normal pdf, exp(1/(2K^2) - x/K) phi(x - 1/K) = phi(x), hence dg/dx = (phi - g) / K and
+    dg/dK = g (x/K^2 - 1/K - 1/K^3) + phi / K^3.
+    """
+    g = emg_pdf(x, K)
+    phi = np.exp(-0.5 * x * x) / np.sqrt(2.0 * np.pi)
+    return g, (phi - g) / K, g * (x / K**2 - 1.0 / K - 1.0 / K**3) + phi / K**3
+
+
 def emg_jacobian(theta: np.ndarray, alpha: float, K: float, mu: float) -> np.ndarray:
     """d eq.(1) / d(alpha, K, mu) : (m, 3), for the least squares fit (the EMG fit has a speed target).
 
-    With x = theta - mu, g = exponnorm.pdf(x, K) and phi the standard normal pdf,
-    exp(1/(2K^2) - x/K) phi(x - 1/K) = phi(x), hence dg/dx = (phi - g) / K and
-    dg/dK = g (x/K^2 - 1/K - 1/K^3) + phi / K^3.
+    With x = theta - mu and g = exponnorm.pdf(x, K) (:func:`emg_pdf_derivatives`): (g, alpha dg/dK, -alpha dg/dx).
     """
-    x = np.asarray(theta, dtype=float) - mu
-    g = emg_pdf(x, K)
-    phi = np.exp(-0.5 * x * x) / np.sqrt(2.0 * np.pi)
-    dg_dK = g * (x / K**2 - 1.0 / K - 1.0 / K**3) + phi / K**3
-    dg_dx = (phi - g) / K
+    g, dg_dx, dg_dK = emg_pdf_derivatives(np.asarray(theta, dtype=float) - mu, K)
     return np.stack([g, alpha * dg_dK, -alpha * dg_dx], axis=1)
+
+
+def emg_free_width(theta: np.ndarray, alpha: float, K: float, mu: float, sigma: float) -> np.ndarray:
+    """Eq. (1) with a free Gaussian width (ours): alpha * exponnorm.pdf((theta - mu) / sigma, K) / sigma.
+
+    scipy's exponnorm with ``loc=mu, scale=sigma`` (docs/references.md, "SciPy"): a Gaussian of width sigma (theta
+    units) convolved with an exponential of decay length K sigma; alpha stays the area. sigma = 1 is eq. 1 to the bit
+    (the same operations).
+    theta : (m,) -> (m,) inliers
+    """
+    return alpha / sigma * emg_pdf((np.asarray(theta, dtype=float) - mu) / sigma, K)
+
+
+def emg_free_width_jacobian(theta: np.ndarray, alpha: float, K: float, mu: float, sigma: float) -> np.ndarray:
+    """d emg_free_width / d(alpha, K, mu, sigma) : (m, 4).
+
+    With z = (theta - mu) / sigma, g = exponnorm.pdf(z, K) and c = alpha / sigma: f = c g, so
+    df/dalpha = g / sigma, df/dK = c dg/dK, df/dmu = -c dg/dz / sigma, df/dsigma = -c (g + z dg/dz) / sigma.
+    """
+    z = (np.asarray(theta, dtype=float) - mu) / sigma
+    g, dg_dz, dg_dK = emg_pdf_derivatives(z, K)
+    c = alpha / sigma
+    return np.stack([g / sigma, c * dg_dK, -c * dg_dz / sigma, -c * (g + z * dg_dz) / sigma], axis=1)
 
 
 def exponential(theta: np.ndarray, a: float, tau: float) -> np.ndarray:
@@ -158,6 +193,16 @@ def _start_emg(s: DecaySummary) -> tuple[list[float], list[float], list[float]]:
     return [s.tau0, s.t0 - 2.0], [0.0, K_MIN, m_lo], [np.inf, k_hi, m_hi]
 
 
+def _start_emg_free_width(s: DecaySummary) -> tuple[list[float], list[float], list[float]]:
+    # the broad start: a half-Gaussian decay from the first sample (K at its least, sigma ~ the decay length), the
+    # shoulder-and-cliff shape eq. 1 cannot take; FreeWidthEMG adds eq. 1's own fit as a second start. sigma's bounds
+    # are the scale bounds widened to contain eq. 1's sigma = 1 theta unit, K (the decay length in sigmas) may reach
+    # eq. 1's longest decay at the narrowest sigma: eq. 1's box at sigma = 1 lies inside, whatever the span.
+    (k_lo, k_hi), (m_lo, m_hi) = s.scale_bounds, s.location_bounds
+    s_lo, s_hi = min(k_lo, 1.0), max(k_hi, 1.0)
+    return [K_MIN, s.t0, s.tau0], [0.0, K_MIN, m_lo, s_lo], [np.inf, k_hi / s_lo, m_hi, s_hi]
+
+
 def _start_exponential(s: DecaySummary) -> tuple[list[float], list[float], list[float]]:
     (k_lo, k_hi) = s.scale_bounds
     return [s.tau0], [0.0, k_lo], [s.level_bound, k_hi]
@@ -216,12 +261,31 @@ class BaseFunction:
         a0 = float(np.dot(g, n_inliers)) / gg if gg > 0 and np.isfinite(gg) else float(n_inliers.max())
         return np.array([np.clip(a0, lower[0], upper[0]), *shape0]), lower, upper
 
+    def starts(self, theta: np.ndarray, n_inliers: np.ndarray, max_nfev: int
+               ) -> tuple[list[np.ndarray], np.ndarray, np.ndarray]:  # fmt: skip
+        """Starting points, each (n_params,), and the bounds (lower, upper) of the fit: one, :meth:`initial_guess`'s."""
+        p0, lower, upper = self.initial_guess(theta, n_inliers)
+        return [p0], lower, upper
+
+    def solve(self, theta: np.ndarray, n_inliers: np.ndarray, p0: np.ndarray, lower: np.ndarray, upper: np.ndarray,
+              max_nfev: int) -> OptimizeResult:  # fmt: skip
+        """Bounded least squares (trf) from p0 on valid samples; raises ValueError when the residuals are not finite.
+
+        curve_fit(method="trf") is this least_squares call (same residuals, Jacobian and options, hence the same
+        parameters); called directly for its active_mask, which curve_fit does not return.
+        """
+        jac = (lambda p: self.jac(theta, *p)) if self.jac else "2-point"
+        return least_squares(lambda p: self.f(theta, *p) - n_inliers, p0, jac=jac, bounds=(lower, upper),
+                             method="trf", x_scale="jac", max_nfev=max_nfev)  # fmt: skip
+
     def fit(self, theta: np.ndarray, n_inliers: np.ndarray, *, theta_end: float, max_nfev: int) -> FittedModel:
         """Fit by bounded non-linear least squares (trf), as scipy.optimize.curve_fit does. Never raises on bad data.
 
         theta : (m,) float, deg or mm;  n_inliers : (m,) counts (NaN and negative samples are dropped)
         theta_end : end of the range (deg or mm), up to which the fitted curve is checked (fitted.py)
-        max_nfev : evaluation budget of the optimizer (``fit.max_nfev``)
+        max_nfev : evaluation budget of the optimizer from each start (``fit.max_nfev``)
+        From several starts (:meth:`starts`) the converged result of least cost is kept; when none converged, the
+        first start's failure is reported.
         Returns a :class:`FittedModel` whose status says whether the fit is "ok", "at_bound" (a parameter ended at a
         bound: scipy.optimize.least_squares' ``active_mask``), "non_physical", or "fallback" (too few distinct
         theta, the optimizer failed, or a non-finite curve).
@@ -230,21 +294,25 @@ class BaseFunction:
         reason = too_few_samples(theta, len(self.param_names))
         if reason is not None:
             return FittedModel.failed(self.name, self.param_names, reason, theta, n_inliers)
-        # curve_fit(method="trf") is this least_squares call (same residuals, Jacobian and options, hence the same
-        # parameters); called directly for its active_mask, which curve_fit does not return
-        jac = (lambda p: self.jac(theta, *p)) if self.jac else "2-point"
         with np.errstate(all="ignore"):
             try:
-                p0, lower, upper = self.initial_guess(theta, n_inliers)
-                result = least_squares(
-                    lambda p: self.f(theta, *p) - n_inliers, p0, jac=jac, bounds=(lower, upper), method="trf",
-                    x_scale="jac", max_nfev=max_nfev,
-                )  # fmt: skip
-            except (ValueError, np.linalg.LinAlgError) as error:  # e.g. residuals not finite at p0
+                starts, lower, upper = self.starts(theta, n_inliers, max_nfev)
+            except (ValueError, np.linalg.LinAlgError) as error:
                 return FittedModel.failed(self.name, self.param_names, f"least squares: {error}", theta, n_inliers)
-            if not result.success:  # e.g. max_nfev exceeded
-                return FittedModel.failed(self.name, self.param_names, f"least squares: {result.message}", theta,
-                                          n_inliers)  # fmt: skip
+            results, failures = [], []
+            for p0 in starts:
+                try:
+                    result = self.solve(theta, n_inliers, p0, lower, upper, max_nfev)
+                except (ValueError, np.linalg.LinAlgError) as error:  # e.g. residuals not finite at p0
+                    failures.append(f"least squares: {error}")
+                    continue
+                if result.success:
+                    results.append(result)
+                else:  # e.g. max_nfev exceeded
+                    failures.append(f"least squares: {result.message}")
+            if not results:
+                return FittedModel.failed(self.name, self.param_names, failures[0], theta, n_inliers)
+            result = min(results, key=lambda r: r.cost)  # the first of equal costs
             curve = BaseCurve(self.f, tuple(float(v) for v in result.x))
             at_bound = [f"{name} = {value:.4g} ({'lower' if side < 0 else 'upper'})"
                         for name, value, side in zip(self.param_names, curve.p, result.active_mask, strict=True)
@@ -253,7 +321,25 @@ class BaseFunction:
                                        n_inliers, theta_end, at_bound)  # fmt: skip
 
 
+@dataclass(frozen=True)
+class FreeWidthEMG(BaseFunction):
+    """The free-width EMG (ours), started from a broad half-Gaussian (its start rule) and from eq. 1's own least
+    squares fit with sigma = 1 (eq. 1 is its member at sigma = 1, inside its bounds). trf only accepts steps that lower
+    the cost, so when the second start converges the fit never fits the samples worse than eq. 1 does."""
+
+    def starts(self, theta: np.ndarray, n_inliers: np.ndarray, max_nfev: int
+               ) -> tuple[list[np.ndarray], np.ndarray, np.ndarray]:  # fmt: skip
+        (broad,), lower, upper = super().starts(theta, n_inliers, max_nfev)
+        try:
+            eq1 = EMG.solve(theta, n_inliers, *EMG.initial_guess(theta, n_inliers), max_nfev)
+        except (ValueError, np.linalg.LinAlgError):  # eq. 1 could not start: the broad start alone
+            return [broad], lower, upper
+        return ([broad, np.clip([*eq1.x, 1.0], lower, upper)] if eq1.success else [broad]), lower, upper
+
+
 EMG = BaseFunction("emg", ("alpha", "K", "mu"), emg, _start_emg, emg_jacobian)
+# The least squares base functions of Fig. 2 (III-D): eq. 1 and the decays it was compared with (stage 02's realism
+# bar R1 compares them, as the paper did)
 BASE_FUNCTIONS: dict[str, BaseFunction] = {
     b.name: b
     for b in (
@@ -264,3 +350,7 @@ BASE_FUNCTIONS: dict[str, BaseFunction] = {
         BaseFunction("power_law", ("a", "t50", "p"), power_law, _start_power_law),
     )
 }
+EMG_FREE_WIDTH = FreeWidthEMG("emg_free_width", ("alpha", "K", "mu", "sigma"), emg_free_width, _start_emg_free_width,
+                              emg_free_width_jacobian)  # fmt: skip
+# Every least squares model fit_model knows: the paper's base functions and ours beside eq. 1
+LEAST_SQUARES: dict[str, BaseFunction] = {**BASE_FUNCTIONS, EMG_FREE_WIDTH.name: EMG_FREE_WIDTH}

@@ -2,7 +2,8 @@
 
 For every dataset and k = k_min .. all stops, each model is fitted to the images of the first k stops
 (theta_deg for arcs, x_mm for lines) and its RMSE is measured over every image of the dataset; the figure
-shows the mean RMSE across datasets per model and k (III-D, Fig. 2; lines as in V-C).
+shows the mean RMSE across datasets per model and k (III-D, Fig. 2; lines as in V-C). A model that needs more
+stops than k_min (``models.distinct_theta_needed``: the free-width EMG's 4 parameters) joins at its own count.
 
 Input: the artifacts table of stage 02, one row per image and PnP method, with at least the columns
 ``dataset, trajectory ("arc"|"line"), stop (0-based), theta_deg, x_mm, method, n_inliers``.
@@ -17,7 +18,7 @@ import pandas as pd
 
 from poseintegrity.seeding import keyed_rng
 from poseintegrity.artifact_models.fitted import FIT_STATUSES, OK, FittedModel
-from poseintegrity.artifact_models.models import fit_model
+from poseintegrity.artifact_models.models import distinct_theta_needed, fit_model
 from poseintegrity.artifact_models.params import FitParams
 from poseintegrity.artifact_models.series import Series, dataset_series
 from poseintegrity.parallel import Workers
@@ -27,7 +28,8 @@ COLUMNS = ["trajectory", "dataset", "k", "model", "rmse", "status", "reason", "n
 
 
 def fit_first_stops(series: Series, k: int, params: FitParams) -> dict[str, FittedModel]:
-    """Every model of ``params.models`` fitted to the first k stops of ``series``, checked up to its range end.
+    """Every model of ``params.models`` that k stops can fit (``distinct_theta_needed(model) <= k``), fitted to the
+    first k stops of ``series``, checked up to its range end.
 
     Each fit draws from ``keyed_rng(seed, "trajectory/dataset", k, model)``:
     the same for any number of workers, any order of work, any other datasets in the table and any other models.
@@ -37,6 +39,7 @@ def fit_first_stops(series: Series, k: int, params: FitParams) -> dict[str, Fitt
         name: fit_model(name, theta, n_inliers, theta_end=series.theta_end, params=params,
                         rng=keyed_rng(params.seed, f"{series.trajectory}/{series.dataset}", k, name))
         for name in params.models
+        if distinct_theta_needed(name) <= k
     }  # fmt: skip
 
 
@@ -67,7 +70,8 @@ def _fig2_rows(task: tuple[Series, int], params: FitParams) -> list[dict]:
 def fig2_rmse(
     artifacts: pd.DataFrame, params: FitParams, protocol: ProtocolParams, workers: Workers, progress: bool = True
 ) -> pd.DataFrame:
-    """The Fig. 2 experiment on the ``protocol.pnp_method`` rows: one row per (trajectory, dataset, k, model).
+    """The Fig. 2 experiment on the ``protocol.pnp_method`` rows: one row per (trajectory, dataset, k, model), for
+    the models that k stops can fit.
 
     Columns: trajectory, dataset, k, model, rmse (inliers, over every image of the dataset), status ("ok",
     "at_bound", "non_physical" or "fallback", artifact_models/fitted.py), reason ("ok" or what was found; a

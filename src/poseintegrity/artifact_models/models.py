@@ -1,22 +1,26 @@
-"""One entry point for every artifact model of Fig. 2: base functions (least squares) and the two MLP recipes."""
+"""One entry point for every artifact model of Fig. 2: base functions (least squares) and the two MLP recipes.
+
+The least squares models are the paper's base functions and ours beside eq. 1 (the free-width EMG,
+base_functions.LEAST_SQUARES).
+"""
 
 from __future__ import annotations
 
 import numpy as np
 
-from poseintegrity.artifact_models.base_functions import BASE_FUNCTIONS
+from poseintegrity.artifact_models.base_functions import LEAST_SQUARES
 from poseintegrity.artifact_models.fitted import FittedModel
 from poseintegrity.artifact_models.mlp import DISTINCT_THETA, fit_mlp
 from poseintegrity.artifact_models.params import FitParams
 
 MLP_RECIPES = {"mlp_scratch": False, "mlp_pretrained": True}  # name -> pretrain on the EMG curve?
-MODEL_NAMES: tuple[str, ...] = (*BASE_FUNCTIONS, *MLP_RECIPES)
+MODEL_NAMES: tuple[str, ...] = (*LEAST_SQUARES, *MLP_RECIPES)
 
 
 def distinct_theta_needed(name: str) -> int:
     """Fewest distinct theta (stops) model ``name`` can be fitted to: its parameter count for a base function
-    (eq. 1 has 3), 2 for the MLP recipes; with fewer its fit is a "fallback" (fitted.py)."""
-    return len(BASE_FUNCTIONS[name].param_names) if name in BASE_FUNCTIONS else DISTINCT_THETA
+    (eq. 1 has 3, the free-width EMG 4), 2 for the MLP recipes; with fewer its fit is a "fallback" (fitted.py)."""
+    return len(LEAST_SQUARES[name].param_names) if name in LEAST_SQUARES else DISTINCT_THETA
 
 
 def fit_model(
@@ -35,8 +39,8 @@ def fit_model(
     input by it and puts its artificial points there
     rng : seeds the MLP weights (unused by base functions)
     """
-    if name in BASE_FUNCTIONS:
-        return BASE_FUNCTIONS[name].fit(theta, n_inliers, theta_end=theta_end, max_nfev=params.max_nfev)
+    if name in LEAST_SQUARES:
+        return LEAST_SQUARES[name].fit(theta, n_inliers, theta_end=theta_end, max_nfev=params.max_nfev)
     if name in MLP_RECIPES:
         return fit_mlp(theta, n_inliers, theta_end=theta_end, mlp=params.mlp, rng=rng, pretrain=MLP_RECIPES[name])
     raise ValueError(f"unknown artifact model {name!r}; expected one of {MODEL_NAMES}")

@@ -14,8 +14,8 @@ from pydantic import Field, ValidationInfo, model_validator
 from poseintegrity.schema import KeyRule, Seed, Section, distinct
 
 ModelName = Literal[
-    "emg", "exponential", "gaussian", "logistic", "power_law", "mlp_scratch", "mlp_pretrained"
-]
+    "emg", "exponential", "gaussian", "logistic", "power_law", "emg_free_width", "mlp_scratch", "mlp_pretrained"
+]  # emg_free_width: ours, eq. 1 with a fitted Gaussian width (base_functions.py)
 ITERATIONS = 100_000  # upper bound of every iteration / evaluation budget: a typo, not a budget, beyond it
 
 
@@ -43,7 +43,8 @@ class FitParams(Section):
     """Stage 03: fit artifact models f: theta -> n_inliers and run the Fig. 2 experiment."""
 
     models: distinct(ModelName) = Field(min_length=1, description="artifact models compared in Fig. 2")
-    k_min: int = Field(ge=2, le=100, description="fewest stops (from the start) used for a fit")
+    k_min: int = Field(ge=2, le=100, description="fewest stops (from the start) used for a fit; a model needing more"
+                                                 " (models.distinct_theta_needed) joins Fig. 2 at its own count")
     k_max: int | None = Field(ge=2, le=100, description="most stops used for a fit; null = all stops")
     max_nfev: int = Field(ge=10, le=ITERATIONS, description="least squares evaluation budget per base-function fit")
     seed: Seed = Field(description="seed of every random draw of the stage (MLP initial weights)")
@@ -56,14 +57,19 @@ class FitParams(Section):
         if self.k_max is not None and self.k_max < self.k_min:
             raise KeyRule("k_max", f"must be null or >= k_min ({self.k_min}), got {self.k_max}")
         needs = {name: distinct_theta_needed(name) for name in self.models}
-        hardest = max(needs, key=needs.get)
-        if self.k_min < needs[hardest]:
-            raise KeyRule("k_min", f"must be >= {needs[hardest]}: model {hardest!r} cannot be fitted to fewer stops "
-                                   f"(every fit would fall back to a line), got {self.k_min}")
+        easiest = min(needs, key=needs.get)
+        if self.k_min < needs[easiest]:
+            raise KeyRule("k_min", f"must be >= {needs[easiest]}: no model can be fitted to fewer stops (model "
+                                   f"{easiest!r} needs the fewest), got {self.k_min}")
         protocol = (info.context or {}).get("protocol")  # the headline RMSE is taken at its sampled stops
         stops = (protocol.sampled_stops.arc, protocol.sampled_stops.line) if protocol else (self.k_min,)
         if min(stops) < self.k_min:
             raise KeyRule("k_min", f"must be <= protocol.sampled_stops ({min(stops)}), got {self.k_min}")
+        for index, name in enumerate(self.models):
+            if protocol is not None and needs[name] > min(stops):
+                raise KeyRule(f"models.{index}", f"model {name!r} needs {needs[name]} stops, more than "
+                                                 f"protocol.sampled_stops gives ({min(stops)}): it would have no "
+                                                 f"headline RMSE")
         if self.k_max is not None and max(stops) > self.k_max:
             raise KeyRule("k_max", f"must be null or >= protocol.sampled_stops ({max(stops)}), got {self.k_max}")
         return self

@@ -5,6 +5,7 @@
     metrics.py      SPL (eq. 3), R_i (eq. 4), SPL vs R_i curves, max mean SPL at zero incursion (Tables I-III)
     sweeps.py       the whole operating-point sweep over datasets, predictors, tolerances, PnP methods (V)
     loso.py         n_t from a target incursion rate by leave-one-scene-out cross-validation (VI, future work), pooled
+    tails.py        ours: the arcs whose long range theta_p overshoots theta_a at every n_t (eq. 1's long tail)
     uncertainty.py  a prediction interval on theta_p (fit covariance or bootstrap) and its lower bound
     supervisor.py   NextStepSupervisor: the next-step predictor as a component of a robot loop
 """
@@ -27,9 +28,11 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "next_step_stops", "relative_thresholds", "static_baseline",
         ],
         "supervisor": ["Decision", "NextStepSupervisor"],
+        "tails": ["TAIL_PREDICTORS", "TailFit", "overshooting_arcs", "tail_fits", "tail_metrics"],
         "sweeps": [
-            "FITTED_PREDICTORS", "PAPER_PREDICTORS", "RELATIVE_PREDICTORS", "attach_envelopes", "best_table",
-            "fit_status_shares", "headline_metrics", "live_trials", "predict_dataset", "sweep", "with_pnp_variants",
+            "FITTED_PREDICTORS", "FREE_WIDTH_PREDICTORS", "PAPER_PREDICTORS", "RELATIVE_PREDICTORS",
+            "attach_envelopes", "best_table", "fit_status_shares", "headline_metrics", "live_trials",
+            "predict_dataset", "sweep", "with_pnp_variants",
         ],
         "uncertainty": ["Interval", "bootstrap_interval", "covariance_interval", "prediction_interval"],
     },

@@ -28,6 +28,12 @@ class PredictorModels(Section):
     long_range: ModelName = Field(description="long range predictor (paper: eq. 1, the EMG)")
     next_step: ModelName = Field(description="next-step predictor (paper: the EMG)")
     mlp: ModelName = Field(description="the MLP baseline of IV-A (paper: the EMG-pretrained, fine-tuned MLP)")
+    long_range_free_width: ModelName = Field(
+        description="ours, beside the paper's: the long range predictor on a second model (the free-width EMG)"
+    )
+    next_step_free_width: ModelName = Field(
+        description="ours, beside the paper's: the next-step predictor on a second model (the free-width EMG)"
+    )
 
 
 class UncertaintyParams(Section):
@@ -65,11 +71,19 @@ class PredictParams(Section):
         " choice; first = headline"
     )
     uncertainty: UncertaintyParams
+    tail_n_t_max: int = Field(
+        ge=1, description="the tail diagnosis: an arc whose long range theta_p exceeds theta_a at every swept n_t up"
+        " to this one, one of n_t_min .. n_t_max"
+    )
+    tail_n_t_shown: distinct(Annotated[int, Field(ge=1)]) = Field(
+        min_length=1, description="thresholds at which the tail diagnosis shows theta_p, each one of n_t_min .."
+        " n_t_max"
+    )
     seed: Seed = Field(description="seed of every random draw of the stage (MLP weights, bootstrap)")
 
     @model_validator(mode="after")
     def _check(self, info: ValidationInfo) -> PredictParams:
-        from poseintegrity.artifact_models.models import BASE_FUNCTIONS, distinct_theta_needed  # no import cycle
+        from poseintegrity.artifact_models.models import LEAST_SQUARES, distinct_theta_needed  # no import cycle
 
         protocol = (info.context or {}).get("protocol")
         for key in ("tolerance_fig6_fig7", "live_tolerance"):
@@ -81,6 +95,13 @@ class PredictParams(Section):
         if not self.n_t_min <= self.live_n_t <= self.n_t_max:
             raise KeyRule("live_n_t", f"must be one of the swept thresholds n_t_min .. n_t_max ({self.n_t_min} .. "
                                       f"{self.n_t_max}), got {self.live_n_t}")
+        if not self.n_t_min <= self.tail_n_t_max <= self.n_t_max:
+            raise KeyRule("tail_n_t_max", f"must be one of the swept thresholds n_t_min .. n_t_max ({self.n_t_min} "
+                                          f".. {self.n_t_max}), got {self.tail_n_t_max}")
+        for index, n_t in enumerate(self.tail_n_t_shown):
+            if not self.n_t_min <= n_t <= self.n_t_max:
+                raise KeyRule(f"tail_n_t_shown.{index}", f"must be one of the swept thresholds n_t_min .. n_t_max "
+                                                         f"({self.n_t_min} .. {self.n_t_max}), got {n_t}")
         if self.relative_max < self.relative_min:
             raise KeyRule("relative_max", f"must be >= relative_min ({self.relative_min}), got {self.relative_max}")
         steps = (self.relative_max - self.relative_min) / self.relative_step
@@ -93,9 +114,9 @@ class PredictParams(Section):
             if fewest is not None and distinct_theta_needed(model) > fewest:
                 raise KeyRule(f"models.{predictor}", f"model {model!r} needs {distinct_theta_needed(model)} stops, "
                                                      f"more than protocol.sampled_stops gives ({fewest})")
-        if self.uncertainty.method == "covariance" and self.models.long_range not in BASE_FUNCTIONS:
+        if self.uncertainty.method == "covariance" and self.models.long_range not in LEAST_SQUARES:
             raise KeyRule("uncertainty.method", f"covariance needs a least squares long_range model (one of "
-                                                f"{sorted(BASE_FUNCTIONS)}), got {self.models.long_range!r}: use "
+                                                f"{sorted(LEAST_SQUARES)}), got {self.models.long_range!r}: use "
                                                 f"bootstrap")
         return self
 

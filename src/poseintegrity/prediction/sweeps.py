@@ -6,13 +6,14 @@
     attach_envelopes  joins the actual envelopes theta_a per tolerance (checked against the protocol) and adds SPL
                       (eq. 3), incursion (eq. 4)
     live_trials       the simulated live trials (V-C): next-step supervision at one fixed n_t vs the static baseline
-    headline_metrics  the keys of ``reports/metrics/predictors.json``
+    headline_metrics  the keys of ``reports/metrics/predictors.json`` (with the tail diagnosis of :mod:`.tails`)
 
 Predictors (column ``predictor``): "long_range", "long_range_lower" (stops on the lower bound of the
 prediction interval, :mod:`.uncertainty`), "mlp", "next_step", "static", and beyond the paper
 "long_range_relative" / "next_step_relative", whose operating point is n_t as a fraction of the dataset's mean n_i
-at the first stop (the same fits as "long_range" / "next_step"). Only "long_range" and "static" run on PnP methods
-other than ``protocol.pnp_method`` (Fig. 6).
+at the first stop (the same fits as "long_range" / "next_step"), and "long_range_free_width" /
+"next_step_free_width", the same predictors on a second artifact model (``predict.models``: the free-width EMG).
+Only "long_range" and "static" run on PnP methods other than ``protocol.pnp_method`` (Fig. 6).
 
 Every row says how its theta_p was found (``status``, predictors.py) and what the fit behind it was worth
 (``fit_status``: ok / at_bound / non_physical / fallback, artifact_models/fitted.py; "no_fit" for the static
@@ -37,12 +38,14 @@ from poseintegrity.prediction.params import PredictParams
 from poseintegrity.prediction.predictors import (
     NO_FIT,
     Boundaries,
+    LongRange,
     fit_rng,
     long_range,
     next_step,
     relative_thresholds,
     static_baseline,
 )
+from poseintegrity.prediction.tails import tail_metrics
 from poseintegrity.prediction.uncertainty import prediction_interval
 from poseintegrity.protocol import ProtocolParams
 
@@ -52,7 +55,10 @@ COLUMNS = [
 ]  # fmt: skip
 PAPER_PREDICTORS = ("static", "long_range", "mlp", "next_step")  # the keys of predictors.json
 RELATIVE_PREDICTORS = ("long_range_relative", "next_step_relative")  # beyond the paper
-FITTED_PREDICTORS = ("long_range", "long_range_lower", "mlp", "next_step", *RELATIVE_PREDICTORS)
+FREE_WIDTH_PREDICTORS = ("long_range_free_width", "next_step_free_width")  # ours: on the free-width EMG
+FITTED_PREDICTORS = ("long_range", "long_range_lower", "mlp", "next_step", *RELATIVE_PREDICTORS,
+                     *FREE_WIDTH_PREDICTORS)  # fmt: skip
+PAPER_COUNTERPART = {"long_range_free_width": "long_range", "next_step_free_width": "next_step"}  # same predictor
 CONSERVATIVE_HIGH = {"static": False}  # a larger operating point is more conservative for n_t, not for a size
 OPERATING_POINT_KEY = {"static": "best_size", "long_range_relative": "best_fraction",
                        "next_step_relative": "best_fraction"}  # predictors.json name of the best operating point
@@ -70,6 +76,11 @@ def _rows(
         },
         columns=COLUMNS,
     )  # fmt: skip
+
+
+def _fit_of(answer: LongRange) -> tuple[str, str]:
+    """(fit_status, reason) of a long range answer; NO_FIT when there were too few stops to fit."""
+    return (answer.fitted.status, answer.fitted.reason) if answer.fitted else (NO_FIT, "too few stops")
 
 
 def _split(values, n: int) -> tuple:
@@ -95,7 +106,7 @@ def predict_dataset(
     tables = [_rows("static", "", method, series, sizes, static_baseline(sizes), NO_FIT, "no fit: one size for all")]
     answer = long_range(series, k, models.long_range, both, fit, fit_rng(predict.seed, method, series, k), predict.n_grid)
     absolute, relative = _split(answer.prediction, n_t.size)
-    fit_status, reason = (answer.fitted.status, answer.fitted.reason) if answer.fitted else (NO_FIT, "too few stops")
+    fit_status, reason = _fit_of(answer)
     tables.append(_rows("long_range", models.long_range, method, series, n_t, absolute, fit_status, reason))
     if method != protocol.pnp_method:  # Fig. 6: the long range predictor alone on the other PnP methods
         return pd.concat(tables, ignore_index=True)
@@ -111,9 +122,9 @@ def predict_dataset(
     lower = Boundaries(interval.lower, np.where(no_interval, "no_interval", absolute.status))
     lower_reason = interval.reason if fit_status == OK else f"{reason}; interval: {interval.reason}"
     tables.append(_rows("long_range_lower", models.long_range, method, series, n_t, lower, fit_status, lower_reason))
-    mlp = long_range(series, k, models.mlp, n_t, fit, fit_rng(predict.seed, method, series, k), predict.n_grid)
-    mlp_status, mlp_reason = (mlp.fitted.status, mlp.fitted.reason) if mlp.fitted else (NO_FIT, "too few stops")
-    tables.append(_rows("mlp", models.mlp, method, series, n_t, mlp.prediction, mlp_status, mlp_reason))
+    for predictor, model in (("mlp", models.mlp), ("long_range_free_width", models.long_range_free_width)):
+        other = long_range(series, k, model, n_t, fit, fit_rng(predict.seed, method, series, k), predict.n_grid)
+        tables.append(_rows(predictor, model, method, series, n_t, other.prediction, *_fit_of(other)))
     step = next_step(series, k, models.next_step, both, fit, predict.seed, method, predict.n_grid)
     step_absolute, step_relative = _split(step.prediction, n_t.size)
     status_absolute, status_relative = _split(step.fit_status, n_t.size)
@@ -122,6 +133,9 @@ def predict_dataset(
                         reason_absolute))  # fmt: skip
     tables.append(_rows("next_step_relative", models.next_step, method, series, fractions, step_relative,
                         status_relative, reason_relative))  # fmt: skip
+    free = next_step(series, k, models.next_step_free_width, n_t, fit, predict.seed, method, predict.n_grid)
+    tables.append(_rows("next_step_free_width", models.next_step_free_width, method, series, n_t, free.prediction,
+                        free.fit_status, free.fit_reason))  # fmt: skip
     return pd.concat(tables, ignore_index=True)
 
 
@@ -266,8 +280,10 @@ def headline_metrics(
     pnp.<method>.{max_mean_spl_zero_incursion, static_max_mean_spl_zero_incursion} (Fig. 6);
     loso.<predictor>.<tolerance>.{heldout_incursion_rate, heldout_mean_spl, ...} at the first target rate;
     live.{n_t, incursions, n_trials, envelope_share, n_flagged_fits, static_*} (V-C); fit_status.<predictor>.{n_rows,
-    ok, at_bound, non_physical, fallback, no_fit} (:func:`fit_status_shares`). NaN where there is no value
-    (:func:`poseintegrity.report.metrics.write_metrics` writes it as null).
+    ok, at_bound, non_physical, fallback, no_fit} (:func:`fit_status_shares`). Ours, beside the paper's keys:
+    <free-width predictor> as the others, with relative_improvement_vs_<its eq. 1 counterpart>;
+    tails.<long_range | long_range_free_width>.<tolerance>.{n_overshooting, datasets} (:func:`.tails.tail_metrics`).
+    NaN where there is no value (:func:`poseintegrity.report.metrics.write_metrics` writes it as null).
     """
     best = best_table(curves)
 
@@ -279,7 +295,7 @@ def headline_metrics(
     tolerances = sorted(table["tolerance"].unique())
     static_mean = float(np.mean([get("static", "arc", t)[0] for t in tolerances]))
     metrics: dict = {}
-    for predictor in (*PAPER_PREDICTORS, "long_range_lower", *RELATIVE_PREDICTORS):
+    for predictor in (*PAPER_PREDICTORS, "long_range_lower", *RELATIVE_PREDICTORS, *FREE_WIDTH_PREDICTORS):
         point_key = OPERATING_POINT_KEY.get(predictor, "best_n_t")
         entry: dict = {}
         for tolerance in tolerances:
@@ -297,6 +313,10 @@ def headline_metrics(
     metrics["next_step"]["relative_improvement_vs_long_range"] = relative_improvement(
         mean["next_step"], mean["long_range"]
     )  # Table I: +7.4 % over the MLP; V-B: +9.8 % over the long range predictor
+    for ours, paper in PAPER_COUNTERPART.items():  # ours on the free-width EMG vs the same predictor on eq. 1
+        metrics[ours][f"relative_improvement_vs_{paper}"] = relative_improvement(
+            metrics[ours]["mean_max_mean_spl_zero_incursion"], metrics[paper]["mean_max_mean_spl_zero_incursion"]
+        )
     tol = predict.tolerance_fig6_fig7
     metrics["straight_line"] = {
         "tolerance": tol,
@@ -323,5 +343,6 @@ def headline_metrics(
         "static_envelope_share": float(live["static_share"].mean()),
     }  # fmt: skip
     metrics["fit_status"] = fit_status_shares(table)
+    metrics["tails"] = tail_metrics(table, predict, protocol)
     return metrics
 

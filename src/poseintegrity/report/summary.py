@@ -40,8 +40,8 @@ SECTIONS = {
 FIT_STATUS_LABELS = {"ok": "ok", "at_bound": "at a bound", "non_physical": "non-physical",
                      "fallback": "fallen back to a line"}  # the statuses of artifact_models/fitted.py
 MODEL_LABELS = {"emg": "EMG (eq. 1)", "exponential": "exponential", "gaussian": "Gaussian", "logistic": "logistic",
-                "power_law": "power law", "mlp_scratch": "MLP, samples only",
-                "mlp_pretrained": "MLP, EMG-pretrained + fine-tuned"}
+                "power_law": "power law", "emg_free_width": "ours: EMG with a fitted Gaussian width",
+                "mlp_scratch": "MLP, samples only", "mlp_pretrained": "MLP, EMG-pretrained + fine-tuned"}
 
 
 def _fit_status_rows() -> list[Headline]:
@@ -115,6 +115,42 @@ def _predictor_rows() -> list[Headline]:
                           else f"... {label}", fmt="{:.1%}")
                  for status, label in FIT_STATUS_LABELS.items()]
     rows.append(Headline("predictors", "live.n_flagged_fits", "simulated live trials that went by a flagged fit"))
+    return rows + _free_width_rows()
+
+
+FREE_WIDTH_LABELS = {"long_range_free_width": ("long range", "long_range"),
+                     "next_step_free_width": ("next step", "next_step")}  # ours -> (name, the paper's predictor)
+
+
+def _free_width_rows() -> list[Headline]:
+    """Ours, not the paper's: the predictors on the free-width EMG beside theirs on eq. 1, and the tail diagnosis (the
+    arcs whose long range theta_p overshoots theta_a at every n_t <= predict.tail_n_t_max)."""
+    rows = []
+    for tolerance in paper.TOLERANCES:
+        label = paper.TOLERANCE_LABELS[tolerance]
+        for predictor, (name, _) in FREE_WIDTH_LABELS.items():
+            rows += [
+                Headline("predictors", f"{predictor}.{tolerance}.max_mean_spl_zero_incursion",
+                         f"ours: {name} on the free-width EMG, {label}: max mean SPL at zero incursion (deg)"),
+                Headline("predictors", f"{predictor}.{tolerance}.best_n_t", "... its threshold n_t"),
+            ]
+    for predictor, (name, theirs) in FREE_WIDTH_LABELS.items():
+        rows.append(Headline("predictors", f"{predictor}.relative_improvement_vs_{theirs}",
+                             f"ours: {name} on the free-width EMG over {name} on eq. 1 (mean of both tolerances)",
+                             fmt="{:+.1%}"))
+        rows += [Headline("predictors", f"fit_status.{predictor}.{status}",
+                          f"ours: {name} on the free-width EMG: share of rows on a fit {label}" if status == "ok"
+                          else f"... {label}", fmt="{:.1%}")
+                 for status, label in FIT_STATUS_LABELS.items()]
+    for tolerance in paper.TOLERANCES:
+        label = paper.TOLERANCE_LABELS[tolerance]
+        for predictor, model in (("long_range", "eq. 1"), ("long_range_free_width", "the free-width EMG")):
+            rows += [
+                Headline("predictors", f"tails.{predictor}.{tolerance}.n_overshooting",
+                         f"ours: arcs whose long range theta_p on {model} overshoots theta_a at every n_t up to "
+                         f"predict.tail_n_t_max, {label}"),
+                Headline("predictors", f"tails.{predictor}.{tolerance}.datasets", "... which arcs"),
+            ]
     return rows
 
 
@@ -181,6 +217,7 @@ HEADLINES: list[Headline] = [
     Headline("fits", "rmse_k4.gaussian", "Gaussian"),
     Headline("fits", "rmse_k4.logistic", "logistic"),
     Headline("fits", "rmse_k4.power_law", "power law"),
+    Headline("fits", "rmse_k4.emg_free_width", "ours, not the paper's: EMG with a fitted Gaussian width"),
     Headline("fits", "rmse_k4.mlp_scratch", "MLP, samples only", "'very high RMSE'"),
     Headline("fits", "rmse_k4.mlp_pretrained", "MLP, EMG-pretrained + fine-tuned", "competitive with least squares"),
     *_fit_status_rows(),
@@ -250,6 +287,8 @@ def _fmt(value, fmt: str = "{:.4g}") -> str:
         return "none"
     if isinstance(value, float):
         return fmt.format(value)
+    if isinstance(value, list):
+        return ", ".join(str(item) for item in value) or "none"
     return str(value)
 
 
