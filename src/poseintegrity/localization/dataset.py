@@ -1,15 +1,19 @@
 """Reader of the rendered datasets written by stage 01 (``data_dir/datasets/``), checked on read.
 
-Layout: ``index.parquet`` (one row per dataset) and per dataset a folder with ``meta.json`` (camera K, image size,
-ArUco board, model images/masks/poses) and ``frames.parquet`` (one row per image with its exact poses). Image paths
-in the tables are relative to the dataset folder (or, failing that, to ``data_dir``).
+Layout: ``index.parquet`` (one row per dataset) and per dataset a folder with ``meta.json`` (world, trajectory,
+ArUco board, model images and masks, the model pair's relative pose), ``camera.yaml`` (the calibrated camera: K,
+distortion, image size; :func:`poseintegrity.lens.read_camera_yaml`) and ``frames.parquet`` (one row per image with
+its exact poses, a diagnostic). Image paths in the tables are relative to the dataset folder (or, failing that, to
+``data_dir``).
 
 What is checked before any work, each failure a :class:`DatasetError` naming the dataset and the file:
 
 - ``index.parquet`` readable, with a ``dataset`` and a ``path`` column; no dataset or folder named twice; every
   folder it names exists; every dataset folder on disk is in it (a folder left out would be skipped silently);
 - ``meta.json`` readable and holding what stages 02 and 05 read (:class:`Meta`): the dataset's name as in the
-  index, the image size, a finite camera matrix K, the board, two model images, masks and rigid finite poses;
+  index, its world and trajectory, the board, two model images, masks and a rigid finite relative pose;
+- ``camera.yaml`` readable, every field valid (positive focal lengths, the plumb_bob model, a lens that does not
+  fold the image);
 - ``frames.parquet`` readable, with its columns, one row per (stop, image) and per file, finite stop positions,
   and every image file present.
 
@@ -28,6 +32,8 @@ import numpy as np
 import pandas as pd
 import pyarrow
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
+
+from poseintegrity.lens import Camera, CameraFileError, read_camera_yaml
 
 INDEX_COLUMNS = ("dataset", "path")
 FRAME_TABLE_COLUMNS = ("dataset", "stop", "image", "theta_deg", "x_mm", "file", "T_cam_board")
@@ -98,25 +104,8 @@ class Meta(_Read):
     dataset: str = Field(min_length=1)
     world: str = Field(min_length=1, description="the world the dataset belongs to (main, validation, ...)")
     trajectory: Literal["arc", "line"]
-    image_size: tuple[int, int] = Field(description="width, height in px of every image of the dataset")
-    K: tuple[tuple[float, float, float], tuple[float, float, float], tuple[float, float, float]]
     board: BoardMeta
     model: ModelMeta
-
-    @field_validator("image_size")
-    @classmethod
-    def _positive(cls, size: tuple[int, int]) -> tuple[int, int]:
-        if min(size) < 1:
-            raise ValueError(f"width and height are positive, got {list(size)}")
-        return size
-
-    @field_validator("K")
-    @classmethod
-    def _camera_matrix(cls, K: tuple) -> tuple:
-        K_ = np.asarray(K)
-        if not (K_[0, 0] > 0 and K_[1, 1] > 0 and K_[1, 0] == 0 and np.array_equal(K_[2], [0.0, 0.0, 1.0])):
-            raise ValueError(f"expected [[fx, s, cx], [0, fy, cy], [0, 0, 1]] with fx, fy > 0, got {K_.tolist()}")
-        return K
 
 
 @dataclass(frozen=True)
@@ -124,15 +113,24 @@ class Dataset:
     """One rendered dataset, checked (module docstring).
 
     folder : its folder; meta : ``meta.json`` as read; frames : ``frames.parquet`` (sorted by stop, image)
-    K : (3, 3) float, pixels; image_size : (width, height), px
+    camera : the calibrated camera of ``camera.yaml`` (K, distortion, image size)
     """
 
     data_dir: Path
     folder: Path
     meta: dict[str, Any]
     frames: pd.DataFrame
-    K: np.ndarray
-    image_size: tuple[int, int]
+    camera: Camera
+
+    @property
+    def K(self) -> np.ndarray:
+        """(3, 3) px: the pinhole camera every undistorted pixel position belongs to."""
+        return self.camera.K
+
+    @property
+    def image_size(self) -> tuple[int, int]:
+        """(width, height), px, of every image of the dataset."""
+        return self.camera.width, self.camera.height
 
     @property
     def name(self) -> str:
@@ -240,7 +238,10 @@ def load_dataset(data_dir: str | Path, folder: str | Path, name: str | None = No
     frames = _read_parquet(frames_path, f"dataset {name}: ")
     _check_frames(frames, frames_path, name)
     frames = frames.sort_values(["stop", "image"], ignore_index=True)
-    width, height = meta["image_size"]
-    dataset = Dataset(data_dir, folder, meta, frames, np.asarray(meta["K"], dtype=np.float64), (int(width), int(height)))
+    try:
+        camera = read_camera_yaml(folder / "camera.yaml")
+    except CameraFileError as error:
+        raise DatasetError(f"dataset {name}: {error}") from None
+    dataset = Dataset(data_dir, folder, meta, frames, camera)
     dataset.check_images()
     return dataset

@@ -1,12 +1,13 @@
 """What one frame gives before any PnP method runs, computed once and cached beside its SIFT features.
 
 Per frame, stages 02 and 05 need the same method-independent evidence: the image checked against its dataset's
-meta.json (8-bit gray, ``image_size``), its CLAHE + SIFT features (IV-C), the ratio-test 2D-3D correspondences
-to M_t (III-B) and the ArUco board pose (the ground truth of IV-C). Stage 02 computes them and stores them in one
+camera (8-bit gray, camera.yaml's size), its CLAHE + SIFT features (IV-C), the ratio-test 2D-3D correspondences
+to M_t (III-B), their image points undistorted by the calibrated lens, and the ArUco board pose (the ground truth of
+IV-C). Stage 02 computes them and stores them in one
 small ``.npz`` per frame (``<features_dir>/<dataset>/images/<image>.evidence.npz``); stage 05, which runs the other
 PnP methods on the same frames, reads them back instead of decoding the image, loading its descriptors,
 matching them and detecting the board again. The entry's key hashes everything the evidence depends on (image
-bytes, CLAHE/SIFT settings, the ratio, M_t itself, the board, K, the image size), so an entry is used only when
+bytes, CLAHE/SIFT settings, the ratio, M_t itself, the board, the camera), so an entry is used only when
 recomputing it would give the same arrays; a frame image that fails its check is never cached (it is checked,
 and flagged, again).
 """
@@ -21,6 +22,7 @@ from typing import Any
 
 import numpy as np
 
+from poseintegrity.lens import Camera
 from poseintegrity.localization.features import (
     ImageReadError, cached_features, decode_gray, features_key, read_image_bytes, write_npz,
 )
@@ -30,7 +32,7 @@ from poseintegrity.localization.params import ExtractParams
 from poseintegrity.poses import NAN_POSE
 from poseintegrity.localization.target_model import TargetModel
 
-EVIDENCE_VERSION = 1  # bump when the cached content or its layout changes
+EVIDENCE_VERSION = 2  # bump when the cached content or its layout changes
 
 
 @dataclass(frozen=True)
@@ -39,7 +41,7 @@ class FrameEvidence:
 
     image_problem : why the image is unusable ("" if it is fine; then nothing else was computed)
     object_points : (k, 3) float64, M_t points of the k ratio-test matches, board frame, mm
-    image_points : (k, 2) float64, the frame's keypoints of those matches, px
+    image_points : (k, 2) float64, the frame's keypoints of those matches, undistorted (ideal pinhole px of K)
     n_keypoints : SIFT keypoints in the frame
     board : the ArUco board pose (ground truth)
     """
@@ -61,21 +63,22 @@ def model_digest(model: TargetModel) -> str:
     return hashlib.sha1(model.points.tobytes() + model.descriptors.tobytes()).hexdigest()
 
 
-def evidence_key(features_key_: str, digest: str, params: ExtractParams, board: dict[str, Any], K: np.ndarray,
-                 image_size: tuple[int, int]) -> str:
-    """Hash of what a frame's evidence depends on beyond its features: M_t, the ratio, the board, K, image size."""
+def evidence_key(features_key_: str, digest: str, params: ExtractParams, board: dict[str, Any], camera: Camera) -> str:
+    """Hash of what a frame's evidence depends on beyond its features: M_t, the ratio, the board, the camera."""
     settings = json.dumps([EVIDENCE_VERSION, features_key_, digest, params.ratio_test, board,
-                           np.asarray(K, np.float64).tolist(), list(image_size)], sort_keys=True)
+                           np.asarray(camera.K, np.float64).tolist(), np.asarray(camera.dist, np.float64).tolist(),
+                           [camera.width, camera.height]], sort_keys=True)
     return hashlib.sha1(settings.encode()).hexdigest()
 
 
-def correspondences(features, model: TargetModel, ratio: float) -> tuple[np.ndarray, np.ndarray]:
+def correspondences(features, model: TargetModel, ratio: float, camera: Camera) -> tuple[np.ndarray, np.ndarray]:
     """2D-3D correspondences of a frame: ratio-test matches of its descriptors to M_t (III-B).
 
-    Returns object points (k, 3, board frame, mm) and image points (k, 2, px).
+    Returns object points (k, 3, board frame, mm) and image points (k, 2), undistorted by ``camera`` (ideal pinhole
+    px of its K).
     """
     pairs = match_ratio_test(features.descriptors, model.descriptors, ratio)
-    return model.points[pairs[:, 1]], features.points[pairs[:, 0]].astype(np.float64)
+    return model.points[pairs[:, 1]], camera.undistort(features.points[pairs[:, 0]])
 
 
 def _load(path: Path, key: str) -> FrameEvidence | None:
@@ -91,24 +94,24 @@ def _load(path: Path, key: str) -> FrameEvidence | None:
 
 def frame_evidence(
     image_path: Path, features_path: Path, evidence_path: Path, model: TargetModel, digest: str,
-    board: dict[str, Any], K: np.ndarray, image_size: tuple[int, int], params: ExtractParams, name: str,
+    board: dict[str, Any], camera: Camera, params: ExtractParams, name: str,
 ) -> FrameEvidence:
     """The evidence of one frame: from ``evidence_path`` when its key matches, else computed (the SIFT features
     from ``features_path``, the SIFT cache) and stored. A missing file raises :class:`ImageReadError`; an image that
-    cannot be decoded or is not 8-bit gray of ``image_size`` (width, height) gives :func:`bad_image` evidence,
+    cannot be decoded or is not 8-bit gray of the camera's size gives :func:`bad_image` evidence,
     naming the file by ``name`` (as frames.parquet does: the table is the same whichever folder holds the data)."""
     data = read_image_bytes(image_path)
     features_key_ = features_key(data, params.clahe, params.sift)
-    key = evidence_key(features_key_, digest, params, board, K, image_size)
+    key = evidence_key(features_key_, digest, params, board, camera)
     if evidence_path.exists() and (cached := _load(evidence_path, key)) is not None:
         return cached
     try:
-        image = decode_gray(data, name, image_size)
+        image = decode_gray(data, name, (camera.width, camera.height))
     except ImageReadError as error:
         return bad_image(str(error))
     features = cached_features(image_path, features_path, params.clahe, params.sift, data=data, image=image)
-    object_points, image_points = correspondences(features, model, params.ratio_test)
-    aruco = board_pose(image, make_board(board), K)
+    object_points, image_points = correspondences(features, model, params.ratio_test, camera)
+    aruco = board_pose(image, make_board(board), camera)
     write_npz(evidence_path, key=key, object_points=object_points, image_points=image_points,
               n_keypoints=features.n_keypoints, board_T_cam_board=aruco.T_cam_board,
               board_n_markers=aruco.n_markers, board_status=aruco.status)

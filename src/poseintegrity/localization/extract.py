@@ -5,7 +5,7 @@ Before any work: the index, each dataset's meta.json and frames.parquet are chec
 workers of the ``parallel`` section (:class:`~poseintegrity.parallel.Workers`):
 
 1. per dataset, M_t from the two model images (III-B); a model image or mask that is not the 8-bit gray image of
-   meta.json's ``image_size`` stops the stage naming it. M_t is stored beside the SIFT cache, and every frame task
+   camera.yaml's image size stops the stage naming it. M_t is stored beside the SIFT cache, and every frame task
    loads it from there once per worker process (a task carries its path, not its 1-2 MB of descriptors);
 2. per frame (one task, results in frame order): its evidence (:mod:`evidence`: image check, CLAHE + SIFT, ratio-test
    matches to M_t, ArUco board pose; cached, so stage 05 reuses stage 02's), then PnP-RANSAC per method ->
@@ -29,6 +29,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from poseintegrity.lens import Camera
 from poseintegrity.seeding import keyed_rng
 from poseintegrity.localization.dataset import Dataset, DatasetError, load_dataset, load_index, pose_problem
 from poseintegrity.localization.evidence import FrameEvidence, frame_evidence, model_digest
@@ -106,15 +107,14 @@ class FrameTask:
     evidence_path: Path
     model: StoredModel
     board: dict[str, Any]
-    K: np.ndarray
-    image_size: tuple[int, int]
+    camera: Camera
     methods: tuple[str, ...]
     params: ExtractParams
 
 
 def dataset_model(dataset: Dataset, params: ExtractParams, cache_dir: Path) -> TargetModel:
     """M_t of a dataset from its two model images (features cached like frames). Each image and mask must be the
-    8-bit gray image of meta.json's ``image_size``: :class:`~poseintegrity.localization.features.ImageReadError`
+    8-bit gray image of camera.yaml's size: :class:`~poseintegrity.localization.features.ImageReadError`
     naming the dataset and the file otherwise."""
     model = dataset.meta["model"]
     try:
@@ -126,12 +126,12 @@ def dataset_model(dataset: Dataset, params: ExtractParams, cache_dir: Path) -> T
         cached_features(dataset.path(name), cache_dir / "model" / f"{index}.npz", params.clahe, params.sift, image=image)
         for index, (name, image) in enumerate(zip(model["images"], images))
     )
-    anchor = board_pose(images[0], make_board(dataset.meta["board"]), dataset.K)  # IV-C: M_t in the board frame
+    anchor = board_pose(images[0], make_board(dataset.meta["board"]), dataset.camera)  # IV-C: M_t in the board frame
     if anchor.status != "ok":
         raise DatasetError(f"dataset {dataset.name}: the ArUco board is not found in model image "
                            f"{model['images'][0]} ({anchor.status}), so the target model cannot be placed in the "
                            f"board frame (IV-C)")
-    return build_target_model(features, masks, dataset.model_baseline(), anchor.T_cam_board, dataset.K,
+    return build_target_model(features, masks, dataset.model_baseline(), anchor.T_cam_board, dataset.camera,
                               params.ratio_test, params.model_max_reprojection_px)
 
 
@@ -163,7 +163,7 @@ def frame_rows(task: FrameTask) -> list[dict[str, Any]]:
     frame, model = task.frame, task.model
     evidence: FrameEvidence = frame_evidence(
         task.image_path, task.features_path, task.evidence_path, load_model(model.path, model.digest), model.digest,
-        task.board, task.K, task.image_size, task.params, frame["file"],
+        task.board, task.camera, task.params, frame["file"],
     )
     truth_problem = pose_problem(frame["T_cam_board"])
     T_cam_board = NAN_POSE if truth_problem else np.asarray(frame["T_cam_board"], dtype=np.float64).reshape(4, 4)
@@ -180,10 +180,11 @@ def frame_rows(task: FrameTask) -> list[dict[str, Any]]:
     for method in task.methods:
         if evidence.image_problem:
             T_est, artifacts = NAN_POSE.copy(), frame_artifacts(failed("bad_image"), evidence.object_points,
-                                                                evidence.image_points, task.K, 0, model.size)
+                                                                evidence.image_points, task.camera.K, 0,
+                                                                model.size)
         else:
             T_est, artifacts, pnp_status = localize(
-                evidence.object_points, evidence.image_points, evidence.n_keypoints, model.size, task.K, method,
+                evidence.object_points, evidence.image_points, evidence.n_keypoints, model.size, task.camera.K, method,
                 task.params, seed,
             )
         E_t_mm, E_r_deg = map(float, pose_errors(T_est, aruco.T_cam_board))  # IV-C: the board is the truth
@@ -213,8 +214,8 @@ def extract_datasets(
     tasks = [
         FrameTask(
             frame, dataset.path(frame["file"]), cache_dir / Path(frame["file"]).with_suffix(".npz"),
-            cache_dir / Path(frame["file"]).with_suffix(".evidence.npz"), model, dataset.meta["board"], dataset.K,
-            dataset.image_size, tuple(methods), params,
+            cache_dir / Path(frame["file"]).with_suffix(".evidence.npz"), model, dataset.meta["board"], dataset.camera,
+            tuple(methods), params,
         )
         for dataset, cache_dir, model in zip(datasets, cache_dirs, models)
         for frame in dataset.frames.assign(world=dataset.meta["world"], trajectory=dataset.meta["trajectory"])

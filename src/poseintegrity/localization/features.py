@@ -25,7 +25,7 @@ CACHE_VERSION = 1  # bump when the cached content or its layout changes
 
 class ImageReadError(DatasetError):
     """An image file of a dataset is missing, cannot be decoded, or is not what its meta.json says (an 8-bit gray
-    image of ``image_size``). Stops the stage for a model image or mask; a frame image is flagged instead."""
+    image of the camera's size). Stops the stage for a model image or mask; a frame image is flagged instead."""
 
 
 @dataclass(frozen=True)
@@ -67,7 +67,7 @@ def decode_gray(data: bytes, path: str | Path, size: tuple[int, int] | None = No
                              f"expected 8-bit gray")
     if size is not None and (image.shape[1], image.shape[0]) != tuple(size):
         raise ImageReadError(f"image file {path} is {image.shape[1]} x {image.shape[0]} px, its dataset's "
-                             f"meta.json image_size is {size[0]} x {size[1]} px")
+                             f"camera.yaml says {size[0]} x {size[1]} px")
     return image
 
 

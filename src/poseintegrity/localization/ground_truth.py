@@ -12,6 +12,7 @@ from typing import Any
 import cv2
 import numpy as np
 
+from poseintegrity.lens import Camera
 from poseintegrity.poses import NAN_POSE, pose_from_rvec_tvec
 
 
@@ -35,8 +36,9 @@ def make_board(board: dict[str, Any]) -> cv2.aruco.GridBoard:
     )
 
 
-def board_pose(image: np.ndarray, board: cv2.aruco.GridBoard, K: np.ndarray) -> BoardPose:
-    """Pose of the board in an 8-bit grayscale image (h, w); K (3, 3) pixels, no distortion.
+def board_pose(image: np.ndarray, board: cv2.aruco.GridBoard, camera: Camera) -> BoardPose:
+    """Pose of the board in an 8-bit grayscale image (h, w) of ``camera`` (its corners undistorted by the calibrated
+    lens, then solvePnP with its K).
 
     Needs at least one board marker (4 coplanar corners); otherwise a NaN pose with a status, never an error.
     """
@@ -51,7 +53,8 @@ def board_pose(image: np.ndarray, board: cv2.aruco.GridBoard, K: np.ndarray) -> 
         return BoardPose(NAN_POSE.copy(), 0, "board_not_detected")
     n_markers = len(object_points) // 4
     try:
-        found, rvec, tvec = cv2.solvePnP(object_points, image_points, np.asarray(K, np.float64), None)
+        ideal = camera.undistort(image_points.reshape(-1, 2))
+        found, rvec, tvec = cv2.solvePnP(object_points, ideal, np.asarray(camera.K, np.float64), None)
     except cv2.error:
         found = False
     if not found or not (np.all(np.isfinite(rvec)) and np.all(np.isfinite(tvec))):

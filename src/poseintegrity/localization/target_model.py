@@ -15,6 +15,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
+from poseintegrity.lens import Camera
 from poseintegrity.localization.features import Features
 from poseintegrity.localization.matching import match_ratio_test
 from poseintegrity.localization.pnp import reprojection_errors
@@ -62,7 +63,7 @@ def build_target_model(
     masks: tuple[np.ndarray, np.ndarray],
     T_cam1_cam0: np.ndarray,
     T_cam0_board: np.ndarray,
-    K: np.ndarray,
+    camera: Camera,
     ratio: float,
     max_reprojection_px: float,
 ) -> TargetModel:
@@ -72,14 +73,16 @@ def build_target_model(
     masks : (h, w) uint8 target masks of both images (nonzero = target)
     T_cam1_cam0 : (4, 4) camera 0 -> camera 1, mm: the model baseline as the robot reports it
     T_cam0_board : (4, 4) board -> camera 0, mm: the ArUco board's pose in model image 0
+    camera : the calibrated camera: keypoints are undistorted before any geometry (masks are looked up raw)
     A point is kept when it lies in front of both cameras, reprojects within ``max_reprojection_px`` in both
     images and its keypoints lie inside both masks. An empty model (no texture, no overlap) is returned
     as such; every frame then fails with ``too_few_matches``.
     """
-    K = np.asarray(K, dtype=np.float64)
+    K = np.asarray(camera.K, dtype=np.float64)
     pairs = match_ratio_test(features[0].descriptors, features[1].descriptors, ratio)
-    x0 = features[0].points[pairs[:, 0]].astype(np.float64)
-    x1 = features[1].points[pairs[:, 1]].astype(np.float64)
+    raw0 = features[0].points[pairs[:, 0]].astype(np.float64)
+    raw1 = features[1].points[pairs[:, 1]].astype(np.float64)
+    x0, x1 = camera.undistort(raw0), camera.undistort(raw1)
     X_cam0 = triangulate(K, T_cam1_cam0, x0, x1)
     finite = np.all(np.isfinite(X_cam0), axis=1)
     X_cam0 = np.where(finite[:, None], X_cam0, 0.0)
@@ -89,8 +92,8 @@ def build_target_model(
         finite
         & (error0 <= max_reprojection_px)
         & (error1 <= max_reprojection_px)
-        & _inside(masks[0], x0)
-        & _inside(masks[1], x1)
+        & _inside(masks[0], raw0)
+        & _inside(masks[1], raw1)
     )
     T_board_cam0 = np.linalg.inv(T_cam0_board)
     points = X_cam0[keep] @ T_board_cam0[:3, :3].T + T_board_cam0[:3, 3]

@@ -43,9 +43,11 @@ from poseintegrity.parallel import Workers
 from poseintegrity.poses import inverse, pose_matrix
 from poseintegrity.protocol import ProtocolParams
 from poseintegrity.scenes import catalog, optics, renderer, trajectories
-from poseintegrity.scenes.camera import Intrinsics
+from poseintegrity.lens import Camera, write_camera_yaml
+from poseintegrity.scenes.calibration_views import CalibrationSession, calibration_session
+from poseintegrity.scenes.camera import Intrinsics, true_camera
 from poseintegrity.scenes.foam import ReliefVolume
-from poseintegrity.scenes.params import BoneFoamParams, CaptureParams, GenerateParams
+from poseintegrity.scenes.params import BoneFoamParams, CameraParams, CaptureParams, GenerateParams
 from poseintegrity.scenes.ringdown import Exposure as RingExposure
 from poseintegrity.scenes.ringdown import RingDown, ring_down
 from poseintegrity.scenes.robot import PlacedRobot, Robot, accuracy, trip_path
@@ -60,6 +62,7 @@ IMAGE_PNG_FLAGS = [cv2.IMWRITE_PNG_STRATEGY, cv2.IMWRITE_PNG_STRATEGY_HUFFMAN_ON
 MASK_PNG_FLAGS = [cv2.IMWRITE_PNG_COMPRESSION, 3]
 MIN_TARGET_IN_VIEW = 0.5  # share of a target's vertices that must project inside the model images
 MIN_TARGET_AREA = 0.005  # share of the image its projected bounding box must cover (not a speck)
+CAMERA_NAME = "ids_u3_3060cp"  # camera.yaml's camera_name
 
 
 @dataclass(frozen=True)
@@ -344,23 +347,28 @@ def _rotation_warp(K: np.ndarray, rotation: np.ndarray, map_x: np.ndarray, map_y
         (H[1, 0] * map_x + H[1, 1] * map_y + H[1, 2]) / w).astype(np.float32)
 
 
-@lru_cache(maxsize=1)
-def _identity_maps(width: int, height: int) -> tuple[np.ndarray, np.ndarray]:
-    x, y = np.meshgrid(np.arange(width, dtype=np.float32), np.arange(height, dtype=np.float32))
-    return x, y
+@lru_cache(maxsize=2)
+def _lens(camera: CameraParams) -> Camera:
+    """The true camera with its canvas and sensor maps computed once per process."""
+    lens = true_camera(camera)
+    lens.sensor_maps  # noqa: B018 (computed here, once)
+    return lens
 
 
 def take_shot(params: GenerateParams, root: Path, shot: Shot) -> None:
-    """Render ``shot`` and write its images (and masks) into the datasets' partial folders under ``root``."""
+    """Render ``shot`` on the lens' ideal canvas, blur it by the lens and the depth of field, and for every image
+    turn it by the image's ring-down path, distort it onto the sensor and expose it; write the images (and masks)
+    into the datasets' partial folders under ``root``."""
     scene_world = world(params, shot.scene_index)
-    cam = Intrinsics.from_params(params.camera)
-    frame = renderer.render(scene_world.geometry, cam.K, cam.width, cam.height, inverse(shot.T_world_cam))
+    lens = _lens(params.camera)
+    K_canvas, width, height = lens.canvas
+    frame = renderer.render(scene_world.geometry, K_canvas, width, height, inverse(shot.T_world_cam))
     irradiance = optics.lens(frame.radiance, frame.depth_mm, shot.focus_mm, params.sensor.blur_sigma_px, params.camera)
-    map_x, map_y = _identity_maps(cam.width, cam.height)
+    map_x, map_y = lens.sensor_maps
     for exposure in shot.exposures:
-        sensor = np.zeros_like(irradiance)
+        sensor = np.zeros(map_x.shape, np.float32)
         for rotation in exposure.rotations:  # the exposure integrates the view along the ring-down's path
-            sensor += cv2.remap(irradiance, *_rotation_warp(cam.K, rotation, map_x, map_y), cv2.INTER_LINEAR,
+            sensor += cv2.remap(irradiance, *_rotation_warp(K_canvas, rotation, map_x, map_y), cv2.INTER_LINEAR,
                                 borderMode=cv2.BORDER_REPLICATE)
         sensor /= len(exposure.rotations)
         image = renderer.expose(sensor, params.sensor, keyed_rng(params.seed, "image", *exposure.rng_key))
@@ -368,7 +376,7 @@ def take_shot(params: GenerateParams, root: Path, shot: Shot) -> None:
         if exposure.mask is not None:
             middle = exposure.rotations[len(exposure.rotations) // 2]
             target = np.isin(frame.object_index, scene_world.target_ids).astype(np.uint8) * 255
-            mask = cv2.remap(target, *_rotation_warp(cam.K, middle, map_x, map_y), cv2.INTER_NEAREST)
+            mask = cv2.remap(target, *_rotation_warp(K_canvas, middle, map_x, map_y), cv2.INTER_NEAREST)
             _write_png(root, exposure.datasets, exposure.mask, mask, MASK_PNG_FLAGS)
 
 
@@ -386,12 +394,12 @@ def _flat(T: np.ndarray) -> list[float]:
 
 
 def finish_dataset(params: GenerateParams, root: Path, plan: DatasetPlan, trip: Trip, route: Route,
-                   scene: catalog.Scene) -> dict:
-    """Once its images are written: the dataset's frames.parquet and meta.json, then its partial folder renamed
-    to ``root / plan.dataset``; returns its row of the index."""
+                   scene: catalog.Scene, camera: Camera) -> dict:
+    """Once its images are written: the dataset's frames.parquet, meta.json and camera.yaml (``camera``: the world's
+    calibration estimate), then its partial folder renamed to ``root / plan.dataset``; returns its row of the index."""
     spec = params.scenes[plan.scene_index]
-    cam = Intrinsics.from_params(params.camera)
-    f_px = cam.K[0, 0]
+    truth = true_camera(params.camera)
+    f_px = truth.K[0, 0]
     tmp, final = _partial(root, plan.dataset), root / plan.dataset
     model_poses = [image_pose(visit, image_motion(visit, params.capture, 0, f_px)) for visit in route.model]
     T_cam1_cam0 = inverse(trip.model_views[1]) @ trip.model_views[0]  # what the robot says it did (III-B)
@@ -412,11 +420,13 @@ def finish_dataset(params: GenerateParams, root: Path, plan: DatasetPlan, trip: 
     meta = {
         "dataset": plan.dataset, "world": plan.world, "scene": spec.name, "targets": list(spec.targets),
         "trajectory": plan.trajectory, "azimuth_deg": plan.azimuth_deg, "offset_deg": plan.offset_deg,
-        "n_stops": len(trip.stops), "images_per_stop": params.images_per_stop, "image_size": [cam.width, cam.height],
-        "K": cam.K.tolist(), "dist": [0.0] * 5, "board": scene.board.as_dict(), "model": model,
-        "model_baseline_mm": params.model_baseline_mm, "distance_mm": trip.distance_mm,
+        "n_stops": len(trip.stops), "images_per_stop": params.images_per_stop,
+        "board": scene.board.as_dict(), "model": model, "model_baseline_mm": params.model_baseline_mm,
+        "distance_mm": trip.distance_mm,
+        "true_camera": {"K": truth.K.tolist(), "dist": truth.dist.tolist()},  # a diagnostic: stage 02 never reads it
     }
     (tmp / "meta.json").write_text(json.dumps(meta, indent=1))
+    write_camera_yaml(tmp / "camera.yaml", camera, CAMERA_NAME)
     shutil.rmtree(final, ignore_errors=True)
     tmp.rename(final)
     return {"dataset": plan.dataset, "world": plan.world, "scene": spec.name, "trajectory": plan.trajectory,
@@ -424,12 +434,36 @@ def finish_dataset(params: GenerateParams, root: Path, plan: DatasetPlan, trip: 
             "path": f"datasets/{plan.dataset}"}
 
 
+def write_calibration(folder: Path, session: CalibrationSession, params: GenerateParams) -> None:
+    """A world's calibration session in ``folder``: the views (``views/view_NN.png``), the estimate
+    (``camera.yaml``) and ``report.json`` (the fit, the board, and the true camera beside the estimate)."""
+    tmp = folder.with_name(f".{folder.name}.partial")
+    shutil.rmtree(tmp, ignore_errors=True)
+    (tmp / "views").mkdir(parents=True)
+    for i, image in enumerate(session.images):
+        ok, encoded = cv2.imencode(".png", image, IMAGE_PNG_FLAGS)
+        (tmp / "views" / f"view_{i:02d}.png").write_bytes(encoded.tobytes())
+    calibration, truth = session.calibration, true_camera(params.camera)
+    write_camera_yaml(tmp / "camera.yaml", calibration.camera, CAMERA_NAME)
+    report = {"rms_px": calibration.rms_px, "per_view_rms_px": list(calibration.per_view_rms_px),
+              "views_used": list(calibration.views_used), "n_corners": list(calibration.n_corners),
+              "board": params.calibration.board.model_dump(),
+              "T_cam_board": [T.tolist() for T in session.T_cam_board],
+              "estimate": {"K": calibration.camera.K.tolist(), "dist": calibration.camera.dist.tolist()},
+              "true": {"K": truth.K.tolist(), "dist": truth.dist.tolist()}}
+    (tmp / "report.json").write_text(json.dumps(report, indent=1))
+    shutil.rmtree(folder, ignore_errors=True)
+    tmp.rename(folder)
+
+
 @dataclass(frozen=True)
 class WorldPlan:
-    """Everything one world renders: its params, scenes, datasets, their commanded trips and actual routes."""
+    """Everything one world renders: its params, calibration session, scenes, datasets, their commanded trips and
+    actual routes."""
 
     name: str
     params: GenerateParams
+    calibration: CalibrationSession
     scenes: list[catalog.Scene]
     plans: list[DatasetPlan]
     trips: list[Trip]
@@ -438,25 +472,28 @@ class WorldPlan:
 
 
 def plan_world(params: GenerateParams, protocol: ProtocolParams, name: str) -> WorldPlan:
-    """Check one world (:func:`check_world`), plan its datasets and drive its robot (:func:`drive`): every error
-    comes here, before any rendering."""
+    """Check one world (:func:`check_world`), calibrate its camera (a calibration error names the key), plan its
+    datasets and drive its robot (:func:`drive`): every error comes here, before any dataset is rendered."""
     scenes = check_world(params, protocol, name)
+    session = calibration_session(params, "generate.calibration" if name == "main" else f"generate.{name}.calibration")
     plans = plan_datasets(params, name)
     trips = [plan_trip(params, protocol, plan, scenes[plan.scene_index]) for plan in plans]
     routes, robot_accuracy = drive(params, plans, trips, scenes, name)
-    return WorldPlan(name, params, scenes, plans, trips, routes, robot_accuracy)
+    return WorldPlan(name, params, session, scenes, plans, trips, routes, robot_accuracy)
 
 
-def generate(params: GenerateParams, protocol: ProtocolParams, root: Path, workers: Workers,
-             progress: bool = True) -> tuple[pd.DataFrame, dict[str, dict]]:
-    """Render every world's datasets under ``root`` (every world planned and checked first), the shots on
-    ``workers``; returns and writes the index, and returns each world's robot accuracy per scene."""
-    worlds = [plan_world(world_params, protocol, name) for name, world_params in params.worlds().items()]
+def generate(params: GenerateParams, protocol: ProtocolParams, root: Path, workers: Workers, *,
+             calibration_dir: Path, progress: bool = True) -> tuple[pd.DataFrame, dict[str, WorldPlan]]:
+    """Render every world's datasets under ``root`` and its calibration session under ``calibration_dir / world``
+    (every world planned, calibrated and checked first), the shots on ``workers``; returns the index (also written)
+    and each world's plan (its calibration and robot accuracy)."""
+    worlds = {name: plan_world(world_params, protocol, name) for name, world_params in params.worlds().items()}
     root = Path(root)
     root.mkdir(parents=True, exist_ok=True)
     (root / "index.parquet").unlink(missing_ok=True)
     rows = []
-    for w in worlds:
+    for w in worlds.values():
+        write_calibration(Path(calibration_dir) / w.name, w.calibration, w.params)
         for plan in w.plans:
             tmp = _partial(root, plan.dataset)
             shutil.rmtree(tmp, ignore_errors=True)
@@ -465,8 +502,8 @@ def generate(params: GenerateParams, protocol: ProtocolParams, root: Path, worke
         shots = plan_shots(w.params, w.plans, w.trips, w.routes)
         workers.map(partial(take_shot, w.params, root), shots,
                     desc=f"camera poses of {len(w.plans)} datasets ({w.name} world)", progress=progress)
-        rows += [finish_dataset(w.params, root, plan, trip, route, w.scenes[plan.scene_index])
-                 for plan, trip, route in zip(w.plans, w.trips, w.routes)]
+        rows += [finish_dataset(w.params, root, plan, trip, route, w.scenes[plan.scene_index],
+                                w.calibration.calibration.camera) for plan, trip, route in zip(w.plans, w.trips, w.routes)]
     index = pd.DataFrame(rows)
     index.to_parquet(root / "index.parquet", index=False)
-    return index, {w.name: w.robot_accuracy for w in worlds}
+    return index, worlds

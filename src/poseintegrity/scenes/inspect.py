@@ -9,6 +9,8 @@ import cv2
 import numpy as np
 import pandas as pd
 
+from poseintegrity.scenes.camera import true_camera
+
 
 def target_appearance(root: Path, index: pd.DataFrame) -> pd.DataFrame:
     """Per scene, on model image 0: the target's RMS contrast (std / mean of its pixels) and the number of SIFT
@@ -33,6 +35,26 @@ def target_appearance(root: Path, index: pd.DataFrame) -> pd.DataFrame:
             "keypoints_clahe": len(sift.detect(clahe.apply(image), mask)),
         })
     return pd.DataFrame(rows)
+
+
+def calibration_errors(worlds: dict) -> pd.DataFrame:
+    """Per world (``dataset.generate``'s plans): the calibration's RMS, views used, and the estimate's errors against
+    the true camera: focal lengths (%), principal point (px), and how far the estimated lens puts the image corners'
+    and centre's rays (undistorted pixels) from where the true lens does (px, the largest)."""
+    rows = {}
+    for name, w in worlds.items():
+        estimate, truth = w.calibration.calibration.camera, true_camera(w.params.camera)
+        probe = np.array([[0.0, 0.0], [truth.width - 1, 0.0], [0.0, truth.height - 1],
+                          [truth.width - 1, truth.height - 1], [(truth.width - 1) / 2, (truth.height - 1) / 2]])
+        rows[name] = {
+            "rms_px": w.calibration.calibration.rms_px, "n_views_used": len(w.calibration.calibration.views_used),
+            "fx_error_pct": 100 * (estimate.K[0, 0] / truth.K[0, 0] - 1),
+            "fy_error_pct": 100 * (estimate.K[1, 1] / truth.K[1, 1] - 1),
+            "principal_point_error_px": float(np.hypot(*(estimate.K[:2, 2] - truth.K[:2, 2]))),
+            "ray_error_px_max": float(np.max(np.linalg.norm(
+                estimate.undistort(probe) - estimate.K[:2, 2] - (truth.undistort(probe) - truth.K[:2, 2]), axis=1))),
+        }
+    return pd.DataFrame(rows).T.rename_axis("world")
 
 
 def folder_size_bytes(root: Path) -> int:

@@ -23,7 +23,7 @@ from poseintegrity.scenes.kinematics import UR5E
 from poseintegrity.scenes.mesh import Material
 from poseintegrity.scenes.scapula import read_mesh
 from poseintegrity.lens import LensError, check_folding
-from poseintegrity.schema import KeyRule, ProjectPath, Section, Seed, distinct
+from poseintegrity.schema import KeyRule, OrderedRange, ProjectPath, Section, Seed, distinct
 
 MIN_IMAGE_PX = 64  # the rendered image's shorter side: below it no target keeps enough pixels to be localized
 MAX_SENSOR_PX = 4096  # a side of the sensor: larger frames take GBs of z-buffer per worker
@@ -78,6 +78,54 @@ class SensorParams(Section):
     blur_sigma_px: float = Field(ge=0, le=20, description="optical blur, Gaussian sigma in pixels")
     flicker: float = Field(ge=0, le=0.1, description="std of the per-image illumination gain (above 0.1 a gain "
                                                      "1 + flicker x N(0, 1) would sometimes be <= 0: a black image)")
+
+
+class CharucoParams(Section):
+    """The calibration board: a ChArUco board (cv2.aruco.CharucoBoard) printed on paper."""
+
+    squares_x: int = Field(ge=3, le=40)
+    squares_y: int = Field(ge=3, le=40)
+    square_mm: float = Field(gt=0, le=200)
+    marker_mm: float = Field(gt=0, le=200, description="the ArUco marker inside each white square")
+    dictionary: str = Field(pattern=r"^DICT_\w+$", description="an OpenCV ArUco dictionary, e.g. DICT_5X5_100")
+
+    @field_validator("dictionary")
+    @classmethod
+    def _known(cls, name: str) -> str:
+        if not isinstance(getattr(cv2.aruco, name, None), int):
+            raise ValueError(f"OpenCV has no ArUco dictionary {name!r}")
+        return name
+
+    @model_validator(mode="after")
+    def _marker_inside(self) -> "CharucoParams":
+        if self.marker_mm >= self.square_mm:
+            raise KeyRule("marker_mm", f"a marker lies inside its square: must be < square_mm ({self.square_mm:g}), "
+                                       f"got {self.marker_mm:g}")
+        n_markers = (self.squares_x * self.squares_y) // 2
+        size = cv2.aruco.getPredefinedDictionary(getattr(cv2.aruco, self.dictionary)).bytesList.shape[0]
+        if n_markers > size:
+            raise KeyRule("dictionary", f"{self.squares_x} x {self.squares_y} squares hold {n_markers} markers, "
+                                        f"{self.dictionary} has {size}")
+        return self
+
+
+class CalibrationParams(Section):
+    """The camera's calibration session before any data (:mod:`.calibration_views`): the board shown in ``n_views``
+    poses; the estimate is what the pipeline uses as the camera."""
+
+    board: CharucoParams
+    n_views: int = Field(ge=5, le=200, description="views rendered (5: the fewest a calibration can use)")
+    distance_mm: OrderedRange = Field(description="camera to board centre, drawn per view")
+    max_tilt_deg: float = Field(ge=0, le=70, description="board tilt from facing the camera, drawn per view")
+    max_rms_px: float = Field(gt=0, le=5, description="a calibration whose reprojection RMS exceeds this stops "
+                                                      "stage 01: its camera would not be worth using")
+
+    @field_validator("distance_mm")
+    @classmethod
+    def _in_focus_range(cls, distance: tuple[float, float]) -> tuple[float, float]:
+        if distance[0] < 100 or distance[1] > 2000:
+            raise ValueError(f"distances lie in [100, 2000] mm (the lens focuses beyond 100 mm), got {list(distance)}")
+        return distance
 
 
 class CaptureParams(Section):
@@ -354,6 +402,7 @@ class GenerateParams(Section):
     model_baseline_mm: float = Field(gt=0, le=100)
     camera: CameraParams
     sensor: SensorParams
+    calibration: CalibrationParams
     capture: CaptureParams
     robot: RobotParams
     arcs: ArcParams

@@ -1,0 +1,99 @@
+"""The calibration session before the robot's data: a ChArUco board held in front of the camera in many poses,
+rendered through the true lens and sensor like every dataset image, then calibrated
+(:func:`poseintegrity.calibration.calibrate`). The pipeline uses that estimate, never the renderer's
+camera: its errors (focal length, principal point, distortion) are the calibration errors a real lab lives with.
+
+Poses are drawn per view (``keyed_rng(seed, "calibration", i)``) so that the board covers the image, centre to
+corners: its centre on a uniformly drawn pixel, at a distance drawn from ``distance_mm`` along that pixel's ray,
+tilted by up to ``max_tilt_deg`` about a random axis of its plane and turned by up to ROLL_DEG about its normal.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import lru_cache
+
+import cv2
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from poseintegrity.lens import Camera
+from poseintegrity.calibration import Calibration, CharucoSpec, calibrate
+from poseintegrity.poses import pose_matrix
+from poseintegrity.scenes import mesh, optics, renderer
+from poseintegrity.scenes.camera import true_camera
+from poseintegrity.scenes.foam import ReliefVolume
+from poseintegrity.scenes.params import GenerateParams
+from poseintegrity.scenes.textures import build_atlas, to_u8
+from poseintegrity.seeding import keyed_rng
+
+ROLL_DEG = 20.0  # a hand or a stand turns the board about its normal this much either way
+CENTRE_MARGIN = 0.1  # the board's centre is drawn inside the image, this share of a side from its edges
+PX_PER_MM = 8.0  # resolution of the printed board's texture
+FLAT = ReliefVolume(np.zeros((8, 8, 8), np.float32), 1.0, 1.0, 0.0, 1.0)  # the board is printed paper, no foam
+
+
+@dataclass(frozen=True)
+class CalibrationSession:
+    """The views of one world's calibration: images (n, h, w) uint8, their exact T_cam_board (n, 4, 4, mm), and the
+    estimate (:class:`~poseintegrity.calibration.Calibration`)."""
+
+    images: list[np.ndarray]
+    T_cam_board: list[np.ndarray]
+    calibration: Calibration
+
+
+def charuco_spec(params: GenerateParams) -> CharucoSpec:
+    board = params.calibration.board
+    return CharucoSpec(board.squares_x, board.squares_y, board.square_mm, board.marker_mm, board.dictionary)
+
+
+@lru_cache(maxsize=2)
+def _board_geometry(spec: CharucoSpec, lights: tuple[float, float, float, float]) -> renderer.SceneGeometry:
+    """The printed board as a textured plane in its own frame (x right, y down, facing -z), gray paper white
+    (0.85) and black ink (0.06) as the ArUco board of the scenes."""
+    width_mm, height_mm = spec.size_mm
+    printed = spec.board().generateImage((round(width_mm * PX_PER_MM), round(height_mm * PX_PER_MM)), marginSize=0)
+    texture = to_u8(0.06 + 0.79 * printed.astype(np.float32) / 255)
+    plane = mesh.plane(width_mm, height_mm, 9, 6, "charuco", material=mesh.Material(0.02, 10.0))
+    board = plane.transformed(pose_matrix(np.diag([1.0, -1.0, -1.0]), [width_mm / 2, height_mm / 2, 0.0]))
+    return renderer.SceneGeometry.from_meshes([("charuco", board)], build_atlas({"charuco": texture}),
+                                              np.array([0.3, -0.5, -1.0]), lights, FLAT)
+
+
+def view_pose(camera: Camera, spec: CharucoSpec, distance_mm: tuple[float, float], max_tilt_deg: float,
+              rng: np.random.Generator) -> np.ndarray:
+    """T_cam_board (4, 4, mm) of one calibration view (module docstring)."""
+    u = rng.uniform(CENTRE_MARGIN, 1 - CENTRE_MARGIN) * (camera.width - 1)
+    v = rng.uniform(CENTRE_MARGIN, 1 - CENTRE_MARGIN) * (camera.height - 1)
+    ray = np.linalg.solve(camera.K, [u, v, 1.0])
+    centre = rng.uniform(*distance_mm) * ray / np.linalg.norm(ray)
+    axis_angle = rng.uniform(0.0, 2 * np.pi)
+    tilt = Rotation.from_rotvec(np.radians(rng.uniform(0.0, max_tilt_deg)) * np.array([np.cos(axis_angle),
+                                                                                      np.sin(axis_angle), 0.0]))
+    R = (tilt * Rotation.from_euler("z", rng.uniform(-ROLL_DEG, ROLL_DEG), degrees=True)).as_matrix()
+    width_mm, height_mm = spec.size_mm
+    return pose_matrix(R, centre - R @ np.array([width_mm / 2, height_mm / 2, 0.0]))
+
+
+def render_view(params: GenerateParams, T_cam_board: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+    """One calibration image (h, w) uint8: the board at T_cam_board through the true lens (focused mid-range) and
+    sensor, as a dataset image is made (scenes/dataset.py)."""
+    camera = true_camera(params.camera)
+    K_canvas, width, height = camera.canvas
+    frame = renderer.render(_board_geometry(charuco_spec(params), params.lights.intensities()), K_canvas, width,
+                            height, T_cam_board)  # the geometry's world frame is the board's
+    focus_mm = float(np.mean(params.calibration.distance_mm))
+    irradiance = optics.lens(frame.radiance, frame.depth_mm, focus_mm, params.sensor.blur_sigma_px, params.camera)
+    sensor = cv2.remap(irradiance, *camera.sensor_maps, cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
+    return renderer.expose(sensor, params.sensor, rng)
+
+
+def calibration_session(params: GenerateParams, key: str) -> CalibrationSession:
+    """Render ``params.calibration.n_views`` views and calibrate the camera from them; ``key``: the params key of
+    the world's calibration section, named by a :class:`~poseintegrity.calibration.CalibrationError`."""
+    camera, spec, session = true_camera(params.camera), charuco_spec(params), params.calibration
+    poses = [view_pose(camera, spec, session.distance_mm, session.max_tilt_deg,
+                       keyed_rng(params.seed, "calibration", i)) for i in range(session.n_views)]
+    images = [render_view(params, T, keyed_rng(params.seed, "calibration noise", i)) for i, T in enumerate(poses)]
+    return CalibrationSession(images, poses, calibrate(images, spec, session.max_rms_px, f"{key}.max_rms_px"))
