@@ -25,7 +25,10 @@ import numpy as np
 import yaml
 
 DISTORTION_MODEL = "plumb_bob"  # ROS's name of OpenCV's 5-coefficient model
-UNDISTORT_CRITERIA = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 100, 1e-14)  # round trip to ~1e-12 px
+# cv2.undistortPoints stops when the re-distorted estimate is within eps px of the pixel: 1e-10 px, as 1e-14 lies
+# below the float64 resolution of pixel coordinates (~1e-13 px at 1000 px) and kept it iterating to its 100 steps
+# (0.76 s for the 968 x 608 sensor maps, 0.13 s now); round trips through cv2.projectPoints to < 1e-9 px
+UNDISTORT_CRITERIA = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 100, 1e-10)
 FOLD_SAMPLES = 4096  # radii sampled when checking that the lens' radial mapping keeps increasing
 CANVAS_MARGIN_PX = 2  # beyond the outermost ray of the sensor: room for bilinear sampling
 

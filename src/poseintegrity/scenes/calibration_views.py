@@ -55,7 +55,13 @@ def _board_geometry(spec: CharucoSpec, lights: tuple[float, float, float, float]
     width_mm, height_mm = spec.size_mm
     printed = spec.board().generateImage((round(width_mm * PX_PER_MM), round(height_mm * PX_PER_MM)), marginSize=0)
     texture = to_u8(0.06 + 0.79 * printed.astype(np.float32) / 255)
-    plane = mesh.plane(width_mm, height_mm, 9, 6, "charuco", material=mesh.Material(0.02, 10.0))
+    # the renderer puts the first and last texel centres on the plane's edges (texture coordinates 0 and 1): texel c
+    # of the print lies at (c + 1/2) / PX_PER_MM, so the plane spans the texel centres, (n - 1) / PX_PER_MM, about the
+    # board's centre. A plane of the print's full size stretched the board by n / (n - 1), more along y (960 texels)
+    # than x (1440): the calibration then found fy / fx = 1.0003 for a camera of square pixels
+    n_y, n_x = texture.shape
+    plane = mesh.plane((n_x - 1) / PX_PER_MM, (n_y - 1) / PX_PER_MM, 9, 6, "charuco",
+                       material=mesh.Material(0.02, 10.0))
     board = plane.transformed(pose_matrix(np.diag([1.0, -1.0, -1.0]), [width_mm / 2, height_mm / 2, 0.0]))
     return renderer.SceneGeometry.from_meshes([("charuco", board)], build_atlas({"charuco": texture}),
                                               np.array([0.3, -0.5, -1.0]), lights, FLAT)
