@@ -31,6 +31,18 @@ BAD_VALUES = [
     ("camera.sensor_width_px", 100000, "camera.sensor_width_px"),  # accepted: GBs of z-buffer per worker
     ("camera.lens_mm", 400, "camera.lens_mm"),  # focus behind the lens; stopped at rendering, blaming distance_mm
     ("camera.f_number", 0.001, "camera.f_number"),  # accepted: a defocus blur of hundreds of pixels
+    ("camera.distortion", [-0.6, 0.0, 0.0, 0.0, 0.0], "camera.distortion"),  # folds: the corners see no ray, or two
+    ("camera.distortion", [0.0, 0.0, 0.6, 0.0, 0.0], "camera.distortion"),  # folds the top rows (tangential)
+    ("camera.distortion", [-0.06, 0.02, 0.0, 0.0], "camera.distortion"),  # 4 coefficients
+    ("camera.principal_point_offset_px", [500.0, 0.0], "camera.principal_point_offset_px.0"),
+    ("calibration.board.marker_mm", 25.0, "calibration.board.marker_mm"),  # a marker larger than its square
+    ("calibration.board.dictionary", "DICT_4X4_NOPE", "calibration.board.dictionary"),
+    ("calibration.board.squares_x", 40, "calibration.board.dictionary"),  # 120 markers, DICT_5X5_100 has 100
+    ("calibration.n_views", 2, "calibration.n_views"),  # fewer than a calibration can use
+    ("calibration.distance_mm", [450.0, 250.0], "calibration.distance_mm"),
+    ("calibration.distance_mm", [50.0, 300.0], "calibration.distance_mm"),  # nearer than the lens focuses
+    ("calibration.max_tilt_deg", 85.0, "calibration.max_tilt_deg"),  # the board seen edge-on
+    ("calibration.max_rms_px", 0.0, "calibration.max_rms_px"),  # no calibration passes
     ("sensor.exposure", 1e6, "sensor.exposure"),  # accepted: every image white
     ("sensor.flicker", 0.45, "sensor.flicker"),  # accepted: ~1 % of the images black (gain <= 0)
     ("sensor.blur_sigma_px", 500, "sensor.blur_sigma_px"),
