@@ -15,7 +15,7 @@ from poseintegrity.scenes import calibration_views as views
 from poseintegrity.scenes.camera import true_camera
 from repository import ROOT
 
-KEY = "generate.calibration.max_rms_px"
+KEY = "generate.calibration"
 
 
 @pytest.fixture(scope="module")
@@ -64,15 +64,15 @@ def test_the_estimate_round_trips_through_camera_yaml(session, tmp_path):
 
 def test_too_few_views_are_refused_naming_the_key(generate, session):
     spec = views.charuco_spec(generate)
-    with pytest.raises(CalibrationError, match=f"{KEY}: only 3 of 3"):
+    with pytest.raises(CalibrationError, match=f"{KEY}.n_views: only 3 of 3"):
         calibrate([session.images[i] for i in session.calibration.views_used[:3]], spec, 0.5, KEY)
     blank = np.full_like(session.images[0], 128)
-    with pytest.raises(CalibrationError, match=f"{KEY}: only 0 of 6"):
+    with pytest.raises(CalibrationError, match=f"{KEY}.n_views: only 0 of 6"):
         calibrate([blank] * 6, spec, 0.5, KEY)
 
 
 def test_an_rms_above_the_bound_is_refused_naming_the_key(generate, session):
-    with pytest.raises(CalibrationError, match=f"{KEY}: .*RMS 0.0\\d+ px exceeds the bound 0.01 px"):
+    with pytest.raises(CalibrationError, match=f"{KEY}.max_rms_px: .*RMS 0.0\\d+ px exceeds the bound 0.01 px"):
         calibrate(session.images, views.charuco_spec(generate), 0.01, KEY)
 
 

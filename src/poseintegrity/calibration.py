@@ -73,7 +73,7 @@ def detect_corners(image: np.ndarray, board: "cv2.aruco.CharucoBoard") -> tuple[
 
 
 def calibrate(images: list[np.ndarray], spec: CharucoSpec, max_rms_px: float, key: str) -> Calibration:
-    """Estimate the camera from calibration images (each (h, w) uint8, one size); ``key``: the params key that
+    """Estimate the camera from calibration images (each (h, w) uint8, one size); ``key``: the params section of the
     ``max_rms_px`` came from, named by :class:`CalibrationError` (too few usable views, no convergence, an RMS above
     the bound)."""
     board = spec.board()
@@ -81,8 +81,9 @@ def calibrate(images: list[np.ndarray], spec: CharucoSpec, max_rms_px: float, ke
     found = [(i, *detect_corners(image, board)) for i, image in enumerate(images)]
     used = [(i, obj, img) for i, obj, img in found if len(obj) >= MIN_CORNERS]
     if len(used) < MIN_VIEWS:
-        raise CalibrationError(f"{key}: only {len(used)} of {len(images)} calibration views show >= {MIN_CORNERS} "
-                               f"ChArUco corners; a calibration needs {MIN_VIEWS} (views too far, tilted or blurred?)")
+        raise CalibrationError(f"{key}.n_views: only {len(used)} of {len(images)} calibration views show >= "
+                               f"{MIN_CORNERS} ChArUco corners; a calibration needs {MIN_VIEWS} (more views, or "
+                               f"{key}.distance_mm / max_tilt_deg: views too far or tilted?)")
     objects = [obj.astype(np.float32) for _, obj, _ in used]
     points = [img.astype(np.float32) for _, _, img in used]
     try:
@@ -94,7 +95,7 @@ def calibrate(images: list[np.ndarray], spec: CharucoSpec, max_rms_px: float, ke
     if not (np.isfinite(rms) and np.all(np.isfinite(K)) and np.all(np.isfinite(dist)) and K[0, 0] > 0 and K[1, 1] > 0):
         raise CalibrationError(f"{key}: the calibration did not converge (RMS {rms}, K {np.round(K, 3).tolist()})")
     if rms > max_rms_px:
-        raise CalibrationError(f"{key}: the calibration's reprojection RMS {rms:.3f} px exceeds the bound "
+        raise CalibrationError(f"{key}.max_rms_px: the calibration's reprojection RMS {rms:.3f} px exceeds the bound "
                                f"{max_rms_px:g} px")
     per_view = []
     for obj, img, rvec, tvec in zip(objects, points, rvecs, tvecs):

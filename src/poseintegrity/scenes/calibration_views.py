@@ -102,4 +102,4 @@ def calibration_session(params: GenerateParams, key: str) -> CalibrationSession:
     poses = [view_pose(camera, spec, session.distance_mm, session.max_tilt_deg,
                        keyed_rng(params.seed, "calibration", i)) for i in range(session.n_views)]
     images = [render_view(params, T, keyed_rng(params.seed, "calibration noise", i)) for i, T in enumerate(poses)]
-    return CalibrationSession(images, poses, calibrate(images, spec, session.max_rms_px, f"{key}.max_rms_px"))
+    return CalibrationSession(images, poses, calibrate(images, spec, session.max_rms_px, key))

@@ -175,7 +175,11 @@ def build_scene(spec: "SceneSpec", index: int, params: "GenerateParams") -> Scen
     origin = np.append(board_centre, height + 0.4) - R_world_board @ np.array([bw / 2, bh / 2, 0.0])
     T_world_board = pose_matrix(R_world_board, origin)
     # plane() faces +z with texture v along -y; flip about x so it faces -z (the board's printed side) with v along +y
-    board_mesh = meshes.plane(bw + 2 * m, bh + 2 * m, 12, 9, "aruco_board", material=meshes.Material(0.02, 10.0))
+    # the plane spans the texture's texel centres (the renderer maps texture coordinates 0 and 1 onto its edges): a
+    # plane of the print's full size would stretch the board by n / (n - 1) texels (calibration_views.py)
+    n_x, n_y = board.texture_size
+    board_mesh = meshes.plane((n_x - 1) / board.px_per_mm, (n_y - 1) / board.px_per_mm, 12, 9, "aruco_board",
+                              material=meshes.Material(0.02, 10.0))
     board_mesh = board_mesh.transformed(pose_matrix(np.diag([1.0, -1.0, -1.0]), [bw / 2, bh / 2, 0.0]))
     placed.append(("aruco_board", board_mesh.transformed(T_world_board)))
     placed += _clutter(spec, params, rng, aim, toward_cam, board_centre)

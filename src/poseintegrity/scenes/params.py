@@ -30,6 +30,10 @@ MAX_SENSOR_PX = 4096  # a side of the sensor: larger frames take GBs of z-buffer
 NAME_PATTERN = r"^[A-Za-z0-9][A-Za-z0-9_-]*$"  # scene names make folder names (no path, no hidden .partial folder)
 
 
+Radial = Annotated[float, Field(ge=-2, le=2)]  # k_i beyond +-2 describe a fisheye, which plumb_bob does not model
+Tangential = Annotated[float, Field(ge=-0.05, le=0.05)]  # a lens decentred enough for p_i = 0.05 is broken
+
+
 class CameraParams(Section):
     """IDS U3-3060CP-M (Sony IMX174, mono) with a fixed-focal lens (docs/references.md, "Camera of the Windsor et al. experiments")."""
 
@@ -43,7 +47,7 @@ class CameraParams(Section):
     principal_point_offset_px: tuple[Annotated[float, Field(ge=-100, le=100)], Annotated[float, Field(ge=-100, le=100)]] = (
         Field(description="where the optical axis meets the sensor, from its centre, full-resolution px (a lens is "
                           "mounted a few px off; 100 px would be a visibly decentred lens)"))
-    distortion: tuple[float, float, float, float, float] = Field(
+    distortion: tuple[Radial, Radial, Tangential, Tangential, Radial] = Field(
         description="k1, k2, p1, p2, k3 of the lens (Brown-Conrady as OpenCV models it, poseintegrity.lens)")
 
     @model_validator(mode="after")

@@ -93,12 +93,21 @@ class BoardSpec:
         return (self.markers_x * self.marker_length_mm + (self.markers_x - 1) * self.separation_mm,
                 self.markers_y * self.marker_length_mm + (self.markers_y - 1) * self.separation_mm)
 
+    @property
+    def margin_px(self) -> int:
+        return int(round(self.margin_mm * self.px_per_mm))
+
+    @property
+    def texture_size(self) -> tuple[int, int]:
+        """(width, height) of :meth:`texture` in texels: the markers' area and the margin on each side."""
+        w_mm, h_mm = self.size_mm
+        return (int(round(w_mm * self.px_per_mm)) + 2 * self.margin_px,
+                int(round(h_mm * self.px_per_mm)) + 2 * self.margin_px)
+
     def texture(self) -> np.ndarray:
         """The printed board with its white margin; gray paper white (0.85), black ink (0.06)."""
-        w_mm, h_mm = self.size_mm
-        margin = int(round(self.margin_mm * self.px_per_mm))
-        size = (int(round(w_mm * self.px_per_mm)) + 2 * margin, int(round(h_mm * self.px_per_mm)) + 2 * margin)
-        img = self.board().generateImage(size, marginSize=margin, borderBits=1).astype(np.float32) / 255
+        img = self.board().generateImage(self.texture_size, marginSize=self.margin_px, borderBits=1)
+        img = img.astype(np.float32) / 255
         return to_u8(0.06 + 0.79 * img)
 
     def as_dict(self) -> dict:
