@@ -22,6 +22,7 @@ from poseintegrity.calibration import Calibration, CharucoSpec, calibrate
 from poseintegrity.poses import pose_matrix
 from poseintegrity.scenes import mesh, optics, renderer
 from poseintegrity.scenes.camera import true_camera
+from poseintegrity.scenes.catalog import print_errors
 from poseintegrity.scenes.foam import ReliefVolume
 from poseintegrity.scenes.params import GenerateParams
 from poseintegrity.scenes.textures import build_atlas, to_u8
@@ -49,9 +50,11 @@ def charuco_spec(params: GenerateParams) -> CharucoSpec:
 
 
 @lru_cache(maxsize=2)
-def _board_geometry(spec: CharucoSpec, lights: tuple[float, float, float, float]) -> renderer.SceneGeometry:
+def _board_geometry(spec: CharucoSpec, lights: tuple[float, float, float, float], scale: tuple[float, float],
+                    sag_mm: float) -> renderer.SceneGeometry:
     """The printed board as a textured plane in its own frame (x right, y down, facing -z), gray paper white
-    (0.85) and black ink (0.06) as the ArUco board of the scenes."""
+    (0.85) and black ink (0.06) as the ArUco board of the scenes, printed at ``scale`` and bowed by ``sag_mm``
+    (:func:`~.mesh.printed_sheet`)."""
     width_mm, height_mm = spec.size_mm
     printed = spec.board().generateImage((round(width_mm * PX_PER_MM), round(height_mm * PX_PER_MM)), marginSize=0)
     texture = to_u8(0.06 + 0.79 * printed.astype(np.float32) / 255)
@@ -60,9 +63,10 @@ def _board_geometry(spec: CharucoSpec, lights: tuple[float, float, float, float]
     # board's centre. A plane of the print's full size stretched the board by n / (n - 1), more along y (960 texels)
     # than x (1440): the calibration then found fy / fx = 1.0003 for a camera of square pixels
     n_y, n_x = texture.shape
-    plane = mesh.plane((n_x - 1) / PX_PER_MM, (n_y - 1) / PX_PER_MM, 9, 6, "charuco",
+    plane = mesh.plane((n_x - 1) / PX_PER_MM, (n_y - 1) / PX_PER_MM, 18, 12, "charuco",
                        material=mesh.Material(0.02, 10.0))
     board = plane.transformed(pose_matrix(np.diag([1.0, -1.0, -1.0]), [width_mm / 2, height_mm / 2, 0.0]))
+    board = mesh.printed_sheet(board, np.array([width_mm / 2, height_mm / 2]), (n_x - 1) / PX_PER_MM / 2, scale, sag_mm)
     return renderer.SceneGeometry.from_meshes([("charuco", board)], build_atlas({"charuco": texture}),
                                               np.array([0.3, -0.5, -1.0]), lights, FLAT)
 
@@ -87,8 +91,9 @@ def render_view(params: GenerateParams, T_cam_board: np.ndarray, rng: np.random.
     sensor, as a dataset image is made (scenes/dataset.py)."""
     camera = true_camera(params.camera)
     K_canvas, width, height = camera.canvas
-    frame = renderer.render(_board_geometry(charuco_spec(params), params.lights.intensities()), K_canvas, width,
-                            height, T_cam_board)  # the geometry's world frame is the board's
+    scale, sag_mm = print_errors(params, "charuco", params.printed_boards.calibration_sag_std_mm)
+    frame = renderer.render(_board_geometry(charuco_spec(params), params.lights.intensities(), scale, sag_mm),
+                            K_canvas, width, height, T_cam_board)  # the geometry's world frame is the board's
     focus_mm = float(np.mean(params.calibration.distance_mm))
     irradiance = optics.lens(frame.radiance, frame.depth_mm, focus_mm, params.sensor.blur_sigma_px, params.camera)
     sensor = cv2.remap(irradiance, *camera.sensor_maps, cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)

@@ -181,12 +181,22 @@ def build_scene(spec: "SceneSpec", index: int, params: "GenerateParams") -> Scen
     board_mesh = meshes.plane((n_x - 1) / board.px_per_mm, (n_y - 1) / board.px_per_mm, 12, 9, "aruco_board",
                               material=meshes.Material(0.02, 10.0))
     board_mesh = board_mesh.transformed(pose_matrix(np.diag([1.0, -1.0, -1.0]), [bw / 2, bh / 2, 0.0]))
+    board_mesh = meshes.printed_sheet(board_mesh, np.array([bw / 2, bh / 2]), (n_x - 1) / board.px_per_mm / 2,
+                                      *print_errors(params, "aruco", params.printed_boards.board_sag_std_mm))
     placed.append(("aruco_board", board_mesh.transformed(T_world_board)))
     placed += _clutter(spec, params, rng, aim, toward_cam, board_centre)
 
     light_dir = np.array([rng.uniform(-0.5, 0.5), rng.uniform(-0.5, 0.3), 1.0])
     return Scene(spec.name, placed, tuple(spec.targets), target_poses[0], T_world_board, board, aim, view_dir,
                  light_dir)
+
+
+def print_errors(params: "GenerateParams", board: str, sag_std_mm: float) -> tuple[tuple[float, float], float]:
+    """(scale (x, y), sag mm) of one printed board of the world, drawn from ``keyed_rng(seed, "print", board)``:
+    the same physical board in every scene (``generate.printed_boards``)."""
+    rng = keyed_rng(params.seed, "print", board)
+    scale = 1.0 + params.printed_boards.scale_std * rng.standard_normal(2)
+    return (float(scale[0]), float(scale[1])), float(sag_std_mm * rng.standard_normal())
 
 
 def scene_textures(scene: Scene, params: "GenerateParams") -> dict[str, np.ndarray]:

@@ -55,6 +55,21 @@ class Mesh:
                        T_world_obj=T_new_old @ self.T_world_obj)
 
 
+def printed_sheet(sheet: Mesh, centre: np.ndarray, half_width_mm: float, scale: tuple[float, float],
+                  sag_mm: float) -> Mesh:
+    """A flat printed sheet (a plane in its z = 0, facing -z: a board's printed side) as it really is: printed at
+    ``scale`` (x, y) of its drawing about ``centre`` (2,), mm, and bowed like a card bent about its y axis, by
+    ``sag_mm`` at the centre towards the viewer (-z; negative: away), z = -sag (1 - ((x - cx) / half_width)^2).
+    Normals follow the bow."""
+    x, y = sheet.vertices[:, 0] - centre[0], sheet.vertices[:, 1] - centre[1]
+    u = x / half_width_mm
+    vertices = np.column_stack([centre[0] + scale[0] * x, centre[1] + scale[1] * y,
+                                sheet.vertices[:, 2] - sag_mm * (1.0 - u * u)])
+    slope = 2.0 * sag_mm * u / (half_width_mm * scale[0])  # dz/dx' of the bowed sheet
+    normals = np.column_stack([slope, np.zeros_like(slope), -np.ones_like(slope)])
+    return replace(sheet, vertices=vertices, normals=normals / np.linalg.norm(normals, axis=1, keepdims=True))
+
+
 def from_trimesh(mesh: "trimesh.Trimesh", material: Material, crease_deg: float = 40.0) -> Mesh:
     """A bone-foam (untextured) mesh from a trimesh mesh: normals smooth except across edges sharper than
     ``crease_deg`` (e.g. a drill hole's rim), where vertices are split (trimesh.graph.smooth_shade)."""

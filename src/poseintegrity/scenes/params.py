@@ -84,6 +84,17 @@ class SensorParams(Section):
                                                      "1 + flicker x N(0, 1) would sometimes be <= 0: a black image)")
 
 
+class PrintedBoardParams(Section):
+    """Printed boards are not their drawings (both the calibration ChArUco and the scenes' ArUco ground-truth board):
+    a printer scales each axis a little, and a sheet is not flat. Drawn once per board and world; every stage that
+    uses a board assumes its drawing, as a lab does."""
+
+    scale_std: float = Field(ge=0, le=0.01, description="per axis: laser printers scale by ~0.1-0.3 %; 1 % would be "
+                                                        "seen with a ruler")
+    calibration_sag_std_mm: float = Field(ge=0, le=5, description="bow of the ChArUco card at its centre")
+    board_sag_std_mm: float = Field(ge=0, le=5, description="bow of the ground-truth board glued on its pedestal")
+
+
 class CharucoParams(Section):
     """The calibration board: a ChArUco board (cv2.aruco.CharucoBoard) printed on paper."""
 
@@ -407,6 +418,7 @@ class GenerateParams(Section):
     camera: CameraParams
     sensor: SensorParams
     calibration: CalibrationParams
+    printed_boards: PrintedBoardParams
     capture: CaptureParams
     robot: RobotParams
     arcs: ArcParams
