@@ -4,6 +4,9 @@
     predictors.py   theta_p for all n_t at once; long range, next-step (III-E) and static (IV-A) predictors
     metrics.py      SPL (eq. 3), R_i (eq. 4), SPL vs R_i curves, max mean SPL at zero incursion (Tables I-III)
     sweeps.py       the whole operating-point sweep over datasets, predictors, tolerances, PnP methods (V)
+    tables.py       Tables I-III, the live trials (V-C) and the metrics of predictors.json; Tables I-III per
+                    failed-frame rule of theta_a
+    transfer.py     operating points chosen on the main world, applied unchanged to the validation world
     loso.py         n_t from a target incursion rate by leave-one-scene-out cross-validation (VI, future work), pooled
     tails.py        ours: the arcs whose long range theta_p overshoots theta_a at every n_t (eq. 1's long tail)
     uncertainty.py  a prediction interval on theta_p (fit covariance or bootstrap) and its lower bound
@@ -31,9 +34,11 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
         "tails": ["TAIL_PREDICTORS", "TailFit", "overshooting_arcs", "tail_fits", "tail_metrics"],
         "sweeps": [
             "FITTED_PREDICTORS", "FREE_WIDTH_PREDICTORS", "PAPER_PREDICTORS", "RELATIVE_PREDICTORS",
-            "attach_envelopes", "best_table", "fit_status_shares", "headline_metrics", "live_trials",
-            "predict_dataset", "sweep", "with_pnp_variants",
+            "attach_envelopes", "predict_dataset", "sweep", "with_pnp_variants",
         ],
+        "tables": ["best_table", "fit_status_shares", "headline_metrics", "live_trials", "rule_metrics",
+                   "table_metrics"],
+        "transfer": ["transfer", "transfer_metrics"],
         "uncertainty": ["Interval", "bootstrap_interval", "covariance_interval", "prediction_interval"],
     },
 )

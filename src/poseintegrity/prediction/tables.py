@@ -1,0 +1,201 @@
+"""Tables I-III and the metrics of stage 04 from the prediction tables of :mod:`.sweeps` (Windsor et al. V).
+
+    best_table        per predictor, PnP method, trajectory and tolerance: max mean SPL at zero incursion and its
+                      operating point (Tables I-III)
+    live_trials       the simulated live trials (V-C): next-step supervision at one fixed n_t vs the static baseline
+    table_metrics     one world's Tables I-III, Figs. 6-7, fit statuses and tails (the validation world's figures)
+    headline_metrics  the keys of ``reports/metrics/predictors.json`` (the main world: table_metrics, LOSO, live)
+    rule_metrics      Tables I-III under each failed-frame rule of theta_a
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from poseintegrity.artifact_models import FIT_STATUSES
+from poseintegrity.artifact_models.fitted import OK
+from poseintegrity.prediction.loso import loso_summary
+from poseintegrity.prediction.metrics import best_operating_point, operating_curves, relative_improvement
+from poseintegrity.prediction.params import PredictParams
+from poseintegrity.prediction.predictors import NO_FIT
+from poseintegrity.prediction.sweeps import (
+    CONSERVATIVE_HIGH, FITTED_PREDICTORS, FREE_WIDTH_PREDICTORS, OPERATING_POINT_KEY, PAPER_COUNTERPART,
+    PAPER_PREDICTORS, RELATIVE_PREDICTORS, attach_envelopes,
+)
+from poseintegrity.prediction.tails import tail_metrics
+from poseintegrity.protocol import FAILED_FRAME_RULES, ProtocolParams
+
+
+def best_table(curves: pd.DataFrame, max_incursion_rate: float = 0.0) -> pd.DataFrame:
+    """Tables I-III: per (predictor, method, trajectory, tolerance) the max mean SPL at R_i <= rate and its point."""
+    rows = []
+    for (predictor, method, trajectory, tolerance), curve in curves.groupby(
+        ["predictor", "method", "trajectory", "tolerance"], sort=True
+    ):
+        spl, point = best_operating_point(curve, max_incursion_rate, CONSERVATIVE_HIGH.get(predictor, True))
+        rows.append(dict(predictor=predictor, method=method, trajectory=trajectory, tolerance=tolerance,
+                         max_mean_spl=spl, best_operating_point=point))  # fmt: skip
+    return pd.DataFrame(rows)
+
+
+def live_trials(table: pd.DataFrame, best: pd.DataFrame, predict: PredictParams, protocol: ProtocolParams
+                ) -> pd.DataFrame:  # fmt: skip
+    """The simulated live trials (V-C): next-step at n_t = live_n_t vs the static baseline at its best size.
+
+    best : :func:`best_table`; the static baseline runs at its largest zero-incursion size on the arcs of
+    ``protocol.pnp_method`` at ``predict.live_tolerance`` (the paper's comparison; NaN rows if it has none).
+    One row per arc dataset of ``protocol.pnp_method`` at ``predict.live_tolerance``: theta_a, the stop angle and
+    its incursion, the share of the actual envelope used (SPL / theta_a), the status of the fits the robot went by,
+    and the same for the static baseline.
+    """
+    rows = table[
+        (table["trajectory"] == "arc") & (table["method"] == protocol.pnp_method)
+        & (table["tolerance"] == predict.live_tolerance)
+    ]  # fmt: skip
+    static_best = best[(best["predictor"] == "static") & (best["trajectory"] == "arc")
+                       & (best["method"] == protocol.pnp_method) & (best["tolerance"] == predict.live_tolerance)]
+    static_size = float(static_best["best_operating_point"].iloc[0]) if len(static_best) else np.nan  # fmt: skip
+    ours = rows[(rows["predictor"] == "next_step") & (rows["operating_point"] == predict.live_n_t)]
+    static = rows[(rows["predictor"] == "static") & np.isclose(rows["operating_point"], static_size)]
+    merged = ours.merge(static[["dataset", "spl", "incursion"]], on="dataset", how="left", suffixes=("", "_static"))
+    return pd.DataFrame(
+        {
+            "dataset": merged["dataset"], "theta_a": merged["theta_a"], "stop_angle": merged["theta_p"],
+            "incursion": merged["incursion"], "share": merged["spl"] / merged["theta_a"],
+            "fit_status": merged["fit_status"], "static_size": static_size,
+            "static_incursion": merged["incursion_static"], "static_share": merged["spl_static"] / merged["theta_a"],
+        }
+    )  # fmt: skip
+
+
+def fit_status_shares(table: pd.DataFrame) -> dict[str, dict]:
+    """predictor -> {n_rows, ok, at_bound, non_physical, fallback, no_fit}: the share of the predictor's rows (every
+    dataset, PnP method, trajectory and operating point of the table, once whatever the tolerances joined) whose
+    theta_p rests on a fit of that status."""
+    table = table.drop_duplicates(["predictor", "method", "trajectory", "dataset", "operating_point"])
+    shares = {}
+    for predictor in FITTED_PREDICTORS:
+        rows = table.loc[table["predictor"] == predictor, "fit_status"]
+        counts = rows.value_counts()
+        entry: dict = {"n_rows": int(len(rows))}
+        for status in (*FIT_STATUSES, NO_FIT):
+            entry[status] = float(counts.get(status, 0) / len(rows)) if len(rows) else np.nan
+        shares[predictor] = entry
+    return shares
+
+
+def table_metrics(table: pd.DataFrame, curves: pd.DataFrame, predict: PredictParams, protocol: ProtocolParams) -> dict:
+    """What one world's prediction table says, as Tables I-III, Figs. 6-7 and beyond report it.
+
+    <predictor>.<tolerance>.{max_mean_spl_zero_incursion, best_n_t} on the arc datasets of the paper's PnP path
+    (best_n_t is null for "static", whose operating point is ``best_size``, and for the relative-threshold
+    predictors, whose operating point is ``best_fraction``); <predictor>.relative_improvement
+    over static on the mean across tolerances (Tables I, II), long_range.relative_improvement_vs_mlp,
+    next_step.relative_improvement_vs_long_range; straight_line.relative_improvement (Fig. 7);
+    pnp.<method>.{max_mean_spl_zero_incursion, static_max_mean_spl_zero_incursion} (Fig. 6);
+    fit_status.<predictor>.{n_rows, ok, at_bound, non_physical, fallback, no_fit} (:func:`fit_status_shares`). Ours,
+    beside the paper's keys: <free-width predictor> as the others, with relative_improvement_vs_<its eq. 1
+    counterpart>; tails.<long_range | long_range_free_width>.<tolerance>.{n_overshooting, datasets}
+    (:func:`.tails.tail_metrics`). NaN where there is no value (written as null).
+    """
+    best = best_table(curves)
+
+    def get(predictor: str, trajectory: str, tolerance: str, method: str = protocol.pnp_method) -> tuple[float, float]:
+        row = best[(best.predictor == predictor) & (best.trajectory == trajectory) & (best.tolerance == tolerance)
+                   & (best.method == method)]  # fmt: skip
+        return (float(row.max_mean_spl.iloc[0]), float(row.best_operating_point.iloc[0])) if len(row) else (np.nan,) * 2
+
+    tolerances = sorted(table["tolerance"].unique())
+    static_mean = float(np.mean([get("static", "arc", t)[0] for t in tolerances]))
+    metrics: dict = {}
+    for predictor in (*PAPER_PREDICTORS, "long_range_lower", *RELATIVE_PREDICTORS, *FREE_WIDTH_PREDICTORS):
+        point_key = OPERATING_POINT_KEY.get(predictor, "best_n_t")
+        entry: dict = {}
+        for tolerance in tolerances:
+            spl, point = get(predictor, "arc", tolerance)
+            entry[tolerance] = {"max_mean_spl_zero_incursion": spl, point_key: point}
+            if point_key != "best_n_t":
+                entry[tolerance]["best_n_t"] = None
+        mean_spl = float(np.mean([entry[t]["max_mean_spl_zero_incursion"] for t in tolerances]))
+        entry["mean_max_mean_spl_zero_incursion"] = mean_spl
+        if predictor != "static":
+            entry["relative_improvement"] = relative_improvement(mean_spl, static_mean)
+        metrics[predictor] = entry
+    mean = {p: metrics[p]["mean_max_mean_spl_zero_incursion"] for p in ("long_range", "mlp", "next_step")}
+    metrics["long_range"]["relative_improvement_vs_mlp"] = relative_improvement(mean["long_range"], mean["mlp"])
+    metrics["next_step"]["relative_improvement_vs_long_range"] = relative_improvement(
+        mean["next_step"], mean["long_range"]
+    )  # Table I: +7.4 % over the MLP; V-B: +9.8 % over the long range predictor
+    for ours, paper in PAPER_COUNTERPART.items():  # ours on the free-width EMG vs the same predictor on eq. 1
+        metrics[ours][f"relative_improvement_vs_{paper}"] = relative_improvement(
+            metrics[ours]["mean_max_mean_spl_zero_incursion"], metrics[paper]["mean_max_mean_spl_zero_incursion"]
+        )
+    tol = predict.tolerance_fig6_fig7
+    metrics["straight_line"] = {
+        "tolerance": tol,
+        "long_range_max_mean_spl_zero_incursion": get("long_range", "line", tol)[0],
+        "static_max_mean_spl_zero_incursion": get("static", "line", tol)[0],
+        "relative_improvement": relative_improvement(get("long_range", "line", tol)[0], get("static", "line", tol)[0]),
+    }
+    metrics["pnp"] = {
+        str(method): {
+            "tolerance": tol,
+            "max_mean_spl_zero_incursion": get("long_range", "arc", tol, method)[0],
+            "best_n_t": get("long_range", "arc", tol, method)[1],
+            "static_max_mean_spl_zero_incursion": get("static", "arc", tol, method)[0],
+        }
+        for method in sorted(table["method"].unique())
+    }
+    metrics["fit_status"] = fit_status_shares(table)
+    metrics["tails"] = tail_metrics(table, predict, protocol)
+    return metrics
+
+
+def headline_metrics(
+    table: pd.DataFrame, curves: pd.DataFrame, loso: pd.DataFrame, live: pd.DataFrame, predict: PredictParams,
+    protocol: ProtocolParams,
+) -> dict:
+    """The content of ``reports/metrics/predictors.json``, of the main world: :func:`table_metrics`, and
+    loso.<predictor>.<tolerance>.{heldout_incursion_rate, heldout_mean_spl, ...} at the first target rate;
+    live.{n_t, incursions, n_trials, envelope_share, n_flagged_fits, static_*} (V-C)."""
+    metrics = table_metrics(table, curves, predict, protocol)
+    metrics["loso"] = loso_summary(loso, predict.loso_target_rates[0])
+    metrics["live"] = {
+        "n_t": predict.live_n_t, "tolerance": predict.live_tolerance, "n_trials": int(len(live)),
+        "incursions": float(live["incursion"].sum()), "envelope_share": float(live["share"].mean()),
+        "n_flagged_fits": int((~live["fit_status"].isin([OK])).sum()),
+        "static_size": float(live["static_size"].iloc[0]) if len(live) else np.nan,
+        "static_incursions": float(live["static_incursion"].sum()),
+        "static_envelope_share": float(live["static_share"].mean()),
+    }  # fmt: skip
+    return metrics
+
+
+def rule_metrics(theta_p: pd.DataFrame, envelopes: pd.DataFrame, protocol: ProtocolParams,
+                 predictors: tuple[str, ...] = PAPER_PREDICTORS) -> dict:
+    """Tables I-III under every failed-frame rule of theta_a (:mod:`poseintegrity.localization.envelope`):
+    <rule>.<predictor>.<tolerance>.{max_mean_spl_zero_incursion, best_operating_point} on the arcs of the paper's PnP
+    path, and <rule>.<predictor>.relative_improvement over static (mean of the tolerances).
+
+    theta_p : :func:`~.sweeps.sweep` rows of one world; envelopes : its stage-02 envelopes, every rule
+    """
+    metrics: dict = {}
+    for rule in FAILED_FRAME_RULES:
+        best = best_table(operating_curves(attach_envelopes(theta_p, envelopes[envelopes["rule"] == rule]
+                                                            .drop(columns="rule"), protocol)))
+        best = best[(best["trajectory"] == "arc") & (best["method"] == protocol.pnp_method)]
+        entry: dict = {}
+        for predictor in predictors:
+            rows = best[best["predictor"] == predictor].set_index("tolerance")
+            entry[predictor] = {tol: {"max_mean_spl_zero_incursion": float(row.max_mean_spl),
+                                      "best_operating_point": float(row.best_operating_point)}
+                                for tol, row in rows.iterrows()}
+            entry[predictor]["mean_max_mean_spl_zero_incursion"] = float(rows["max_mean_spl"].mean())
+        static = entry["static"]["mean_max_mean_spl_zero_incursion"] if "static" in entry else np.nan
+        for predictor in predictors:
+            if predictor != "static":
+                entry[predictor]["relative_improvement"] = relative_improvement(
+                    entry[predictor]["mean_max_mean_spl_zero_incursion"], static)
+        metrics[rule] = entry
+    return metrics
