@@ -3,7 +3,7 @@
 The scene is the board plane z = 0 (board frame of ``GridBoard.getObjPoints()``, mm): an ArUco GridBoard at the
 origin and a richly textured target rectangle beside it. Images are exact perspective views of that plane,
 ``cv2.warpPerspective`` of a canvas by the homography K [r1 r2 t] A (A: canvas pixel -> board mm), so every
-pose is known exactly. :func:`write_dataset` writes the stage-01 format (meta.json, frames.parquet, PNGs).
+pose is known exactly. :func:`write_dataset` writes the stage-01 format (meta.json, camera.yaml, frames.parquet, PNGs).
 """
 
 from __future__ import annotations
@@ -16,6 +16,8 @@ import numpy as np
 import pandas as pd
 from scipy.spatial.transform import Rotation
 
+from poseintegrity.lens import Camera, write_camera_yaml
+
 BOARD = dict(dictionary="DICT_4X4_50", markers_x=3, markers_y=2, marker_length_mm=20.0, separation_mm=5.0, first_id=0)
 CANVAS_MM = (-20.0, -30.0, 180.0, 80.0)  # x_min, y_min, x_max, y_max of the scene plane
 TARGET_MM = (85.0, -20.0, 165.0, 65.0)  # textured target rectangle
@@ -24,6 +26,7 @@ IMAGE_SIZE = (640, 400)  # width, height
 K = np.array([[600.0, 0.0, 320.0], [0.0, 600.0, 200.0], [0.0, 0.0, 1.0]])
 CENTRE_MM = np.array([80.0, 25.0, 0.0])  # the camera looks at this point of the plane
 DISTANCE_MM = 260.0
+CAMERA = Camera(K, np.zeros(5), *IMAGE_SIZE)  # an exact pinhole camera: these images have no lens distortion
 
 
 def texture(rng: np.random.Generator, shape: tuple[int, int]) -> np.ndarray:
@@ -68,13 +71,15 @@ def canvas(rng: np.random.Generator, with_board: bool = True) -> tuple[np.ndarra
     return image, mask
 
 
-def render(plane: np.ndarray, T_cam_board: np.ndarray, interpolation: int = cv2.INTER_LINEAR) -> np.ndarray:
-    """Exact perspective image (h, w) of the plane z = 0 seen from T_cam_board (board -> camera, mm)."""
+def render(plane: np.ndarray, T_cam_board: np.ndarray, interpolation: int = cv2.INTER_LINEAR,
+           K: np.ndarray = K, size: tuple[int, int] = IMAGE_SIZE) -> np.ndarray:
+    """Exact perspective image (h, w) of the plane z = 0 seen from T_cam_board (board -> camera, mm) by a pinhole
+    camera K of ``size`` (width, height)."""
     x_min, y_min = CANVAS_MM[:2]
     # canvas pixel centre u -> board X = x_min + (u + 0.5) / s (pixel u covers [u, u + 1) / s beyond x_min)
     A = np.array([[1 / PX_PER_MM, 0, x_min + 0.5 / PX_PER_MM], [0, 1 / PX_PER_MM, y_min + 0.5 / PX_PER_MM], [0, 0, 1]])
     H = K @ T_cam_board[:3, [0, 1, 3]] @ A
-    return cv2.warpPerspective(plane, H, IMAGE_SIZE, flags=interpolation, borderValue=128)
+    return cv2.warpPerspective(plane, H, size, flags=interpolation, borderValue=128)
 
 
 def look_at(centre_board: np.ndarray, R_board_cam: np.ndarray) -> np.ndarray:
@@ -114,14 +119,13 @@ def write_dataset(
     plane, target = canvas(rng)
     T_model = arc_pose(0.0, azimuth_deg)
     model_poses = [T_model, shifted(T_model, np.array([20.0, 0.0, 0.0]))]  # IV-D: 2 cm along camera x
-    model = dict(images=[], masks=[], T_cam_board=[], T_cam_target=[])
+    model = dict(images=[], masks=[], T_cam1_cam0=(model_poses[1] @ np.linalg.inv(model_poses[0])).tolist(),
+                 exact_T_cam_board=[T.tolist() for T in model_poses])
     for index, T in enumerate(model_poses):
         cv2.imwrite(str(folder / f"model/image_{index}.png"), render(plane, T))
         cv2.imwrite(str(folder / f"model/mask_{index}.png"), render(target, T, cv2.INTER_NEAREST))
         model["images"].append(f"model/image_{index}.png")
         model["masks"].append(f"model/mask_{index}.png")
-        model["T_cam_board"].append(T.tolist())
-        model["T_cam_target"].append(T.tolist())
     rows = []
     for stop, position in enumerate(stops):
         if trajectory == "arc":
@@ -136,13 +140,14 @@ def write_dataset(
                              T_cam_board=T.ravel().tolist(), T_cam_target=T.ravel().tolist()))
     pd.DataFrame(rows).to_parquet(folder / "frames.parquet")
     meta = dict(
-        dataset=name, scene="synthetic", targets=["texture"], trajectory=trajectory, azimuth_deg=azimuth_deg,
-        offset_deg=0.0, n_stops=len(stops), images_per_stop=images_per_stop, image_size=list(IMAGE_SIZE),
-        K=K.tolist(), dist=[0.0] * 5, board=BOARD, model=model,
+        dataset=name, world="main", scene="synthetic", targets=["texture"], trajectory=trajectory,
+        azimuth_deg=azimuth_deg, offset_deg=0.0, n_stops=len(stops), images_per_stop=images_per_stop, board=BOARD,
+        model=model,
     )
     (folder / "meta.json").write_text(json.dumps(meta))
-    return dict(dataset=name, scene="synthetic", trajectory=trajectory, azimuth_deg=azimuth_deg, offset_deg=0.0,
-                n_frames=len(rows), path=f"datasets/{name}")
+    write_camera_yaml(folder / "camera.yaml", CAMERA, "synthetic")
+    return dict(dataset=name, world="main", scene="synthetic", trajectory=trajectory, azimuth_deg=azimuth_deg,
+                offset_deg=0.0, n_frames=len(rows), path=f"datasets/{name}")
 
 
 def write_index(data_dir: Path, rows: list[dict]) -> None:

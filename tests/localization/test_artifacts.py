@@ -6,7 +6,7 @@ from poseintegrity.artifact_models.base_functions import emg
 from poseintegrity.localization.frame_artifacts import frame_artifacts
 from poseintegrity.localization.realism import realism_metrics
 from poseintegrity.localization.summaries import method_summary
-from poseintegrity.localization.envelope import envelopes
+from poseintegrity.localization.envelope import envelopes, headline
 from poseintegrity.config import load_params
 from repository import ROOT
 from poseintegrity.localization.pnp import PnPResult, failed
@@ -48,7 +48,7 @@ def world(counts_by_dataset, trajectory="arc"):
             theta = 2.25 * stop
             n_i = max(int(counts(theta)), 0)
             for image in range(2):
-                rows.append(dict(dataset=dataset, trajectory=trajectory, stop=stop, image=image,
+                rows.append(dict(world="main", dataset=dataset, trajectory=trajectory, stop=stop, image=image,
                                  theta_deg=theta if trajectory == "arc" else 0.0,
                                  x_mm=10.0 * stop if trajectory == "line" else 0.0, method="usac_magsac",
                                  n_inliers=n_i, status="ok" if n_i else "pnp_failed",
@@ -62,7 +62,7 @@ def linear(decay):
 
 def test_realism_metrics_of_a_world_with_known_answers():
     table = world({"a": linear(1.5), "b": linear(2.2), "c": linear(0.8)})  # strictly decreasing n_i, never 0
-    metrics = realism_metrics(table, envelopes(table, PROTOCOL.tolerances), REALISM, PROTOCOL)
+    metrics = realism_metrics(table, envelopes(table, PROTOCOL.tolerances, PROTOCOL.envelope), REALISM, PROTOCOL)
     assert metrics["min_abs_spearman"] == pytest.approx(1.0)
     assert metrics["min_first_stop_mean_inliers"] == 100  # every dataset starts at the model view
     low = 50.0 / table.loc[table.n_inliers < 15, "n_inliers"]
@@ -82,13 +82,25 @@ def test_realism_metrics_of_a_world_with_known_answers():
     assert metrics["theta_a_gap"] == {"b": pytest.approx(metrics["theta_a_4mm10deg"]["b"] - metrics["min_theta_a_2mm3deg"])}
     assert metrics["decay_ratio_arc"] == pytest.approx({"a": 0.89, "b": 0.85, "c": 0.94})
     assert not metrics["passed"]["r5_early_decay"]  # linear decays keep most inliers over the sampled stops
+    # R6-R10: the hardest arc (b) far past 9 deg; mean / min of the three envelopes; no lines; E_t at the sampled
+    # stops (50 / n_i, frames with a pose); b's theta_a between stops
+    theta_a = metrics["theta_a_2mm3deg"]
+    assert not metrics["passed"]["r6_hardest_arc"]
+    assert metrics["arc_theta_a_mean_over_min_2mm3deg"] == pytest.approx(np.mean(list(theta_a.values())) / theta_a["b"])
+    assert np.isnan(metrics["line_x_a_mean_over_min_2mm3deg"]) and not metrics["passed"]["r8_line_spread"]
+    first = table[table.stop < 4]
+    assert metrics["median_E_t_mm_first_stops"] == pytest.approx(first.E_t_mm.median())
+    assert metrics["passed"]["r9_pipeline_accuracy"]  # 50 / n_i of 90-100 inliers: ~0.5 mm
+    # b crosses 2 mm exactly at its stop 33.75 (n_i 25, E_t 2.0): its theta_a lies on a stop, R10 sees it
+    assert metrics["share_theta_a_on_stop_2mm3deg"] == 1.0 and not metrics["passed"]["r10_interpolated"]
+    assert metrics["n_bars"] == len(metrics["passed"]) and metrics["n_bars_passed"] == sum(metrics["passed"].values())
 
 
 def test_r1_prefers_the_emg_only_on_emg_shaped_decays():
     emg_world = world({f"d{i}": lambda t, K=K: emg(np.array([t]), 3000.0, K, -1.0)[0] for i, K in enumerate((5, 7, 9))})
     gauss_world = world({f"d{i}": lambda t, s=s: 300 * np.exp(-0.5 * (t / s) ** 2) for i, s in enumerate((10, 14, 18))})
     for table, near_best in ((emg_world, True), (gauss_world, False)):
-        metrics = realism_metrics(table, envelopes(table, PROTOCOL.tolerances), REALISM, PROTOCOL)
+        metrics = realism_metrics(table, envelopes(table, PROTOCOL.tolerances, PROTOCOL.envelope), REALISM, PROTOCOL)
         assert set(metrics["rmse_by_base_function"]) == {"emg", "exponential", "gaussian", "logistic", "power_law"}
         assert metrics["passed"]["r1_emg_near_best"] == near_best, metrics["rmse_by_base_function"]
 
@@ -96,7 +108,7 @@ def test_r1_prefers_the_emg_only_on_emg_shaped_decays():
 def test_r2_flags_envelopes_inside_the_sampled_stops_and_r5_compares_lines():
     table = pd.concat([world({"early": lambda t: 30 - 3 * t, "late": linear(2.0)}),
                        world({"line": linear(0.2)}, trajectory="line")], ignore_index=True)
-    metrics = realism_metrics(table, envelopes(table, PROTOCOL.tolerances), REALISM, PROTOCOL)
+    metrics = realism_metrics(table, envelopes(table, PROTOCOL.tolerances, PROTOCOL.envelope), REALISM, PROTOCOL)
     # early: E_t = 50 / n_i > 2 once n_i < 25, i.e. at theta 2.25 (n_i 23) -> theta_a <= 6.75, the 4th stop
     assert metrics["theta_a_2mm3deg_within_sampling"] == ["early"]
     assert not metrics["passed"]["r2_envelopes_beyond_sampling"]
@@ -106,7 +118,8 @@ def test_r2_flags_envelopes_inside_the_sampled_stops_and_r5_compares_lines():
 def test_method_summary():
     table = pd.concat([world({"a": linear(2.3)}).assign(method=m) for m in ("epnp", "p3p")], ignore_index=True)
     table.loc[table.method == "p3p", "n_inliers"] += 10
-    summary = method_summary(table, envelopes(table, [(2.0, 3.0)])).set_index("method")
+    summary = method_summary(table, headline(envelopes(table, [(2.0, 3.0)], PROTOCOL.envelope), PROTOCOL.envelope)
+                             ).set_index("method")
     assert summary.loc["p3p", "mean_n_inliers_first_stop"] == summary.loc["epnp", "mean_n_inliers_first_stop"] + 10
     assert summary.loc["epnp", "n_frames"] == 40
     assert summary.loc["epnp", "failure_rate"] == pytest.approx(0.0)  # n_i = 100 - 2.3 theta > 0 up to 42.75

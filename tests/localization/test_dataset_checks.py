@@ -9,6 +9,7 @@ import cv2
 import numpy as np
 import pandas as pd
 import pytest
+import yaml
 
 import loc_synthetic as synthetic
 from poseintegrity.localization import extract as E
@@ -27,7 +28,7 @@ def data_dir(synthetic_data_dir, tmp_path):
 
 
 def index_row(name: str) -> dict:
-    return dict(dataset=name, scene="synthetic", trajectory="line", azimuth_deg=0.0, offset_deg=0.0, n_frames=4,
+    return dict(dataset=name, world="main", scene="synthetic", trajectory="line", azimuth_deg=0.0, offset_deg=0.0, n_frames=4,
                 path=f"datasets/{name}")
 
 
@@ -39,6 +40,12 @@ def edit_meta(data_dir, change):
     meta = json.loads((folder(data_dir) / "meta.json").read_text())
     change(meta)
     (folder(data_dir) / "meta.json").write_text(json.dumps(meta))
+
+
+def edit_camera(data_dir, change):
+    camera = yaml.safe_load((folder(data_dir) / "camera.yaml").read_text())
+    change(camera)
+    (folder(data_dir) / "camera.yaml").write_text(yaml.safe_dump(camera))
 
 
 def edit_frames(data_dir, change):
@@ -68,7 +75,7 @@ def scaled_pose(frames, row=2):
 # A bad frame: rows of that frame flagged (status, text the reason holds), the other frames localized as usual.
 FLAGGED = {
     "image twice the size": (lambda d: write_image(d, "images/s01_i00.png", cv2.resize(frame_image(d), (1280, 800))),
-                             "bad_image", "1280 x 800 px, its dataset's meta.json image_size is 640 x 400"),
+                             "bad_image", "1280 x 800 px, its dataset's camera.yaml says 640 x 400"),
     "image half the size": (lambda d: write_image(d, "images/s01_i00.png", cv2.resize(frame_image(d), (320, 200))),
                             "bad_image", "320 x 200 px"),
     "16-bit image": (lambda d: write_image(d, "images/s01_i00.png", frame_image(d).astype(np.uint16) * 256),
@@ -119,11 +126,20 @@ STOPS = {
     "missing meta.json": (lambda d: (folder(d) / "meta.json").unlink(), ["dataset line_a", "meta.json is missing"]),
     "unreadable meta.json": (lambda d: (folder(d) / "meta.json").write_text("{not json"),
                              ["dataset line_a", "cannot read", "meta.json"]),
-    "meta.json without image_size": (lambda d: edit_meta(d, lambda m: m.pop("image_size")),
-                                     ["meta.json has invalid values", "image_size: Field required"]),
-    "NaN in K": (lambda d: edit_meta(d, lambda m: m["K"][0].__setitem__(0, float("nan"))), ["meta.json", "K.0.0"]),
-    "NaN model pose": (lambda d: edit_meta(d, lambda m: m["model"]["T_cam_board"][1][0].__setitem__(3, float("nan"))),
-                       ["meta.json", "model.T_cam_board", "the pose of model image 1 holds NaN or inf"]),
+    "meta.json without its world": (lambda d: edit_meta(d, lambda m: m.pop("world")),
+                                    ["meta.json has invalid values", "world: Field required"]),
+    "NaN model baseline": (lambda d: edit_meta(d, lambda m: m["model"]["T_cam1_cam0"][0].__setitem__(3, float("nan"))),
+                           ["meta.json", "model.T_cam1_cam0", "the model pair's relative pose holds NaN or inf"]),
+    "missing camera.yaml": (lambda d: (folder(d) / "camera.yaml").unlink(), ["dataset line_a", "camera.yaml"]),
+    "camera.yaml with a negative focal length": (
+        lambda d: edit_camera(d, lambda c: c["camera_matrix"]["data"].__setitem__(0, -600.0)),
+        ["dataset line_a", "camera.yaml", "camera_matrix", "fx, fy > 0"]),
+    "camera.yaml of an unknown lens model": (
+        lambda d: edit_camera(d, lambda c: c.__setitem__("distortion_model", "fisheye")),
+        ["dataset line_a", "distortion_model", "'fisheye'"]),
+    "camera.yaml of a folding lens": (
+        lambda d: edit_camera(d, lambda c: c["distortion_coefficients"]["data"].__setitem__(0, -2.0)),
+        ["dataset line_a", "distortion_coefficients", "folds the image"]),
     "meta.json of another dataset": (lambda d: edit_meta(d, lambda m: m.__setitem__("dataset", "arc_a")),
                                      ["dataset line_a", "names the dataset 'arc_a'"]),
     "missing frames.parquet": (lambda d: (folder(d) / "frames.parquet").unlink(),

@@ -70,7 +70,7 @@ def test_missing_and_unreadable_files_name_the_file(tmp_path, settings):
 @pytest.mark.parametrize("stored, size, message", [
     (np.zeros((40, 60), np.uint16), None, "16-bit with 1 channel"),
     (np.zeros((40, 60, 3), np.uint8), None, "8-bit with 3 channel"),
-    (np.zeros((40, 60), np.uint8), (120, 80), "60 x 40 px, its dataset's meta.json image_size is 120 x 80"),
+    (np.zeros((40, 60), np.uint8), (120, 80), "60 x 40 px, its dataset's camera.yaml says 120 x 80"),
 ])
 def test_images_are_read_as_stored_never_converted(tmp_path, stored, size, message):
     """IMREAD_GRAYSCALE would quietly turn these into plausible 8-bit images of another size or content."""

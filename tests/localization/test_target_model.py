@@ -28,7 +28,8 @@ def model_views(rng, params, target_mask=True):
 
 def test_model_points_lie_on_the_target_in_the_board_frame(extract_params):
     features, masks, poses = model_views(np.random.default_rng(1), extract_params)
-    model = build_target_model(features, masks, poses, synthetic.K, extract_params.ratio_test,
+    model = build_target_model(features, masks, poses[1] @ np.linalg.inv(poses[0]), poses[0], synthetic.CAMERA,
+                               extract_params.ratio_test,
                                extract_params.model_max_reprojection_px)
     assert model.size > 200 and model.descriptors.shape == (model.size, 128)
     x_min, y_min, x_max, y_max = synthetic.TARGET_MM
@@ -40,6 +41,7 @@ def test_model_points_lie_on_the_target_in_the_board_frame(extract_params):
 
 def test_empty_mask_gives_an_empty_model(extract_params):
     features, masks, poses = model_views(np.random.default_rng(2), extract_params, target_mask=False)
-    model = build_target_model(features, masks, poses, synthetic.K, extract_params.ratio_test,
+    model = build_target_model(features, masks, poses[1] @ np.linalg.inv(poses[0]), poses[0], synthetic.CAMERA,
+                               extract_params.ratio_test,
                                extract_params.model_max_reprojection_px)
     assert model.size == 0 and model.points.shape == (0, 3) and model.descriptors.shape == (0, 128)

@@ -189,6 +189,8 @@ def frame_rows(task: FrameTask) -> list[dict[str, Any]]:
             )
         E_t_mm, E_r_deg = map(float, pose_errors(T_est, aruco.T_cam_board))  # IV-C: the board is the truth
         E_t_exact_mm, E_r_exact_deg = map(float, pose_errors(T_est, T_cam_board))
+        if status in DATA_FLAGS:  # a flagged frame is no evidence: no error is reported for it
+            E_t_mm = E_r_deg = np.nan
         rows.append(
             {key: frame[key] for key in FRAME_COLUMNS}
             | dict(method=method, status=status or pnp_status, reason=reason, model_size=model.size)
