@@ -165,15 +165,14 @@ def with_pnp_variants(
 ) -> tuple[pd.DataFrame, pd.DataFrame]:
     """Stage 02's (artifacts, envelopes) with stage 05's tables of the other PnP methods added (Fig. 6).
 
-    A method already in ``artifacts`` keeps stage 02's rows; an envelope (dataset, trajectory, tolerance, method)
-    present in both keeps stage 02's.
+    A method already in ``artifacts`` keeps stage 02's rows; an envelope (dataset, trajectory, tolerance, method
+    and, when the tables have one, failed-frame rule) present in both keeps stage 02's.
     """
     extra = variants[~variants["method"].isin(artifacts["method"].unique())]
+    keys = ["dataset", "trajectory", "tolerance", "method", *(["rule"] if "rule" in envelopes.columns else [])]
     return (
         pd.concat([artifacts, extra], ignore_index=True),
-        pd.concat([envelopes, variant_envelopes], ignore_index=True).drop_duplicates(
-            ["dataset", "trajectory", "tolerance", "method"]
-        ),
+        pd.concat([envelopes, variant_envelopes], ignore_index=True).drop_duplicates(keys),
     )
 
 
