@@ -6,7 +6,8 @@ import re
 import pytest
 
 from poseintegrity.report import paper
-from poseintegrity.report.summary import HEADLINES, SECTIONS, render_summary
+from poseintegrity.report.headlines import HEADLINES, SECTIONS
+from poseintegrity.report.summary import render_summary
 from repository import ROOT, outside_references
 
 # Rows of Windsor et al.'s tables as printed (system, 2mm/3deg, 4mm/10deg, mean, relative improvement)
@@ -93,7 +94,7 @@ def test_fit_statuses_have_a_row_per_model_and_predictor():
     """Stages 03 and 04 count flagged fits (artifact_models/fitted.py): the summary shows every status of every model
     of Fig. 2 and of every predictor, beside the RMSE and SPL they qualify."""
     from poseintegrity.artifact_models import FIT_STATUSES, MODEL_NAMES
-    from poseintegrity.report.summary import FIT_STATUS_LABELS, MODEL_LABELS
+    from poseintegrity.report.headlines import FIT_STATUS_LABELS, MODEL_LABELS
 
     assert list(FIT_STATUS_LABELS) == list(FIT_STATUSES) and set(MODEL_LABELS) == set(MODEL_NAMES)
     keys = {(h.stage, h.key) for h in HEADLINES}

@@ -1,0 +1,327 @@
+"""The rows of ``reports/summary.md``: which keys of ``reports/metrics/<stage>.json`` are headline figures, what the
+papers reported for them (:mod:`poseintegrity.report.paper`) and the project's target where there is one."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from poseintegrity.report import paper
+
+
+@dataclass(frozen=True)
+class Headline:
+    """One row: ``key`` is a dotted path into ``metrics/<stage>.json``."""
+
+    stage: str
+    key: str
+    label: str
+    paper: str = "-"
+    target: str = "-"
+    fmt: str = "{:.4g}"  # how a float is shown, e.g. "{:+.1%}" for a relative improvement
+
+
+SECTIONS = {
+    "generate": "Stage 01 · rendered robot datasets (Windsor et al. IV-D)",
+    "artifacts": "Stage 02 · artifact extraction and the realism of the rendered world (Windsor et al. III-B, IV-C)",
+    "pnp": "Stage 05 · PnP variants (Windsor et al. V-A, Fig. 6)",
+    "fits": "Stage 03 · artifact models, mean RMSE over the whole dataset from the first 4 stops (Fig. 2)",
+    "predictors": "Stage 04 · localization-envelope predictors (Windsor et al. V, Tables I-III)",
+    "validation": "Stage 04 · the validation world, nothing tuned on it: the main world's operating points applied "
+                  "unchanged, and its own sweep",
+    "tracking": "Stage 06 · marker tracking (Black & Salcudean, IEEE TIM 2024, DOI 10.1109/TIM.2024.3398108, section III)",
+}
+
+FIT_STATUS_LABELS = {"ok": "ok", "at_bound": "at a bound", "non_physical": "non-physical",
+                     "fallback": "fallen back to a line"}  # the statuses of artifact_models/fitted.py
+MODEL_LABELS = {"emg": "EMG (eq. 1)", "exponential": "exponential", "gaussian": "Gaussian", "logistic": "logistic",
+                "power_law": "power law", "emg_free_width": "ours: EMG with a fitted Gaussian width",
+                "mlp_scratch": "MLP, samples only", "mlp_pretrained": "MLP, EMG-pretrained + fine-tuned"}
+
+
+def _fit_status_rows() -> list[Headline]:
+    """fits.json: per model, the share of all its Fig. 2 fits per status (ok / at a bound / non-physical / fallback)."""
+    rows = []
+    for model, name in MODEL_LABELS.items():
+        for status, label in FIT_STATUS_LABELS.items():
+            rows.append(Headline("fits", f"fit_status.{model}.{status}",
+                                 f"{name}: share of fits {label}" if status == "ok" else f"... {label}",
+                                 target=">= 0.99" if (model, status) == ("emg", "ok") else "-", fmt="{:.1%}"))
+    return rows
+
+
+def _predictor_rows() -> list[Headline]:
+    """Tables I-III per tolerance, each row beside the paper's own value for that tolerance (report/paper.py)."""
+    names = {"static": "static baseline", "mlp": "MLP", "long_range": "long range (EMG, eq. 1)",
+             "next_step": "next step"}
+    rows = []
+    for tolerance in paper.TOLERANCES:
+        label = paper.TOLERANCE_LABELS[tolerance]
+        for predictor, name in names.items():
+            rows.append(Headline("predictors", f"{predictor}.{tolerance}.max_mean_spl_zero_incursion",
+                                 f"{name}, {label}: max mean SPL at zero incursion (deg)",
+                                 f"{paper.WINDSOR_SPL_ZERO_INCURSION[predictor][tolerance]:g}"))
+        for predictor in paper.WINDSOR_THRESHOLDS:
+            rows.append(Headline("predictors", f"{predictor}.{tolerance}.best_n_t",
+                                 f"{names[predictor]}, {label}: its threshold n_t",
+                                 f"{paper.WINDSOR_THRESHOLDS[predictor][tolerance]}"))
+    improvement = paper.WINDSOR_IMPROVEMENTS
+    rows += [
+        Headline("predictors", "long_range.relative_improvement", "long range over static (mean of both tolerances)",
+                 f"+{improvement['long_range_vs_static']:.1%}", fmt="{:+.1%}"),
+        Headline("predictors", "long_range.relative_improvement_vs_mlp", "long range over MLP",
+                 f"+{improvement['long_range_vs_mlp']:.1%}", fmt="{:+.1%}"),
+        Headline("predictors", "next_step.relative_improvement", "next step over static",
+                 f"+{improvement['next_step_vs_static']:.1%}", fmt="{:+.1%}"),
+        Headline("predictors", "next_step.relative_improvement_vs_long_range", "next step over long range",
+                 f"+{improvement['next_step_vs_long_range']:.1%}", fmt="{:+.1%}"),
+        Headline("predictors", "straight_line.relative_improvement", "straight lines (2 mm/3 deg): long range over static",
+                 f"+{improvement['straight_line_vs_static']:.1%}", fmt="{:+.1%}"),
+        Headline("predictors", "live.incursions", "simulated live trials: incursions (next step, fixed n_t)",
+                 f"{paper.WINDSOR_LIVE['incursions']} of {paper.WINDSOR_LIVE['n_trials']}"),
+        Headline("predictors", "live.envelope_share", "simulated live trials: share of the actual envelope used",
+                 f"{paper.WINDSOR_LIVE['envelope_share']:.1%}", fmt="{:.1%}"),
+        Headline("predictors", "live.static_envelope_share", "... static baseline",
+                 f"{paper.WINDSOR_LIVE['static_envelope_share']:.1%}", fmt="{:.1%}"),
+    ]
+    for tolerance in paper.TOLERANCES:
+        label = paper.TOLERANCE_LABELS[tolerance]
+        for predictor, name in (("long_range_relative", "long range"), ("next_step_relative", "next step")):
+            rows += [
+                Headline("predictors", f"{predictor}.{tolerance}.max_mean_spl_zero_incursion",
+                         f"beyond the paper: {name}, n_t relative to the first stop, {label}: max mean SPL at zero "
+                         "incursion (deg)"),
+                Headline("predictors", f"{predictor}.{tolerance}.best_fraction", "... its n_t / first-stop mean n_i"),
+            ]
+        for predictor in ("long_range", "long_range_relative", "next_step", "next_step_relative"):
+            rows += [
+                Headline("predictors", f"loso.{predictor}.{tolerance}.heldout_incursion_rate",
+                         f"beyond the paper, LOSO: {predictor}, {label}, operating point chosen for 0 incursions on "
+                         "the other scenes: held-out R_i"),
+                Headline("predictors", f"loso.{predictor}.{tolerance}.heldout_mean_spl", "... held-out mean SPL (deg)"),
+            ]
+    rows += [Headline("predictors", f"pnp.{method}.max_mean_spl_zero_incursion",
+                      f"long range on {name}, 2 mm/3 deg (deg)", "similar to USAC (Fig. 6)" if method == "epnp" else "-")
+             for method, name in (("epnp", "EPnP"), ("p3p", "P3P"), ("ap3p", "AP3P"), ("sqpnp", "SQPnP"))]
+    # every row of a predictor rests on a fit: the share resting on a flagged one (still counted, as the robot acted)
+    for predictor in ("long_range", "mlp", "next_step"):
+        rows += [Headline("predictors", f"fit_status.{predictor}.{status}",
+                          f"{names[predictor]}: share of rows (dataset x n_t) on a fit {label}" if status == "ok"
+                          else f"... {label}", fmt="{:.1%}")
+                 for status, label in FIT_STATUS_LABELS.items()]
+    rows.append(Headline("predictors", "live.n_flagged_fits", "simulated live trials that went by a flagged fit"))
+    return rows + _free_width_rows() + _rule_rows()
+
+
+def _rule_rows() -> list[Headline]:
+    """predictors.json envelope_rules: Tables I-II under each rule for frames without a pose (theta_a, IV-E)."""
+    rows = []
+    for rule in ("fail_fraction", "capped", "infinite"):
+        for tolerance in paper.TOLERANCES:
+            label = paper.TOLERANCE_LABELS[tolerance]
+            for predictor in ("static", "long_range", "next_step"):
+                rows.append(Headline("predictors", f"envelope_rules.{rule}.{predictor}.{tolerance}"
+                                     f".max_mean_spl_zero_incursion",
+                                     f"theta_a rule '{rule}': {predictor}, {label} (deg)",
+                                     f"{paper.WINDSOR_SPL_ZERO_INCURSION[predictor][tolerance]:g}"))
+        rows.append(Headline("predictors", f"envelope_rules.{rule}.long_range.relative_improvement",
+                             f"theta_a rule '{rule}': long range over static",
+                             f"+{paper.WINDSOR_IMPROVEMENTS['long_range_vs_static']:.1%}", fmt="{:+.1%}"))
+    return rows
+
+
+def _validation_rows() -> list[Headline]:
+    """validation.json: per tolerance, each predictor at the main world's operating point (R_i, mean SPL) and at its
+    own best; the relative improvements of its own sweep."""
+    names = {"static": "static baseline", "mlp": "MLP", "long_range": "long range (eq. 1)", "next_step": "next step",
+             "long_range_free_width": "ours: long range, free-width EMG",
+             "next_step_free_width": "ours: next step, free-width EMG"}
+    rows = []
+    for tolerance in paper.TOLERANCES:
+        label = paper.TOLERANCE_LABELS[tolerance]
+        for predictor, name in names.items():
+            rows += [
+                Headline("validation", f"transfer.{predictor}.{tolerance}.incursion_rate",
+                         f"{name}, {label}, the main world's operating point: R_i", "0 (live trials, V-C)"),
+                Headline("validation", f"transfer.{predictor}.{tolerance}.mean_spl", "... mean SPL (deg)"),
+                Headline("validation", f"{predictor}.{tolerance}.max_mean_spl_zero_incursion",
+                         f"{name}, {label}, its own sweep: max mean SPL at zero incursion (deg)",
+                         f"{paper.WINDSOR_SPL_ZERO_INCURSION[predictor][tolerance]:g}"
+                         if predictor in paper.WINDSOR_SPL_ZERO_INCURSION else "-"),
+            ]
+    improvement = paper.WINDSOR_IMPROVEMENTS
+    rows += [
+        Headline("validation", "long_range.relative_improvement", "its own sweep: long range over static",
+                 f"+{improvement['long_range_vs_static']:.1%}", fmt="{:+.1%}"),
+        Headline("validation", "next_step.relative_improvement", "its own sweep: next step over static",
+                 f"+{improvement['next_step_vs_static']:.1%}", fmt="{:+.1%}"),
+        Headline("validation", "straight_line.relative_improvement", "its own sweep: straight lines, long range over "
+                 "static", f"+{improvement['straight_line_vs_static']:.1%}", fmt="{:+.1%}"),
+        Headline("validation", "tails.long_range.2mm_3deg.n_overshooting",
+                 "arcs whose eq. 1 theta_p overshoots theta_a at every n_t <= 30, 2 mm/3 deg"),
+    ]
+    return rows
+
+
+FREE_WIDTH_LABELS = {"long_range_free_width": ("long range", "long_range"),
+                     "next_step_free_width": ("next step", "next_step")}  # ours -> (name, the paper's predictor)
+
+
+def _free_width_rows() -> list[Headline]:
+    """Ours, not the paper's: the predictors on the free-width EMG beside theirs on eq. 1, and the tail diagnosis (the
+    arcs whose long range theta_p overshoots theta_a at every n_t <= predict.tail_n_t_max)."""
+    rows = []
+    for tolerance in paper.TOLERANCES:
+        label = paper.TOLERANCE_LABELS[tolerance]
+        for predictor, (name, _) in FREE_WIDTH_LABELS.items():
+            rows += [
+                Headline("predictors", f"{predictor}.{tolerance}.max_mean_spl_zero_incursion",
+                         f"ours: {name} on the free-width EMG, {label}: max mean SPL at zero incursion (deg)"),
+                Headline("predictors", f"{predictor}.{tolerance}.best_n_t", "... its threshold n_t"),
+            ]
+    for predictor, (name, theirs) in FREE_WIDTH_LABELS.items():
+        rows.append(Headline("predictors", f"{predictor}.relative_improvement_vs_{theirs}",
+                             f"ours: {name} on the free-width EMG over {name} on eq. 1 (mean of both tolerances)",
+                             fmt="{:+.1%}"))
+        rows += [Headline("predictors", f"fit_status.{predictor}.{status}",
+                          f"ours: {name} on the free-width EMG: share of rows on a fit {label}" if status == "ok"
+                          else f"... {label}", fmt="{:.1%}")
+                 for status, label in FIT_STATUS_LABELS.items()]
+    for tolerance in paper.TOLERANCES:
+        label = paper.TOLERANCE_LABELS[tolerance]
+        for predictor, model in (("long_range", "eq. 1"), ("long_range_free_width", "the free-width EMG")):
+            rows += [
+                Headline("predictors", f"tails.{predictor}.{tolerance}.n_overshooting",
+                         f"ours: arcs whose long range theta_p on {model} overshoots theta_a at every n_t up to "
+                         f"predict.tail_n_t_max, {label}"),
+                Headline("predictors", f"tails.{predictor}.{tolerance}.datasets", "... which arcs"),
+            ]
+    return rows
+
+
+BLACK = paper.BLACK_RESULTS  # Black and Salcudean, section III
+
+HEADLINES: list[Headline] = [
+    Headline("generate", "n_viewing_angle_datasets", "viewing-angle datasets", "21 (7 scenes x 3 azimuths)"),
+    Headline("generate", "n_straight_line_datasets", "straight-line datasets", "4"),
+    Headline("generate", "n_images", "images (incl. model pairs)", "~4 850"),
+    Headline("generate", "image_width_px", "image width (px)", "1936 (full sensor)"),
+    Headline("generate", "focal_px", "focal length (px)", "not published"),
+    Headline("generate", "clahe_keypoint_gain_bone", "SIFT keypoints on bone targets, CLAHE / raw",
+             "CLAHE used 'to improve feature detection on low texture bone phantoms'"),
+    Headline("generate", "calibration.rms_px", "camera calibration (ChArUco, rendered): reprojection RMS (px)", "-",
+             "<= generate.calibration.max_rms_px"),
+    Headline("generate", "calibration.fx_error_pct", "... its focal length error (%)"),
+    Headline("generate", "calibration.principal_point_error_px", "... its principal point error (px)"),
+    Headline("generate", "calibration.ray_error_px_max", "... largest ray error over the image (px)"),
+    Headline("generate", "robot.abs_position_mm_mean", "robot: absolute camera position error, mean (mm)",
+             "Franka Panda (ours: a UR5e, docs/references.md)"),
+    Headline("generate", "robot.baseline_error_mm_mean", "robot: the 20 mm model baseline's error, mean (mm)"),
+    Headline("generate", "robot.theta_error_deg_mean", "robot: error of the recorded viewing angle theta (deg)"),
+    Headline("generate", "disk_gb", "disk (GB)", "-", "<= 3"),
+    Headline("generate", "wall_time_s", "stage wall time (s), both worlds", "-", "<= 480 (main world)"),
+    Headline("artifacts", "realism.min_abs_spearman", "weakest decay over arcs: min of -Spearman(theta, mean n_i)",
+             "n_i 'decays' with viewing angle", ">= 0.8"),
+    Headline("artifacts", "realism.min_abs_spearman_to_failure",
+             "... over the stops up to theta_a (4 mm/10 deg) only, a diagnostic: the floor after failure is noise"),
+    Headline("artifacts", "realism.min_first_stop_mean_inliers", "smallest mean n_i at the first stop", "-",
+             ">= 50"),
+    Headline("artifacts", "realism.error_ratio_low_vs_high_inliers",
+             "median E_t: frames with n_i < 15 over frames with n_i > 50", "error blows up at low n_i", ">= 3"),
+    Headline("artifacts", "realism.n_uncensored_4mm10deg", "arcs whose envelope ends inside the arc, 4 mm/10 deg",
+             "-", ">= 18 of 21"),
+    Headline("artifacts", "realism.cv_theta_a_2mm3deg", "coefficient of variation of theta_a, 2 mm/3 deg", "-",
+             ">= 0.25"),
+    Headline("artifacts", "realism.median_inliers_at_theta_a_4mm10deg",
+             "median mean n_i at theta_a, 4 mm/10 deg (failure by running out of inliers)",
+             "12-28 (n_t at zero incursion, Table III)", "<= 30; R4: 10-35"),
+    Headline("artifacts", "realism.emg_rmse_ratio",
+             "R1: EMG mean RMSE from 4 stops / best other least-squares base function's (arcs)",
+             "EMG lowest (Fig. 2)", "<= 1.10"),
+    Headline("artifacts", "realism.n_theta_a_2mm3deg_within_sampling",
+             "R2: arcs failing at 2 mm/3 deg within the 4 sampled stops (<= 6.75 deg)",
+             "4 stops 'only drawn from within the localization envelope' (IV-A)", "0"),
+    Headline("artifacts", "realism.median_theta_a_gap", "R3: median theta_a(4 mm/10 deg) - theta_a(2 mm/3 deg) (deg)",
+             "static 7.0 at both tolerances", "<= 4.5"),
+    Headline("artifacts", "realism.median_inliers_at_theta_a_2mm3deg", "R4: median mean n_i at theta_a, 2 mm/3 deg",
+             "n_t 12-23 at zero incursion", "10-35"),
+    Headline("artifacts", "realism.p90_inliers_at_theta_a_2mm3deg", "R4: 90th percentile of n_i at theta_a, "
+             "2 mm/3 deg", "-", "<= 50"),
+    Headline("artifacts", "realism.p90_inliers_at_theta_a_4mm10deg", "R4: 90th percentile of n_i at theta_a, "
+             "4 mm/10 deg", "-", "<= 50"),
+    Headline("artifacts", "realism.median_decay_ratio_arc", "R5: median mean n_i at the 4th stop / first stop, arcs",
+             "4 stops suffice to fit the decay", "<= 0.75"),
+    Headline("artifacts", "realism.median_decay_ratio_line", "R5: the same on straight lines",
+             "'begins to decay later' (V-A)", "> arcs"),
+    Headline("artifacts", "realism.min_theta_a_2mm3deg", "R6: smallest arc theta_a at 2 mm/3 deg (deg)",
+             "7.0 (static baseline at zero incursion)", "6.75-9.0"),
+    Headline("artifacts", "realism.arc_theta_a_mean_over_min_2mm3deg", "R7: arcs' mean theta_a / smallest, 2 mm/3 deg",
+             "next step's 13.9-14.4 over static's 7.0", ">= 2.0"),
+    Headline("artifacts", "realism.line_x_a_mean_over_min_2mm3deg", "R8: lines' mean x_a / smallest, 2 mm/3 deg",
+             "+46.2 % for the line predictor", ">= 1.4"),
+    Headline("artifacts", "realism.median_E_t_mm_first_stops",
+             "R9: median E_t vs the ArUco ground truth, frames with a pose, sampled stops (mm)",
+             "2 mm/3 deg 'the accuracy limit of our pose estimation pipeline'", "0.3-1.5"),
+    Headline("artifacts", "realism.share_theta_a_on_stop_2mm3deg",
+             "R10: uncensored arcs whose theta_a lies within 0.01 deg of a stop", "interpolated between stops (IV-E)",
+             "<= 0.5", fmt="{:.0%}"),
+    Headline("artifacts", "realism.n_bars_passed", "realism bars passed (of realism.n_bars, artifacts.json)"),
+    Headline("artifacts", "realism.n_bars", "... realism bars"),
+    Headline("artifacts", "board_vs_exact.median_E_t_mm", "ArUco ground truth vs exact pose, median E_t (mm)",
+             "ArUco board used as ground truth"),
+    Headline("artifacts", "board_vs_exact.detection_rate", "frames with the board detected"),
+    Headline("pnp", "methods.usac_magsac.mean_n_inliers_first_stop", "USAC (P3P + MAGSAC): mean n_i, first stop"),
+    Headline("pnp", "methods.epnp.mean_n_inliers_first_stop", "EPnP: mean n_i, first stop"),
+    Headline("pnp", "methods.p3p.mean_n_inliers_first_stop", "P3P: mean n_i, first stop"),
+    Headline("pnp", "methods.ap3p.mean_n_inliers_first_stop", "AP3P: mean n_i, first stop"),
+    Headline("pnp", "methods.sqpnp.mean_n_inliers_first_stop", "SQPnP: mean n_i, first stop"),
+    Headline("pnp", "methods.usac_magsac.mean_theta_a_arc_2mm_3deg", "USAC: mean theta_a, arcs, 2 mm/3 deg (deg)"),
+    Headline("pnp", "methods.epnp.mean_theta_a_arc_2mm_3deg", "EPnP: mean theta_a, arcs, 2 mm/3 deg (deg)"),
+    Headline("pnp", "methods.sqpnp.mean_theta_a_arc_2mm_3deg", "SQPnP: mean theta_a, arcs, 2 mm/3 deg (deg)"),
+    Headline("fits", "rmse_k4.emg", "EMG (eq. 1)", "lowest of the least-squares fits"),
+    Headline("fits", "rmse_k4.exponential", "exponential"),
+    Headline("fits", "rmse_k4.gaussian", "Gaussian"),
+    Headline("fits", "rmse_k4.logistic", "logistic"),
+    Headline("fits", "rmse_k4.power_law", "power law"),
+    Headline("fits", "rmse_k4.emg_free_width", "ours, not the paper's: EMG with a fitted Gaussian width"),
+    Headline("fits", "rmse_k4.mlp_scratch", "MLP, samples only", "'very high RMSE'"),
+    Headline("fits", "rmse_k4.mlp_pretrained", "MLP, EMG-pretrained + fine-tuned", "competitive with least squares"),
+    *_fit_status_rows(),
+    *_predictor_rows(),
+    *_validation_rows(),
+    Headline("tracking", "rms_axis_mm.no_filter", "RMS position error per axis, no filter (mm; paper's metric)",
+             f"{BLACK['rms_mm']['no_filter']:g}"),
+    Headline("tracking", "rms_axis_mm.ukf", "RMS position error per axis, UKF (mm; paper's metric)",
+             f"{BLACK['rms_mm']['ukf']:g}"),
+    Headline("tracking", "rms_axis_mm.ukf_gyro", "RMS position error per axis, UKF + gyro (mm; paper's metric)"),
+    Headline("tracking", "rms_euler_deg.no_filter", "RMS Euler-angle error, no filter (deg; paper's metric, Unity YXZ)",
+             f"{BLACK['rms_deg']['no_filter']:g}"),
+    Headline("tracking", "rms_euler_deg.ukf", "RMS Euler-angle error, UKF (deg; paper's metric, Unity YXZ)",
+             f"{BLACK['rms_deg']['ukf']:g}"),
+    Headline("tracking", "rms_euler_deg.ukf_gyro", "RMS Euler-angle error, UKF + gyro (deg; paper's metric, Unity YXZ)"),
+    Headline("tracking", "rms_mm.no_filter", "RMS position error norm, no filter (mm; ours)"),
+    Headline("tracking", "rms_mm.ukf", "RMS position error norm, UKF (mm; ours)"),
+    Headline("tracking", "rms_mm.ukf_gyro", "RMS position error norm, UKF + gyro (mm; ours)"),
+    Headline("tracking", "rms_deg.no_filter", "RMS geodesic rotation error, no filter (deg; ours)"),
+    Headline("tracking", "rms_deg.ukf", "RMS geodesic rotation error, UKF (deg; ours)"),
+    Headline("tracking", "rms_deg.ukf_gyro", "RMS geodesic rotation error, UKF + gyro (deg; ours)"),
+    Headline("tracking", "success_rates.a_markers4", "correct pose, 4 markers, motion (a) paper-like",
+             f"{BLACK['success_rate']['markers4']:.2%}", fmt="{:.2%}"),
+    Headline("tracking", "success_rates.a_markers3", "correct pose, 3 markers, motion (a) paper-like",
+             f"{BLACK['success_rate']['markers3']:.2%}", fmt="{:.2%}"),
+    Headline("tracking", "success_rates.b_markers4", "correct pose, 4 markers, motion (b) stress test", fmt="{:.2%}"),
+    Headline("tracking", "success_rates.b_markers3", "correct pose, 3 markers, motion (b) stress test", fmt="{:.2%}"),
+    Headline("tracking", "success_rates.b_markers4_no_split", "correct pose, 4 markers, motion (b), touching blobs not split", fmt="{:.2%}"),
+    Headline("tracking", "lag_ms.ukf", "lag of the filtered signal, our sigmas (ms)", f"{BLACK['lag_ms']:g}"),
+    Headline("tracking", "sigmas_motion_a.published.lag_ms", "lag on motion (a), published sigmas (ms)",
+             f"{BLACK['lag_ms']:g}"),
+    Headline("tracking", "sigmas_motion_a.published.axis_mm",
+             "RMS position error per axis on motion (a), published sigmas (mm)", f"{BLACK['rms_mm']['ukf']:g}"),
+    Headline("tracking", "sigmas_motion_a.ours.axis_mm", "RMS position error per axis on motion (a), our sigmas (mm)"),
+    Headline("tracking", "small_blobs.marker_keep_rate.pixel", "small blobs (0.4-0.9 m, f 250 px) kept, pixel shape measure", "-", ">= 0.99"),
+    Headline("tracking", "small_blobs.marker_keep_rate.contour", "small blobs kept, published contour shape measure"),
+    Headline("tracking", "ten_metre_jump.ok_while_off", "frames reported ok while > 0.1 m off after a 10 m jump", "-", "0"),
+    Headline("tracking", "failed_downdates", "failed Cholesky downdates",
+             f"16 in 25 000 ({BLACK['failed_downdate_share']:.2%})"),
+    Headline("tracking", "speedup_vs_filterpy", "SR-UKF step speed-up over filterpy", "-", ">= 10"),
+    Headline("tracking", "speedup_vs_pykalman", "SR-UKF step speed-up over pykalman's SR-UKF"),
+]
