@@ -10,7 +10,7 @@ import pytest
 from artifact_models.tiny import protocol, tiny, tiny_fit, workers  # noqa: F401 (fixtures)
 
 sys.path.insert(0, str(Path(__file__).parent))
-from pred_synthetic import scene_tables  # noqa: E402
+from pred_synthetic import headline_rows, scene_tables  # noqa: E402
 
 
 @pytest.fixture(scope="session")
@@ -20,5 +20,7 @@ def tiny_predict(tiny):
 
 @pytest.fixture(scope="session")
 def tables(protocol):
-    """(artifacts, envelopes): 6 arc datasets over 3 scenes, 2 line datasets, 2 PnP methods."""
-    return scene_tables(protocol)
+    """(artifacts, envelopes of the headline theta_a rule): 6 arc datasets over 3 scenes, 2 line datasets, 2 PnP
+    methods."""
+    artifacts, envelopes = scene_tables(protocol)
+    return artifacts, headline_rows(envelopes, protocol)

@@ -25,7 +25,9 @@ FIGURES = ["04_fig5_long_range.png", "04_fig6_pnp.png", "04_fig7_straight_line.p
 def test_notebook_runs_on_tiny_params(tmp_path, tiny):
     """Stage 04 alone on the tiny params (``tiny`` fails the test if they do not validate)."""
     protocol = tiny.protocol
-    artifacts, envelopes = scene_tables(protocol, n_arcs=3, n_lines=1, images_per_stop=2)
+    main, validation = (scene_tables(protocol, seed, n_arcs=3, n_lines=1, images_per_stop=2, world=world)
+                        for seed, world in ((0, "main"), (1, "validation")))
+    artifacts, envelopes = (pd.concat(parts, ignore_index=True) for parts in zip(main, validation))
     (tmp_path / "data" / "artifacts").mkdir(parents=True)
     artifacts.to_parquet(tmp_path / "data" / "artifacts" / "artifacts.parquet", index=False)
     envelopes.to_parquet(tmp_path / "data" / "artifacts" / "envelopes.parquet", index=False)
@@ -38,13 +40,19 @@ def test_notebook_runs_on_tiny_params(tmp_path, tiny):
     metrics = json.loads((tmp_path / "reports" / "metrics" / "predictors.json").read_text())
     for predictor in ("static", "long_range", "mlp", "next_step", *FREE_WIDTH_PREDICTORS):
         assert set(protocol.tolerance_names) <= set(metrics[predictor])
-    assert {"straight_line", "pnp", "loso", "live", "fit_status", "tails"} <= set(metrics)
+    assert {"straight_line", "pnp", "loso", "live", "fit_status", "tails", "envelope_rules"} <= set(metrics)
+    validation = json.loads((tmp_path / "reports" / "metrics" / "validation.json").read_text())
+    for predictor in ("static", "long_range", "mlp", "next_step"):  # the issue's keys
+        for tolerance in protocol.tolerance_names:
+            assert "max_mean_spl_zero_incursion" in validation[predictor][tolerance]
+            assert {"incursion_rate", "mean_spl"} <= set(validation["transfer"][predictor][tolerance])
     tails = pd.read_parquet(tmp_path / "data" / "predictions" / "tails.parquet")
     for predictor, entry in metrics["tails"].items():  # the table the notebook shows is the one the metrics count
         for tolerance, counted in entry.items():
             listed = tails[(tails.predictor == predictor) & (tails.tolerance == tolerance)]
             assert counted == {"n_overshooting": len(listed), "datasets": sorted(listed.dataset)}
     table = pd.read_parquet(tmp_path / "data" / "predictions" / "predictions.parquet")
+    table = table[table.world == "main"]  # predictors.json: the main world (validation.json the other)
     for predictor in FITTED_PREDICTORS:
         rows = table[(table.predictor == predictor) & (table.tolerance == protocol.tolerance_names[0])]
         assert metrics["fit_status"][predictor]["n_rows"] == len(rows)

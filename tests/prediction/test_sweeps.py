@@ -202,6 +202,8 @@ BAD_ENVELOPES = [
     (lambda e: e.assign(tolerance=e.tolerance.replace("4mm_10deg", "5mm_10deg")), "another protocol"),
     (lambda e: e[e.tolerance == "2mm_3deg"], "another protocol"),  # a tolerance of the protocol has no envelope
     (lambda e: e.assign(theta_a=e.theta_a + 200.0), "outside"),
+    (lambda e: pd.concat([e, e.iloc[[3]]]), "1 failed-frame rule's rows|2 rows for the same dataset"),  # a duplicate
+    (lambda e: e.drop(columns="world"), r"lacks columns \['world'\]"),
 ]
 
 

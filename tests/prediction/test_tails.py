@@ -78,11 +78,12 @@ def test_a_shoulder_and_a_cliff_eq1_overshoots_and_the_free_width_emg_does_not(t
     free-width EMG still overshot at every n_t <= 30 in 6 of 8, by less (theta_p at n_t = 30: 14.6-24.1 deg against
     eq. 1's 24.1-28.1)."""
     theta = np.repeat(2.25 * np.arange(20), 3)
-    artifacts = pd.DataFrame({"dataset": "scene_1_arc00", "trajectory": "arc", "stop": np.repeat(np.arange(20), 3),
+    artifacts = pd.DataFrame({"world": "main", "dataset": "scene_1_arc00", "trajectory": "arc",
+                              "stop": np.repeat(np.arange(20), 3),
                               "image": np.arange(60), "theta_deg": theta, "x_mm": 0.0, "method": protocol.pnp_method,
                               "n_inliers": cliff(theta)})  # fmt: skip
     theta_a = 8.0 + 4.0 * np.log(200.0 / 20.0 - 1.0)
-    envelopes = pd.DataFrame({"dataset": "scene_1_arc00", "trajectory": "arc", "method": protocol.pnp_method,
+    envelopes = pd.DataFrame({"world": "main", "dataset": "scene_1_arc00", "trajectory": "arc", "method": protocol.pnp_method,
                               "tolerance": protocol.tolerance_names, "theta_a": theta_a, "censored": False})
     table = attach_envelopes(sweep(artifacts, tiny_predict, tiny_fit, protocol, workers, progress=False), envelopes,
                              protocol)  # fmt: skip
@@ -113,7 +114,8 @@ def test_the_tail_figure_shows_both_fits_and_every_theta_a(tiny_predict, tiny_fi
     from poseintegrity.report.figures import tail_figure
 
     theta = np.repeat(2.25 * np.arange(20), 3)
-    artifacts = pd.DataFrame({"dataset": "scene_1_arc00", "trajectory": "arc", "stop": np.repeat(np.arange(20), 3),
+    artifacts = pd.DataFrame({"world": "main", "dataset": "scene_1_arc00", "trajectory": "arc",
+                              "stop": np.repeat(np.arange(20), 3),
                               "image": np.arange(60), "theta_deg": theta, "x_mm": 0.0, "method": protocol.pnp_method,
                               "n_inliers": cliff(theta)})  # fmt: skip
     table = pd.DataFrame({"dataset": "scene_1_arc00", "method": protocol.pnp_method,
