@@ -7,7 +7,6 @@ import cv2
 import numpy as np
 import pytest
 
-from conftest import TINY_PARAMS
 from poseintegrity.calibration import CalibrationError, calibrate
 from poseintegrity.config import parse_params, read_raw
 from poseintegrity.lens import read_camera_yaml, write_camera_yaml
@@ -16,6 +15,7 @@ from poseintegrity.scenes.camera import true_camera
 from repository import ROOT
 
 KEY = "generate.calibration"
+TINY_PARAMS = ROOT / "tests" / "params_tiny.yaml"
 
 
 @pytest.fixture(scope="module")

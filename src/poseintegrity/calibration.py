@@ -86,11 +86,15 @@ def calibrate(images: list[np.ndarray], spec: CharucoSpec, max_rms_px: float, ke
                                f"{key}.distance_mm / max_tilt_deg: views too far or tilted?)")
     objects = [obj.astype(np.float32) for _, obj, _ in used]
     points = [img.astype(np.float32) for _, _, img in used]
+    threads = cv2.getNumThreads()
+    cv2.setNumThreads(1)  # OpenCV's parallel sums differ in the last bits from run to run: stage 01 must repeat exactly
     try:
         rms, K, dist, rvecs, tvecs = cv2.calibrateCamera(objects, points, (width, height), None, None,
                                                          flags=cv2.CALIB_FIX_K3)
     except cv2.error as error:
         raise CalibrationError(f"{key}: cv2.calibrateCamera failed: {str(error).strip().splitlines()[-1]}") from None
+    finally:
+        cv2.setNumThreads(threads)
     dist = np.asarray(dist, dtype=np.float64).ravel()[:5]
     if not (np.isfinite(rms) and np.all(np.isfinite(K)) and np.all(np.isfinite(dist)) and K[0, 0] > 0 and K[1, 1] > 0):
         raise CalibrationError(f"{key}: the calibration did not converge (RMS {rms}, K {np.round(K, 3).tolist()})")

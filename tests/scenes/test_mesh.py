@@ -61,3 +61,26 @@ def test_transformed_keeps_shape():
     moved = box.transformed(T)
     assert signed_volume(moved) == pytest.approx(signed_volume(box))
     assert np.allclose(moved.vertices.mean(axis=0), [5, 6, 7])
+
+
+def test_a_printed_sheet_is_scaled_about_its_centre_and_bowed_with_normals_that_follow():
+    """printed_sheet: x' = c + s (x - c), z = -sag (1 - u^2) with u the drawn x from the centre over the half width;
+    the normals are unit, face the viewer (-z) and stand perpendicular to the bowed surface (finite differences)."""
+    from poseintegrity.scenes.mesh import plane, printed_sheet
+    from poseintegrity.poses import pose_matrix
+
+    flat = plane(100.0, 60.0, 20, 12, "paper").transformed(pose_matrix(np.diag([1.0, -1.0, -1.0]), [50.0, 30.0, 0.0]))
+    centre, scale, sag = np.array([50.0, 30.0]), (1.003, 0.998), 0.8
+    sheet = printed_sheet(flat, centre, 50.0, scale, sag)
+    u = (flat.vertices[:, 0] - 50.0) / 50.0
+    np.testing.assert_allclose(sheet.vertices[:, 0], 50.0 + 1.003 * (flat.vertices[:, 0] - 50.0))
+    np.testing.assert_allclose(sheet.vertices[:, 1], 30.0 + 0.998 * (flat.vertices[:, 1] - 30.0))
+    np.testing.assert_allclose(sheet.vertices[:, 2], -sag * (1 - u**2), atol=1e-12)
+    assert sheet.vertices[:, 2].min() == pytest.approx(-sag)  # the centre bows towards the viewer
+    np.testing.assert_allclose(np.linalg.norm(sheet.normals, axis=1), 1.0)
+    assert (sheet.normals[:, 2] < 0).all()
+    x = sheet.vertices[:, 0]
+    h = 1e-4  # tangent of z(x') along x' by central differences of the bow's formula
+    z_of = lambda xp: -sag * (1 - ((xp - 50.0) / 1.003 / 50.0) ** 2)  # noqa: E731
+    tangent = np.column_stack([np.ones_like(x), np.zeros_like(x), (z_of(x + h) - z_of(x - h)) / (2 * h)])
+    np.testing.assert_allclose(np.einsum("ij,ij->i", tangent, sheet.normals), 0.0, atol=1e-9)

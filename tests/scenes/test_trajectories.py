@@ -75,15 +75,3 @@ def test_line_moves_back_along_the_optical_axis(offset):
         np.testing.assert_allclose(stop.T_world_cam[:3, :3], stops[0].T_world_cam[:3, :3])
         assert angle_between_deg(T0[:3, :3], stop.T_world_cam[:3, :3]) == pytest.approx(offset, abs=1e-9)
         assert stop.theta_deg == offset
-
-
-def test_defocus_is_zero_in_focus_and_follows_the_thin_lens_law():
-    from poseintegrity.scenes.camera import defocus_sigma_px
-
-    camera = CAMERA.model_copy(update={"lens_mm": 12.0, "f_number": 4.0, "pixel_um": 5.86, "downscale": 2})
-    assert defocus_sigma_px(220.0, 220.0, camera) == 0.0
-    # c = f^2/N |d - d_f| / (d (d_f - f)) = 144/4 * 150 / (370 * 208) mm; sigma = c/2 in half-resolution pixels
-    c_mm = 36.0 * 150.0 / (370.0 * 208.0)
-    assert defocus_sigma_px(370.0, 220.0, camera) == pytest.approx(0.5 * c_mm / 0.00586 / 2)
-    sigmas = [defocus_sigma_px(d, 220.0, camera) for d in (240.0, 300.0, 370.0)]
-    assert sigmas == sorted(sigmas)
