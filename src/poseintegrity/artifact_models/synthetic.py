@@ -31,7 +31,7 @@ def synthetic_artifacts(
 ) -> tuple[pd.DataFrame, pd.DataFrame]:
     """Draw (artifacts, truth).
 
-    artifacts : one row per image and method: dataset, trajectory, stop, image, theta_deg, x_mm, method,
+    artifacts : one row per image and method: world ("main"), dataset, trajectory, stop, image, theta_deg, x_mm, method,
         n_inliers (round(f + N(0, (2 + 0.1 f)^2)), clipped at 0), status
     truth : one row per (dataset, method): trajectory, method, alpha, K, mu of eq. 1 in the unit of the
         trajectory's variable (deg for arcs, mm for lines)
@@ -53,6 +53,7 @@ def synthetic_artifacts(
             rows.append(
                 pd.DataFrame(
                     {
+                        "world": "main",
                         "dataset": dataset,
                         "trajectory": trajectory,
                         "stop": np.repeat(np.arange(stops.size), images_per_stop),
