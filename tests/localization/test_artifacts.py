@@ -31,7 +31,7 @@ def test_inlier_geometry_of_a_known_square():
 
 
 def test_failed_result_has_zero_inliers_and_nan_geometry():
-    row = frame_artifacts(failed("pnp_failed"), np.zeros((2, 3)), np.zeros((2, 2)), K, 10, 8)
+    row = frame_artifacts(failed("pnp_failed", "no consensus"), np.zeros((2, 3)), np.zeros((2, 2)), K, 10, 8)
     assert row["n_inliers"] == 0 and row["inlier_ratio"] == 0.0 and np.isnan(row["inlier_spread_px"])
 
 

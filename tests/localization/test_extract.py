@@ -97,6 +97,8 @@ def test_bad_frames_give_flagged_rows_not_crashes(synthetic_data_dir, extract_pa
     assert no_truth.status == "bad_pose" and "NaN" in no_truth.reason and np.isnan(no_truth.E_t_mm)
     assert no_truth.n_inliers > 100 and no_truth.board_status == "ok"  # localized: only the exact pose is damaged
     assert set(E.usable(rows)["image"]) == {0, 1, 2}
+    assert (rows.loc[rows.status != "ok", "reason"] != "").all()  # every row without a pose says why
+    assert "SIFT found no keypoints" in blank.reason and "matches, a pose needs 4" in few_blobs.reason
 
 
 def test_unknown_dataset_in_params_is_named(synthetic_data_dir, extract_params, workers):

@@ -13,9 +13,9 @@ workers of the ``parallel`` section (:class:`~poseintegrity.parallel.Workers`):
    ``E_r_deg`` (NaN without a pose or without a detected board); against the exact renderer pose as a diagnostic:
    ``E_t_exact_mm``, ``E_r_exact_deg``.
 
-A frame whose image is unusable gives rows with status ``bad_image``, one whose ground-truth pose is not a finite
-rigid transform rows with status ``bad_pose`` (localized, but without E_t/E_r against it); the ``reason`` column
-says why (empty for every other row). Neither is evidence about localization: :func:`usable` drops them before
+A frame whose image is unusable gives rows with status ``bad_image``, one whose exact pose in frames.parquet is not a
+finite rigid transform rows with status ``bad_pose`` (a damaged file: no error is reported); a frame without a pose
+gives its PnP status. The ``reason`` column says why for every row whose status is not "ok" (empty otherwise). Neither is evidence about localization: :func:`usable` drops them before
 envelopes and summaries.
 """
 
@@ -37,7 +37,7 @@ from poseintegrity.localization.features import cached_features, read_gray, writ
 from poseintegrity.localization.frame_artifacts import frame_artifacts
 from poseintegrity.localization.ground_truth import board_pose, make_board
 from poseintegrity.localization.params import ExtractParams
-from poseintegrity.localization.pnp import failed, solve_pnp_ransac
+from poseintegrity.localization.pnp import failed, minimal_sample_size, ransac_iterations, solve_pnp_ransac
 from poseintegrity.poses import NAN_POSE, pose_errors
 from poseintegrity.localization.target_model import TargetModel, build_target_model
 from poseintegrity.parallel import Workers
@@ -60,19 +60,27 @@ def frame_seed(seed: int, dataset: str, stop: int, image: int) -> int:
 def localize(
     object_points: np.ndarray, image_points: np.ndarray, n_keypoints: int, model_size: int, K: np.ndarray,
     method: str, params: ExtractParams, seed: int,
-) -> tuple[np.ndarray, dict[str, Any], str]:
-    """PnP-RANSAC of one frame's correspondences with one method: (T_cam_board estimate (4, 4), artifacts, status).
+) -> tuple[np.ndarray, dict[str, Any], str, str]:
+    """PnP-RANSAC of one frame's correspondences with one method: (T_cam_board estimate (4, 4), artifacts, status,
+    reason).
 
-    Status "no_keypoints" when SIFT found nothing, else the PnP status ("too_few_matches", ...).
+    Status "no_keypoints" when SIFT found nothing, else the PnP status ("too_few_matches", ...); the reason says why
+    a frame has no pose ("" when it has one). The classic methods' iteration cap is sized for
+    ``params.ransac_budget_inlier_ratio`` at ``params.ransac_confidence`` (pnp.py).
     """
-    max_iterations = params.usac_max_iterations if method == "usac_magsac" else params.ransac_max_iterations
+    if method == "usac_magsac":
+        max_iterations = params.usac_max_iterations
+    else:
+        max_iterations = ransac_iterations(params.ransac_confidence, params.ransac_budget_inlier_ratio,
+                                           minimal_sample_size(method))
     result = solve_pnp_ransac(
         object_points, image_points, K, method, params.reprojection_threshold_px, params.ransac_confidence,
         max_iterations, seed, params.usac_refine_lm,
     )
-    status = "no_keypoints" if n_keypoints == 0 else result.status
     artifacts = frame_artifacts(result, object_points, image_points, K, n_keypoints, model_size)
-    return result.T_cam_model, artifacts, status
+    if n_keypoints == 0:
+        return result.T_cam_model, artifacts, "no_keypoints", "SIFT found no keypoints in the frame"
+    return result.T_cam_model, artifacts, result.status, result.reason
 
 
 @dataclass(frozen=True)
@@ -179,11 +187,11 @@ def frame_rows(task: FrameTask) -> list[dict[str, Any]]:
     rows = []
     for method in task.methods:
         if evidence.image_problem:
-            T_est, artifacts = NAN_POSE.copy(), frame_artifacts(failed("bad_image"), evidence.object_points,
+            T_est, artifacts = NAN_POSE.copy(), frame_artifacts(failed("bad_image", reason), evidence.object_points,
                                                                 evidence.image_points, task.camera.K, 0,
                                                                 model.size)
         else:
-            T_est, artifacts, pnp_status = localize(
+            T_est, artifacts, pnp_status, pnp_reason = localize(
                 evidence.object_points, evidence.image_points, evidence.n_keypoints, model.size, task.camera.K, method,
                 task.params, seed,
             )
@@ -193,7 +201,7 @@ def frame_rows(task: FrameTask) -> list[dict[str, Any]]:
             E_t_mm = E_r_deg = np.nan
         rows.append(
             {key: frame[key] for key in FRAME_COLUMNS}
-            | dict(method=method, status=status or pnp_status, reason=reason, model_size=model.size)
+            | dict(method=method, status=status or pnp_status, reason=reason or pnp_reason, model_size=model.size)
             | artifacts
             | dict(
                 E_t_mm=E_t_mm, E_r_deg=E_r_deg, E_t_exact_mm=E_t_exact_mm, E_r_exact_deg=E_r_exact_deg,

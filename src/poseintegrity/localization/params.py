@@ -57,11 +57,11 @@ class ExtractParams(Section):
     usac_max_iterations: int = Field(ge=1, le=MAX_ITERATIONS, description="USAC_MAGSAC iteration cap (paper path)")
     usac_refine_lm: bool = Field(
         description="polish the USAC pose by Levenberg-Marquardt on its inliers (pnp.solve_pnp_ransac)")
-    ransac_max_iterations: int = Field(
-        ge=1, le=MAX_ITERATIONS,
-        description="classic RANSAC iteration cap (stage 05); 100 is OpenCV's default iterationsCount."
-        " docs/references.md, 'OpenCV 5': EPnP needed ~10 000 at 80 % outliers, so the classic solvers give up earlier than USAC on low-inlier"
-        " frames (where each 5-point EPnP iteration costs ~0.1-0.2 ms)",
+    ransac_budget_inlier_ratio: float = Field(
+        gt=0, le=1,
+        description="classic RANSAC (stage 05): the iteration cap of each method is sized to draw an all-inlier sample "
+        "with ransac_confidence at this inlier ratio (pnp.ransac_iterations); OpenCV stops earlier once its best "
+        "consensus makes the confidence reached. Frames below it may fail, with the reason said",
     )
     pnp_methods: distinct(PnPMethod) = Field(
         min_length=1, description="stage 05 (paper Fig. 6), beside protocol.pnp_method (which stage 02 runs)")

@@ -13,6 +13,13 @@ frame of ours with 108 inliers, all true: 2.5 mm / 1.0 deg from USAC, 0.05 mm / 
 to them). With ``refine_lm`` the USAC pose is therefore polished by Levenberg-Marquardt on its inliers
 (``cv2.solvePnPRefineLM``), the step classic ``solvePnPRansac`` takes itself with its final refit.
 
+Iterations of the classic path: OpenCV stops as soon as the best consensus found makes ``confidence`` reached (its
+adaptive RANSAC count), capped by ``iterationsCount``. The cap is sized, per method, for a stated inlier ratio w
+(``extract.ransac_budget_inlier_ratio``): N = log(1 - p) / log(1 - w^s) (Fischler & Bolles 1981; Hartley &
+Zisserman, Multiple View Geometry, 2nd ed., eq. 4.18), s the minimal sample OpenCV draws: 5 points solved by EPnP
+for every flag but P3P/AP3P, which draw 4 (calib3d solvepnp.cpp, ``model_points``; docs/references.md "OpenCV 5").
+A frame with a lower inlier ratio may then fail (status "pnp_failed" with its reason): a budget, not a guarantee.
+
 n_i: classic RANSAC reports the inliers of the best *hypothesis*, not of the refined pose it returns (OpenCV
 issue 29573; docs/references.md, "OpenCV 5"). For every method the inliers are therefore recounted on the returned pose with
 ``cv2.projectPoints`` and the same threshold; OpenCV's own count is kept as ``n_inliers_reported``.
@@ -39,6 +46,21 @@ METHODS = ("usac_magsac", *CLASSIC_FLAGS)
 MIN_CORRESPONDENCES = 4  # a unique pose needs 4 points; P3P with 3 leaves up to 4 solutions
 
 
+def minimal_sample_size(method: str) -> int:
+    """Correspondences per classic RANSAC hypothesis in OpenCV's solvePnPRansac: 4 for P3P/AP3P, else 5 (EPnP)."""
+    return 4 if method in ("p3p", "ap3p") else 5
+
+
+def ransac_iterations(confidence: float, inlier_ratio: float, sample_size: int) -> int:
+    """N = ceil(log(1 - p) / log(1 - w^s)): hypotheses needed to draw one all-inlier sample of s with probability p
+    when a share w of the correspondences are inliers (H&Z eq. 4.18)."""
+    if not (0 < confidence < 1 and 0 < inlier_ratio <= 1 and sample_size >= 1):
+        raise ValueError(f"ransac_iterations needs 0 < confidence < 1, 0 < inlier_ratio <= 1 and a sample size >= 1, "
+                         f"got {confidence}, {inlier_ratio}, {sample_size}")
+    all_inliers = inlier_ratio**sample_size
+    return 1 if all_inliers >= 1 else int(np.ceil(np.log(1 - confidence) / np.log1p(-all_inliers)))
+
+
 @dataclass(frozen=True)
 class PnPResult:
     """Outcome of one PnP-RANSAC run.
@@ -47,21 +69,23 @@ class PnPResult:
     inliers : (k,) int, indices of correspondences reprojecting within the threshold under T_cam_model
     n_inliers_reported : int, size of OpenCV's own inlier set
     status : "ok", "too_few_matches", "degenerate_points" or "pnp_failed"
+    reason : why it failed ("" when ok)
     """
 
     T_cam_model: np.ndarray
     inliers: np.ndarray
     n_inliers_reported: int
     status: str
+    reason: str = ""
 
     @property
     def n_inliers(self) -> int:
         return len(self.inliers)
 
 
-def failed(status: str) -> PnPResult:
-    """The documented failed value: NaN pose, no inliers, a reason."""
-    return PnPResult(NAN_POSE.copy(), np.empty(0, dtype=np.intp), 0, status)
+def failed(status: str, reason: str) -> PnPResult:
+    """The documented failed value: NaN pose, no inliers, a status and its reason."""
+    return PnPResult(NAN_POSE.copy(), np.empty(0, dtype=np.intp), 0, status, reason)
 
 
 def reprojection_errors(object_points: np.ndarray, image_points: np.ndarray, K: np.ndarray, T_cam_model: np.ndarray) -> np.ndarray:
@@ -126,9 +150,9 @@ def solve_pnp_ransac(
     image_points = np.ascontiguousarray(image_points, dtype=np.float64).reshape(-1, 2)
     K = np.asarray(K, dtype=np.float64)
     if len(object_points) < MIN_CORRESPONDENCES:
-        return failed("too_few_matches")
+        return failed("too_few_matches", f"{len(object_points)} matches, a pose needs {MIN_CORRESPONDENCES}")
     if _is_degenerate(object_points):
-        return failed("degenerate_points")
+        return failed("degenerate_points", f"the {len(object_points)} matched model points are (nearly) collinear")
     try:
         if method == "usac_magsac":
             usac = _usac_params(threshold_px, confidence, max_iterations, seed)
@@ -139,10 +163,13 @@ def solve_pnp_ransac(
                 object_points, image_points, K, None, iterationsCount=max_iterations,
                 reprojectionError=threshold_px, confidence=confidence, flags=CLASSIC_FLAGS[method],
             )
-    except cv2.error:
-        return failed("pnp_failed")
-    if not found or rvec is None or not (np.all(np.isfinite(rvec)) and np.all(np.isfinite(tvec))):
-        return failed("pnp_failed")
+    except cv2.error as error:
+        return failed("pnp_failed", f"cv2.solvePnPRansac ({method}): {str(error).strip().splitlines()[-1]}")
+    if not found or rvec is None:
+        return failed("pnp_failed", f"{method}: no consensus within {max_iterations} iterations at {threshold_px:g} px "
+                                    f"({len(object_points)} matches)")
+    if not (np.all(np.isfinite(rvec)) and np.all(np.isfinite(tvec))):
+        return failed("pnp_failed", f"{method}: a non-finite pose")
     T_cam_model = pose_from_rvec_tvec(rvec, tvec)
     inliers = np.flatnonzero(reprojection_errors(object_points, image_points, K, T_cam_model) <= threshold_px)
     if method == "usac_magsac" and refine_lm and len(inliers) >= MIN_CORRESPONDENCES:
@@ -150,6 +177,7 @@ def solve_pnp_ransac(
         T_cam_model = pose_from_rvec_tvec(rvec, tvec)
         inliers = np.flatnonzero(reprojection_errors(object_points, image_points, K, T_cam_model) <= threshold_px)
     if len(inliers) < MIN_CORRESPONDENCES:
-        return failed("pnp_failed")
+        return failed("pnp_failed", f"{method}: {len(inliers)} of {len(object_points)} matches within "
+                                    f"{threshold_px:g} px of the returned pose, a pose needs {MIN_CORRESPONDENCES}")
     n_reported = 0 if reported is None else len(reported)
     return PnPResult(T_cam_model, inliers, n_reported, "ok")

@@ -51,6 +51,13 @@ def envelope_rule_summary(envelope_table: pd.DataFrame, table: pd.DataFrame, met
     return pd.DataFrame(out)
 
 
+def failure_shares(table: pd.DataFrame) -> pd.DataFrame:
+    """Per PnP method (rows) the share of its frames per status that is not "ok" (columns; every failed row carries
+    its reason in the artifacts table)."""
+    shares = pd.crosstab(table["method"], table["status"], normalize="index")
+    return shares.drop(columns=[c for c in ("ok",) if c in shares.columns])
+
+
 def board_summary(table: pd.DataFrame) -> dict[str, float]:
     """How far the ArUco ground truth is from the exact renderer pose (one row per frame is enough)."""
     frames = table.drop_duplicates(["dataset", "stop", "image"])
