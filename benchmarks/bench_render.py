@@ -19,7 +19,8 @@ from timing import paired_medians  # benchmarks/timing.py
 from poseintegrity.config import load_params
 from poseintegrity.poses import inverse
 from poseintegrity.scenes import dataset, optics, renderer, trajectories
-from poseintegrity.scenes.camera import Intrinsics
+from poseintegrity.scenes.acquisition import rotation_maps
+from poseintegrity.scenes.camera import Intrinsics, true_camera
 
 cv2.setNumThreads(1)
 everything = load_params("params.yaml")
@@ -58,14 +59,14 @@ def stop(world, T_cam_world, expose, png_flags) -> list[bytes]:
 def realistic_stop(world, T_cam_world, focus_mm) -> list[bytes]:
     """One stop of today's stage 01 (scenes/dataset.take_shot without the writes): the lens' ideal canvas, depth of
     field per pixel, per image the ring-down warp and the lens distortion onto the sensor, expose, encode."""
-    lens = dataset._lens(params.camera)
+    lens = true_camera(params.camera)
     K_canvas, width, height = lens.canvas
     frame = renderer.render(world.geometry, K_canvas, width, height, T_cam_world)
     irradiance = optics.lens(frame.radiance, frame.depth_mm, focus_mm, params.sensor.blur_sigma_px, params.camera)
     images = []
     for i in range(params.images_per_stop):
         rotation = np.array([1e-4, -2e-4, 5e-5]) * np.exp(-i / 5)  # a ring-down's turn (rad), one sub-exposure
-        sensor = cv2.remap(irradiance, *dataset._rotation_warp(K_canvas, rotation, *lens.sensor_maps), cv2.INTER_LINEAR,
+        sensor = cv2.remap(irradiance, *rotation_maps(K_canvas, rotation, *lens.sensor_maps), cv2.INTER_LINEAR,
                            borderMode=cv2.BORDER_REPLICATE)
         images.append(cv2.imencode(".png", renderer.expose(sensor, params.sensor, np.random.default_rng([0, i])),
                                    dataset.IMAGE_PNG_FLAGS)[1])

@@ -2,8 +2,7 @@
 
 import pytest
 
-from params_cases import refusal, with_value
-from poseintegrity.config import parse_params
+from params_cases import refusal
 from poseintegrity.scenes import dataset
 from poseintegrity.scenes.params import GenerateParams
 
