@@ -18,8 +18,9 @@ from timing import paired_medians  # benchmarks/timing.py
 
 from poseintegrity.config import load_params
 from poseintegrity.poses import inverse
-from poseintegrity.scenes import dataset, renderer, trajectories
-from poseintegrity.scenes.camera import Intrinsics
+from poseintegrity.scenes import dataset, optics, renderer, trajectories
+from poseintegrity.scenes.acquisition import rotation_maps
+from poseintegrity.scenes.camera import Intrinsics, true_camera
 
 cv2.setNumThreads(1)
 everything = load_params("params.yaml")
@@ -41,12 +42,35 @@ def reference_expose(irradiance, sensor, rng):
     return dn.astype(np.uint8)
 
 
+def pinhole_optics(radiance):
+    """The previous optics: one Gaussian (the lens' own blur) for the whole frame, no lens distortion."""
+    return cv2.GaussianBlur(radiance, (0, 0), params.sensor.blur_sigma_px)
+
+
 def stop(world, T_cam_world, expose, png_flags) -> list[bytes]:
-    """One stop of stage 01 without the file writes: render, optics, then expose and encode every image."""
+    """One stop of the previous stage 01 without the file writes: a pinhole render, one blur, then expose and encode
+    every image."""
     frame = renderer.render(world.geometry, cam.K, cam.width, cam.height, T_cam_world)
-    irradiance = renderer.optics(frame.radiance, params.sensor)
+    irradiance = pinhole_optics(frame.radiance)
     return [cv2.imencode(".png", expose(irradiance, params.sensor, np.random.default_rng([0, i])), png_flags)[1]
             for i in range(params.images_per_stop)]
+
+
+def realistic_stop(world, T_cam_world, focus_mm) -> list[bytes]:
+    """One stop of today's stage 01 (scenes/dataset.take_shot without the writes): the lens' ideal canvas, depth of
+    field per pixel, per image the ring-down warp and the lens distortion onto the sensor, expose, encode."""
+    lens = true_camera(params.camera)
+    K_canvas, width, height = lens.canvas
+    frame = renderer.render(world.geometry, K_canvas, width, height, T_cam_world)
+    irradiance = optics.lens(frame.radiance, frame.depth_mm, focus_mm, params.sensor.blur_sigma_px, params.camera)
+    images = []
+    for i in range(params.images_per_stop):
+        rotation = np.array([1e-4, -2e-4, 5e-5]) * np.exp(-i / 5)  # a ring-down's turn (rad), one sub-exposure
+        sensor = cv2.remap(irradiance, *rotation_maps(K_canvas, rotation, *lens.sensor_maps), cv2.INTER_LINEAR,
+                           borderMode=cv2.BORDER_REPLICATE)
+        images.append(cv2.imencode(".png", renderer.expose(sensor, params.sensor, np.random.default_rng([0, i])),
+                                   dataset.IMAGE_PNG_FLAGS)[1])
+    return images
 
 
 def median_ms(fn, repeats: int) -> float:
@@ -67,13 +91,12 @@ for scene_index in (0, 1, 2, 4):  # a scapula, the drilled scapula, a block, a s
         params.arcs.n_stops // 4].T_world_cam)
     rng = np.random.default_rng(0)
     frame = renderer.render(world.geometry, cam.K, cam.width, cam.height, T_cam_world)  # compile / warm up
-    image = renderer.expose(renderer.optics(frame.radiance, params.sensor), params.sensor, rng)
+    image = renderer.expose(pinhole_optics(frame.radiance), params.sensor, rng)
     H = np.array([[1.02, 0.05, -10], [0.01, 0.98, 5], [1e-5, 2e-5, 1]])
 
     render_ms = median_ms(lambda: renderer.render(world.geometry, cam.K, cam.width, cam.height, T_cam_world), 15)
-    full_ms = median_ms(lambda: renderer.expose(renderer.optics(
-        renderer.render(world.geometry, cam.K, cam.width, cam.height, T_cam_world).radiance, params.sensor),
-        params.sensor, rng), 15)
+    full_ms = median_ms(lambda: renderer.expose(pinhole_optics(
+        renderer.render(world.geometry, cam.K, cam.width, cam.height, T_cam_world).radiance), params.sensor, rng), 15)
     sift_ms = median_ms(lambda: sift.detectAndCompute(image, None), 7)
     warp_ms = median_ms(lambda: cv2.warpPerspective(image, H, (cam.width, cam.height)), 15)
     print(f"{spec.name} ({'+'.join(spec.targets)}, {len(world.geometry.faces)} triangles, {cam.width}x{cam.height})")
@@ -97,3 +120,7 @@ for scene_index in (0, 1, 2, 4):  # a scapula, the drilled scapula, a block, a s
           f"{size_now / 1e3:.0f} kB vs {size_ref / 1e3:.0f} kB")
     print(f"  one stop of {params.images_per_stop} images {1000 * stop_now:5.0f} ms vs {1000 * stop_ref:5.0f} ms: "
           f"{stop_ref / stop_now:.2f} x (pixels identical)")
+    realistic = lambda: realistic_stop(world, T_cam_world, spec.distance_mm)  # noqa: E731
+    pinhole, lensed = paired_medians(current, realistic, 5)
+    print(f"  the real lens (canvas, depth of field, distortion, ring-down warp): one stop {1000 * lensed:5.0f} ms vs "
+          f"{1000 * pinhole:5.0f} ms pinhole: {lensed / pinhole:.2f} x")

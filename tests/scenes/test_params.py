@@ -2,8 +2,7 @@
 
 import pytest
 
-from params_cases import refusal, with_value
-from poseintegrity.config import parse_params
+from params_cases import refusal
 from poseintegrity.scenes import dataset
 from poseintegrity.scenes.params import GenerateParams
 
@@ -43,6 +42,14 @@ BAD_VALUES = [
     ("calibration.distance_mm", [50.0, 300.0], "calibration.distance_mm"),  # nearer than the lens focuses
     ("calibration.max_tilt_deg", 85.0, "calibration.max_tilt_deg"),  # the board seen edge-on
     ("calibration.max_rms_px", 0.0, "calibration.max_rms_px"),  # no calibration passes
+    ("camera.distortion", [-3.0, 0.0, 0.0, 0.0, 0.0], "camera.distortion.0"),  # a fisheye: plumb_bob cannot model it
+    ("printed_boards.scale_std", 0.05, "printed_boards.scale_std"),  # 5 %: seen with a ruler
+    ("capture.exposure_ms", 50.0, "capture.exposure_ms"),  # longer than the 33.3 ms frame period
+    ("validation.scenes.0.name", "scene_a", "validation.scenes"),  # names the main world's datasets
+    ("validation.lines", {"scene": "scene_a", "distance_mm": 240, "offsets_deg": [0], "n_stops": 6},
+     "validation.lines.scene"),  # a scene of the other world
+    ("validation.images_per_stop", 0, "validation.images_per_stop"),
+    ("validation.seed", -1, "validation.seed"),
     ("sensor.exposure", 1e6, "sensor.exposure"),  # accepted: every image white
     ("sensor.flicker", 0.45, "sensor.flicker"),  # accepted: ~1 % of the images black (gain <= 0)
     ("sensor.blur_sigma_px", 500, "sensor.blur_sigma_px"),

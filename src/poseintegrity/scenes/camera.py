@@ -16,7 +16,7 @@ from poseintegrity.lens import Camera
 from poseintegrity.poses import pose_matrix
 
 if TYPE_CHECKING:
-    from poseintegrity.scenes.params import CameraParams
+    from poseintegrity.scenes.camera_params import CameraParams
 
 
 @dataclass(frozen=True)
@@ -32,16 +32,8 @@ class Intrinsics:
 
     @classmethod
     def from_params(cls, camera: "CameraParams") -> "Intrinsics":
-        """IDS U3-3060CP: f_px = f_mm / pixel pitch (docs/references.md, "Camera of the Windsor et al. experiments"),
-        the principal point ``principal_point_offset_px`` from the sensor's centre, downscaled."""
-        scale = 1.0 / camera.downscale
-        f_px = camera.lens_mm / (camera.pixel_um * 1e-3) * scale
-        width = camera.sensor_width_px // camera.downscale
-        height = camera.sensor_height_px // camera.downscale
-        # pixel centres at integer coordinates: the sensor's centre is at (w - 1) / 2
-        cx = (width - 1) / 2 + camera.principal_point_offset_px[0] * scale
-        cy = (height - 1) / 2 + camera.principal_point_offset_px[1] * scale
-        K = np.array([[f_px, 0.0, cx], [0.0, f_px, cy], [0.0, 0.0, 1.0]])
+        """The true intrinsics of ``camera`` (:meth:`~.camera_params.CameraParams.intrinsics`)."""
+        K, width, height = camera.intrinsics()
         return cls(width, height, K)
 
 

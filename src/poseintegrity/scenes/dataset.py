@@ -27,7 +27,6 @@ backend, the worker count or the order the shots run in.
 from __future__ import annotations
 
 import json
-import math
 import shutil
 from collections import OrderedDict
 from dataclasses import dataclass
@@ -37,20 +36,18 @@ from pathlib import Path
 import cv2
 import numpy as np
 import pandas as pd
-from scipy.spatial.transform import Rotation
 
+from poseintegrity.lens import Camera, write_camera_yaml
 from poseintegrity.parallel import Workers
-from poseintegrity.poses import inverse, pose_matrix
+from poseintegrity.poses import inverse
 from poseintegrity.protocol import ProtocolParams
 from poseintegrity.scenes import catalog, optics, renderer, trajectories
-from poseintegrity.lens import Camera, write_camera_yaml
-from poseintegrity.scenes.calibration_views import CalibrationSession, calibration_session
+from poseintegrity.scenes.acquisition import Route, image_motion, image_pose, rotation_maps, visits
+from poseintegrity.scenes.calibration_views import CalibrationSession, calibration_session, write_calibration
 from poseintegrity.scenes.camera import Intrinsics, true_camera
 from poseintegrity.scenes.foam import ReliefVolume
-from poseintegrity.scenes.params import BoneFoamParams, CameraParams, CaptureParams, GenerateParams
-from poseintegrity.scenes.ringdown import Exposure as RingExposure
-from poseintegrity.scenes.ringdown import RingDown, ring_down
-from poseintegrity.scenes.robot import PlacedRobot, Robot, accuracy, trip_path
+from poseintegrity.scenes.params import BoneFoamParams, GenerateParams
+from poseintegrity.scenes.robot import Robot, accuracy, trip_path
 from poseintegrity.scenes.textures import build_atlas
 from poseintegrity.seeding import keyed_rng
 
@@ -163,30 +160,6 @@ def _check_in_view(points_cam: np.ndarray, cam: Intrinsics, key: str, name: str,
                          f"to be seen; {hint}")
 
 
-@dataclass(frozen=True)
-class Visit:
-    """The camera at one stop of the robot (or one model view): its actual T_world_cam (4, 4) when the controller
-    reported the stop, and how the arm rings down from there."""
-
-    T_world_cam: np.ndarray
-    ring_down: RingDown
-
-
-@dataclass(frozen=True)
-class Route:
-    """Where the camera of one dataset really was: the visits of its model pair and of its stops."""
-
-    model: tuple[Visit, ...]
-    stops: tuple[Visit, ...]
-
-
-def _visits(placed: PlacedRobot, path: list[np.ndarray], params: GenerateParams, *key) -> tuple[Visit, ...]:
-    """One visit to each commanded pose of ``path`` in order, its repeatability and ring-downs drawn by ``key``."""
-    actual = placed.moves(path, keyed_rng(params.seed, "visit", *key))
-    return tuple(Visit(T, ring_down(params.robot.ring_down, keyed_rng(params.seed, "ring", *key, k)))
-                 for k, T in enumerate(actual))
-
-
 def drive(params: GenerateParams, plans: list[DatasetPlan], trips: list[Trip], scenes: list[catalog.Scene],
           world: str = "main") -> tuple[list[Route], dict[str, dict[str, float]]]:
     """The world's robot (drawn from its seed) placed in each scene where it reaches every commanded pose, then
@@ -204,10 +177,10 @@ def drive(params: GenerateParams, plans: list[DatasetPlan], trips: list[Trip], s
         except ValueError as error:
             raise WorldError(f"{scenes_key(world)}.{scene_index}: {error}") from None
         first_trip = {plan.trajectory: trip for plan, trip in reversed(mine)}  # arcs share one model pair, lines one
-        model = {kind: _visits(placed, trip.model_views, params, "model", scene_index, kind)
+        model = {kind: visits(placed, trip.model_views, params, "model", scene_index, kind)
                  for kind, trip in first_trip.items()}
         for plan, trip in mine:
-            stops = _visits(placed, trip_path(trip), params, plan.dataset)[len(trip.model_views):]
+            stops = visits(placed, trip_path(trip), params, plan.dataset)[len(trip.model_views):]
             routes[plan.dataset] = Route(model[plan.trajectory], stops)
         summary[scene.name] = accuracy(placed, [t for p, t in mine if p.trajectory == "arc"],
                                        [t for p, t in mine if p.trajectory == "line"],
@@ -252,30 +225,6 @@ def _build_world(params: GenerateParams, scene_index: int) -> World:
                                                   _relief(params.bone_foam, params.seed))
     target_ids = np.array([i for i, name in enumerate(geometry.object_names) if name in scene.target_objects])
     return World(scene, geometry, target_ids)
-
-
-def exposure_times(capture: CaptureParams, image: int) -> tuple[float, float]:
-    """(start, end) of image ``image``'s exposure, s after the robot reported its stop."""
-    start = (capture.delay_ms + image * capture.interval_ms) / 1000.0
-    return start, start + capture.exposure_ms / 1000.0
-
-
-def image_motion(visit: Visit, capture: CaptureParams, image: int, f_px: float) -> RingExposure:
-    """The ring-down during image ``image``'s exposure: its rotation at mid-exposure and a path sampled so that
-    consecutive samples move the image by at most ``capture.blur_step_px`` (f_px |delta r| bounds the motion of a
-    pixel under a small rotation r); one sample, the mid-exposure rotation, when it moves less."""
-    t0, t1 = exposure_times(capture, image)
-    ends = visit.ring_down.rotation(np.array([t0, t1]))
-    extent_px = f_px * float(np.linalg.norm(ends[1] - ends[0]))
-    if extent_px <= capture.blur_step_px:
-        mid = visit.ring_down.rotation(0.5 * (t0 + t1))
-        return RingExposure(mid, mid[None], np.array([0.5 * (t0 + t1)]))
-    return visit.ring_down.exposure(t0, t1, math.ceil(extent_px / capture.blur_step_px) + 1)
-
-
-def image_pose(visit: Visit, motion: RingExposure) -> np.ndarray:
-    """Actual T_world_cam (4, 4) of an image: the visit's pose turned by its mid-exposure rotation (camera frame)."""
-    return visit.T_world_cam @ pose_matrix(Rotation.from_rotvec(motion.mid).as_matrix(), np.zeros(3))
 
 
 @dataclass(frozen=True)
@@ -337,30 +286,12 @@ def _partial(root: Path, dataset: str) -> Path:
     return root / f".{dataset}.partial"
 
 
-def _rotation_warp(K: np.ndarray, rotation: np.ndarray, map_x: np.ndarray, map_y: np.ndarray
-                   ) -> tuple[np.ndarray, np.ndarray]:
-    """Sampling maps of the view turned by ``rotation`` (3,) rad (camera frame): the canvas pixel p' an output
-    pixel sees through (map_x, map_y) is where the unturned camera saw that ray, p = K R K^-1 p' (pure rotation)."""
-    H = K @ Rotation.from_rotvec(rotation).as_matrix() @ np.linalg.inv(K)
-    w = H[2, 0] * map_x + H[2, 1] * map_y + H[2, 2]
-    return ((H[0, 0] * map_x + H[0, 1] * map_y + H[0, 2]) / w).astype(np.float32), (
-        (H[1, 0] * map_x + H[1, 1] * map_y + H[1, 2]) / w).astype(np.float32)
-
-
-@lru_cache(maxsize=2)
-def _lens(camera: CameraParams) -> Camera:
-    """The true camera with its canvas and sensor maps computed once per process."""
-    lens = true_camera(camera)
-    lens.sensor_maps  # noqa: B018 (computed here, once)
-    return lens
-
-
 def take_shot(params: GenerateParams, root: Path, shot: Shot) -> None:
     """Render ``shot`` on the lens' ideal canvas, blur it by the lens and the depth of field, and for every image
     turn it by the image's ring-down path, distort it onto the sensor and expose it; write the images (and masks)
     into the datasets' partial folders under ``root``."""
     scene_world = world(params, shot.scene_index)
-    lens = _lens(params.camera)
+    lens = true_camera(params.camera)  # its canvas and sensor maps are computed once per process
     K_canvas, width, height = lens.canvas
     frame = renderer.render(scene_world.geometry, K_canvas, width, height, inverse(shot.T_world_cam))
     irradiance = optics.lens(frame.radiance, frame.depth_mm, shot.focus_mm, params.sensor.blur_sigma_px, params.camera)
@@ -368,7 +299,7 @@ def take_shot(params: GenerateParams, root: Path, shot: Shot) -> None:
     for exposure in shot.exposures:
         sensor = np.zeros(map_x.shape, np.float32)
         for rotation in exposure.rotations:  # the exposure integrates the view along the ring-down's path
-            sensor += cv2.remap(irradiance, *_rotation_warp(K_canvas, rotation, map_x, map_y), cv2.INTER_LINEAR,
+            sensor += cv2.remap(irradiance, *rotation_maps(K_canvas, rotation, map_x, map_y), cv2.INTER_LINEAR,
                                 borderMode=cv2.BORDER_REPLICATE)
         sensor /= len(exposure.rotations)
         image = renderer.expose(sensor, params.sensor, keyed_rng(params.seed, "image", *exposure.rng_key))
@@ -376,7 +307,7 @@ def take_shot(params: GenerateParams, root: Path, shot: Shot) -> None:
         if exposure.mask is not None:
             middle = exposure.rotations[len(exposure.rotations) // 2]
             target = np.isin(frame.object_index, scene_world.target_ids).astype(np.uint8) * 255
-            mask = cv2.remap(target, *_rotation_warp(K_canvas, middle, map_x, map_y), cv2.INTER_NEAREST)
+            mask = cv2.remap(target, *rotation_maps(K_canvas, middle, map_x, map_y), cv2.INTER_NEAREST)
             _write_png(root, exposure.datasets, exposure.mask, mask, MASK_PNG_FLAGS)
 
 
@@ -434,28 +365,6 @@ def finish_dataset(params: GenerateParams, root: Path, plan: DatasetPlan, trip: 
             "path": f"datasets/{plan.dataset}"}
 
 
-def write_calibration(folder: Path, session: CalibrationSession, params: GenerateParams) -> None:
-    """A world's calibration session in ``folder``: the views (``views/view_NN.png``), the estimate
-    (``camera.yaml``) and ``report.json`` (the fit, the board, and the true camera beside the estimate)."""
-    tmp = folder.with_name(f".{folder.name}.partial")
-    shutil.rmtree(tmp, ignore_errors=True)
-    (tmp / "views").mkdir(parents=True)
-    for i, image in enumerate(session.images):
-        ok, encoded = cv2.imencode(".png", image, IMAGE_PNG_FLAGS)
-        (tmp / "views" / f"view_{i:02d}.png").write_bytes(encoded.tobytes())
-    calibration, truth = session.calibration, true_camera(params.camera)
-    write_camera_yaml(tmp / "camera.yaml", calibration.camera, CAMERA_NAME)
-    report = {"rms_px": calibration.rms_px, "per_view_rms_px": list(calibration.per_view_rms_px),
-              "views_used": list(calibration.views_used), "n_corners": list(calibration.n_corners),
-              "board": params.calibration.board.model_dump(),
-              "T_cam_board": [T.tolist() for T in session.T_cam_board],
-              "estimate": {"K": calibration.camera.K.tolist(), "dist": calibration.camera.dist.tolist()},
-              "true": {"K": truth.K.tolist(), "dist": truth.dist.tolist()}}
-    (tmp / "report.json").write_text(json.dumps(report, indent=1))
-    shutil.rmtree(folder, ignore_errors=True)
-    tmp.rename(folder)
-
-
 @dataclass(frozen=True)
 class WorldPlan:
     """Everything one world renders: its params, calibration session, scenes, datasets, their commanded trips and
@@ -493,7 +402,7 @@ def generate(params: GenerateParams, protocol: ProtocolParams, root: Path, worke
     (root / "index.parquet").unlink(missing_ok=True)
     rows = []
     for w in worlds.values():
-        write_calibration(Path(calibration_dir) / w.name, w.calibration, w.params)
+        write_calibration(Path(calibration_dir) / w.name, w.calibration, w.params, CAMERA_NAME, IMAGE_PNG_FLAGS)
         for plan in w.plans:
             tmp = _partial(root, plan.dataset)
             shutil.rmtree(tmp, ignore_errors=True)

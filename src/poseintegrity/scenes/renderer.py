@@ -1,7 +1,7 @@
 """A small software renderer: perspective z-buffer rasterisation of triangle meshes, per-pixel shading with
 trilinear mip-mapped textures or a bone-foam solid texture (relief by bump mapping), Lambert + Blinn-Phong under a
-ring light on the camera and a light fixed to the scene, then the optics (blur) and the sensor: exposure,
-illumination flicker, shot and read noise.
+ring light on the camera and a light fixed to the scene, and the sensor: exposure, illumination flicker, shot and
+read noise (the lens between them: :mod:`poseintegrity.scenes.optics`, :mod:`poseintegrity.lens`).
 
 Two passes (deferred shading): :func:`_rasterize` keeps, per pixel, the nearest triangle and its
 perspective-correct barycentric coordinates; :func:`_shade` then shades each pixel once: it interpolates the
@@ -15,14 +15,13 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-import cv2
 import numba
 import numpy as np
 
 from poseintegrity.scenes import foam
 from poseintegrity.scenes.foam import ReliefVolume
 from poseintegrity.scenes.mesh import Mesh
-from poseintegrity.scenes.params import SensorParams
+from poseintegrity.scenes.camera_params import SensorParams
 from poseintegrity.scenes.textures import TextureAtlas
 
 NEAR_MM = 20.0
@@ -262,19 +261,6 @@ def render(scene: SceneGeometry, K: np.ndarray, width: int, height: int, T_cam_w
     with np.errstate(divide="ignore"):
         depth_mm = np.where(depth > 0, 1.0 / depth, np.inf).astype(np.float32)
     return Render(radiance, object_index, depth_mm)
-
-
-def optics(radiance: np.ndarray, sensor: SensorParams, defocus_sigma_px: float = 0.0) -> np.ndarray:
-    """The lens: (h, w) radiance -> (h, w) irradiance on the sensor, blurred by a Gaussian combining the lens'
-    own blur and the defocus of the target's depth (one sigma for the whole frame: the scene's objects of
-    interest lie near the target's depth).
-
-    Done once per robot stop: blur is linear and flicker is a scalar gain, so the two commute.
-    """
-    sigma = float(np.hypot(sensor.blur_sigma_px, defocus_sigma_px))
-    if sigma <= 0:
-        return radiance
-    return cv2.GaussianBlur(radiance, (0, 0), sigma)
 
 
 def expose(irradiance: np.ndarray, sensor: SensorParams, rng: np.random.Generator) -> np.ndarray:

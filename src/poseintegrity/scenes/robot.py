@@ -25,7 +25,7 @@ from poseintegrity.scenes.kinematics import DH, UR5E
 from poseintegrity.scenes.trajectories import Stop
 
 if TYPE_CHECKING:
-    from poseintegrity.scenes.params import PlacementParams, RobotParams
+    from poseintegrity.scenes.robot_params import PlacementParams, RobotParams
 
 ISO_9283_CYCLES = 30  # visits per pose of the ISO 9283 repeatability test
 

@@ -1,0 +1,158 @@
+"""Schema of the camera side of the ``generate`` section (stage 01): the camera and its lens, the sensor, how a
+stop's images are captured, the calibration session and the printed boards (:mod:`.camera`, :mod:`.optics`,
+:mod:`.calibration_views`, :mod:`poseintegrity.lens`). Every number bounded, its key named when refused."""
+
+from __future__ import annotations
+
+from typing import Annotated
+
+import cv2
+import numpy as np
+from pydantic import Field, field_validator, model_validator
+
+from poseintegrity.lens import LensError, check_folding
+from poseintegrity.schema import KeyRule, OrderedRange, Section
+
+MIN_IMAGE_PX = 64  # the rendered image's shorter side: below it no target keeps enough pixels to be localized
+MAX_SENSOR_PX = 4096  # a side of the sensor: larger frames take GBs of z-buffer per worker
+
+
+Radial = Annotated[float, Field(ge=-2, le=2)]  # k_i beyond +-2 describe a fisheye, which plumb_bob does not model
+Tangential = Annotated[float, Field(ge=-0.05, le=0.05)]  # a lens decentred enough for p_i = 0.05 is broken
+
+
+class CameraParams(Section):
+    """IDS U3-3060CP-M (Sony IMX174, mono) with a fixed-focal lens (docs/references.md, "Camera of the Windsor et al. experiments")."""
+
+    sensor_width_px: int = Field(gt=0, le=MAX_SENSOR_PX)
+    sensor_height_px: int = Field(gt=0, le=MAX_SENSOR_PX)
+    pixel_um: float = Field(gt=0, le=50)
+    lens_mm: float = Field(gt=0, le=75, description="focal length of the (unpublished) lens; ours. Below every "
+                                                    "camera distance (>= 100 mm): the lens must focus")
+    downscale: int = Field(ge=1, description="images are rendered at sensor size / downscale")
+    f_number: float = Field(ge=0.5, le=64, description="aperture; sets the depth of field (focus at the model view)")
+    principal_point_offset_px: tuple[Annotated[float, Field(ge=-100, le=100)], Annotated[float, Field(ge=-100, le=100)]] = (
+        Field(description="where the optical axis meets the sensor, from its centre, full-resolution px (a lens is "
+                          "mounted a few px off; 100 px would be a visibly decentred lens)"))
+    distortion: tuple[Radial, Radial, Tangential, Tangential, Radial] = Field(
+        description="k1, k2, p1, p2, k3 of the lens (Brown-Conrady as OpenCV models it, poseintegrity.lens)")
+
+    @model_validator(mode="after")
+    def _image_size(self) -> "CameraParams":
+        shorter = min(self.sensor_width_px, self.sensor_height_px) // self.downscale
+        if shorter < MIN_IMAGE_PX:
+            raise KeyRule("downscale", f"the image's shorter side would be {shorter} px "
+                                       f"({self.sensor_width_px} x {self.sensor_height_px} / {self.downscale}); "
+                                       f"at most {min(self.sensor_width_px, self.sensor_height_px) // MIN_IMAGE_PX} "
+                                       f"keeps it >= {MIN_IMAGE_PX} px")
+        return self
+
+    @model_validator(mode="after")
+    def _lens_does_not_fold(self) -> "CameraParams":
+        K, width, height = self.intrinsics()
+        try:
+            check_folding(K, np.array(self.distortion), width, height)
+        except LensError as error:
+            raise KeyRule("distortion", str(error)) from None
+        return self
+
+    def intrinsics(self) -> tuple[np.ndarray, int, int]:
+        """(K (3, 3) px, width, height) of the rendered images: f_px = f_mm / pixel pitch (docs/references.md,
+        "Camera of the Windsor et al. experiments"), the principal point ``principal_point_offset_px`` from the
+        sensor's centre, downscaled. Pixel centres at integer coordinates: the sensor's centre is at (w - 1) / 2."""
+        scale = 1.0 / self.downscale
+        f_px = self.lens_mm / (self.pixel_um * 1e-3) * scale
+        width, height = self.sensor_width_px // self.downscale, self.sensor_height_px // self.downscale
+        cx = (width - 1) / 2 + self.principal_point_offset_px[0] * scale
+        cy = (height - 1) / 2 + self.principal_point_offset_px[1] * scale
+        return np.array([[f_px, 0.0, cx], [0.0, f_px, cy], [0.0, 0.0, 1.0]]), width, height
+
+
+class SensorParams(Section):
+    """Image formation after the optics: exposure, noise, blur, flicker (8-bit output)."""
+
+    exposure: float = Field(gt=0, le=1000, description="DN for a white Lambertian surface facing the ring light "
+                                                       "(255 saturates; 1000 is white everywhere)")
+    read_noise_dn: float = Field(ge=0, le=50)
+    shot_noise_dn_per_dn: float = Field(ge=0, le=10, description="variance of shot noise per DN of signal")
+    blur_sigma_px: float = Field(ge=0, le=20, description="optical blur, Gaussian sigma in pixels")
+    flicker: float = Field(ge=0, le=0.1, description="std of the per-image illumination gain (above 0.1 a gain "
+                                                     "1 + flicker x N(0, 1) would sometimes be <= 0: a black image)")
+
+
+class PrintedBoardParams(Section):
+    """Printed boards are not their drawings (both the calibration ChArUco and the scenes' ArUco ground-truth board):
+    a printer scales each axis a little, and a sheet is not flat. Drawn once per board and world; every stage that
+    uses a board assumes its drawing, as a lab does."""
+
+    scale_std: float = Field(ge=0, le=0.01, description="per axis: laser printers scale by ~0.1-0.3 %; 1 % would be "
+                                                        "seen with a ruler")
+    calibration_sag_std_mm: float = Field(ge=0, le=5, description="bow of the ChArUco card at its centre")
+    board_sag_std_mm: float = Field(ge=0, le=5, description="bow of the ground-truth board glued on its pedestal")
+
+
+class CharucoParams(Section):
+    """The calibration board: a ChArUco board (cv2.aruco.CharucoBoard) printed on paper."""
+
+    squares_x: int = Field(ge=3, le=40)
+    squares_y: int = Field(ge=3, le=40)
+    square_mm: float = Field(gt=0, le=200)
+    marker_mm: float = Field(gt=0, le=200, description="the ArUco marker inside each white square")
+    dictionary: str = Field(pattern=r"^DICT_\w+$", description="an OpenCV ArUco dictionary, e.g. DICT_5X5_100")
+
+    @field_validator("dictionary")
+    @classmethod
+    def _known(cls, name: str) -> str:
+        if not isinstance(getattr(cv2.aruco, name, None), int):
+            raise ValueError(f"OpenCV has no ArUco dictionary {name!r}")
+        return name
+
+    @model_validator(mode="after")
+    def _marker_inside(self) -> "CharucoParams":
+        if self.marker_mm >= self.square_mm:
+            raise KeyRule("marker_mm", f"a marker lies inside its square: must be < square_mm ({self.square_mm:g}), "
+                                       f"got {self.marker_mm:g}")
+        n_markers = (self.squares_x * self.squares_y) // 2
+        size = cv2.aruco.getPredefinedDictionary(getattr(cv2.aruco, self.dictionary)).bytesList.shape[0]
+        if n_markers > size:
+            raise KeyRule("dictionary", f"{self.squares_x} x {self.squares_y} squares hold {n_markers} markers, "
+                                        f"{self.dictionary} has {size}")
+        return self
+
+
+class CalibrationParams(Section):
+    """The camera's calibration session before any data (:mod:`.calibration_views`): the board shown in ``n_views``
+    poses; the estimate is what the pipeline uses as the camera."""
+
+    board: CharucoParams
+    n_views: int = Field(ge=5, le=200, description="views rendered (5: the fewest a calibration can use)")
+    distance_mm: OrderedRange = Field(description="camera to board centre, drawn per view")
+    max_tilt_deg: float = Field(ge=0, le=70, description="board tilt from facing the camera, drawn per view")
+    max_rms_px: float = Field(gt=0, le=5, description="a calibration whose reprojection RMS exceeds this stops "
+                                                      "stage 01: its camera would not be worth using")
+
+    @field_validator("distance_mm")
+    @classmethod
+    def _in_focus_range(cls, distance: tuple[float, float]) -> tuple[float, float]:
+        if distance[0] < 100 or distance[1] > 2000:
+            raise ValueError(f"distances lie in [100, 2000] mm (the lens focuses beyond 100 mm), got {list(distance)}")
+        return distance
+
+
+class CaptureParams(Section):
+    """How the images of a stop are taken once the robot reports it has stopped (IV-D: "stopping every 2.25 deg to
+    capture 10 images"): a burst of exposures while the arm rings down (:mod:`.ringdown`). Ours: the paper gives no
+    timing."""
+
+    delay_ms: float = Field(ge=0, le=5000, description="from the reported stop to the first exposure's start")
+    interval_ms: float = Field(gt=0, le=5000, description="between exposure starts (the frame period of the burst)")
+    exposure_ms: float = Field(gt=0, le=200, description="shutter time; with the ring light a few ms suffice")
+    blur_step_px: float = Field(gt=0, le=5, description="motion blur: sub-exposures no further apart in the image than "
+                                                        "this (1 sub-exposure when the image moves less)")
+
+    @model_validator(mode="after")
+    def _one_at_a_time(self) -> "CaptureParams":
+        if self.exposure_ms > self.interval_ms:
+            raise KeyRule("exposure_ms", f"a camera exposes one frame at a time: must be <= interval_ms "
+                                         f"({self.interval_ms:g}), got {self.exposure_ms:g}")
+        return self

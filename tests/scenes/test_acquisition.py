@@ -1,0 +1,53 @@
+"""How a stop's images are taken (scenes/acquisition.py): the rotation warp against OpenCV's perspective warp, the
+burst's exposure times, the sub-exposures of the motion blur, and the image's pose against its ring-down."""
+
+from dataclasses import replace
+
+import cv2
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+from poseintegrity.config import load_params
+from poseintegrity.scenes.acquisition import Visit, exposure_times, image_motion, image_pose, rotation_maps
+from poseintegrity.scenes.ringdown import RingDown
+from repository import ROOT
+
+CAPTURE = load_params(ROOT / "params.yaml").generate.capture
+K = np.array([[500.0, 0.0, 160.0], [0.0, 500.0, 120.0], [0.0, 0.0, 1.0]])
+
+
+def test_the_rotation_warp_is_the_homography_of_a_turned_camera():
+    """With identity maps, remap by rotation_maps equals warpPerspective by H = K R K^-1 (its inverse map)."""
+    image = cv2.GaussianBlur(np.random.default_rng(0).random((240, 320)).astype(np.float32), (0, 0), 2.0)
+    x, y = np.meshgrid(np.arange(320, dtype=np.float32), np.arange(240, dtype=np.float32))
+    rotation = np.array([0.01, -0.02, 0.03])
+    ours = cv2.remap(image, *rotation_maps(K, rotation, x, y), cv2.INTER_LINEAR)
+    H = K @ Rotation.from_rotvec(rotation).as_matrix() @ np.linalg.inv(K)
+    reference = cv2.warpPerspective(image, H, (320, 240), flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP)
+    np.testing.assert_allclose(ours[20:-20, 20:-20], reference[20:-20, 20:-20], atol=2e-3)
+
+
+def test_a_world_point_lands_where_the_turned_camera_sees_it():
+    """The pose of an image is the visit's pose turned by the mid-exposure rotation (camera frame): a point straight
+    ahead of the unturned camera appears at K R^T (0, 0, 1) in the turned one."""
+    rotation = np.array([0.002, -0.001, 0.0005])
+    visit = Visit(np.eye(4), RingDown(np.array([1.0, 0.0, 0.0]), 0.0, 0.0, 60.0, 0.05))
+    motion = image_motion(visit, CAPTURE, 0, 500.0)
+    T = image_pose(visit, replace(motion, mid=rotation))
+    point_cam = np.linalg.inv(T) @ np.array([0.0, 0.0, 300.0, 1.0])
+    pixel = K @ (point_cam[:3] / point_cam[2])
+    expected = K @ Rotation.from_rotvec(rotation).as_matrix().T @ [0.0, 0.0, 1.0]
+    np.testing.assert_allclose(pixel[:2], expected[:2] / expected[2], atol=1e-9)
+
+
+def test_the_burst_and_its_sub_exposures():
+    t0, t1 = exposure_times(CAPTURE, 3)
+    assert t0 == pytest.approx((CAPTURE.delay_ms + 3 * CAPTURE.interval_ms) / 1000)
+    assert t1 - t0 == pytest.approx(CAPTURE.exposure_ms / 1000)
+    still = Visit(np.eye(4), RingDown(np.array([0.0, 0.0, 1.0]), 0.0, 0.0, 60.0, 0.05))
+    assert len(image_motion(still, CAPTURE, 0, 1000.0).path) == 1  # no motion: one sub-exposure
+    shaking = Visit(np.eye(4), RingDown(np.array([0.0, 1.0, 0.0]), np.radians(0.5), 1.0, 2 * np.pi * 10, 0.05))
+    motion = image_motion(shaking, CAPTURE, 0, 1000.0)
+    steps = np.linalg.norm(np.diff(motion.path, axis=0), axis=1) * 1000.0  # px moved between sub-exposures
+    assert len(motion.path) > 2 and steps.max() <= CAPTURE.blur_step_px + 1e-9
