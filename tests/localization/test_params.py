@@ -43,6 +43,7 @@ BAD_VALUES = [
     ("extract.usac_max_iterations", 10**9, "extract.usac_max_iterations"),
     ("extract.ransac_budget_inlier_ratio", 0.0, "extract.ransac_budget_inlier_ratio"),
     ("extract.ransac_budget_inlier_ratio", 1.5, "extract.ransac_budget_inlier_ratio"),
+    ("extract.ransac_budget_inlier_ratio", 0.05, "extract.ransac_budget_inlier_ratio"),  # 22 million samples of 5
     ("extract.usac_refine_lm", "maybe", "extract.usac_refine_lm"),
     ("extract.pnp_methods", ["dls"], "extract.pnp_methods.0"),
     ("extract.pnp_methods", [], "extract.pnp_methods"),

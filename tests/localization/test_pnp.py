@@ -6,9 +6,8 @@ from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
 from poseintegrity.poses import pose_errors
-from poseintegrity.localization.pnp import (
-    METHODS, minimal_sample_size, ransac_iterations, reprojection_errors, solve_pnp_ransac,
-)
+from poseintegrity.localization.pnp import METHODS, reprojection_errors, solve_pnp_ransac
+from poseintegrity.localization.ransac import minimal_sample_size, ransac_iterations
 
 K = np.array([[700.0, 0.0, 480.0], [0.0, 700.0, 300.0], [0.0, 0.0, 1.0]])
 

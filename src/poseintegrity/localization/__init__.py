@@ -2,9 +2,9 @@
 
 dataset (stage-01 datasets, checked on read) -> features (CLAHE + SIFT, cached) -> matching (ratio test) ->
 target_model (M_t, III-B) -> evidence (a frame's checked image, matches and ArUco pose, cached for stage 05) -> pnp
-(PnP-RANSAC: USAC and classic variants) -> poseintegrity.poses (E_t, E_r) against the exact pose and the ground_truth (ArUco
-board) -> frame_artifacts (n_i and friends), realism checks -> envelope (theta_a, IV-E). extract runs it over
-datasets on the workers of poseintegrity.parallel.
+(PnP-RANSAC: USAC and classic variants, the classic iteration budget from ransac) -> poseintegrity.poses (E_t, E_r)
+against the exact pose and the ground_truth (ArUco board) -> frame_artifacts (n_i and friends), realism checks ->
+envelope (theta_a, IV-E). extract runs it over datasets on the workers of poseintegrity.parallel.
 """
 
 import lazy_loader
@@ -19,6 +19,7 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
         "extract": ["DATA_FLAGS", "extract_all", "extract_dataset", "usable"],
         "params": ["ExtractParams"],
         "pnp": ["METHODS", "solve_pnp_ransac"],
+        "ransac": ["minimal_sample_size", "ransac_iterations"],
         "target_model": ["TargetModel", "build_target_model"],
     },
 )

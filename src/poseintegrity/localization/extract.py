@@ -37,7 +37,8 @@ from poseintegrity.localization.features import cached_features, read_gray, writ
 from poseintegrity.localization.frame_artifacts import frame_artifacts
 from poseintegrity.localization.ground_truth import board_pose, make_board
 from poseintegrity.localization.params import ExtractParams
-from poseintegrity.localization.pnp import failed, minimal_sample_size, ransac_iterations, solve_pnp_ransac
+from poseintegrity.localization.pnp import failed, solve_pnp_ransac
+from poseintegrity.localization.ransac import minimal_sample_size, ransac_iterations
 from poseintegrity.poses import NAN_POSE, pose_errors
 from poseintegrity.localization.target_model import TargetModel, build_target_model
 from poseintegrity.parallel import Workers
@@ -66,7 +67,7 @@ def localize(
 
     Status "no_keypoints" when SIFT found nothing, else the PnP status ("too_few_matches", ...); the reason says why
     a frame has no pose ("" when it has one). The classic methods' iteration cap is sized for
-    ``params.ransac_budget_inlier_ratio`` at ``params.ransac_confidence`` (pnp.py).
+    ``params.ransac_budget_inlier_ratio`` at ``params.ransac_confidence`` (ransac.py).
     """
     if method == "usac_magsac":
         max_iterations = params.usac_max_iterations

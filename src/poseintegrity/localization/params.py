@@ -11,11 +11,12 @@ from __future__ import annotations
 
 from pydantic import Field, ValidationInfo, model_validator
 
+from poseintegrity.localization.ransac import minimal_sample_size, ransac_iterations
 from poseintegrity.protocol import PnPMethod
 from poseintegrity.schema import KeyRule, Section, Seed, distinct
 
 MAX_PIXELS = 20.0  # a reprojection bound beyond this accepts wrong poses at 968 x 608 px: a setting gone astray
-MAX_ITERATIONS = 1_000_000  # RANSAC iteration caps: 10^6 EPnP hypotheses are minutes per frame
+MAX_ITERATIONS = 1_000_000  # RANSAC iteration caps: 10^6 EPnP hypotheses are ~75 s per frame (bench_localization.py)
 
 
 class ClaheParams(Section):
@@ -60,7 +61,7 @@ class ExtractParams(Section):
     ransac_budget_inlier_ratio: float = Field(
         gt=0, le=1,
         description="classic RANSAC (stage 05): the iteration cap of each method is sized to draw an all-inlier sample "
-        "with ransac_confidence at this inlier ratio (pnp.ransac_iterations); OpenCV stops earlier once its best "
+        "with ransac_confidence at this inlier ratio (ransac.ransac_iterations); OpenCV stops earlier once its best "
         "consensus makes the confidence reached. Frames below it may fail, with the reason said",
     )
     pnp_methods: distinct(PnPMethod) = Field(
@@ -77,6 +78,12 @@ class ExtractParams(Section):
         if protocol is not None and protocol.pnp_method in self.pnp_methods:
             raise KeyRule("pnp_methods", f"must not repeat protocol.pnp_method ({protocol.pnp_method}): stage 02 "
                                          f"runs it and stage 05 shows it beside these, got {self.pnp_methods}")
+        s = max(minimal_sample_size(method) for method in self.pnp_methods)
+        cap = ransac_iterations(self.ransac_confidence, self.ransac_budget_inlier_ratio, s)
+        if cap > MAX_ITERATIONS:
+            raise KeyRule("ransac_budget_inlier_ratio", f"classic RANSAC would draw up to {cap} samples of {s} per "
+                                                        f"frame at ransac_confidence {self.ransac_confidence}, more "
+                                                        f"than {MAX_ITERATIONS}: raise it")
         if self.datasets is not None and any(not name.strip() for name in self.datasets):
             raise KeyRule("datasets", f"dataset ids are non-empty names, got {self.datasets}")
         return self

@@ -17,7 +17,8 @@ Iterations of the classic path: OpenCV stops as soon as the best consensus found
 adaptive RANSAC count), capped by ``iterationsCount``. The cap is sized, per method, for a stated inlier ratio w
 (``extract.ransac_budget_inlier_ratio``): N = log(1 - p) / log(1 - w^s) (Fischler & Bolles 1981; Hartley &
 Zisserman, Multiple View Geometry, 2nd ed., eq. 4.18), s the minimal sample OpenCV draws: 5 points solved by EPnP
-for every flag but P3P/AP3P, which draw 4 (calib3d solvepnp.cpp, ``model_points``; docs/references.md "OpenCV 5").
+for every flag but P3P/AP3P, which draw 4 (:mod:`~poseintegrity.localization.ransac`; docs/references.md, "RANSAC
+iteration count").
 A frame with a lower inlier ratio may then fail (status "pnp_failed" with its reason): a budget, not a guarantee.
 
 n_i: classic RANSAC reports the inliers of the best *hypothesis*, not of the refined pose it returns (OpenCV
@@ -44,21 +45,6 @@ CLASSIC_FLAGS = {
 }
 METHODS = ("usac_magsac", *CLASSIC_FLAGS)
 MIN_CORRESPONDENCES = 4  # a unique pose needs 4 points; P3P with 3 leaves up to 4 solutions
-
-
-def minimal_sample_size(method: str) -> int:
-    """Correspondences per classic RANSAC hypothesis in OpenCV's solvePnPRansac: 4 for P3P/AP3P, else 5 (EPnP)."""
-    return 4 if method in ("p3p", "ap3p") else 5
-
-
-def ransac_iterations(confidence: float, inlier_ratio: float, sample_size: int) -> int:
-    """N = ceil(log(1 - p) / log(1 - w^s)): hypotheses needed to draw one all-inlier sample of s with probability p
-    when a share w of the correspondences are inliers (H&Z eq. 4.18)."""
-    if not (0 < confidence < 1 and 0 < inlier_ratio <= 1 and sample_size >= 1):
-        raise ValueError(f"ransac_iterations needs 0 < confidence < 1, 0 < inlier_ratio <= 1 and a sample size >= 1, "
-                         f"got {confidence}, {inlier_ratio}, {sample_size}")
-    all_inliers = inlier_ratio**sample_size
-    return 1 if all_inliers >= 1 else int(np.ceil(np.log(1 - confidence) / np.log1p(-all_inliers)))
 
 
 @dataclass(frozen=True)
