@@ -125,7 +125,9 @@ def solve_pnp_ransac(
     image_points : (n, 2) float, pixels (no lens distortion)
     K : (3, 3) float, camera matrix, pixels
     method : one of :data:`METHODS`
-    seed : seeds OpenCV's RANSAC sampler (USAC state or cv2.setRNGSeed), so runs repeat exactly
+    seed : seeds the RANSAC samples, so that runs repeat exactly: USAC's generator state; on the classic path, whose
+        generator OpenCV starts from one fixed state on every call (cv2.setRNGSeed does not reach it;
+        docs/references.md, "RANSAC iteration count"), the order in which the matches are handed to OpenCV
     refine_lm : polish a USAC pose by Levenberg-Marquardt on its inliers (the classic path refits by itself)
     Fails (see :class:`PnPResult`) with fewer than 4 correspondences, collinear object points, an OpenCV
     error, a non-finite pose or fewer than 4 recounted inliers; never raises for bad data.
@@ -144,9 +146,9 @@ def solve_pnp_ransac(
             usac = _usac_params(threshold_px, confidence, max_iterations, seed)
             found, _, rvec, tvec, reported = cv2.solvePnPRansac(object_points, image_points, K, None, params=usac)
         else:
-            cv2.setRNGSeed(seed)
+            order = np.random.default_rng(seed).permutation(len(object_points))  # OpenCV's fixed sampler, seeded
             found, rvec, tvec, reported = cv2.solvePnPRansac(
-                object_points, image_points, K, None, iterationsCount=max_iterations,
+                object_points[order], image_points[order], K, None, iterationsCount=max_iterations,
                 reprojectionError=threshold_px, confidence=confidence, flags=CLASSIC_FLAGS[method],
             )
     except cv2.error as error:
