@@ -5,7 +5,7 @@ import pytest
 from poseintegrity.artifact_models.base_functions import emg
 from poseintegrity.localization.frame_artifacts import frame_artifacts
 from poseintegrity.localization.realism import realism_metrics
-from poseintegrity.localization.summaries import method_summary
+from poseintegrity.localization.summaries import FAILURE_STATUSES, failure_shares, method_summary
 from poseintegrity.localization.envelope import envelopes, headline
 from poseintegrity.config import load_params
 from repository import ROOT
@@ -31,7 +31,7 @@ def test_inlier_geometry_of_a_known_square():
 
 
 def test_failed_result_has_zero_inliers_and_nan_geometry():
-    row = frame_artifacts(failed("pnp_failed", "no consensus"), np.zeros((2, 3)), np.zeros((2, 2)), K, 10, 8)
+    row = frame_artifacts(failed("no_consensus", "no consensus: none of 100 samples ..."), np.zeros((2, 3)), np.zeros((2, 2)), K, 10, 8)
     assert row["n_inliers"] == 0 and row["inlier_ratio"] == 0.0 and np.isnan(row["inlier_spread_px"])
 
 
@@ -51,7 +51,7 @@ def world(counts_by_dataset, trajectory="arc"):
                 rows.append(dict(world="main", dataset=dataset, trajectory=trajectory, stop=stop, image=image,
                                  theta_deg=theta if trajectory == "arc" else 0.0,
                                  x_mm=10.0 * stop if trajectory == "line" else 0.0, method="usac_magsac",
-                                 n_inliers=n_i, status="ok" if n_i else "pnp_failed",
+                                 n_inliers=n_i, status="ok" if n_i else "no_consensus",
                                  E_t_mm=50.0 / n_i if n_i else np.nan, E_r_deg=0.0))
     return pd.DataFrame(rows)
 
@@ -124,3 +124,18 @@ def test_method_summary():
     assert summary.loc["epnp", "n_frames"] == 40
     assert summary.loc["epnp", "failure_rate"] == pytest.approx(0.0)  # n_i = 100 - 2.3 theta > 0 up to 42.75
     assert "mean_theta_a_arc_2mm_3deg" in summary.columns
+
+
+def test_failure_shares_by_method_and_status():
+    """p3p: 4 of its 40 frames fail, 3 without consensus and 1 with too few inliers; epnp: none."""
+    table = pd.concat([world({"a": linear(2.3)}).assign(method=m) for m in ("epnp", "p3p")], ignore_index=True)
+    p3p = table.index[table.method == "p3p"]
+    table.loc[p3p[:3], "status"] = "no_consensus"
+    table.loc[p3p[3], "status"] = "too_few_inliers"
+    shares = failure_shares(table)
+    assert list(shares.columns) == list(FAILURE_STATUSES)  # every status, in a fixed order
+    assert shares.loc["p3p", "no_consensus"] == pytest.approx(3 / 40)
+    assert shares.loc["p3p", "too_few_inliers"] == pytest.approx(1 / 40)
+    assert shares.loc["p3p"].sum() == pytest.approx(4 / 40) and (shares.loc["epnp"] == 0.0).all()
+    table.loc[p3p[4], "status"] = "pnp_failed"  # a status of an older table is kept, not dropped
+    assert failure_shares(table).loc["p3p", "pnp_failed"] == pytest.approx(1 / 40)

@@ -6,7 +6,7 @@ from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
 from poseintegrity.poses import pose_errors
-from poseintegrity.localization.pnp import METHODS, reprojection_errors, solve_pnp_ransac
+from poseintegrity.localization.pnp import FAILURES, METHODS, reprojection_errors, solve_pnp_ransac
 from poseintegrity.localization.ransac import minimal_sample_size, ransac_iterations
 
 K = np.array([[700.0, 0.0, 480.0], [0.0, 700.0, 300.0], [0.0, 0.0, 1.0]])
@@ -93,7 +93,9 @@ def test_reprojection_errors_match_opencv_and_reject_points_behind():
 def test_bad_correspondences_fail_with_a_status(X, status, method):
     x = np.random.default_rng(0).uniform(0, 900, (len(X), 2))
     result = solve_pnp_ransac(X, x, K, method, 3.0, 0.99, 100, seed=0, refine_lm=True)
-    assert result.status == status and result.n_inliers == 0 and result.reason
+    assert result.status == status and result.n_inliers == 0
+    assert result.reason == ("3 matches, a pose needs 4" if status == "too_few_matches" else
+                             "the 10 matched model points are (nearly) collinear or coincident")
     assert np.all(np.isnan(result.T_cam_model))
 
 
@@ -102,9 +104,29 @@ def test_pure_outliers_never_crash():
     X, x = rng.uniform(-50, 50, (30, 3)), rng.uniform(0, 900, (30, 2))
     for method in METHODS:
         result = solve_pnp_ransac(X, x, K, method, 1.0, 0.99, 200, seed=1, refine_lm=True)
-        assert result.status in ("ok", "pnp_failed")
+        assert result.status in ("ok", *FAILURES)
         assert (result.status == "ok") == np.all(np.isfinite(result.T_cam_model))
         assert (result.status == "ok") == (result.reason == "")  # every failure says why
+
+
+@pytest.mark.parametrize(
+    "method, K_used, max_iterations, status, words",
+    [  # pure outliers (below): no sample reaches a consensus of its size within 1 px
+        ("epnp", K, 50, "no_consensus", ["none of 50 samples of 5 of the 30 matches", "within 1 px"]),
+        ("p3p", K, 50, "no_consensus", ["none of 50 samples of 4 of the 30 matches"]),
+        ("sqpnp", K, 50, "no_consensus", ["samples of 5", "SQPnP refit"]),
+        ("usac_magsac", K, 200, "too_few_inliers", ["3 of the 30 matches within 1 px", "consensus: 3"]),
+        ("epnp", np.eye(2), 50, "opencv_error", ["cv2.error in", "cameraMatrix"]),  # a 2 x 2 camera matrix
+        ("usac_magsac", np.diag([1e300, 1e300, 1.0]), 50, "non_finite_pose", ["nan"]),  # overflows inside OpenCV
+    ],
+)
+def test_every_failure_says_why(method, K_used, max_iterations, status, words):
+    rng = np.random.default_rng(5)
+    X, x = rng.uniform(-50, 50, (30, 3)), rng.uniform(0, 900, (30, 2))
+    result = solve_pnp_ransac(X, x, K_used, method, 1.0, 0.99, max_iterations, seed=1, refine_lm=True)
+    assert result.status == status and np.all(np.isnan(result.T_cam_model)) and result.n_inliers == 0
+    for word in words:
+        assert word in result.reason
 
 
 @settings(deadline=None, max_examples=25)

@@ -19,7 +19,9 @@ adaptive RANSAC count), capped by ``iterationsCount``. The cap is sized, per met
 Zisserman, Multiple View Geometry, 2nd ed., eq. 4.18), s the minimal sample OpenCV draws: 5 points solved by EPnP
 for every flag but P3P/AP3P, which draw 4 (:mod:`~poseintegrity.localization.ransac`; docs/references.md, "RANSAC
 iteration count").
-A frame with a lower inlier ratio may then fail (status "pnp_failed" with its reason): a budget, not a guarantee.
+A frame with a lower inlier ratio may then fail: a budget, not a guarantee.
+
+Failures: every run without a pose has a status of :data:`FAILURES` and a reason that says why, with its numbers.
 
 n_i: classic RANSAC reports the inliers of the best *hypothesis*, not of the refined pose it returns (OpenCV
 issue 29573; docs/references.md, "OpenCV 5"). For every method the inliers are therefore recounted on the returned pose with
@@ -33,6 +35,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
+from poseintegrity.localization.ransac import minimal_sample_size
 from poseintegrity.poses import NAN_POSE, pose_from_rvec_tvec
 
 # names of docs/references.md, "OpenCV 5" (OpenCV 5 renumbered the flags: never use the integers)
@@ -45,6 +48,14 @@ CLASSIC_FLAGS = {
 }
 METHODS = ("usac_magsac", *CLASSIC_FLAGS)
 MIN_CORRESPONDENCES = 4  # a unique pose needs 4 points; P3P with 3 leaves up to 4 solutions
+FAILURES = (
+    "too_few_matches",    # fewer than MIN_CORRESPONDENCES matches
+    "degenerate_points",  # collinear or coincident model points: no pose is defined
+    "no_consensus",       # OpenCV returned no pose: no hypothesis reached a consensus within its iterations
+    "opencv_error",       # cv2.error
+    "non_finite_pose",    # OpenCV returned a pose with NaN or inf
+    "too_few_inliers",    # fewer than MIN_CORRESPONDENCES matches within the threshold of the returned pose
+)
 
 
 @dataclass(frozen=True)
@@ -54,8 +65,8 @@ class PnPResult:
     T_cam_model : (4, 4) float, model (board) -> camera, mm; all NaN on failure
     inliers : (k,) int, indices of correspondences reprojecting within the threshold under T_cam_model
     n_inliers_reported : int, size of OpenCV's own inlier set
-    status : "ok", "too_few_matches", "degenerate_points" or "pnp_failed"
-    reason : why it failed ("" when ok)
+    status : "ok" or one of :data:`FAILURES`
+    reason : why it failed, with its numbers ("" when ok)
     """
 
     T_cam_model: np.ndarray
@@ -108,6 +119,20 @@ def _usac_params(threshold_px: float, confidence: float, max_iterations: int, se
     return usac
 
 
+def _no_pose(method: str, n: int, threshold_px: float, max_iterations: int) -> str:
+    """Why cv2.solvePnPRansac returned no pose (OpenCV 5's solvePnPRansac and RANSAC loop; docs/references.md,
+    "RANSAC iteration count")."""
+    if method == "usac_magsac":
+        return f"USAC_MAGSAC found no pose in at most {max_iterations} iterations at {threshold_px:g} px ({n} matches)"
+    s = 4 if n == 4 else minimal_sample_size(method)  # 4 matches: OpenCV takes P3P whatever the flag
+    if n == s:  # as many matches as a sample: OpenCV solves them at once, without sampling
+        return f"no pose: OpenCV solved the {n} matches at once (as many as a sample) and found none"
+    reason = (f"no consensus: none of {max_iterations} samples of {s} of the {n} matches gave a pose with {s} or more "
+              f"matches within {threshold_px:g} px")
+    # SQPnP's refit on the best consensus can itself find no solution, which OpenCV reports the same way
+    return reason + (", or the SQPnP refit on the consensus found none" if method == "sqpnp" else "")
+
+
 def solve_pnp_ransac(
     object_points: np.ndarray,
     image_points: np.ndarray,
@@ -129,35 +154,37 @@ def solve_pnp_ransac(
         generator OpenCV starts from one fixed state on every call (cv2.setRNGSeed does not reach it;
         docs/references.md, "RANSAC iteration count"), the order in which the matches are handed to OpenCV
     refine_lm : polish a USAC pose by Levenberg-Marquardt on its inliers (the classic path refits by itself)
-    Fails (see :class:`PnPResult`) with fewer than 4 correspondences, collinear object points, an OpenCV
-    error, a non-finite pose or fewer than 4 recounted inliers; never raises for bad data.
+    Fails (see :class:`PnPResult`, :data:`FAILURES`) with fewer than 4 correspondences, collinear object points, no
+    pose from OpenCV, an OpenCV error, a non-finite pose or fewer than 4 recounted inliers; never raises for bad data.
     """
     if method not in METHODS:
         raise ValueError(f"unknown PnP method {method!r}; expected one of {METHODS}")
     object_points = np.ascontiguousarray(object_points, dtype=np.float64).reshape(-1, 3)
     image_points = np.ascontiguousarray(image_points, dtype=np.float64).reshape(-1, 2)
     K = np.asarray(K, dtype=np.float64)
-    if len(object_points) < MIN_CORRESPONDENCES:
-        return failed("too_few_matches", f"{len(object_points)} matches, a pose needs {MIN_CORRESPONDENCES}")
+    n = len(object_points)
+    if n < MIN_CORRESPONDENCES:
+        return failed("too_few_matches", f"{n} matches, a pose needs {MIN_CORRESPONDENCES}")
     if _is_degenerate(object_points):
-        return failed("degenerate_points", f"the {len(object_points)} matched model points are (nearly) collinear")
+        return failed("degenerate_points", f"the {n} matched model points are (nearly) collinear or coincident")
     try:
         if method == "usac_magsac":
             usac = _usac_params(threshold_px, confidence, max_iterations, seed)
             found, _, rvec, tvec, reported = cv2.solvePnPRansac(object_points, image_points, K, None, params=usac)
         else:
-            order = np.random.default_rng(seed).permutation(len(object_points))  # OpenCV's fixed sampler, seeded
+            order = np.random.default_rng(seed).permutation(n)  # OpenCV's fixed sampler, seeded
             found, rvec, tvec, reported = cv2.solvePnPRansac(
                 object_points[order], image_points[order], K, None, iterationsCount=max_iterations,
                 reprojectionError=threshold_px, confidence=confidence, flags=CLASSIC_FLAGS[method],
             )
     except cv2.error as error:
-        return failed("pnp_failed", f"cv2.solvePnPRansac ({method}): {str(error).strip().splitlines()[-1]}")
+        return failed("opencv_error", f"cv2.error in {error.func}: {error.err}")
     if not found or rvec is None:
-        return failed("pnp_failed", f"{method}: no consensus within {max_iterations} iterations at {threshold_px:g} px "
-                                    f"({len(object_points)} matches)")
+        return failed("no_consensus", _no_pose(method, n, threshold_px, max_iterations))
     if not (np.all(np.isfinite(rvec)) and np.all(np.isfinite(tvec))):
-        return failed("pnp_failed", f"{method}: a non-finite pose")
+        return failed("non_finite_pose", f"OpenCV returned a non-finite pose: rvec {np.ravel(rvec)}, "
+                                         f"tvec {np.ravel(tvec)}")
+    n_reported = 0 if reported is None else len(reported)
     T_cam_model = pose_from_rvec_tvec(rvec, tvec)
     inliers = np.flatnonzero(reprojection_errors(object_points, image_points, K, T_cam_model) <= threshold_px)
     if method == "usac_magsac" and refine_lm and len(inliers) >= MIN_CORRESPONDENCES:
@@ -165,7 +192,7 @@ def solve_pnp_ransac(
         T_cam_model = pose_from_rvec_tvec(rvec, tvec)
         inliers = np.flatnonzero(reprojection_errors(object_points, image_points, K, T_cam_model) <= threshold_px)
     if len(inliers) < MIN_CORRESPONDENCES:
-        return failed("pnp_failed", f"{method}: {len(inliers)} of {len(object_points)} matches within "
-                                    f"{threshold_px:g} px of the returned pose, a pose needs {MIN_CORRESPONDENCES}")
-    n_reported = 0 if reported is None else len(reported)
+        return failed("too_few_inliers", f"{len(inliers)} of the {n} matches within {threshold_px:g} px of the "
+                                         f"returned pose (OpenCV's consensus: {n_reported}), a pose needs "
+                                         f"{MIN_CORRESPONDENCES}")
     return PnPResult(T_cam_model, inliers, n_reported, "ok")

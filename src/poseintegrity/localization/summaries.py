@@ -5,6 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from poseintegrity.localization.pnp import FAILURES
+
+FAILURE_STATUSES = ("no_keypoints", *FAILURES)  # no_keypoints: SIFT found nothing in the frame (extract.localize)
+
 
 def method_summary(table: pd.DataFrame, envelope_table: pd.DataFrame) -> pd.DataFrame:
     """One row per PnP method: frames, failure rate, n_i at the first stop, median errors, mean theta_a per
@@ -52,10 +56,12 @@ def envelope_rule_summary(envelope_table: pd.DataFrame, table: pd.DataFrame, met
 
 
 def failure_shares(table: pd.DataFrame) -> pd.DataFrame:
-    """Per PnP method (rows) the share of its frames per status that is not "ok" (columns; every failed row carries
-    its reason in the artifacts table)."""
+    """Per PnP method (rows) the share of its frames per status that is not "ok" (columns: every status of
+    :data:`FAILURE_STATUSES`, 0 where none, then any other failed status found). Every failed row carries its reason
+    in the artifacts table. table : usable rows (the data flags are not failures of a method)."""
     shares = pd.crosstab(table["method"], table["status"], normalize="index")
-    return shares.drop(columns=[c for c in ("ok",) if c in shares.columns])
+    others = [status for status in shares.columns if status != "ok" and status not in FAILURE_STATUSES]
+    return shares.reindex(columns=[*FAILURE_STATUSES, *others], fill_value=0.0)
 
 
 def board_summary(table: pd.DataFrame) -> dict[str, float]:
