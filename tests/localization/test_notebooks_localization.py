@@ -10,6 +10,7 @@ import papermill
 import pytest
 
 from poseintegrity import config
+from poseintegrity.localization.summaries import FAILURE_STATUSES
 
 ROOT = Path(__file__).resolve().parents[2]
 PNP_METHODS = config.load_params(ROOT / "tests" / "params_tiny.yaml").extract.pnp_methods
@@ -66,6 +67,12 @@ def test_stage_05_writes_one_row_per_frame_and_method(executed):
         flagged = usac.status.isin(["bad_image", "bad_pose"])
         pd.testing.assert_frame_equal(variant.loc[flagged, same_frames], usac.loc[flagged, same_frames])
         pd.testing.assert_frame_equal(variant[same_frames[:3] + same_frames[5:]], usac[same_frames[:3] + same_frames[5:]])
+    for rows in (usac, table):  # every row without a pose says why, USAC and classic alike
+        assert ((rows["reason"] != "") == (rows["status"] != "ok")).all()
     metrics = json.loads((reports_dir / "metrics" / "pnp.json").read_text())
     assert set(metrics["methods"]) == {"usac_magsac", *PNP_METHODS}
+    assert metrics["iteration_caps"] == {"epnp": 672, "sqpnp": 672}  # w = 0.4, p = 0.999, samples of 5
+    for method, shares in metrics["failure_shares"].items():  # the causes add up to the method's failure rate
+        assert set(FAILURE_STATUSES) <= set(shares)  # every cause, 0 where none
+        assert sum(shares.values()) == pytest.approx(metrics["methods"][method]["failure_rate"])
     assert (reports_dir / "figures" / "05_theta_a_by_method.png").stat().st_size > 0

@@ -69,19 +69,22 @@ def localize(
     a frame has no pose ("" when it has one). The classic methods' iteration cap is sized for
     ``params.ransac_budget_inlier_ratio`` at ``params.ransac_confidence`` (ransac.py).
     """
-    if method == "usac_magsac":
-        max_iterations = params.usac_max_iterations
-    else:
-        max_iterations = ransac_iterations(params.ransac_confidence, params.ransac_budget_inlier_ratio,
-                                           minimal_sample_size(method))
     result = solve_pnp_ransac(
         object_points, image_points, K, method, params.reprojection_threshold_px, params.ransac_confidence,
-        max_iterations, seed, params.usac_refine_lm,
+        iteration_cap(method, params), seed, params.usac_refine_lm,
     )
     artifacts = frame_artifacts(result, object_points, image_points, K, n_keypoints, model_size)
     if n_keypoints == 0:
         return result.T_cam_model, artifacts, "no_keypoints", "SIFT found no keypoints in the frame"
     return result.T_cam_model, artifacts, result.status, result.reason
+
+
+def iteration_cap(method: str, params: ExtractParams) -> int:
+    """RANSAC iterations ``method`` may draw at most: usac_max_iterations for USAC; for classic RANSAC the count that
+    reaches ransac_confidence at ransac_budget_inlier_ratio with the method's samples (ransac.py)."""
+    if method == "usac_magsac":
+        return params.usac_max_iterations
+    return ransac_iterations(params.ransac_confidence, params.ransac_budget_inlier_ratio, minimal_sample_size(method))
 
 
 @dataclass(frozen=True)
