@@ -6,4 +6,7 @@ Augmented Reality Guidance and Teleoperation" (IEEE Transactions on Instrumentat
 DOI 10.1109/TIM.2024.3398108), as a DVC pipeline of papermill notebooks (docs/references.md).
 """
 
+from poseintegrity.errors import ArgumentError, PoseIntegrityError
+
+__all__ = ["ArgumentError", "PoseIntegrityError"]
 __version__ = "0.1.0"

@@ -15,13 +15,14 @@ from typing import Any
 import cv2
 import numpy as np
 
+from poseintegrity.errors import PoseIntegrityError
 from poseintegrity.lens import Camera
 
 MIN_CORNERS = 8  # ChArUco corners a view needs to add a constraint worth its 6 pose unknowns
 MIN_VIEWS = 5  # views a calibration needs: the intrinsics and distortion are 8 unknowns beside 6 per view
 
 
-class CalibrationError(ValueError):
+class CalibrationError(PoseIntegrityError):
     """A calibration session that cannot give an estimate, or gives one worse than the bound asked for."""
 
 

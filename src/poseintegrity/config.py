@@ -22,6 +22,7 @@ import yaml
 from pydantic import BaseModel, ConfigDict, ValidationError
 
 from poseintegrity.artifact_models.params import FitParams
+from poseintegrity.errors import PoseIntegrityError
 from poseintegrity.localization.params import ExtractParams
 from poseintegrity.parallel import ParallelParams
 from poseintegrity.prediction.params import PredictParams
@@ -34,7 +35,7 @@ from poseintegrity.tracking.params import TrackParams
 PROTOCOL_READERS = ("protocol", "generate", "extract", "fit", "predict")  # sections checked against ``protocol``
 
 
-class ParamsError(ValueError):
+class ParamsError(PoseIntegrityError):
     """``params.yaml`` is unreadable or one of its keys has an invalid value."""
 
 

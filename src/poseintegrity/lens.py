@@ -24,6 +24,8 @@ import cv2
 import numpy as np
 import yaml
 
+from poseintegrity.errors import PoseIntegrityError
+
 DISTORTION_MODEL = "plumb_bob"  # ROS's name of OpenCV's 5-coefficient model
 # cv2.undistortPoints stops when the re-distorted estimate is within eps px of the pixel: 1e-10 px, as 1e-14 lies
 # below the float64 resolution of pixel coordinates (~1e-13 px at 1000 px) and kept it iterating to its 100 steps
@@ -33,11 +35,11 @@ FOLD_SAMPLES = 4096  # radii sampled when checking that the lens' radial mapping
 CANVAS_MARGIN_PX = 2  # beyond the outermost ray of the sensor: room for bilinear sampling
 
 
-class LensError(ValueError):
+class LensError(PoseIntegrityError):
     """Distortion coefficients that cannot describe a lens over the image (it would fold)."""
 
 
-class CameraFileError(ValueError):
+class CameraFileError(PoseIntegrityError):
     """A camera.yaml that is unreadable or has a missing or invalid field (the message names file and field)."""
 
 

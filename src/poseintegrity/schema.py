@@ -15,6 +15,8 @@ from typing import Annotated, TypeVar
 
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field, ValidationInfo
 
+from poseintegrity.errors import PoseIntegrityError
+
 T = TypeVar("T")
 
 
@@ -24,7 +26,7 @@ class Section(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
 
 
-class KeyRule(ValueError):
+class KeyRule(PoseIntegrityError):
     """A rule between keys of one section failed; ``key`` (dotted, relative to the model that raised it) is the
     key the error message names, e.g. ``KeyRule("k_report_arc", "must be <= k_max (5), got 30")``."""
 

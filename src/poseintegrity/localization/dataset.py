@@ -33,6 +33,7 @@ import pandas as pd
 import pyarrow
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
 
+from poseintegrity.errors import PoseIntegrityError
 from poseintegrity.lens import Camera, CameraFileError, read_camera_yaml
 
 INDEX_COLUMNS = ("dataset", "path")
@@ -40,7 +41,7 @@ FRAME_TABLE_COLUMNS = ("dataset", "stop", "image", "theta_deg", "x_mm", "file", 
 RIGID_TOLERANCE = 1e-6  # |R^T R - I| and |bottom row - (0, 0, 0, 1)|: stage 01 writes poses exact to ~1e-15
 
 
-class DatasetError(RuntimeError):
+class DatasetError(PoseIntegrityError):
     """A dataset on disk is missing, unreadable or inconsistent (stops the stage, naming the dataset and file)."""
 
 

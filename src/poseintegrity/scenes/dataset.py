@@ -37,6 +37,7 @@ import cv2
 import numpy as np
 import pandas as pd
 
+from poseintegrity.errors import PoseIntegrityError
 from poseintegrity.lens import Camera, write_camera_yaml
 from poseintegrity.parallel import Workers
 from poseintegrity.poses import inverse
@@ -110,7 +111,7 @@ def plan_trip(params: GenerateParams, protocol: ProtocolParams, plan: DatasetPla
     return Trip(distance_mm, model_views, stops)
 
 
-class WorldError(ValueError):
+class WorldError(PoseIntegrityError):
     """A scene cannot give the datasets: its target would leave (or vanish from) the model view, or the robot
     cannot reach its poses."""
 

@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING, Protocol
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from poseintegrity.errors import PoseIntegrityError
 from poseintegrity.poses import inverse as inverse_pose
 from poseintegrity.poses import pose_errors, pose_matrix, rotation_angle_deg
 from poseintegrity.scenes import kinematics
@@ -30,7 +31,7 @@ if TYPE_CHECKING:
 ISO_9283_CYCLES = 30  # visits per pose of the ISO 9283 repeatability test
 
 
-class ReachError(ValueError):
+class ReachError(PoseIntegrityError):
     """The robot cannot reach a commanded pose (or no base placement reaches all of a scene's poses)."""
 
 

@@ -19,13 +19,15 @@ from typing import TYPE_CHECKING
 import numpy as np
 import trimesh
 
+from poseintegrity.errors import PoseIntegrityError
+
 if TYPE_CHECKING:
     from poseintegrity.scenes.params import ScapulaParams
 
 HOLE_VOLUME_TOLERANCE = 0.3  # the hole must remove at least 70 % of its cylinder's volume from the bone
 
 
-class MeshError(ValueError):
+class MeshError(PoseIntegrityError):
     """A mesh file or a mesh parameter cannot give a renderable, closed target."""
 
 

@@ -29,13 +29,14 @@ import warnings
 import cv2
 import numpy as np
 
+from poseintegrity.errors import PoseIntegrityError
 from poseintegrity.tracking.geometry import transform_points
 from poseintegrity.tracking.params import DetectionParams
 
 MIN_METRES_DEPTH_MM = 10.0  # a median depth below this is metres, not millimetres (AHAT depth is 100-1000 mm)
 
 
-class FrameError(ValueError):
+class FrameError(PoseIntegrityError):
     """A recorded frame cannot be used as given (wrong shape, dtype, units or lookup table)."""
 
 

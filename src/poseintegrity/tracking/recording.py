@@ -40,12 +40,13 @@ import numpy as np
 import pandas as pd
 from scipy.spatial.transform import Rotation
 
+from poseintegrity.errors import PoseIntegrityError
 from poseintegrity.tracking.detection import detect_markers, validate_frame
 from poseintegrity.tracking.params import TrackParams
 from poseintegrity.tracking.tools import MultiToolTracker
 
 
-class RecordingError(ValueError):
+class RecordingError(PoseIntegrityError):
     """A recording folder that cannot be replayed as a whole."""
 
 

@@ -16,12 +16,13 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from poseintegrity.errors import PoseIntegrityError
 from poseintegrity.tracking.geometry import tool_geometry_problem
 from poseintegrity.tracking.params import FilterParams, MatchingParams
 from poseintegrity.tracking.tracker import FrameResult, MarkerTracker
 
 
-class ToolError(ValueError):
+class ToolError(PoseIntegrityError):
     """A tool file that cannot be used: unreadable, too few markers, or distances that are not distinct."""
 
 
