@@ -1,0 +1,378 @@
+"""The registry of public entry points the battery runs: for each, a valid call and the kind of each argument.
+
+An :class:`EntryPoint` builds its valid arguments (``valid``, cached), calls the function with one of them
+replaced (``call``), and says which results are flagged (``flagged``: a status other than "ok", a flag, a
+warning); ``accepts`` lists bad-value labels whose plain result is the documented, correct one (e.g. a NaN depth
+pixel is an invalid pixel, not an error). Add a public function here when you add one.
+"""
+
+from __future__ import annotations
+
+import json
+import warnings
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from functools import cache
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+from scipy.spatial.transform import Rotation
+
+ROOT = Path(__file__).resolve().parents[2]
+TINY_PARAMS = ROOT / "tests" / "params_tiny.yaml"
+
+
+@dataclass(frozen=True)
+class EntryPoint:
+    name: str
+    call: Callable[[dict[str, Any]], Any]
+    valid: Callable[[Path], dict[str, Any]]
+    arguments: dict[str, str]  # argument -> kind of bad_values.KINDS
+    flagged: Callable[[Any], bool] = lambda result: False
+    accepts: dict[str, set[str]] = field(default_factory=dict)  # argument -> labels whose result is correct
+    names: dict[str, str] = field(default_factory=dict)  # argument -> the word its error message must contain
+
+
+# ----------------------------------------------------------------------------------------------- valid inputs
+@cache
+def params():
+    from poseintegrity.config import load_params
+
+    return load_params(TINY_PARAMS)
+
+
+@cache
+def localization_scene() -> dict[str, Any]:
+    """A rendered view of the synthetic plane (board + textured target) with exact pose and matches."""
+    import loc_synthetic as synthetic
+
+    rng = np.random.default_rng(0)
+    plane, _ = synthetic.canvas(rng)
+    T = synthetic.arc_pose(10.0, 0.0)
+    image = synthetic.render(plane, T)
+    world = rng.uniform([85, -20, 0], [165, 65, 0], (60, 3))
+    uv, _ = __import__("cv2").projectPoints(world, __import__("cv2").Rodrigues(T[:3, :3])[0], T[:3, 3], synthetic.K, None)
+    return dict(image=image, T=T, object_points=world, image_points=uv.reshape(-1, 2), K=synthetic.K,
+                camera=synthetic.CAMERA, board=synthetic.make_board())
+
+
+@cache
+def inlier_series() -> tuple[np.ndarray, np.ndarray]:
+    from poseintegrity.artifact_models.base_functions import emg
+
+    theta = np.repeat(np.arange(0.0, 40.0, 2.5), 3)
+    return theta, np.round(emg(theta, 3000.0, 8.0, -3.0)) + np.tile([0.0, 3.0, 2.0], len(theta) // 3)
+
+
+@cache
+def tracking_frame() -> dict[str, Any]:
+    from poseintegrity.tracking.frames import intrinsics, render_frame, unit_plane_lut
+    from poseintegrity.tracking.geometry import MARKER_DIAMETER_M
+
+    track = params().track
+    geometry = np.array(track.markers_body)
+    markers = geometry @ Rotation.from_rotvec([0.3, 0.2, 0.1]).as_matrix().T + [0.02, -0.01, 0.45]
+    ir, depth = render_frame(markers, [], track.camera, track.frames, MARKER_DIAMETER_M / 2, np.random.default_rng(0))
+    K = intrinsics(track.camera)
+    return dict(ir=ir, depth=depth, lut=unit_plane_lut(K, track.camera.width, track.camera.height), K=K,
+                markers=markers, geometry=geometry)
+
+
+def _tracker():
+    from poseintegrity.tracking.tracker import MarkerTracker
+
+    track = params().track
+    tracker = MarkerTracker(np.array(track.markers_body), track.filter, track.matching)
+    tracker.frame(0.0, tracking_frame()["markers"])
+    return tracker
+
+
+def _filter(cls_name: str):
+    from poseintegrity.tracking.srukf import SquareRootUKF
+    from poseintegrity.tracking.ukf import UnscentedKalmanFilter
+
+    cls = SquareRootUKF if cls_name == "srukf" else UnscentedKalmanFilter
+    track = params().track
+    f = cls(np.array(track.markers_body), track.filter)
+    f.initialize(tracking_frame()["markers"])
+    return f
+
+
+def _write(folder: Path, name: str, text: str) -> Path:
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / name).write_text(text)
+    return folder / name
+
+
+def _recording_dir(tmp: Path) -> Path:
+    from poseintegrity.tracking.recording import RecordingWriter
+
+    frame = tracking_frame()
+    folder = tmp / "recording"
+    writer = RecordingWriter(folder, frame["lut"])
+    for k in range(3):
+        writer.add_frame(0.046 * k, frame["ir"], frame["depth"])
+    writer.close(np.array([0.01, 0.02]), np.zeros((2, 3)))
+    return folder
+
+
+def _status_not_ok(result: Any) -> bool:
+    status = getattr(result, "status", None)
+    return status is not None and status != "ok"
+
+
+NORMAL = ("ok", "initialized")  # statuses and tracker flags of a result that did not fail
+
+
+def _any_flag(result: Any) -> bool:
+    """A result that says it failed: a status or flag other than ok, or a flag column with such a row."""
+    if isinstance(result, pd.DataFrame):
+        for column in ("status", "flag"):
+            if column in result and (~result[column].isin(NORMAL)).any():
+                return True
+        return False
+    if isinstance(result, dict):
+        return any(_any_flag(v) for v in result.values())
+    for attribute in ("status", "flag"):
+        value = getattr(result, attribute, None)
+        if value is not None and not isinstance(value, np.ndarray) and value not in NORMAL:
+            return True
+        if isinstance(value, np.ndarray) and (~np.isin(value, NORMAL)).any():
+            return True
+    return False
+
+
+# ------------------------------------------------------------------------------------------------- registry
+def _entries() -> list[EntryPoint]:
+    from poseintegrity import config, lens, poses
+    from poseintegrity.artifact_models.models import fit_model
+    from poseintegrity.localization import dataset, envelope, features, ground_truth, matching, pnp, target_model
+    from poseintegrity.prediction import metrics, predictors, supervisor
+    from poseintegrity.tracking import correspondence, detection, recording, tools
+    from poseintegrity.tracking.kabsch import kabsch as kabsch_fit
+
+    P = params
+    loc = localization_scene
+    entries = [
+        # ---- params
+        EntryPoint("config.load_params", lambda a: config.load_params(a["path"]),
+                   lambda tmp: {"path": TINY_PARAMS}, {"path": "file"}),
+        # ---- lens
+        EntryPoint("lens.read_camera_yaml", lambda a: lens.read_camera_yaml(a["path"]),
+                   lambda tmp: {"path": _camera_yaml(tmp)}, {"path": "file"}),
+        EntryPoint("lens.Camera", lambda a: lens.Camera(a["K"], a["dist"], 640, 400),
+                   lambda tmp: {"K": loc()["K"], "dist": np.zeros(5)}, {"K": "matrix", "dist": "array"},
+                   names={"dist": "dist"}),
+        # ---- localization
+        EntryPoint("localization.detect_features",
+                   lambda a: features.detect_features(a["image"], P().extract.clahe, P().extract.sift),
+                   lambda tmp: {"image": loc()["image"]}, {"image": "image"}),
+        EntryPoint("localization.decode_gray", lambda a: features.read_gray(a["path"]),
+                   lambda tmp: {"path": _png(tmp)}, {"path": "file"}),
+        EntryPoint("localization.match_ratio_test",
+                   lambda a: matching.match_ratio_test(a["query"], a["train"], 0.8),
+                   lambda tmp: {"query": _descriptors(0), "train": _descriptors(1)},
+                   {"query": "points", "train": "points"}),
+        EntryPoint("localization.solve_pnp_ransac",
+                   lambda a: pnp.solve_pnp_ransac(a["object_points"], a["image_points"], a["K"], "usac_magsac", 2.0,
+                                                  0.999, 1000, 0, True),
+                   lambda tmp: {k: loc()[k] for k in ("object_points", "image_points", "K")},
+                   {"object_points": "points", "image_points": "points", "K": "matrix"}, flagged=_status_not_ok),
+        EntryPoint("localization.board_pose", lambda a: ground_truth.board_pose(a["image"], loc()["board"], a["camera"]),
+                   lambda tmp: {"image": loc()["image"], "camera": loc()["camera"]}, {"image": "image"},
+                   flagged=_status_not_ok),
+        EntryPoint("localization.triangulate",
+                   lambda a: target_model.triangulate(a["K"], a["T_cam1_cam0"], a["x0"], a["x1"]),
+                   lambda tmp: _two_views(), {"K": "matrix", "T_cam1_cam0": "matrix", "x0": "points", "x1": "points"}),
+        EntryPoint("localization.actual_envelope",
+                   lambda a: envelope.actual_envelope(a["theta"], a["criteria"], a["bounds"]),
+                   lambda tmp: {"theta": np.arange(0.0, 40, 2.5), "criteria": np.c_[np.linspace(0.1, 3, 16),
+                                np.linspace(0.1, 4, 16)], "bounds": np.array([2.0, 3.0])},
+                   {"theta": "array", "criteria": "points", "bounds": "array"}),
+        EntryPoint("localization.load_index", lambda a: dataset.load_index(a["index"].parents[1]),
+                   lambda tmp: {"index": _dataset_dir(tmp)}, {"index": "file"}, names={"index": "index.parquet"}),
+        EntryPoint("localization.load_dataset",
+                   lambda a: dataset.load_dataset(a["meta"].parents[2], a["meta"].parent.relative_to(a["meta"].parents[2])),
+                   lambda tmp: {"meta": _dataset_dir(tmp).parent / "ds_arc" / "meta.json"}, {"meta": "file"},
+                   names={"meta": "meta.json"}),
+        EntryPoint("poses.pose_errors", lambda a: poses.pose_errors(a["T_est"], a["T_true"]),
+                   lambda tmp: {"T_est": loc()["T"], "T_true": loc()["T"]}, {"T_est": "matrix", "T_true": "matrix"}),
+        # ---- artifact models
+        EntryPoint("artifact_models.fit_model",
+                   lambda a: fit_model("emg", a["theta"], a["n_inliers"], theta_end=a["theta_end"], params=P().fit,
+                                       rng=np.random.default_rng(0)),
+                   lambda tmp: {"theta": inlier_series()[0], "n_inliers": inlier_series()[1], "theta_end": 60.0},
+                   {"theta": "array", "n_inliers": "array", "theta_end": "scalar"}, flagged=_status_not_ok,
+                   accepts={"n_inliers": {"nan"}}),  # a NaN count is a sample without a pose: documented as dropped
+        # ---- prediction
+        EntryPoint("prediction.boundaries",
+                   lambda a: predictors.boundaries(lambda x: 300.0 - 5.0 * x, a["thresholds"], a["theta_start"],
+                                                   a["theta_end"], a["n_grid"]),
+                   lambda tmp: {"thresholds": np.array([15.0, 30.0]), "theta_start": 0.0, "theta_end": 60.0,
+                                "n_grid": 50},
+                   {"thresholds": "array", "theta_start": "scalar", "theta_end": "scalar", "n_grid": "scalar"},
+                   flagged=lambda b: bool(np.isin(b.status, ["non_finite", "bad_threshold"]).any())),
+        EntryPoint("prediction.safe_path_length", lambda a: metrics.safe_path_length(a["theta_p"], a["theta_a"]),
+                   lambda tmp: {"theta_p": np.array([5.0, 9.0]), "theta_a": np.array([7.0, 8.0])},
+                   {"theta_p": "array", "theta_a": "array"}, accepts={"theta_p": {"nan"}}),
+        EntryPoint("prediction.incursion", lambda a: metrics.incursion(a["theta_p"], a["theta_a"]),
+                   lambda tmp: {"theta_p": np.array([5.0, 9.0]), "theta_a": np.array([7.0, 8.0])},
+                   {"theta_p": "array", "theta_a": "array"}),
+        EntryPoint("prediction.NextStepSupervisor.update",
+                   lambda a: _supervisor().update(a["theta"], a["n_inliers"]),
+                   lambda tmp: {"theta": 2.5, "n_inliers": np.array([200.0, 210.0])},
+                   {"theta": "scalar", "n_inliers": "array"},
+                   flagged=lambda d: d.status in ("non_finite", "bad_threshold") or d.fit_status not in ("ok", "no_fit")),
+        # ---- tracking
+        EntryPoint("tracking.detect_markers",
+                   lambda a: _warned(detection.detect_markers, a["ir"], a["depth_mm"], a["unproject"],
+                                     P().track.detection),
+                   lambda tmp: {"ir": tracking_frame()["ir"], "depth_mm": tracking_frame()["depth"],
+                                "unproject": tracking_frame()["lut"]},
+                   {"ir": "image", "depth_mm": "image", "unproject": "points"}, flagged=_warning_flag,
+                   accepts={"ir": {"uint16", "float32", "int32"}, "depth_mm": {"uint16", "float32", "int32"}}),
+        EntryPoint("tracking.kabsch", lambda a: kabsch_fit(a["points_world"], a["points_body"]),
+                   lambda tmp: {"points_world": tracking_frame()["markers"], "points_body": tracking_frame()["geometry"]},
+                   {"points_world": "points", "points_body": "points"}),
+        EntryPoint("tracking.match_markers",
+                   lambda a: correspondence.match_markers(a["points"], a["geometry"], None, P().track.matching),
+                   lambda tmp: {"points": tracking_frame()["markers"], "geometry": tracking_frame()["geometry"]},
+                   {"points": "points", "geometry": "points"},
+                   flagged=lambda result: bool((np.asarray(result) < 0).any())),
+        EntryPoint("tracking.MarkerTracker.frame", lambda a: _tracker().frame(a["t"], a["points"]),
+                   lambda tmp: {"t": 0.05, "points": tracking_frame()["markers"]},
+                   {"t": "timestamp", "points": "points"}, flagged=_any_flag),
+        EntryPoint("tracking.MarkerTracker.gyro", lambda a: _tracker().gyro(a["t"], a["omega_body"]),
+                   lambda tmp: {"t": 0.01, "omega_body": np.array([0.1, 0.0, 0.0])},
+                   {"t": "timestamp", "omega_body": "array"}, flagged=lambda r: r != "ok"),
+        EntryPoint("tracking.SquareRootUKF.predict", lambda a: _filter("srukf").predict(a["dt"]),
+                   lambda tmp: {"dt": 0.01}, {"dt": "scalar"}, flagged=lambda ok: ok is False),
+        EntryPoint("tracking.SquareRootUKF.update",
+                   lambda a: _filter("srukf").update(a["z"], a["observed"], False),
+                   lambda tmp: {"z": tracking_frame()["markers"].ravel(), "observed": np.ones(4, bool)},
+                   {"z": "array", "observed": "array"}, flagged=lambda ok: ok is False),
+        EntryPoint("tracking.UnscentedKalmanFilter.update",
+                   lambda a: _filter("ukf").update(a["z"], a["observed"], False),
+                   lambda tmp: {"z": tracking_frame()["markers"].ravel(), "observed": np.ones(4, bool)},
+                   {"z": "array", "observed": "array"}, flagged=lambda ok: ok is False),
+        EntryPoint("tracking.read_tools", lambda a: tools.read_tools(a["path"], P().track.matching.distinct_m),
+                   lambda tmp: {"path": _tools_json(tmp)}, {"path": "file"}),
+        EntryPoint("tracking.MultiToolTracker",
+                   lambda a: tools.MultiToolTracker(a["tools"], P().track.filter, P().track.matching).frame(
+                       0.0, a["points"]),
+                   lambda tmp: {"tools": {"probe": tracking_frame()["geometry"]}, "points": tracking_frame()["markers"]},
+                   {"points": "points"}, flagged=_any_flag),
+        *[EntryPoint(f"tracking.read_recording[{name}]", lambda a: recording.read_recording(a["file"].parent),
+                     lambda tmp, name=name: {"file": _recording_dir(tmp) / name}, {"file": "file"},
+                     names={"file": name}, accepts={"file": {"missing"}} if name == "gyro.csv" else {})
+          for name in ("frames.csv", "gyro.csv", "lut_x.npy")],
+        EntryPoint("tracking.track_recording",
+                   lambda a: recording.track_recording(recording.read_recording(a["file"].parents[1]),
+                                                       {"probe": tracking_frame()["geometry"]}, P().track),
+                   lambda tmp: {"file": _recording_dir(tmp) / "ir" / "000001.png"}, {"file": "file"},
+                   names={"file": "000001.png"}, flagged=_any_flag),
+        # ---- stage tables
+        EntryPoint("stage table: envelopes", lambda a: envelope.headline(a["table"], P().protocol.envelope),
+                   lambda tmp: {"table": _envelope_table()}, {"table": "table"}),
+    ]
+    return entries
+
+
+ENTRY_POINTS: dict[str, EntryPoint] = {}
+
+
+def entry_points() -> dict[str, EntryPoint]:
+    if not ENTRY_POINTS:
+        ENTRY_POINTS.update({entry.name: entry for entry in _entries()})
+    return ENTRY_POINTS
+
+
+# ------------------------------------------------------------------------------------------------ helpers
+def _warned(function, *args):
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        result = function(*args)
+    return result, [str(w.message) for w in caught]
+
+
+def _warning_flag(result) -> bool:
+    return bool(result[1])
+
+
+def _supervisor():
+    from poseintegrity.prediction.supervisor import NextStepSupervisor
+
+    s = NextStepSupervisor.from_params(params(), "arc", n_t=30.0, theta_b=2.5, rng=np.random.default_rng(0))
+    s.update(0.0, np.array([300.0, 305.0]))
+    return s
+
+
+def _descriptors(seed: int) -> np.ndarray:
+    return np.random.default_rng(seed).random((40, 128)).astype(np.float32)
+
+
+def _two_views() -> dict[str, Any]:
+    import cv2
+
+    rng = np.random.default_rng(3)
+    X = rng.uniform([-20, -20, 280], [20, 20, 320], (30, 3))
+    T = np.eye(4)
+    T[:3, 3] = [-20.0, 0.0, 0.0]
+    K = localization_scene()["K"]
+
+    def project(points):
+        uv = (K @ points.T).T
+        return uv[:, :2] / uv[:, 2:]
+
+    return {"K": K, "T_cam1_cam0": T, "x0": project(X), "x1": project(X + T[:3, 3])}
+
+
+def _png(tmp: Path) -> Path:
+    import cv2
+
+    path = tmp / "image.png"
+    cv2.imwrite(str(path), localization_scene()["image"])
+    return path
+
+
+def _camera_yaml(tmp: Path) -> Path:
+    from poseintegrity.lens import write_camera_yaml
+
+    path = tmp / "camera.yaml"
+    write_camera_yaml(path, localization_scene()["camera"], "battery")
+    return path
+
+
+def _tools_json(tmp: Path) -> Path:
+    geometry = tracking_frame()["geometry"]
+    return _write(tmp, "tools.json", json.dumps({"tools": [{"name": "probe", "markers_body": geometry.tolist()}]}))
+
+
+def _recording_copy(tmp: Path, name: str) -> Path:
+    import shutil
+
+    source = _recording_dir(str(tmp.parent / "shared"))
+    folder = tmp / f"copy_{name}"
+    if not folder.exists():
+        shutil.copytree(source, folder)
+    return folder / name
+
+
+def _dataset_dir(tmp: Path) -> Path:
+    import loc_synthetic as synthetic
+
+    data_dir = tmp / "data"
+    rows = [synthetic.write_dataset(data_dir, "ds_arc", np.random.default_rng(0), stops=(10.0,), images_per_stop=1)]
+    synthetic.write_index(data_dir, rows)
+    return data_dir / "datasets" / "index.parquet"
+
+
+def _envelope_table() -> pd.DataFrame:
+    rows = []
+    for dataset, theta_a in (("scene_1_arc000", 12.5), ("scene_1_arc001", 17.0)):
+        for tolerance in ("2mm_3deg", "4mm_10deg"):
+            rows.append(dict(world="main", dataset=dataset, trajectory="arc", method="usac_magsac",
+                             tolerance=tolerance, rule="fail_fraction", theta_a=theta_a, censored=False))
+    return pd.DataFrame(rows)
