@@ -385,7 +385,7 @@ def recording_replay(params: TrackParams, folder: Path) -> tuple[pd.DataFrame, d
     """Write evaluation.replay_s seconds of a simulated recording as a recording folder (16-bit PNG frames,
     gyro.csv, the unit-plane LUT) and replay it from disk with :func:`track_recording`; the in-memory run of the
     same recording (:func:`run_filter`, gyro fused) must give the same poses.  Returns (pose table, agreement)."""
-    writer = RecordingWriter(folder, unit_plane_lut(intrinsics(params.camera), params.camera.width, params.camera.height))
+    writer = RecordingWriter(folder, unit_plane_lut(intrinsics(params.camera), params.camera.width, params.camera.height), overwrite=True)
     [sim] = simulate(params, experiment_rng(params, "replay"), duration_s=params.evaluation.replay_s, sink=writer.add_frame)
     writer.close(sim.trajectory.t[sim.timeline.gyro_index], sim.timeline.gyro)
     table = track_recording(read_recording(folder), {"tool": sim.markers_body}, params, gyro_tool="tool")

@@ -179,5 +179,7 @@ class MultiToolTracker:
 
     def gyro(self, t: float, omega_body: np.ndarray) -> dict[str, str]:
         """A gyro sample (rad/s, body frame of gyro_tool): fused by that tool's filter; the others only advance."""
-        t, omega_body = check_timestamp(t), check_rates(omega_body)
+        return self._gyro(check_timestamp(t), check_rates(omega_body))
+
+    def _gyro(self, t: float, omega_body: np.ndarray) -> dict[str, str]:
         return {name: tracker._gyro(t, omega_body) for name, tracker in self.trackers.items()}
