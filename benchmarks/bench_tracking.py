@@ -9,6 +9,9 @@
    (:func:`reference_render_frame` below: numpy ray casting and a float32 normal drawn for every pixel, the
    same depth and reflections to the bit, and the same distribution of the IR noise), and against its former
    floor, drawing the 512 x 512 float32 normals alone.
+5. The argument checks of the public entry points (kabsch, the filter's predict_steps / update, the tracker's
+   frame): each checked call against its unchecked inner call on the same input, timed alternately in this run
+   (paired medians), as a ratio; the hot paths (run_filter, detect_match_kabsch, correspondence) call the inner ones.
 4. A whole filter run (run_filter over a simulated recording with gyro, the stage-06 workload) against the same
    run with the SR-UKF computed one numpy / LAPACK call per step (benchmarks/srukf_reference.py, the
    implementation before the fused kernels), and the same run with the plain covariance-form UKF; the largest
@@ -36,7 +39,10 @@ from poseintegrity.tracking.peers import filter_speed  # noqa: E402
 from poseintegrity.tracking.simulation import run_filter, simulate  # noqa: E402
 from poseintegrity.tracking.srukf import SquareRootUKF  # noqa: E402
 from poseintegrity.tracking.ukf import UnscentedKalmanFilter  # noqa: E402
+from poseintegrity.tracking.kabsch import kabsch, kabsch_unchecked  # noqa: E402
+from poseintegrity.tracking.tracker import MarkerTracker  # noqa: E402
 from srukf_reference import StepwiseSquareRootUKF  # noqa: E402
+from timing import paired_medians  # noqa: E402
 
 RUN_DURATION_S = 20.0  # a third of the accuracy recording; a run costs the same per second of recording
 
@@ -149,6 +155,31 @@ def main():
         print(f"  {name:16s} {seconds[name]:7.2f} s   run / fused = {seconds[name] / seconds['fused kernels']:5.1f}")
     diff = np.nanmax(np.abs(fused[["x_mm", "y_mm", "z_mm"]].to_numpy() - stepwise[["x_mm", "y_mm", "z_mm"]].to_numpy()))
     print(f"  fused vs stepwise: max |position difference| {diff:.2e} mm, flags identical: {fused.flag.equals(stepwise.flag)}")
+
+    check_overhead(params, geometry, rng)
+
+
+def check_overhead(params, geometry, rng):
+    """Checked public call / unchecked inner call, paired medians over the same inputs."""
+    markers = geometry + [0.02, -0.01, 0.45]
+    z = np.r_[(markers + rng.normal(0, 0.001, markers.shape)).ravel(), rng.normal(0, 0.5, 3)]
+    observed = np.ones(len(geometry), dtype=bool)
+    f = SquareRootUKF(geometry, params.filter)
+    f.initialize(markers)
+    tracker = MarkerTracker(geometry, params.filter, params.matching)
+    clock = iter(np.arange(1, 10**7) * params.filter.dt * 4)
+    tracker.frame(0.0, markers)
+    pairs = {
+        "kabsch (4 points)": (lambda: kabsch_unchecked(markers, geometry), lambda: kabsch(markers, geometry)),
+        "SR-UKF predict_steps(1)": (lambda: f._predict_steps(1, params.filter.dt, None), lambda: f.predict_steps(1, params.filter.dt)),
+        "SR-UKF update (4 markers + gyro)": (lambda: f._update(z, observed, True), lambda: f.update(z, observed, True)),
+        "tracker frame (4 markers)": (lambda: tracker._frame(float(next(clock)), markers), lambda: tracker.frame(float(next(clock)), markers)),
+    }
+    print("argument checks: checked public call / unchecked inner call (paired medians, same run)")
+    for name, (inner, public) in pairs.items():
+        inner(), public()
+        t_inner, t_public = paired_medians(inner, public, 3000)
+        print(f"  {name:34s} inner {t_inner * 1e6:8.2f} us  checked {t_public * 1e6:8.2f} us  ratio {t_public / t_inner:5.3f}")
 
 
 if __name__ == "__main__":

@@ -3,7 +3,7 @@ import pytest
 from pykalman.sqrt.unscented import Moments, moments2points, unscented_filter_correct
 from scipy.spatial.transform import Rotation
 
-
+from poseintegrity.errors import PoseIntegrityError
 from poseintegrity.tracking.peers import additive_model, correlated_state, filterpy_filter, pykalman_time_update
 from poseintegrity.tracking.srukf import SquareRootUKF
 from poseintegrity.tracking.ukf import UnscentedKalmanFilter
@@ -107,7 +107,10 @@ def test_a_failed_final_downdate_is_counted_and_keeps_the_prior_factor():
 def test_divergence_is_detected_and_the_filter_stops():
     f = SquareRootUKF(GEOMETRY, TRACK.filter)
     f.initialize(GEOMETRY + [0, 0, 0.5])
-    assert not f.update(np.full(12, np.nan), np.ones(4, bool), gyro=False)
+    with pytest.raises(PoseIntegrityError, match="z: entries must be finite"):  # a NaN measurement is refused
+        f.update(np.full(12, np.nan), np.ones(4, bool), gyro=False)
+    f.x[0] = np.nan  # a NaN reached inside the filter is divergence
+    assert not f.predict(0.0025)
     assert not f.initialized and f.n_divergences == 1 and f.last_reason == "non-finite state or covariance"
     f.initialize(GEOMETRY + [0, 0, 0.5])
     f.S = f.S * 1e4  # runaway covariance

@@ -5,7 +5,7 @@ import pytest
 from poseintegrity.tracking.evaluation import recording_replay
 from poseintegrity.tracking.frames import intrinsics, render_frame, unit_plane_lut
 from poseintegrity.tracking.geometry import MARKER_DIAMETER_M
-from poseintegrity.tracking.recording import RecordingError, RecordingWriter, read_recording, track_recording
+from poseintegrity.tracking.recording import RecordingError, RecordingWriter, read_recording, track_recording, write_manifest
 
 from tracking.track_section import GEOMETRY
 from tracking.track_section import TINY as PARAMS
@@ -31,6 +31,7 @@ def _write(folder, n=4, depth_scale=1.0, npy=False):
         np.save(folder / "depth" / "last.npy", depth.astype(float) * depth_scale)
         frames.loc[len(frames) - 1, "depth"] = "depth/last.npy"
         frames.to_csv(folder / "frames.csv", index=False)
+        write_manifest(folder)  # a deliberate change: sealed again
 
 
 def test_depth_in_metres_and_wrong_shapes_are_flagged_rows_with_a_warning(tmp_path):
@@ -39,6 +40,7 @@ def test_depth_in_metres_and_wrong_shapes_are_flagged_rows_with_a_warning(tmp_pa
         table = track_recording(read_recording(tmp_path), {"tool": GEOMETRY}, PARAMS)
     assert list(table.flag) == ["initialized", "ok", "ok", "bad_frame"]
     np.save(tmp_path / "depth" / "last.npy", np.zeros((10, 10)))
+    write_manifest(tmp_path)
     with pytest.warns(RuntimeWarning, match="differs from IR shape"):
         table = track_recording(read_recording(tmp_path), {"tool": GEOMETRY}, PARAMS)
     assert table.flag.iloc[-1] == "bad_frame" and np.isfinite(table.x_mm.iloc[-1])  # the filter's pose, not NaN points
@@ -69,10 +71,12 @@ def test_bad_recordings_are_refused_naming_the_problem(tmp_path):
 def test_a_missing_frame_file_is_refused_before_tracking_and_an_undecodable_one_is_a_flagged_row(tmp_path):
     _write(tmp_path)
     (tmp_path / "ir" / "000002.png").write_bytes(b"not a png")  # present but truncated / corrupt
+    write_manifest(tmp_path)
     with pytest.warns(RuntimeWarning, match="cannot decode ir/000002.png"):
         table = track_recording(read_recording(tmp_path), {"tool": GEOMETRY}, PARAMS)
     assert list(table.flag) == ["initialized", "ok", "bad_frame", "ok"] and table.n_points.iloc[2] == 0
     (tmp_path / "depth" / "000001.png").unlink()
+    write_manifest(tmp_path)
     with pytest.raises(RecordingError, match="1 frame file.* missing, e.g. 'depth/000001.png'"):
         read_recording(tmp_path)
 

@@ -33,7 +33,7 @@ def test_duplicate_distances_are_refused_naming_the_pairs(tmp_path):
     with pytest.raises(ToolError, match="probe markers .* and copy markers"):
         read_tools(tmp_path / "two.json", 0.001)
     (tmp_path / "bad.json").write_text('{"tools": [{"name": "a"}]}')
-    with pytest.raises(ToolError, match="cannot read"):
+    with pytest.raises(ToolError, match="bad.json: tools\\[0\\] needs the fields name and markers_body"):
         read_tools(tmp_path / "bad.json", 0.001)
 
 

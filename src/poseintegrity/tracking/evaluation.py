@@ -29,7 +29,7 @@ from poseintegrity.tracking.errors import rms, rms_summary
 from poseintegrity.tracking.frames import draw_phantoms, intrinsics, render_frame, unit_plane_lut
 from poseintegrity.poses import pose_matrix
 from poseintegrity.tracking.geometry import MARKER_DIAMETER_M, transform_points
-from poseintegrity.tracking.kabsch import kabsch, pose_from_points
+from poseintegrity.tracking.kabsch import kabsch_unchecked, pose_from_points_unchecked
 from poseintegrity.tracking.motion import sample_sensors, simulate_trajectory
 from poseintegrity.parallel import Workers
 from poseintegrity.report.paper import BLACK_RESULTS
@@ -385,7 +385,7 @@ def recording_replay(params: TrackParams, folder: Path) -> tuple[pd.DataFrame, d
     """Write evaluation.replay_s seconds of a simulated recording as a recording folder (16-bit PNG frames,
     gyro.csv, the unit-plane LUT) and replay it from disk with :func:`track_recording`; the in-memory run of the
     same recording (:func:`run_filter`, gyro fused) must give the same poses.  Returns (pose table, agreement)."""
-    writer = RecordingWriter(folder, unit_plane_lut(intrinsics(params.camera), params.camera.width, params.camera.height))
+    writer = RecordingWriter(folder, unit_plane_lut(intrinsics(params.camera), params.camera.width, params.camera.height), overwrite=True)
     [sim] = simulate(params, experiment_rng(params, "replay"), duration_s=params.evaluation.replay_s, sink=writer.add_frame)
     writer.close(sim.trajectory.t[sim.timeline.gyro_index], sim.timeline.gyro)
     table = track_recording(read_recording(folder), {"tool": sim.markers_body}, params, gyro_tool="tool")
@@ -413,7 +413,7 @@ def detect_match_kabsch(ir: np.ndarray, depth_mm: np.ndarray, K: np.ndarray, par
     matched = assignment >= 0
     if matched.sum() < 3:
         return np.full((4, 4), np.nan)
-    return pose_from_points(points[assignment[matched]], geometry[matched])
+    return pose_from_points_unchecked(points[assignment[matched]], geometry[matched])
 
 
 def timing_table(sim: Simulation, params: TrackParams) -> pd.DataFrame:
@@ -437,7 +437,7 @@ def timing_table(sim: Simulation, params: TrackParams) -> pd.DataFrame:
         "Contour detection": lambda: detect_markers(ir, depth_mm, K, params.detection),
         "Euclidean matching": lambda: match_voting(points, geometry, tolerance_m=tol),
         "Brute force matching": lambda: match_brute_force(points, geometry, tolerance_m=tol, min_markers=params.matching.min_markers),
-        "Kabsch algorithm": lambda: kabsch(z.reshape(-1, 3), geometry),
+        "Kabsch algorithm": lambda: kabsch_unchecked(z.reshape(-1, 3), geometry),
         "Detection + correspondence + Kabsch": lambda: detect_match_kabsch(ir, depth_mm, K, params, geometry),
         "UKF state update (one dt step)": lambda: filt.predict(params.filter.dt),
         "UKF measurement update (markers + gyro)": lambda: filt.update(np.r_[z, np.zeros(3)], observed, True),

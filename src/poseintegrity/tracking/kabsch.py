@@ -9,6 +9,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
+from poseintegrity.errors import ArgumentError, check_array
 from poseintegrity.poses import pose_matrix
 
 
@@ -21,8 +22,40 @@ def kabsch(points_world: np.ndarray, points_body: np.ndarray) -> tuple[np.ndarra
     R is the proper rotation maximising tr(R P^T Q) (Alg. 4's R = V diag(1, 1, d) U^T of the SVD of
     H = P^T Q), found as the top eigenvector of Horn's 4x4 quaternion matrix (Horn 1987) by compiled Jacobi
     sweeps: one call costs microseconds instead of a LAPACK SVD and numpy's per-call overhead.
-    Fewer than 3 non-collinear points give one of the equally good rotations (no error is raised).
+
+    The arguments are checked once (:func:`check_kabsch_arguments`): fewer than 3 points, non-finite
+    coordinates, shapes that do not correspond, or body points on one line (the rotation about the line is
+    then undetermined) raise :class:`~poseintegrity.errors.ArgumentError` naming the argument.  The library's
+    own per-frame callers, whose points are already checked, use :func:`kabsch_unchecked`.
     """
+    return kabsch_unchecked(*check_kabsch_arguments(points_world, points_body))
+
+
+def check_kabsch_arguments(points_world: object, points_body: object) -> tuple[np.ndarray, np.ndarray]:
+    """(points_world, points_body) as float arrays, or :class:`ArgumentError` saying what is wrong with them:
+    world (..., n, 3) and body (n, 3) or the same shape as world, n >= 3, finite, body points not collinear
+    (their centred spread off the best line at most 1e-9 of the spread along it, or all coincident)."""
+    world = check_array("points_world", points_world, shape=None)
+    body = check_array("points_body", points_body, shape=None)
+    for name, array in (("points_world", world), ("points_body", body)):
+        if array.ndim < 2 or array.shape[-1] != 3:
+            raise ArgumentError(f"{name}: expected shape (..., n, 3), got {array.shape}")
+    if world.shape[-2] < 3:
+        raise ArgumentError(f"points_world: Kabsch needs at least 3 corresponding points, got {world.shape[-2]}")
+    if body.shape != world.shape and body.shape != world.shape[-2:]:
+        raise ArgumentError(f"points_body: expected shape {world.shape[-2:]} or {world.shape} to match points_world, got {body.shape}")
+    spread = np.linalg.svd(body - body.mean(axis=-2, keepdims=True), compute_uv=False)  # (..., 3)
+    degenerate = spread[..., 1] <= 1e-9 * np.maximum(spread[..., 0], np.finfo(float).tiny)
+    if np.any(degenerate):
+        where = "" if body.ndim == 2 else f" (problem {tuple(int(i) for i in np.argwhere(degenerate)[0])})"
+        raise ArgumentError(f"points_body: the points lie on one line or coincide{where}; the rotation about that line "
+                            f"is undetermined (singular values of the centred points {np.ravel(spread[degenerate])[:3].tolist()})")
+    return world, body
+
+
+def kabsch_unchecked(points_world: np.ndarray, points_body: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`kabsch` without the argument checks, for callers whose points are known to be good (finite,
+    (..., n, 3) with n >= 1); fewer than 3 non-collinear points give one of the equally good rotations."""
     points_world = np.asarray(points_world, dtype=np.float64)
     points_body = np.asarray(points_body, dtype=np.float64)
     batch, n = points_world.shape[:-2], points_world.shape[-2]
@@ -55,13 +88,19 @@ def _kabsch_kernel(points_world, points_body):  # pragma: no cover - compiled
 
 
 def pose_from_points(points_world: np.ndarray, points_body: np.ndarray) -> np.ndarray:
-    """``T_world_body`` (..., 4, 4) from corresponding points (see :func:`kabsch`)."""
+    """``T_world_body`` (..., 4, 4) from corresponding points (see :func:`kabsch`; the same checks)."""
     return pose_matrix(*kabsch(points_world, points_body))
 
 
+def pose_from_points_unchecked(points_world: np.ndarray, points_body: np.ndarray) -> np.ndarray:
+    """:func:`pose_from_points` without the argument checks (see :func:`kabsch_unchecked`)."""
+    return pose_matrix(*kabsch_unchecked(points_world, points_body))
+
+
 def kabsch_residuals(points_world: np.ndarray, points_body: np.ndarray) -> np.ndarray:
-    """Distances ``|R y^i + t - r^i|`` after the Kabsch fit, (..., n) metres (the error of Alg. 3)."""
-    R, t = kabsch(points_world, points_body)
+    """Distances ``|R y^i + t - r^i|`` after the Kabsch fit, (..., n) metres (the error of Alg. 3); unchecked
+    (correspondence calls it on its own candidate sets, see :func:`kabsch_unchecked`)."""
+    R, t = kabsch_unchecked(points_world, points_body)
     fitted = points_body @ np.swapaxes(R, -1, -2) + t[..., None, :]
     return np.linalg.norm(fitted - points_world, axis=-1)
 

@@ -21,7 +21,7 @@ from poseintegrity.tracking.frames import draw_phantoms, intrinsics, render_fram
 from poseintegrity.parallel import in_worker_task
 from poseintegrity.poses import NAN_POSE, pose_matrix
 from poseintegrity.tracking.geometry import MARKER_DIAMETER_M, transform_points
-from poseintegrity.tracking.kabsch import pose_from_points
+from poseintegrity.tracking.kabsch import pose_from_points_unchecked
 from poseintegrity.tracking.motion import (
     SensorTimeline,
     Trajectory,
@@ -150,7 +150,7 @@ def run_no_filter(sim: Simulation, params: TrackParams) -> pd.DataFrame:
         assignment = match_markers(points, sim.markers_body, None, m)
         matched = assignment >= 0
         true_markers = transform_points(sim.T_true[f], sim.markers_body)
-        poses.append(pose_from_points(points[assignment[matched]], sim.markers_body[matched]) if matched.sum() >= 3 else NAN_POSE)
+        poses.append(pose_from_points_unchecked(points[assignment[matched]], sim.markers_body[matched]) if matched.sum() >= 3 else NAN_POSE)
         err = np.linalg.norm(points[assignment[matched]] - true_markers[matched], axis=1) if matched.any() else np.zeros(0)
         correct = matched.sum() >= m.min_markers and bool(np.all(err <= params.evaluation.correct_tolerance_m))
         visible = int((~sim.timeline.occluded[f]).sum())
@@ -188,10 +188,10 @@ def run_filter(
     flags, n_matched, poses = [], np.full(len(grid), -1), np.empty((len(grid), 4, 4))
     for e in range(len(grid)):
         if is_gyro[e]:
-            flags.append(tracker.gyro(t[e], tl.gyro[k[e]]))
+            flags.append(tracker._gyro(float(t[e]), tl.gyro[k[e]]))  # simulated: already good, unchecked
             poses[e] = tracker.pose()
         else:
-            result = tracker.frame(t[e], sim.points[k[e]])
+            result = tracker._frame(float(t[e]), sim.points[k[e]])
             flags.append(result.flag)
             n_matched[e] = int((result.assignment >= 0).sum())
             poses[e] = result.T_filtered

@@ -44,7 +44,7 @@ class SquareRootUKF(UnscentedMarkerFilter):
     def _set_covariance(self, std: np.ndarray) -> None:
         self.S = np.diag(std)
 
-    def predict_steps(self, n_steps: int, dt: float, noise_sqrt: np.ndarray | None = None) -> bool:
+    def _predict_steps(self, n_steps: int, dt: float, noise_sqrt: np.ndarray | None) -> bool:
         s = self.settings
         B = _NO_NOISE_SQRT if noise_sqrt is None else np.ascontiguousarray(noise_sqrt, dtype=np.float64)
         self.x, self.S, code, failed = _time_update_steps(

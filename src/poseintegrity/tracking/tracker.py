@@ -5,19 +5,26 @@ measurement update with the markers that were matched; gyro samples (body frame)
 world frame with the current estimate and update omega only.  Between measurements the filter predicts in
 steps of at most ``dt`` (the paper's 400 Hz filter clock).
 
-Failure handling (every step returns a flag; only a non-finite timestamp raises, a ValueError saying so):
+Bad arguments (checked once per call at :meth:`MarkerTracker.frame` / :meth:`MarkerTracker.gyro`, never inside the
+filter) raise :class:`~poseintegrity.errors.ArgumentError` naming the argument: a timestamp that is not a finite
+number of seconds within +-1e12 (None, text, NaN, 1e300), points that are not an (n, 3) array of numbers (NaN
+rows are allowed and ignored), a gyro sample that is not 3 numbers.  Bad data returns a flag instead:
+
+Failure handling (every step returns a flag):
 - "no_points" / "no_markers": nothing detected / nothing matched; the filter keeps predicting;
 - "gated" (ours): every matched marker lies outside the innovation gate, i.e. its squared Mahalanobis distance
   to the predicted marker, under the predicted covariance plus sigma_r^2 I, exceeds innovation_gate_chi2
   (3 dof); the measurement is not fused and the filter keeps predicting.  Markers outside the gate in a frame
   whose other markers pass are left out of the update ("ok" then; ``n_gated`` counts them).
-- "restart": no marker for ``restart_after_s`` and no gyro fused (their code restarts after 1 s): the
+- "restart": no marker for ``restart_after_s`` and (with use_gyro) no gyro fused either (their code restarts
+  after 1 s; a time jump longer than that is one, so a clock glitch never runs the filter for hours): the
   filter waits for the next frame with >= min_markers matched markers; or (ours) ``restart_after_rejections``
   frames in a row were gated although they had >= min_markers rigidly matched markers: the object really
   moved (or the filter is lost), so the filter restarts from that measurement;
 - "diverged": NaN or runaway covariance (see :class:`UnscentedMarkerFilter`); re-initialised from the next
   good frame;
-- "stale": a measurement older than the filter's time; ignored; "bad_gyro": a non-finite gyro sample; ignored.
+- "stale": a measurement older than the filter's time (time went backwards); ignored; "bad_gyro": a non-finite gyro
+  sample; ignored.
 """
 
 from __future__ import annotations
@@ -26,22 +33,41 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from poseintegrity.tracking.correspondence import match_markers
+from poseintegrity.errors import check_array, check_scalar
 from poseintegrity.poses import NAN_POSE
+from poseintegrity.tracking.correspondence import match_markers
 from poseintegrity.tracking.geometry import transform_points
-from poseintegrity.tracking.kabsch import pose_from_points
+from poseintegrity.tracking.kabsch import pose_from_points_unchecked
 from poseintegrity.tracking.params import FilterParams, MatchingParams
 from poseintegrity.tracking.srukf import SquareRootUKF
 from poseintegrity.tracking.unscented import UnscentedMarkerFilter
 
+MAX_ABS_TIME_S = 1e12  # a timestamp beyond +-1e12 s (31 700 years) is not a clock reading
 
 
-def check_timestamp(t: float) -> float:
-    """t as a float; a ValueError naming the problem if it is not a finite number of seconds."""
-    t = float(t)
-    if not np.isfinite(t):
-        raise ValueError(f"timestamp must be a finite number of seconds, got {t}")
-    return t
+def check_timestamp(t: object, name: str = "t") -> float:
+    """t as a float, or :class:`~poseintegrity.errors.ArgumentError` naming ``name`` if it is not a finite
+    number of seconds within +-MAX_ABS_TIME_S (None, text, bool, NaN, 1e300 are refused)."""
+    if type(t) is float and -MAX_ABS_TIME_S <= t <= MAX_ABS_TIME_S:  # the common case, without a call
+        return t
+    return check_scalar(name, t, low=-MAX_ABS_TIME_S, high=MAX_ABS_TIME_S)
+
+
+def check_points(points: object, name: str = "points") -> np.ndarray:
+    """points as a float (n, 3) array (an empty sequence is (0, 3)); NaN / inf rows are kept (the matchers
+    ignore them); :class:`~poseintegrity.errors.ArgumentError` if it is not an (n, 3) array of numbers."""
+    if type(points) is np.ndarray and points.dtype == np.float64 and points.ndim == 2 and points.shape[1] == 3:
+        return points
+    if isinstance(points, (list, tuple, np.ndarray)) and np.size(points) == 0:
+        return np.zeros((0, 3))
+    return check_array(name, points, shape=(None, 3), finite=False)
+
+
+def check_rates(omega: object, name: str = "omega_body") -> np.ndarray:
+    """A gyro sample as a float (3,) array (non-finite entries are kept: the tracker flags them bad_gyro)."""
+    if type(omega) is np.ndarray and omega.shape == (3,) and omega.dtype == np.float64:
+        return omega
+    return check_array(name, omega, shape=(3,), finite=False)
 
 
 @dataclass(frozen=True)
@@ -73,13 +99,14 @@ class MarkerTracker:
         use_gyro: bool = True,
         filter_cls: type[UnscentedMarkerFilter] = SquareRootUKF,
     ):
-        self.markers_body = np.asarray(markers_body, dtype=float)
-        self.filter = filter_cls(self.markers_body, filter_params)
+        self.filter = filter_cls(markers_body, filter_params)  # refuses < 3, non-finite or collinear markers
+        self.markers_body = self.filter.markers_body
         self.params = filter_params
         self.matching = matching
         self.use_gyro = use_gyro
-        self.t = 0.0
+        self.t = -np.inf  # time of the last event; any first timestamp is accepted
         self.last_marker_t = -np.inf
+        self.last_fused_t = -np.inf  # last marker or gyro update
         self.n_restarts = 0
         self.n_rejected = 0  # consecutive gated frames
         self.n_gated = 0  # markers left out of an update by the innovation gate
@@ -93,7 +120,7 @@ class MarkerTracker:
         if not self.filter.initialized:
             self.t = t
             return ""
-        if not self.use_gyro and t - self.last_marker_t > self.params.restart_after_s:
+        if t - (self.last_fused_t if self.use_gyro else self.last_marker_t) > self.params.restart_after_s:
             self.filter.initialized = False
             self.n_restarts += 1
             self.t = t
@@ -104,8 +131,12 @@ class MarkerTracker:
         return "" if ok else "diverged"
 
     def gyro(self, t: float, omega_body: np.ndarray) -> str:
-        """A gyro sample at t: omega_body (3,) rad/s in the body frame.  Returns "ok" or a flag."""
-        t = check_timestamp(t)
+        """A gyro sample at t: omega_body (3,) rad/s in the body frame.  Returns "ok" or a flag (module
+        docstring); a bad timestamp or a sample that is not 3 numbers raises ArgumentError."""
+        return self._gyro(check_timestamp(t), check_rates(omega_body))
+
+    def _gyro(self, t: float, omega_body: np.ndarray) -> str:
+        """:meth:`gyro` on checked arguments (t a finite float, omega_body float (3,))."""
         if t < self.t - 1e-9:
             return "stale"
         if not np.all(np.isfinite(omega_body)):
@@ -113,8 +144,10 @@ class MarkerTracker:
         flag = self.advance(t)
         if flag or not self.use_gyro or not self.filter.initialized:
             return flag or ("ok" if self.filter.initialized else "not_running")
-        omega_world = self.filter.pose()[:3, :3] @ np.asarray(omega_body, dtype=float)
-        ok = self.filter.update(omega_world, np.zeros(self.filter.n, dtype=bool), gyro=True)
+        omega_world = self.filter.pose()[:3, :3] @ omega_body
+        ok = self.filter._update(omega_world, np.zeros(self.filter.n, dtype=bool), gyro=True)
+        if ok:
+            self.last_fused_t = t
         return "ok" if ok else "diverged"
 
     def innovation_ok(self, points: np.ndarray, observed: np.ndarray) -> np.ndarray:
@@ -128,16 +161,20 @@ class MarkerTracker:
         return ok
 
     def frame(self, t: float, points: np.ndarray) -> FrameResult:
-        """A marker frame at t: measured points (n, 3), metres, world frame (may be empty, NaN rows ignored)."""
-        t = check_timestamp(t)
-        points = np.asarray(points, dtype=float).reshape(-1, 3)
+        """A marker frame at t: measured points (n, 3), metres, world frame (may be empty, NaN rows ignored).
+        Returns a :class:`FrameResult` whose flag says whether (and why not) the frame was used; a bad timestamp
+        or points that are not an (n, 3) array raise ArgumentError."""
+        return self._frame(check_timestamp(t), check_points(points))
+
+    def _frame(self, t: float, points: np.ndarray) -> FrameResult:
+        """:meth:`frame` on checked arguments (t a finite float, points float (n, 3))."""
         if t < self.t - 1e-9:
             return FrameResult(np.full(self.filter.n, -1), NAN_POSE, self.pose(), "stale")
         flag = self.advance(t)
         predicted = self.filter.markers() if self.filter.initialized else None
         assignment = match_markers(points, self.markers_body, predicted, self.matching)
         matched = assignment >= 0
-        T_measured = pose_from_points(points[assignment[matched]], self.markers_body[matched]) if matched.sum() >= 3 else NAN_POSE
+        T_measured = pose_from_points_unchecked(points[assignment[matched]], self.markers_body[matched]) if matched.sum() >= 3 else NAN_POSE
         if not matched.any():
             return FrameResult(assignment, T_measured, self.pose(), flag or ("no_markers" if len(points) else "no_points"))
         if not self.filter.initialized:  # without a prediction a match has >= min_markers markers
@@ -153,8 +190,8 @@ class MarkerTracker:
                 return self._restart(assignment, T_measured, t, "restart")
             return FrameResult(assignment, T_measured, self.pose(), flag or "gated")
         self.n_rejected = 0
-        ok = self.filter.update(measured[accepted].ravel(), accepted, gyro=False)
-        self.last_marker_t = t
+        ok = self.filter._update(measured[accepted].ravel(), accepted, gyro=False)
+        self.last_marker_t = self.last_fused_t = t
         if not ok:
             return FrameResult(assignment, T_measured, NAN_POSE, "diverged")
         return FrameResult(assignment, T_measured, self.pose(), flag or "ok")
@@ -162,6 +199,6 @@ class MarkerTracker:
     def _restart(self, assignment: np.ndarray, T_measured: np.ndarray, t: float, flag: str) -> FrameResult:
         """Start the filter from a good measurement (>= min_markers matched, so T_measured is finite)."""
         self.filter.initialize(transform_points(T_measured, self.markers_body))
-        self.last_marker_t = t
+        self.last_marker_t = self.last_fused_t = t
         self.n_rejected = 0
         return FrameResult(assignment, T_measured, self.pose(), flag)

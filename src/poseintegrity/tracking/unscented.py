@@ -11,7 +11,8 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from poseintegrity.tracking.kabsch import pose_from_points
+from poseintegrity.errors import ArgumentError, check_array
+from poseintegrity.tracking.kabsch import check_kabsch_arguments, pose_from_points_unchecked
 from poseintegrity.tracking.params import FilterParams
 from poseintegrity.tracking.model import (
     centred,
@@ -73,7 +74,7 @@ class UnscentedMarkerFilter:
     """
 
     def __init__(self, markers_body: np.ndarray, settings: FilterParams):
-        self.markers_body = np.asarray(markers_body, dtype=float)
+        self.markers_body = check_kabsch_arguments(markers_body, markers_body)[1]  # >= 3 finite markers, not on one line
         self.ell = centred(self.markers_body)
         self.n = self.ell.shape[0]
         self.N = state_dim(self.n)
@@ -114,7 +115,9 @@ class UnscentedMarkerFilter:
     def initialize(self, markers: np.ndarray, omega: np.ndarray | None = None) -> None:
         """Start from a good measurement (Alg. 5): markers (n, 3) m in geometry order, omega (3,) rad/s or None."""
         s = self.settings
-        self.x = np.concatenate([np.asarray(markers, float).ravel(), np.zeros(3) if omega is None else omega, np.zeros(3)])
+        markers = check_array("markers", markers, shape=(self.n, 3))
+        omega = np.zeros(3) if omega is None else check_array("omega", omega, shape=(3,))
+        self.x = np.concatenate([markers.ravel(), omega, np.zeros(3)])
         std = np.concatenate([np.full(3 * self.n, s.sigma_r), np.full(3, s.init_std_omega), np.full(3, s.init_std_velocity)])
         self._set_covariance(std)
         self.initialized = True
@@ -134,7 +137,27 @@ class UnscentedMarkerFilter:
         return self.predict_steps(1, dt, noise_sqrt)
 
     def predict_steps(self, n_steps: int, dt: float, noise_sqrt: np.ndarray | None = None) -> bool:
-        """n_steps time updates of dt seconds each (see :meth:`predict`); stops at the first divergence."""
+        """n_steps time updates of dt seconds each (see :meth:`predict`); stops at the first divergence.
+
+        Refused with :class:`~poseintegrity.errors.ArgumentError` (checked here, once per call, never in the
+        compiled steps): n_steps not a non-negative integer; dt not a finite number > 0 when n_steps > 0 (a
+        filter does not run backwards or stand still); noise_sqrt not a finite (N, p) array.
+        """
+        if isinstance(n_steps, (bool, np.bool_)) or not isinstance(n_steps, (int, np.integer)) or n_steps < 0:
+            raise ArgumentError(f"n_steps: expected a non-negative integer, got {type(n_steps).__name__} {n_steps!r:.40}")
+        if n_steps:
+            try:
+                ok = not isinstance(dt, (bool, np.bool_)) and 0.0 < dt < np.inf
+            except TypeError:
+                ok = False
+            if not ok:
+                raise ArgumentError(f"dt: expected a finite time step > 0 s, got {type(dt).__name__} {dt!r:.40}")
+        if noise_sqrt is not None:
+            noise_sqrt = check_array("noise_sqrt", noise_sqrt, shape=(self.N, None))
+        return self._predict_steps(int(n_steps), float(dt), noise_sqrt)
+
+    def _predict_steps(self, n_steps: int, dt: float, noise_sqrt: np.ndarray | None) -> bool:
+        """:meth:`predict_steps` on checked arguments."""
         for _ in range(n_steps):
             X_f = process_model(self.sigma_points(), dt, self.ell)  # X_{k|k-1} = f(X_{k-1})
             B = process_noise_sqrt(self.x, dt, self.ell, self.settings.sigma_c, self.settings.sigma_alpha) if noise_sqrt is None else noise_sqrt
@@ -154,12 +177,34 @@ class UnscentedMarkerFilter:
         z : measured rows in state order: the observed markers (3 each, metres) then omega (3, rad/s)
         if gyro.  observed : (n,) bool.  With nothing measured the call is a no-op.
         Returns False if the filter diverged (then ``initialized`` is False and it must be restarted).
+        Refused with :class:`~poseintegrity.errors.ArgumentError` (checked here, before the compiled update):
+        observed not a boolean (n,) mask, gyro not a bool, z not finite or not of length
+        3 * observed.sum() + 3 * gyro.
         """
-        rows = measurement_rows(np.asarray(observed, bool), gyro)
+        observed = np.asarray(observed)
+        if observed.shape != (self.n,) or observed.dtype != np.bool_:
+            raise ArgumentError(f"observed: expected a boolean mask of shape ({self.n},) (one per marker), "
+                                f"got shape {observed.shape} and dtype {observed.dtype}")
+        if not isinstance(gyro, (bool, np.bool_)):
+            raise ArgumentError(f"gyro: expected True or False, got {type(gyro).__name__} {gyro!r:.40}")
+        try:
+            z = np.asarray(z, dtype=np.float64)
+        except (TypeError, ValueError):
+            raise ArgumentError(f"z: expected real numbers, got {type(z).__name__} {z!r:.60}") from None
+        m = 3 * int(np.count_nonzero(observed)) + 3 * bool(gyro)
+        if z.shape != (m,):
+            raise ArgumentError(f"z: expected shape ({m},) (3 per observed marker{' + 3 gyro rates' if gyro else ''}), got {z.shape}")
+        if not np.isfinite(z).all():
+            raise ArgumentError(f"z: entries must be finite, got {z[~np.isfinite(z)][0]!r} at index {int(np.flatnonzero(~np.isfinite(z))[0])}")
+        return self._update(z, observed, bool(gyro))
+
+    def _update(self, z: np.ndarray, observed: np.ndarray, gyro: bool) -> bool:
+        """:meth:`update` on checked arguments (z float64 of the right length, observed (n,) bool)."""
+        rows = measurement_rows(observed, gyro)
         if rows.size == 0:
             return True
-        noise_std = measurement_noise_std(np.asarray(observed, bool), gyro, self.settings.sigma_r, self.settings.sigma_omega)
-        return self._record_health(self._measurement_update(rows, np.asarray(z, dtype=np.float64), noise_std))
+        noise_std = measurement_noise_std(observed, gyro, self.settings.sigma_r, self.settings.sigma_omega)
+        return self._record_health(self._measurement_update(rows, z, noise_std))
 
     def markers(self) -> np.ndarray:
         """Estimated marker centres (n, 3), metres, world frame."""
@@ -167,7 +212,7 @@ class UnscentedMarkerFilter:
 
     def pose(self) -> np.ndarray:
         """T_world_body (4, 4) of the marker geometry, from the estimated markers by Kabsch (Alg. 4)."""
-        return pose_from_points(self.markers(), self.markers_body)
+        return pose_from_points_unchecked(self.markers(), self.markers_body)
 
     def _health_code(self) -> int:
         """:func:`health_code` of the current state and covariance."""
