@@ -29,7 +29,7 @@ def test_every_project_error_class_derives_from_the_family():
 def test_check_array_converts_and_names_what_is_wrong():
     assert check_array("points", [[1, 2, 3]], shape=(None, 3)).dtype == np.float64
     cases = [(None, "expected an array"), ("abc", "expected an array"), ([[1, 2]], r"expected shape \(n, 3\)"),
-             ([[np.nan, 0, 0]], "entries must be finite"), ([[1e300, 0, 0]], "entries must be finite"), ([[True, 0, 0]], None),
+             ([[np.nan, 0, 0]], "entries must be finite"), ([[1e300, 0, 0]], "entries must be finite"), ([[True, False, True]], "expected real numbers"),
              ([["a", 1, 2]], "expected real numbers"), ([[1, 2], [3]], "expected an array")]
     for value, message in cases:
         if message is None:

@@ -45,7 +45,7 @@ def check_array(name: str, value: object, *, shape: Sequence[int | None] | None 
         array = np.asarray(value)
     except (ValueError, TypeError) as error:
         raise ArgumentError(f"{name}: expected an array, got {_describe(value)} ({error})") from None
-    if array.dtype.kind not in "biuf" or (dtype == "int" and array.dtype.kind not in "iu"):
+    if array.dtype.kind not in "iuf" or (dtype == "int" and array.dtype.kind not in "iu"):  # True is not a number
         raise ArgumentError(f"{name}: expected {'integers' if dtype == 'int' else 'real numbers'}, "
                             f"got {_describe(value) if array.dtype == object else 'dtype ' + str(array.dtype)}")
     if dtype == "float":

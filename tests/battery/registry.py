@@ -145,6 +145,10 @@ def _any_flag(result: Any) -> bool:
 
 
 # ------------------------------------------------------------------------------------------------- registry
+# A tracker frame with fewer points is a partial update; NaN rows and points 1e300 m away are dropped detections.
+TRACKER_ACCEPTS = {"points": {"one_element", "one_fewer", "nan", "inf", "huge"}}
+
+
 def _entries() -> list[EntryPoint]:
     from poseintegrity import config, lens, poses
     from poseintegrity.artifact_models.models import fit_model
@@ -232,18 +236,21 @@ def _entries() -> list[EntryPoint]:
                    lambda tmp: {"ir": tracking_frame()["ir"], "depth_mm": tracking_frame()["depth"],
                                 "unproject": tracking_frame()["lut"]},
                    {"ir": "image", "depth_mm": "image", "unproject": "points"}, flagged=_warning_flag,
-                   accepts={"ir": {"uint16", "float32", "int32"}, "depth_mm": {"uint16", "float32", "int32"}}),
+                   # uint8/uint16/float IR and depth are documented inputs; a NaN pixel is an invalid pixel
+                   accepts={"ir": {"uint16", "float32", "int32", "float_nan"},
+                            "depth_mm": {"uint16", "float32", "int32", "float_nan"}}),
         EntryPoint("tracking.kabsch", lambda a: kabsch_fit(a["points_world"], a["points_body"]),
                    lambda tmp: {"points_world": tracking_frame()["markers"], "points_body": tracking_frame()["geometry"]},
-                   {"points_world": "points", "points_body": "points"}),
+                   {"points_world": "points", "points_body": "points"},
+                   accepts={"points_world": {"wrong_ndim"}}),  # (..., n, 3): a stack of frames is documented
         EntryPoint("tracking.match_markers",
                    lambda a: correspondence.match_markers(a["points"], a["geometry"], None, P().track.matching),
                    lambda tmp: {"points": tracking_frame()["markers"], "geometry": tracking_frame()["geometry"]},
-                   {"points": "points", "geometry": "points"},
+                   {"points": "points", "geometry": "points"}, accepts={"geometry": {"one_fewer"}},  # 3 markers: a tool
                    flagged=lambda result: bool((np.asarray(result) < 0).any())),
         EntryPoint("tracking.MarkerTracker.frame", lambda a: _tracker().frame(a["t"], a["points"]),
                    lambda tmp: {"t": 0.05, "points": tracking_frame()["markers"]},
-                   {"t": "timestamp", "points": "points"}, flagged=_any_flag),
+                   {"t": "timestamp", "points": "points"}, flagged=_any_flag, accepts=TRACKER_ACCEPTS),
         EntryPoint("tracking.MarkerTracker.gyro", lambda a: _tracker().gyro(a["t"], a["omega_body"]),
                    lambda tmp: {"t": 0.01, "omega_body": np.array([0.1, 0.0, 0.0])},
                    {"t": "timestamp", "omega_body": "array"}, flagged=lambda r: r != "ok"),
@@ -252,18 +259,20 @@ def _entries() -> list[EntryPoint]:
         EntryPoint("tracking.SquareRootUKF.update",
                    lambda a: _filter("srukf").update(a["z"], a["observed"], False),
                    lambda tmp: {"z": tracking_frame()["markers"].ravel(), "observed": np.ones(4, bool)},
-                   {"z": "array", "observed": "array"}, flagged=lambda ok: ok is False),
+                   {"z": "array", "observed": "array"}, flagged=lambda ok: ok is False,
+                   accepts={"observed": {"bool"}}),  # all True: every marker observed, a valid mask
         EntryPoint("tracking.UnscentedKalmanFilter.update",
                    lambda a: _filter("ukf").update(a["z"], a["observed"], False),
                    lambda tmp: {"z": tracking_frame()["markers"].ravel(), "observed": np.ones(4, bool)},
-                   {"z": "array", "observed": "array"}, flagged=lambda ok: ok is False),
+                   {"z": "array", "observed": "array"}, flagged=lambda ok: ok is False,
+                   accepts={"observed": {"bool"}}),  # all True: every marker observed, a valid mask
         EntryPoint("tracking.read_tools", lambda a: tools.read_tools(a["path"], P().track.matching.distinct_m),
                    lambda tmp: {"path": _tools_json(tmp)}, {"path": "file"}),
         EntryPoint("tracking.MultiToolTracker",
                    lambda a: tools.MultiToolTracker(a["tools"], P().track.filter, P().track.matching).frame(
                        0.0, a["points"]),
                    lambda tmp: {"tools": {"probe": tracking_frame()["geometry"]}, "points": tracking_frame()["markers"]},
-                   {"points": "points"}, flagged=_any_flag),
+                   {"points": "points"}, flagged=_any_flag, accepts=TRACKER_ACCEPTS),
         *[EntryPoint(f"tracking.read_recording[{name}]", lambda a: recording.read_recording(a["file"].parent),
                      lambda tmp, name=name: {"file": _recording_dir(tmp) / name}, {"file": "file"},
                      names={"file": name}, accepts={"file": {"missing"}} if name == "gyro.csv" else {})

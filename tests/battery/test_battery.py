@@ -31,13 +31,15 @@ def outcome(name: str, argument: str, label: str, tmp_path: Path) -> str:
     entry = entry_points()[name]
     arguments = dict(entry.valid(tmp_path))
     arguments[argument] = KINDS[entry.arguments[argument]][label](arguments[argument], tmp_path)
+    word = entry.names.get(argument, argument)
+    if entry.arguments[argument] == "file":  # a file is named by its name (its folder for a recording)
+        word = entry.names.get(argument, Path(arguments[argument]).name)
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             with np.errstate(all="ignore"):
                 result = entry.call(arguments)
     except PoseIntegrityError as error:
-        word = entry.names.get(argument, argument)
         return "refused" if word.lower() in str(error).lower() else "unnamed"
     except Exception as error:  # noqa: BLE001 - the battery classifies every other exception as a failure
         return f"raw {type(error).__name__}"

@@ -21,9 +21,12 @@ from itertools import combinations, permutations
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
+from poseintegrity.errors import ArgumentError, check_array
 from poseintegrity.tracking.geometry import pairwise_distances
 from poseintegrity.tracking.kabsch import kabsch_residuals
 from poseintegrity.tracking.params import MatchingParams
+
+MAX_ABS_M = 1e6  # a measured or body point farther than 1000 km is not a marker
 
 
 def _finite_rows(points: np.ndarray) -> np.ndarray:
@@ -214,7 +217,22 @@ def match_markers(
     non-outliers; if that leaves markers unmatched although points remain, brute force also runs on all
     points and wins if it matches more.  If all of that finds nothing, a consistent
     gated match of one or two markers is returned (the filter can use a partial update); else all -1.
+    Refused (:class:`~poseintegrity.errors.ArgumentError`): points not (n, 3) numbers (NaN rows are allowed:
+    dropped detections), geometry not >= 3 finite (m, 3) markers, previous not (m, 3).
     """
+    points = np.zeros((0, 3)) if np.size(points) == 0 and points is not None and not isinstance(points, str) else points
+    points = check_array("points", points, shape=(None, 3), finite=False)  # NaN rows are dropped detections
+    if not np.all(np.isnan(points) | (np.abs(points) <= MAX_ABS_M)):
+        raise ArgumentError(f"points: entries must be NaN (no detection) or at most {MAX_ABS_M:g} m in magnitude")
+    geometry = check_array("geometry", geometry, shape=(None, 3), min_rows=3, max_abs=MAX_ABS_M)
+    if previous is not None:
+        previous = check_array("previous", previous, shape=geometry.shape, finite=False)
+    return match_markers_unchecked(points, geometry, previous, matching)
+
+
+def match_markers_unchecked(points: np.ndarray, geometry: np.ndarray, previous: np.ndarray | None,
+                            matching: MatchingParams) -> np.ndarray:
+    """:func:`match_markers` on checked arguments (float (n, 3) points, (m, 3) geometry): the per-frame path."""
     tolerance_m, min_markers = matching.tolerance_m, matching.min_markers
     geometry = np.asarray(geometry, dtype=float)
     points = np.asarray(points, dtype=float).reshape(-1, 3)

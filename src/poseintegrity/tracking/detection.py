@@ -34,6 +34,7 @@ from poseintegrity.tracking.geometry import transform_points
 from poseintegrity.tracking.params import DetectionParams
 
 MIN_METRES_DEPTH_MM = 10.0  # a median depth below this is metres, not millimetres (AHAT depth is 100-1000 mm)
+MAX_UNIT_PLANE = 20.0  # |x|, |y| of a pixel ray on the unit plane: 20 is a field of view of 174 deg, beyond any depth camera
 
 
 class FrameError(PoseIntegrityError):
@@ -54,12 +55,15 @@ def validate_frame(ir: np.ndarray, depth_mm: np.ndarray, unproject: np.ndarray) 
         return f"depth shape {depth_mm.shape} differs from IR shape {ir.shape}"
     if not (np.issubdtype(ir.dtype, np.number) and np.issubdtype(depth_mm.dtype, np.number)) or ir.dtype == np.bool_:
         return f"IR and depth must be numeric arrays, got dtypes {ir.dtype} and {depth_mm.dtype}"
+    if unproject.dtype.kind not in "iuf":
+        return f"unproject must be a numeric K or lookup table, got dtype {unproject.dtype}"
     if unproject.shape != (3, 3) and unproject.shape != ir.shape + (2,):
         return f"unproject must be a 3x3 K or an (H, W, 2) = {ir.shape + (2,)} lookup table, got {unproject.shape}"
     grid = (slice(None, None, 8), slice(None, None, 8))  # the unit checks read every 8th row and column (fast)
     lut = unproject[grid] if unproject.shape != (3, 3) else None
-    if lut is not None and (not np.all(np.isfinite(lut)) or not np.any(lut)):
-        return "unit-plane lookup table is all zero or not finite: it cannot unproject pixels"
+    if lut is not None and (not np.all(np.abs(lut) <= MAX_UNIT_PLANE) or not np.any(lut)):
+        return (f"unit-plane lookup table is all zero, not finite or beyond {MAX_UNIT_PLANE:g} (a field of view over "
+                f"{2 * np.degrees(np.arctan(MAX_UNIT_PLANE)):.0f} deg): it cannot unproject pixels")
     sample = np.asarray(depth_mm[grid], dtype=float)
     median = small_median(sample[np.isfinite(sample) & (sample > 0)])
     if median < MIN_METRES_DEPTH_MM:  # False for NaN: no valid depth

@@ -22,7 +22,7 @@ import numpy as np
 import pandas as pd
 
 from poseintegrity.seeding import keyed_rng
-from poseintegrity.tracking.correspondence import match_brute_force, match_markers, match_voting
+from poseintegrity.tracking.correspondence import match_brute_force, match_markers_unchecked, match_voting
 from poseintegrity.tracking.detection import detect_markers
 from poseintegrity.tracking.detection_sweep import small_blob_sweep, sweep_summary
 from poseintegrity.tracking.errors import rms, rms_summary
@@ -409,7 +409,7 @@ def detect_match_kabsch(ir: np.ndarray, depth_mm: np.ndarray, K: np.ndarray, par
     """The no-filter chain on one frame: detection, correspondence, Kabsch.  Returns T_world_body (4, 4),
     NaN if fewer than 3 markers were matched."""
     points = detect_markers(ir, depth_mm, K, params.detection)
-    assignment = match_markers(points, geometry, None, params.matching)
+    assignment = match_markers_unchecked(points, geometry, None, params.matching)
     matched = assignment >= 0
     if matched.sum() < 3:
         return np.full((4, 4), np.nan)

@@ -194,7 +194,7 @@ def read_recording(folder: str | Path) -> Recording:
         raise RecordingError(f"{folder}: {len(absent)} frame file(s) listed in frames.csv are missing, e.g. {absent[0]!r}")
     try:
         lut = np.stack([np.load(folder / "lut_x.npy"), np.load(folder / "lut_y.npy")], axis=-1).astype(float)
-    except (OSError, ValueError, TypeError) as error:
+    except (OSError, ValueError, TypeError, EOFError) as error:
         raise RecordingError(f"{folder}: cannot read the unit-plane lookup table lut_x.npy / lut_y.npy ({error})") from None
     if lut.ndim != 3:
         raise RecordingError(f"{folder}: lut_x.npy and lut_y.npy must be (H, W) arrays, got {lut.shape[:-1]}")
@@ -219,7 +219,7 @@ def load_image(path: Path) -> np.ndarray | None:
     if path.suffix.lower() == ".npy":
         try:
             return np.load(path)
-        except (OSError, ValueError):
+        except (OSError, ValueError, EOFError):
             return None
     return cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
 

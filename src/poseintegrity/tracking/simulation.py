@@ -14,7 +14,7 @@ import numpy as np
 import pandas as pd
 from tqdm.auto import tqdm
 
-from poseintegrity.tracking.correspondence import match_markers
+from poseintegrity.tracking.correspondence import match_markers_unchecked
 from poseintegrity.tracking.detection import detect_markers
 from poseintegrity.tracking.errors import error_columns
 from poseintegrity.tracking.frames import draw_phantoms, intrinsics, render_frame
@@ -147,7 +147,7 @@ def run_no_filter(sim: Simulation, params: TrackParams) -> pd.DataFrame:
     """
     m, rows, poses = params.matching, [], []
     for f, points in enumerate(sim.points):
-        assignment = match_markers(points, sim.markers_body, None, m)
+        assignment = match_markers_unchecked(points, sim.markers_body, None, m)
         matched = assignment >= 0
         true_markers = transform_points(sim.T_true[f], sim.markers_body)
         poses.append(pose_from_points_unchecked(points[assignment[matched]], sim.markers_body[matched]) if matched.sum() >= 3 else NAN_POSE)

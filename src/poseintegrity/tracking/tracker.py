@@ -24,7 +24,7 @@ Failure handling (every step returns a flag):
 - "diverged": NaN or runaway covariance (see :class:`UnscentedMarkerFilter`); re-initialised from the next
   good frame;
 - "stale": a measurement older than the filter's time (time went backwards); ignored; "bad_gyro": a non-finite gyro
-  sample; ignored.
+  sample or one above MAX_RATE_RAD_S; ignored.
 """
 
 from __future__ import annotations
@@ -35,7 +35,7 @@ import numpy as np
 
 from poseintegrity.errors import check_array, check_scalar
 from poseintegrity.poses import NAN_POSE
-from poseintegrity.tracking.correspondence import match_markers
+from poseintegrity.tracking.correspondence import match_markers_unchecked
 from poseintegrity.tracking.geometry import transform_points
 from poseintegrity.tracking.kabsch import pose_from_points_unchecked
 from poseintegrity.tracking.params import FilterParams, MatchingParams
@@ -43,6 +43,7 @@ from poseintegrity.tracking.srukf import SquareRootUKF
 from poseintegrity.tracking.unscented import UnscentedMarkerFilter
 
 MAX_ABS_TIME_S = 1e12  # a timestamp beyond +-1e12 s (31 700 years) is not a clock reading
+MAX_RATE_RAD_S = 100.0  # beyond any MEMS gyro's range (2000 deg/s = 35 rad/s): a sample above it is bad_gyro
 
 
 def check_timestamp(t: object, name: str = "t") -> float:
@@ -139,7 +140,7 @@ class MarkerTracker:
         """:meth:`gyro` on checked arguments (t a finite float, omega_body float (3,))."""
         if t < self.t - 1e-9:
             return "stale"
-        if not np.all(np.isfinite(omega_body)):
+        if not np.all(np.abs(omega_body) <= MAX_RATE_RAD_S):  # also False for NaN
             return "bad_gyro"
         flag = self.advance(t)
         if flag or not self.use_gyro or not self.filter.initialized:
@@ -172,7 +173,7 @@ class MarkerTracker:
             return FrameResult(np.full(self.filter.n, -1), NAN_POSE, self.pose(), "stale")
         flag = self.advance(t)
         predicted = self.filter.markers() if self.filter.initialized else None
-        assignment = match_markers(points, self.markers_body, predicted, self.matching)
+        assignment = match_markers_unchecked(points, self.markers_body, predicted, self.matching)
         matched = assignment >= 0
         T_measured = pose_from_points_unchecked(points[assignment[matched]], self.markers_body[matched]) if matched.sum() >= 3 else NAN_POSE
         if not matched.any():

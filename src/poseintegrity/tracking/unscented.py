@@ -48,6 +48,7 @@ def _sigma_points_kernel(x, S, gamma):  # pragma: no cover - compiled
 
 
 DIVERGENCE_REASONS = ("", "non-finite state or covariance", "runaway covariance")  # by health_code
+MAX_ABS_MEASUREMENT = 1e6  # |z| above this (metres or rad/s) is not a marker position or a body rate
 
 
 @numba.njit(cache=True)
@@ -146,10 +147,7 @@ class UnscentedMarkerFilter:
         if isinstance(n_steps, (bool, np.bool_)) or not isinstance(n_steps, (int, np.integer)) or n_steps < 0:
             raise ArgumentError(f"n_steps: expected a non-negative integer, got {type(n_steps).__name__} {n_steps!r:.40}")
         if n_steps:
-            try:
-                ok = not isinstance(dt, (bool, np.bool_)) and 0.0 < dt < np.inf
-            except TypeError:
-                ok = False
+            ok = isinstance(dt, (int, float, np.integer, np.floating)) and not isinstance(dt, (bool, np.bool_)) and 0.0 < dt < np.inf
             if not ok:
                 raise ArgumentError(f"dt: expected a finite time step > 0 s, got {type(dt).__name__} {dt!r:.40}")
         if noise_sqrt is not None:
@@ -188,14 +186,18 @@ class UnscentedMarkerFilter:
         if not isinstance(gyro, (bool, np.bool_)):
             raise ArgumentError(f"gyro: expected True or False, got {type(gyro).__name__} {gyro!r:.40}")
         try:
-            z = np.asarray(z, dtype=np.float64)
+            z = np.asarray(z)
+            if z.dtype.kind not in "iuf":  # text, objects and True are not measurements
+                raise TypeError
+            z = z.astype(np.float64, copy=False)
         except (TypeError, ValueError):
             raise ArgumentError(f"z: expected real numbers, got {type(z).__name__} {z!r:.60}") from None
         m = 3 * int(np.count_nonzero(observed)) + 3 * bool(gyro)
         if z.shape != (m,):
             raise ArgumentError(f"z: expected shape ({m},) (3 per observed marker{' + 3 gyro rates' if gyro else ''}), got {z.shape}")
-        if not np.isfinite(z).all():
-            raise ArgumentError(f"z: entries must be finite, got {z[~np.isfinite(z)][0]!r} at index {int(np.flatnonzero(~np.isfinite(z))[0])}")
+        if not (np.abs(z) <= MAX_ABS_MEASUREMENT).all():  # also False for NaN
+            bad = int(np.flatnonzero(~(np.abs(z) <= MAX_ABS_MEASUREMENT))[0])
+            raise ArgumentError(f"z: entries must be finite and at most {MAX_ABS_MEASUREMENT:g} (m, rad/s), got {z[bad]!r} at index {bad}")
         return self._update(z, observed, bool(gyro))
 
     def _update(self, z: np.ndarray, observed: np.ndarray, gyro: bool) -> bool:
