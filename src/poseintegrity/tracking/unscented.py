@@ -48,7 +48,7 @@ def _sigma_points_kernel(x, S, gamma):  # pragma: no cover - compiled
 
 
 DIVERGENCE_REASONS = ("", "non-finite state or covariance", "runaway covariance")  # by health_code
-MAX_ABS_MEASUREMENT = 1e6  # |z| above this (metres or rad/s) is not a marker position or a body rate
+MAX_ABS_MEASUREMENT = 1e6  # a measurement vector longer than this (metres, rad/s) holds no marker position or rate
 
 
 @numba.njit(cache=True)
@@ -176,28 +176,30 @@ class UnscentedMarkerFilter:
         if gyro.  observed : (n,) bool.  With nothing measured the call is a no-op.
         Returns False if the filter diverged (then ``initialized`` is False and it must be restarted).
         Refused with :class:`~poseintegrity.errors.ArgumentError` (checked here, before the compiled update):
-        observed not a boolean (n,) mask, gyro not a bool, z not finite or not of length
+        observed not a boolean (n,) mask, gyro not a bool, z not finite (or of norm above 1e6) or not of length
         3 * observed.sum() + 3 * gyro.
         """
-        observed = np.asarray(observed)
-        if observed.shape != (self.n,) or observed.dtype != np.bool_:
-            raise ArgumentError(f"observed: expected a boolean mask of shape ({self.n},) (one per marker), "
-                                f"got shape {observed.shape} and dtype {observed.dtype}")
-        if not isinstance(gyro, (bool, np.bool_)):
+        if type(observed) is not np.ndarray or observed.dtype.char != "?" or observed.shape != (self.n,):
+            observed = np.asarray(observed)
+            if observed.shape != (self.n,) or observed.dtype != np.bool_:
+                raise ArgumentError(f"observed: expected a boolean mask of shape ({self.n},) (one per marker), "
+                                    f"got shape {observed.shape} and dtype {observed.dtype}")
+        if gyro is not True and gyro is not False and not isinstance(gyro, np.bool_):
             raise ArgumentError(f"gyro: expected True or False, got {type(gyro).__name__} {gyro!r:.40}")
-        try:
-            z = np.asarray(z)
-            if z.dtype.kind not in "iuf":  # text, objects and True are not measurements
-                raise TypeError
-            z = z.astype(np.float64, copy=False)
-        except (TypeError, ValueError):
-            raise ArgumentError(f"z: expected real numbers, got {type(z).__name__} {z!r:.60}") from None
+        if type(z) is not np.ndarray or z.dtype.char != "d":
+            try:
+                z = np.asarray(z)
+                if z.dtype.kind not in "iuf":  # text, objects and True are not measurements
+                    raise TypeError
+                z = z.astype(np.float64)
+            except (TypeError, ValueError):
+                raise ArgumentError(f"z: expected real numbers, got {type(z).__name__} {z!r:.60}") from None
         m = 3 * int(np.count_nonzero(observed)) + 3 * bool(gyro)
         if z.shape != (m,):
             raise ArgumentError(f"z: expected shape ({m},) (3 per observed marker{' + 3 gyro rates' if gyro else ''}), got {z.shape}")
-        if not (np.abs(z) <= MAX_ABS_MEASUREMENT).all():  # also False for NaN
-            bad = int(np.flatnonzero(~(np.abs(z) <= MAX_ABS_MEASUREMENT))[0])
-            raise ArgumentError(f"z: entries must be finite and at most {MAX_ABS_MEASUREMENT:g} (m, rad/s), got {z[bad]!r} at index {bad}")
+        if not z @ z <= MAX_ABS_MEASUREMENT**2:  # one dot product (cheap per step): False for NaN, inf and 1e300
+            raise ArgumentError(f"z: must be finite with a norm of at most {MAX_ABS_MEASUREMENT:g} (m, rad/s), "
+                                f"got norm {float(np.sqrt(z @ z))!r}")
         return self._update(z, observed, bool(gyro))
 
     def _update(self, z: np.ndarray, observed: np.ndarray, gyro: bool) -> bool:
