@@ -47,7 +47,7 @@ class ParamsError(PoseIntegrityError):
 class Params(BaseModel):
     """The whole of ``params.yaml``: one section per pipeline stage."""
 
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    model_config = ConfigDict(extra="forbid", frozen=True, strict=True)  # like every Section (schema.py)
 
     protocol: ProtocolParams  # stages 01-05: the facts of Windsor et al.'s protocol they share
     generate: GenerateParams  # stage 01
