@@ -35,7 +35,8 @@ ALLOWED_UNBOUNDED: dict[str, str] = {}
 
 @dataclass
 class Place:
-    """One place a number can stand: ``Model.field`` plus ``[i]`` for a tuple entry, ``[]`` for a list or dict entry."""
+    """One place a number can stand: ``module.Model.field`` plus ``[i]`` for a tuple entry, ``[]`` for a list or
+    dict entry (e.g. ``tracking.params.TrackParams.markers_body[][0]``)."""
 
     path: str
     type: type
@@ -109,7 +110,8 @@ def walk_model(model: type[BaseModel], places: list[Place], models: dict[type, N
         return
     models[model] = None
     for name, info in model.model_fields.items():
-        _walk(f"{model.__name__}.{name}", info.annotation, list(info.metadata), places, models)
+        module = model.__module__.removeprefix("poseintegrity.")  # two models are named CameraParams
+        _walk(f"{module}.{model.__name__}.{name}", info.annotation, list(info.metadata), places, models)
 
 
 def numeric_places(root: type[BaseModel] = Params) -> tuple[list[Place], list[type]]:
@@ -172,9 +174,9 @@ class _Unbounded(Section):
 def test_walker_catches_a_careless_model():
     places, models = numeric_places(_Unbounded)
     assert set(models) == {_Unbounded, _Nested}
-    assert unbounded(places) == ["_Unbounded.no_upper", "_Unbounded.bare", "_Unbounded.inside_tuple[1]",
-                                 "_Unbounded.inside_list[]", "_Unbounded.inside_dict[]", "_Unbounded.optional",
-                                 "_Nested.count", "_Unbounded.infinite"]
+    assert [path.removeprefix(f"{__name__}.") for path in unbounded(places)] == [
+        "_Unbounded.no_upper", "_Unbounded.bare", "_Unbounded.inside_tuple[1]", "_Unbounded.inside_list[]",
+        "_Unbounded.inside_dict[]", "_Unbounded.optional", "_Nested.count", "_Unbounded.infinite"]
 
 
 def test_walker_refuses_a_type_it_does_not_know():
