@@ -9,7 +9,7 @@ import pytest
 import yaml
 
 from params_cases import refusal
-from poseintegrity.config import ParamsError, load_params, parse_params, read_raw
+from poseintegrity.config import ParamsError, load_params, load_section, parse_params, read_raw
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -101,11 +101,20 @@ def test_missing_section_and_bad_yaml(tmp_path):
 # non-UTF-8 bytes raised a raw UnicodeDecodeError, an extends cycle a RecursionError, and a key written twice was
 # silently replaced by its last value.
 
-def test_non_utf8_bytes_name_the_file_and_offset(tmp_path):
+@pytest.mark.parametrize("read", [load_params, read_raw, lambda path: load_section(path, "parallel")],
+                         ids=["load_params", "read_raw", "load_section"])
+def test_non_utf8_bytes_name_the_file_and_offset(tmp_path, read):
     latin = tmp_path / "params.yaml"
     latin.write_bytes("protocol:\n  note: caf\xe9\n".encode("latin-1"))
     with pytest.raises(ParamsError, match=r"params\.yaml is not UTF-8 text: byte 0xe9 at offset 21 \(line 2\)"):
-        load_params(latin)
+        read(latin)
+
+
+def test_non_utf8_bytes_in_an_extended_file_name_that_file(tmp_path):
+    (tmp_path / "base.yaml").write_bytes(b"parallel: {n_jobs: 1}\n# \xff\n")
+    (tmp_path / "overlay.yaml").write_text("extends: base.yaml\n")
+    with pytest.raises(ParamsError, match=r"base\.yaml is not UTF-8 text: byte 0xff at offset 24 \(line 2\)"):
+        load_section(tmp_path / "overlay.yaml", "parallel")
 
 
 @pytest.mark.parametrize("files, chain", [
