@@ -1,6 +1,7 @@
 """params.yaml validation: every bad value stops before any work, with the offending key named."""
 
 import copy
+import re
 from pathlib import Path
 
 import numpy as np
@@ -8,7 +9,7 @@ import pytest
 import yaml
 
 from params_cases import refusal
-from poseintegrity.config import ParamsError, load_params, parse_params
+from poseintegrity.config import ParamsError, load_params, load_section, parse_params, read_raw
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -94,3 +95,105 @@ def test_missing_section_and_bad_yaml(tmp_path):
     (tmp_path / "list.yaml").write_text(yaml.safe_dump([1, 2]))
     with pytest.raises(ParamsError, match="expected a mapping"):
         load_params(tmp_path / "list.yaml")
+
+
+# What reading a params file refuses, each a ParamsError naming the file (and the line, key or chain): before,
+# non-UTF-8 bytes raised a raw UnicodeDecodeError, an extends cycle a RecursionError, and a key written twice was
+# silently replaced by its last value.
+
+@pytest.mark.parametrize("read", [load_params, read_raw, lambda path: load_section(path, "parallel")],
+                         ids=["load_params", "read_raw", "load_section"])
+def test_non_utf8_bytes_name_the_file_and_offset(tmp_path, read):
+    latin = tmp_path / "params.yaml"
+    latin.write_bytes("protocol:\n  note: caf\xe9\n".encode("latin-1"))
+    with pytest.raises(ParamsError, match=r"params\.yaml is not UTF-8 text: byte 0xe9 at offset 21 \(line 2\)"):
+        read(latin)
+
+
+def test_non_utf8_bytes_in_an_extended_file_name_that_file(tmp_path):
+    (tmp_path / "base.yaml").write_bytes(b"parallel: {n_jobs: 1}\n# \xff\n")
+    (tmp_path / "overlay.yaml").write_text("extends: base.yaml\n")
+    with pytest.raises(ParamsError, match=r"base\.yaml is not UTF-8 text: byte 0xff at offset 24 \(line 2\)"):
+        load_section(tmp_path / "overlay.yaml", "parallel")
+
+
+@pytest.mark.parametrize("files, chain", [
+    ({"a.yaml": "extends: b.yaml\n", "b.yaml": "extends: a.yaml\n"}, r"a\.yaml -> \S*b\.yaml -> \S*a\.yaml"),
+    ({"a.yaml": "extends: a.yaml\n"}, r"a\.yaml -> \S*a\.yaml"),
+    ({"a.yaml": "extends: ./sub/../b.yaml\n", "b.yaml": "extends: c.yaml\n", "c.yaml": "extends: b.yaml\n"},
+     r"b\.yaml -> \S*c\.yaml -> \S*b\.yaml"),
+])
+def test_extends_cycle_names_the_chain(tmp_path, files, chain):
+    (tmp_path / "sub").mkdir()
+    for name, text in files.items():
+        (tmp_path / name).write_text(text)
+    with pytest.raises(ParamsError, match=f"extends makes a cycle: .*{chain}"):
+        load_params(tmp_path / "a.yaml")
+
+
+@pytest.mark.parametrize("value, message", [
+    ("missing.yaml", r"a\.yaml: extends 'missing\.yaml': no such file"),
+    ("[params.yaml]", r"a\.yaml: extends must be the path of a params file \(text\), got list"),
+    ("3", r"a\.yaml: extends must be the path of a params file \(text\), got int"),
+    ("''", r"a\.yaml: extends must be the path of a params file \(text\), got str"),
+    ("list.yaml", r"a\.yaml: extends 'list\.yaml', which is not a mapping"),
+])
+def test_bad_extends_names_the_file(tmp_path, value, message):
+    (tmp_path / "list.yaml").write_text("- 1\n")
+    (tmp_path / "a.yaml").write_text(f"extends: {value}\nparallel: {{n_jobs: 1}}\n")
+    with pytest.raises(ParamsError, match=message):
+        load_params(tmp_path / "a.yaml")
+
+
+def _with_line_after(text: str, anchor: str, line: str) -> str:
+    assert anchor in text
+    return text.replace(anchor, anchor + line, 1)
+
+
+PARAMS_TEXT = (ROOT / "params.yaml").read_text()
+
+
+@pytest.mark.parametrize("text, key", [
+    (PARAMS_TEXT + "parallel: {n_jobs: 1}\n", "parallel"),  # a whole section twice
+    (_with_line_after(PARAMS_TEXT, "  n_jobs: 2 ", "\n  n_jobs: 3 "), "parallel.n_jobs"),
+    (PARAMS_TEXT.replace("{arc: 4, line: 5}", "{arc: 4, line: 5, arc: 3}"), "protocol.sampled_stops.arc"),  # flow
+    (PARAMS_TEXT.replace("distance_mm: 300, elevation_deg: 50,", "distance_mm: 300, distance_mm: 310, "
+                                                                  "elevation_deg: 50,", 1),
+     "generate.scenes.0.distance_mm"),  # inside a list
+])
+def test_duplicate_key_names_the_dotted_key_and_lines(tmp_path, text, key):
+    path = tmp_path / "params.yaml"
+    path.write_text(text)
+    with pytest.raises(ParamsError, match=rf"params\.yaml: line \d+: key '{re.escape(key)}' is written twice "
+                                          rf"\(lines \d+ and \d+\)"):
+        load_params(path)
+
+
+def test_duplicate_key_in_an_overlay_names_the_overlay(tmp_path):
+    overlay = tmp_path / "tiny.yaml"
+    overlay.write_text(f"extends: {ROOT / 'params.yaml'}\nfit:\n  k_max: 5\n  k_max: 6\n")
+    with pytest.raises(ParamsError, match=r"tiny\.yaml: line 4: key 'fit\.k_max' is written twice \(lines 3 and 4\)"):
+        load_params(overlay)
+
+
+def test_yaml_merge_keys_may_override_what_they_merge(tmp_path):
+    path = tmp_path / "merge.yaml"
+    path.write_text("base: &base {n_jobs: 1, backend: local}\nparallel:\n  <<: *base\n  n_jobs: 2\n")
+    assert read_raw(path)[0]["parallel"] == {"n_jobs": 2, "backend": "local"}
+
+
+def test_valid_files_still_load_unchanged():
+    """params.yaml and its tiny overlay validate; a few values spot-checked, including an int written for a float
+    (distance_mm: 300), tuples and paths from YAML lists and text, literals and null."""
+    params = load_params(ROOT / "params.yaml")
+    tiny = load_params(ROOT / "tests" / "params_tiny.yaml")
+    scene = params.generate.scenes[0]
+    assert scene.distance_mm == 300.0 and type(scene.distance_mm) is float
+    assert scene.glenoid_tilt_deg == (0.0, 25.0)
+    assert params.protocol.tolerances == [(2.0, 3.0), (4.0, 10.0)]
+    assert params.generate.scapula.mesh == ROOT / "assets" / "scapula_left.stl"
+    assert params.generate.calibration.distance_mm == (250.0, 450.0)
+    assert params.protocol.pnp_method == "usac_magsac" and params.fit.k_max is None
+    assert params.track.filter.kappa is None and params.track.motion.occlusions == [(20.0, 2.0)]
+    assert tiny.generate.camera.downscale == 4 and tiny.parallel.n_jobs == 1 and tiny.fit.k_max == 5
+    assert tiny.track.evaluation.lag_max_ms == 300.0 and tiny.generate.lines.scene == "scene_b"

@@ -11,6 +11,11 @@ A params file may start with ``extends: <path>``: it is then an overlay on that 
 merged key by key (mappings recursively, everything else replaced). ``tests/params_tiny.yaml`` is such an overlay
 on ``params.yaml``: tests run the real configuration, shrunk. File paths inside params (:data:`ProjectPath`) are
 relative to the directory of the file at the root of the ``extends`` chain (the repository for ``params.yaml``).
+
+What reading refuses, each with a :class:`ParamsError` naming the file: bytes that are not UTF-8 (with their
+offset and line), invalid YAML, a key written twice in one mapping (YAML would silently keep the last; the error
+names the dotted key and both lines), an ``extends`` that is not a file path, names a missing file or closes a
+cycle (the chain is named), and a file that is not a mapping.
 """
 
 from __future__ import annotations
@@ -42,7 +47,7 @@ class ParamsError(PoseIntegrityError):
 class Params(BaseModel):
     """The whole of ``params.yaml``: one section per pipeline stage."""
 
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    model_config = ConfigDict(extra="forbid", frozen=True, strict=True)  # like every Section (schema.py)
 
     protocol: ProtocolParams  # stages 01-05: the facts of Windsor et al.'s protocol they share
     generate: GenerateParams  # stage 01
@@ -96,22 +101,100 @@ def merge(base: Any, overlay: Any) -> Any:
     return overlay
 
 
+class _DuplicateKey(yaml.YAMLError):
+    """A mapping of a params file holds the same key twice."""
+
+
+class _UniqueKeyLoader(yaml.SafeLoader):
+    """``yaml.SafeLoader`` that refuses a key written twice in one mapping (PyYAML keeps the last one silently).
+    The check walks the composed node tree before construction, so that the error names the dotted key and both
+    lines; a merge key (``<<``) may override what it merges, as YAML intends."""
+
+    def get_single_data(self) -> Any:
+        node = self.get_single_node()
+        if node is None:
+            return None
+        self._check_unique(node, (), set())
+        return self.construct_document(node)
+
+    def _check_unique(self, node: yaml.Node, path: tuple, seen: set[int]) -> None:
+        if id(node) in seen:  # an alias: its node was checked where its anchor stands
+            return
+        seen.add(id(node))
+        if isinstance(node, yaml.MappingNode):
+            first_line: dict[Any, int] = {}
+            for key_node, value_node in node.value:
+                if key_node.tag == "tag:yaml.org,2002:merge":
+                    self._check_unique(value_node, path, seen)
+                    continue
+                key = self.construct_object(key_node) if isinstance(key_node, yaml.ScalarNode) else None
+                line = key_node.start_mark.line + 1
+                if key is not None:
+                    try:
+                        if key in first_line:
+                            dotted = ".".join(map(str, (*path, key)))
+                            raise _DuplicateKey(f"line {line}: key {dotted!r} is written twice (lines "
+                                                f"{first_line[key]} and {line}); YAML would keep only the last")
+                        first_line[key] = line
+                    except TypeError:  # an unhashable key: construction names it
+                        pass
+                self._check_unique(value_node, (*path, key), seen)
+        elif isinstance(node, yaml.SequenceNode):
+            for index, item in enumerate(node.value):
+                self._check_unique(item, (*path, index), seen)
+
+
 def _read_yaml(path: Path) -> Any:
+    """One params file parsed (UTF-8 YAML, each key once per mapping); :class:`ParamsError` naming the file."""
     try:
-        return yaml.safe_load(path.read_text())
+        data = path.read_bytes()
     except OSError as error:
         raise ParamsError(f"cannot read params file {path}: {error.strerror}") from None
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as error:
+        line = data[:error.start].count(b"\n") + 1
+        raise ParamsError(f"{path} is not UTF-8 text: byte 0x{data[error.start]:02x} at offset {error.start} "
+                          f"(line {line}) cannot be decoded; save the file as UTF-8") from None
+    loader = _UniqueKeyLoader(text)
+    loader.name = str(path)  # YAML's own errors name the file, not "<unicode string>"
+    try:
+        return loader.get_single_data()
+    except _DuplicateKey as error:
+        raise ParamsError(f"{path}: {error}") from None
     except yaml.YAMLError as error:
         raise ParamsError(f"{path} is not valid YAML: {error}") from None
+    finally:
+        loader.dispose()
 
 
 def read_raw(path: str | Path) -> tuple[Any, Path]:
-    """The parsed params file with its ``extends`` chain merged, and the directory its paths are relative to."""
-    path = Path(path)
+    """The parsed params file with its ``extends`` chain merged, and the directory its paths are relative to.
+
+    ``extends`` must be a path (text, relative to the file that names it) of an existing params file that is a
+    mapping; a chain that comes back to a file already in it is refused, naming the chain."""
+    return _read_chain(Path(path), ())
+
+
+def _read_chain(path: Path, chain: tuple[Path, ...]) -> tuple[Any, Path]:
+    resolved = path.resolve()
+    if resolved in chain:
+        names = " -> ".join(str(p) for p in (*chain, resolved))
+        raise ParamsError(f"{chain[-1]}: extends makes a cycle: {names}")
     raw = _read_yaml(path)
     if not (isinstance(raw, dict) and "extends" in raw):
-        return raw, path.resolve().parent
-    base, base_dir = read_raw(path.parent / str(raw.pop("extends")))
+        return raw, resolved.parent
+    target = raw.pop("extends")
+    if not isinstance(target, str) or not target.strip():
+        raise ParamsError(f"{path}: extends must be the path of a params file (text), got "
+                          f"{type(target).__name__} {target!r:.80}")
+    base_path = path.parent / target
+    if not base_path.is_file():
+        raise ParamsError(f"{path}: extends {target!r}: no such file {base_path}")
+    base, base_dir = _read_chain(base_path, (*chain, resolved))
+    if not isinstance(base, dict):
+        raise ParamsError(f"{path}: extends {target!r}, which is not a mapping of sections "
+                          f"(got {type(base).__name__})")
     return merge(base, raw), base_dir
 
 

@@ -8,11 +8,11 @@ tolerance (``predict.tolerance_fig6_fig7``, ``predict.live_tolerance``) is check
 
 from __future__ import annotations
 
-from typing import Literal, get_args
+from typing import Annotated, Literal, get_args
 
 from pydantic import Field, field_validator
 
-from poseintegrity.schema import Section
+from poseintegrity.schema import FromList, Section
 
 Trajectory = Literal["arc", "line"]
 PnPMethod = Literal["usac_magsac", "epnp", "p3p", "ap3p", "sqpnp", "iterative"]
@@ -51,8 +51,11 @@ class ProtocolParams(Section):
     arc_span_deg: float = Field(gt=0, le=90, description="arcs: theta = 0 .. span, the model view at 0 (IV-D: 45)")
     line_length_mm: float = Field(gt=0, le=1000, description="lines: x = 0 .. length from their start (IV-D: 150)")
     pnp_method: PnPMethod = Field(description="the PnP-RANSAC of the paper's tables (OpenCV USAC, MAGSAC)")
-    tolerances: list[tuple[float, float]] = Field(
-        min_length=1, description="(E_t mm, E_r deg) error tolerances of IV-E (paper: 2 mm/3 deg, 4 mm/10 deg)")
+    tolerances: list[Annotated[tuple[Annotated[float, Field(gt=0, le=1000)], Annotated[float, Field(gt=0, le=180)]],
+                               FromList]] = Field(
+        min_length=1, description="(E_t mm, E_r deg) error tolerances of IV-E (paper: 2 mm/3 deg, 4 mm/10 deg); "
+                                  "E_t up to a metre (no localization task tolerates more), E_r up to 180 deg (the "
+                                  "largest rotation error)")
     sampled_stops: SampledStops
     envelope: EnvelopeParams
 

@@ -1,7 +1,10 @@
 """Building blocks shared by the params schemas of every section (``poseintegrity.<subpackage>.params``).
 
-Every section model derives from :class:`Section`: unknown keys are refused, values are frozen, and every float
-must be finite (NaN and inf are refused wherever a number is expected). Field types here carry the rules that
+Every section model derives from :class:`Section`: unknown keys are refused, values are frozen, every float
+must be finite (NaN and inf are refused wherever a number is expected) and numbers are strict: YAML's ``true``,
+the text ``"3"`` and ``2.0`` for a count are refused, an integer where a float is expected is taken (JSON's rule).
+Every number carries a lower and an upper bound with its reason (tests/test_params_schema.py walks the schema).
+A tuple field is written as a YAML list: it is marked :data:`FromList` (its entries stay strict). Field types here carry the rules that
 recur across sections (seeds, worker counts, ordered ranges, distinct entries), so that a bad value is refused
 by the field itself and the error names its key. A rule between several keys of one model raises
 :class:`KeyRule` from a ``model_validator``; :mod:`poseintegrity.config` then names the key it carries.
@@ -13,7 +16,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Annotated, TypeVar
 
-from pydantic import AfterValidator, BaseModel, ConfigDict, Field, ValidationInfo
+from pydantic import AfterValidator, BaseModel, ConfigDict, Field, Strict, ValidationInfo
 
 from poseintegrity.errors import PoseIntegrityError
 
@@ -21,9 +24,14 @@ T = TypeVar("T")
 
 
 class Section(BaseModel):
-    """Base of every params.yaml (sub)section: extra keys refused, frozen, floats finite."""
+    """Base of every params.yaml (sub)section: extra keys refused, frozen, floats finite, numbers strict."""
 
-    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False, strict=True)
+
+
+# Strict mode takes a tuple only from a tuple and a Path only from a Path; YAML gives lists and text. This marker
+# lets the container (or path) be converted while every number inside stays strict.
+FromList = Strict(False)
 
 
 class KeyRule(PoseIntegrityError):
@@ -42,7 +50,7 @@ def _resolve(path: Path, info: ValidationInfo) -> Path:
     return path if path.is_absolute() or base is None else Path(base) / path
 
 
-ProjectPath = Annotated[Path, AfterValidator(_resolve)]  # a file named in params.yaml, relative to its directory
+ProjectPath = Annotated[Path, Strict(False), AfterValidator(_resolve)]  # a file named in params.yaml, relative to its directory
 
 
 def _worker_count(n_jobs: int) -> int:
@@ -51,7 +59,8 @@ def _worker_count(n_jobs: int) -> int:
     return n_jobs
 
 
-WorkerCount = Annotated[int, AfterValidator(_worker_count)]  # n_jobs: processes, or -1 for all cores
+# n_jobs: processes, or -1 for all cores; more than 1024 is no machine's core count (and each worker holds a scene)
+WorkerCount = Annotated[int, Field(ge=-1, le=1024), AfterValidator(_worker_count)]
 Seed = Annotated[int, Field(ge=0, lt=2**63)]  # a numpy SeedSequence entropy: a non-negative integer
 
 
@@ -61,7 +70,11 @@ def _ordered(bounds: tuple[float, float]) -> tuple[float, float]:
     return bounds
 
 
-OrderedRange = Annotated[tuple[float, float], AfterValidator(_ordered)]  # [low, high], low <= high
+def ordered_range(**bounds: float) -> type:
+    """``[low, high]`` with ``low <= high``, each end within ``bounds`` (``Field`` keywords: ``ge``, ``gt``,
+    ``le``, ``lt``), e.g. ``ordered_range(ge=100, le=2000)`` for a camera distance in mm."""
+    end = Annotated[float, Field(**bounds)]
+    return Annotated[tuple[end, end], FromList, AfterValidator(_ordered)]
 
 
 def _distinct(values: Sequence[T]) -> Sequence[T]:

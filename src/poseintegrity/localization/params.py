@@ -29,7 +29,8 @@ class ClaheParams(Section):
 class SiftParams(Section):
     """cv2.SIFT_create arguments (Lowe 2004's values in params.yaml)."""
 
-    n_features: int = Field(ge=0, description="keep the n strongest keypoints; 0 keeps all")
+    n_features: int = Field(ge=0, le=100_000, description="keep the n strongest keypoints; 0 keeps all (10^5 "
+                                                          "descriptors are 51 MB per frame and worker)")
     n_octave_layers: int = Field(ge=1, le=8, description="layers per octave of the difference-of-Gaussian pyramid")
     contrast_threshold: float = Field(gt=0, lt=1, description="drops weak extrema (image intensities scaled to 0..1)")
     edge_threshold: float = Field(ge=1, le=100, description="drops edge-like extrema: ratio of principal curvatures")

@@ -50,7 +50,7 @@ class UncertaintyParams(Section):
 class PredictParams(Section):
     """Stage 04: predictors, the n_t sweep, the static baseline, LOSO threshold choice, live-trial simulation."""
 
-    n_t_min: int = Field(ge=1, description="smallest inlier threshold of the sweep (paper: 4)")
+    n_t_min: int = Field(ge=1, le=GRID, description="smallest inlier threshold of the sweep (paper: 4)")
     n_t_max: int = Field(ge=1, le=GRID, description="largest inlier threshold of the sweep (paper: 100)")
     relative_min: float = Field(gt=0, lt=1, description="beyond the paper: smallest n_t / first-stop mean n_i")
     relative_max: float = Field(gt=0, lt=1, description="largest n_t / first-stop mean n_i of the sweep")
@@ -62,7 +62,7 @@ class PredictParams(Section):
     )
     n_grid: int = Field(ge=16, le=GRID, description="grid points of the theta_p crossing scan per fitted curve")
     models: PredictorModels
-    live_n_t: int = Field(ge=1, description="fixed n_t of the simulated live trials (paper: 15, from Table III), one of"
+    live_n_t: int = Field(ge=1, le=GRID, description="fixed n_t of the simulated live trials (paper: 15, from Table III), one of"
                                             " the swept n_t_min .. n_t_max")
     live_tolerance: str = Field(min_length=1, description="tolerance of the simulated live trials (paper: 4mm_10deg), one of"
                                                             " protocol.tolerances")
@@ -72,10 +72,10 @@ class PredictParams(Section):
     )
     uncertainty: UncertaintyParams
     tail_n_t_max: int = Field(
-        ge=1, description="the tail diagnosis: an arc whose long range theta_p exceeds theta_a at every swept n_t up"
+        ge=1, le=GRID, description="the tail diagnosis: an arc whose long range theta_p exceeds theta_a at every swept n_t up"
         " to this one, one of n_t_min .. n_t_max"
     )
-    tail_n_t_shown: distinct(Annotated[int, Field(ge=1)]) = Field(
+    tail_n_t_shown: distinct(Annotated[int, Field(ge=1, le=GRID)]) = Field(
         min_length=1, description="thresholds at which the tail diagnosis shows theta_p, each one of n_t_min .."
         " n_t_max"
     )

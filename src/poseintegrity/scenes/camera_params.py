@@ -11,7 +11,7 @@ import numpy as np
 from pydantic import Field, field_validator, model_validator
 
 from poseintegrity.lens import LensError, check_folding
-from poseintegrity.schema import KeyRule, OrderedRange, Section
+from poseintegrity.schema import FromList, KeyRule, Section, ordered_range
 
 MIN_IMAGE_PX = 64  # the rendered image's shorter side: below it no target keeps enough pixels to be localized
 MAX_SENSOR_PX = 4096  # a side of the sensor: larger frames take GBs of z-buffer per worker
@@ -29,12 +29,15 @@ class CameraParams(Section):
     pixel_um: float = Field(gt=0, le=50)
     lens_mm: float = Field(gt=0, le=75, description="focal length of the (unpublished) lens; ours. Below every "
                                                     "camera distance (>= 100 mm): the lens must focus")
-    downscale: int = Field(ge=1, description="images are rendered at sensor size / downscale")
+    downscale: int = Field(ge=1, le=MAX_SENSOR_PX // MIN_IMAGE_PX,
+                           description="images are rendered at sensor size / downscale (the shorter side >= "
+                                       "MIN_IMAGE_PX, checked below)")
     f_number: float = Field(ge=0.5, le=64, description="aperture; sets the depth of field (focus at the model view)")
-    principal_point_offset_px: tuple[Annotated[float, Field(ge=-100, le=100)], Annotated[float, Field(ge=-100, le=100)]] = (
+    principal_point_offset_px: Annotated[tuple[Annotated[float, Field(ge=-100, le=100)],
+                                               Annotated[float, Field(ge=-100, le=100)]], FromList] = (
         Field(description="where the optical axis meets the sensor, from its centre, full-resolution px (a lens is "
                           "mounted a few px off; 100 px would be a visibly decentred lens)"))
-    distortion: tuple[Radial, Radial, Tangential, Tangential, Radial] = Field(
+    distortion: Annotated[tuple[Radial, Radial, Tangential, Tangential, Radial], FromList] = Field(
         description="k1, k2, p1, p2, k3 of the lens (Brown-Conrady as OpenCV models it, poseintegrity.lens)")
 
     @model_validator(mode="after")
@@ -126,17 +129,12 @@ class CalibrationParams(Section):
 
     board: CharucoParams
     n_views: int = Field(ge=5, le=200, description="views rendered (5: the fewest a calibration can use)")
-    distance_mm: OrderedRange = Field(description="camera to board centre, drawn per view")
+    distance_mm: ordered_range(ge=100, le=2000) = Field(
+        description="camera to board centre, drawn per view: within [100, 2000] mm, where the lens focuses and the "
+                    "board covers more than a few pixels")
     max_tilt_deg: float = Field(ge=0, le=70, description="board tilt from facing the camera, drawn per view")
     max_rms_px: float = Field(gt=0, le=5, description="a calibration whose reprojection RMS exceeds this stops "
                                                       "stage 01: its camera would not be worth using")
-
-    @field_validator("distance_mm")
-    @classmethod
-    def _in_focus_range(cls, distance: tuple[float, float]) -> tuple[float, float]:
-        if distance[0] < 100 or distance[1] > 2000:
-            raise ValueError(f"distances lie in [100, 2000] mm (the lens focuses beyond 100 mm), got {list(distance)}")
-        return distance
 
 
 class CaptureParams(Section):

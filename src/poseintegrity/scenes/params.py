@@ -25,7 +25,8 @@ from poseintegrity.scenes.foam import VOXEL_MM, ReliefVolume, relief_volume
 from poseintegrity.scenes.mesh import Material
 from poseintegrity.scenes.robot_params import RobotParams
 from poseintegrity.scenes.scapula import read_mesh
-from poseintegrity.schema import KeyRule, ProjectPath, Section, Seed, distinct
+from poseintegrity.errors import ArgumentError
+from poseintegrity.schema import FromList, KeyRule, ProjectPath, Section, Seed, distinct
 
 NAME_PATTERN = r"^[A-Za-z0-9][A-Za-z0-9_-]*$"  # scene names make folder names (no path, no hidden .partial folder)
 
@@ -56,13 +57,20 @@ class DrillParams(Section):
     depth_mm: float = Field(gt=0, le=40, description="depth below the glenoid centre")
 
 
+MeshCoordinate = Annotated[float, Field(ge=-1e6, le=1e6)]  # mesh units (m to um): a 170 mm bone in um spans 1.7e5
+UnitComponent = Annotated[float, Field(ge=-1, le=1)]  # a direction's component
+
+
 class ScapulaParams(Section):
     """The anatomical scapula phantom (:mod:`poseintegrity.scenes.scapula`)."""
 
     mesh: ProjectPath = Field(description="closed triangle mesh of a left scapula (STL, OBJ, PLY: anything trimesh reads)")
     length_mm: float = Field(ge=50, le=400, description="the mesh is scaled so that its longest extent is this long")
-    glenoid_centre: tuple[float, float, float] = Field(description="glenoid centre in the mesh file's own units")
-    glenoid_normal: tuple[float, float, float] = Field(description="outward normal of the glenoid, mesh frame")
+    glenoid_centre: Annotated[tuple[MeshCoordinate, MeshCoordinate, MeshCoordinate], FromList] = Field(
+        description="glenoid centre in the mesh file's own units")
+    glenoid_normal: Annotated[tuple[UnitComponent, UnitComponent, UnitComponent], FromList] = Field(
+        description="outward normal of the glenoid, mesh frame (normalised: any direction can be written with "
+                    "components in [-1, 1])")
     drill: DrillParams
 
     @field_validator("mesh")
@@ -117,7 +125,8 @@ class SceneSpec(Section):
     distance_mm: Distance = Field(description="camera to target centre at the model view")
     elevation_deg: float = Field(gt=5, lt=90, description="of the model view above the table")
     n_clutter: int = Field(ge=0, le=20)
-    glenoid_tilt_deg: tuple[Annotated[float, Field(ge=-45, le=45)], Annotated[float, Field(ge=-45, le=45)]] | None = (
+    glenoid_tilt_deg: Annotated[tuple[Annotated[float, Field(ge=-45, le=45)], Annotated[float, Field(ge=-45, le=45)]],
+                                FromList] | None = (
         Field(None, description="a scapula's glenoid normal turned from the model camera about its x, then y axis; "
                                 "required with a scapula target, refused without one"))
 
@@ -293,7 +302,7 @@ class GenerateParams(Section):
         "validation" these with ``validation``'s keys in place of the main world's."""
         if name not in WORLDS or (name == "validation" and self.validation is None):
             available = [w for w in WORLDS if w == "main" or self.validation is not None]
-            raise ValueError(f"unknown world {name!r}; these params have {available}")
+            raise ArgumentError(f"name: unknown world {name!r}; these params have {available}")
         if name == "main":
             return self.model_copy(update={"validation": None})
         fields = self.model_dump() | self.validation.model_dump() | {"validation": None}

@@ -10,7 +10,7 @@ from typing import Annotated
 from pydantic import Field, field_validator
 
 from poseintegrity.scenes.kinematics import UR5E
-from poseintegrity.schema import Section, distinct
+from poseintegrity.schema import FromList, Section, distinct
 
 
 class DHErrorParams(Section):
@@ -25,14 +25,18 @@ class DHErrorParams(Section):
     joint_offset_std_deg: float = Field(ge=0, le=1, description="theta_i: each encoder's zero; same bound")
 
 
+Turn = Annotated[float, Field(ge=-360, le=360)]  # deg: a component beyond a full turn is a typo (the length rule is tighter)
+
+
 class MountParams(Section):
     """The adapter holding the camera on the tool flange: T_flange_cam (:mod:`.robot`)."""
 
-    translation_mm: tuple[Annotated[float, Field(ge=-300, le=300)], Annotated[float, Field(ge=-300, le=300)],
-                          Annotated[float, Field(ge=-300, le=300)]] = Field(
+    translation_mm: Annotated[tuple[Annotated[float, Field(ge=-300, le=300)], Annotated[float, Field(ge=-300, le=300)],
+                                    Annotated[float, Field(ge=-300, le=300)]], FromList] = Field(
         description="camera centre in the flange frame; within 300 mm: an adapter, not a second arm")
-    rotation_deg: tuple[float, float, float] = Field(description="rotation vector (axis x angle) of the camera "
-                                                                 "frame in the flange frame")
+    rotation_deg: Annotated[tuple[Turn, Turn, Turn], FromList] = Field(
+        description="rotation vector (axis x angle) of the camera frame in the flange frame; its length at most "
+                    "180 deg (checked below)")
 
     @field_validator("rotation_deg")
     @classmethod

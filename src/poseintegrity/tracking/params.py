@@ -15,20 +15,8 @@ from typing import Annotated, Literal
 import numpy as np
 from pydantic import AfterValidator, Field, model_validator
 
-from poseintegrity.schema import KeyRule, OrderedRange, Section, Seed
+from poseintegrity.schema import FromList, KeyRule, Section, Seed, ordered_range
 from poseintegrity.tracking.geometry import tool_geometry_problem
-
-
-def _positive_low(bounds: tuple[float, float]) -> tuple[float, float]:
-    if not bounds[0] > 0:
-        raise ValueError(f"a range of positive values needs low > 0, got {list(bounds)}")
-    return bounds
-
-
-def _non_negative_low(bounds: tuple[float, float]) -> tuple[float, float]:
-    if not bounds[0] >= 0:
-        raise ValueError(f"a range of durations needs low >= 0, got {list(bounds)}")
-    return bounds
 
 
 def _non_empty(values: list) -> list:
@@ -37,42 +25,49 @@ def _non_empty(values: list) -> list:
     return values
 
 
-PositiveRange = Annotated[OrderedRange, AfterValidator(_positive_low)]  # [low, high], 0 < low <= high
-NonNegativeRange = Annotated[OrderedRange, AfterValidator(_non_negative_low)]  # [low, high], 0 <= low <= high
-PositiveList = Annotated[list[Annotated[float, Field(gt=0)]], AfterValidator(_non_empty)]  # non-empty, every entry > 0
-Point = tuple[float, float, float]  # metres
+# Bounds shared by several keys. Each refuses what no setting can mean (a typo such as 1e9), not what is unusual.
+IR_MAX = 65535.0  # raw IR is a 16-bit reading (the AHAT's reaches ~1000; a marker saturates it)
+DEPTH_MAX_MM = 65535.0  # depth images are uint16 mm
+IMAGE_MAX_PX = 4096  # a side of the simulated frame: larger ones take GBs per recording
+FOCAL_MAX_PX = 10_000.0  # beyond it a 512 px frame sees under 3 deg: no tracking camera
+ANGULAR_MAX = 100.0  # rad/s (and its spreads): 16 turns a second is no hand
+ACCEL_MAX = 1000.0  # m/s^2 (100 g): no hand, no tool
+SECONDS_MAX = 3600.0  # an hour: longer than any simulated recording or time constant here
+MAX_SIM_STEPS = 1e7  # motion.duration_s / motion.sim_dt: 10^7 steps of the simulated trajectory ~ 1 GB
+FRAMES_MAX = 1_000_000  # frames or repeats of one run: ~13 h of 46 ms frames; minutes per 10^4 on 2 cores
+
+Room = Annotated[float, Field(ge=-10, le=10)]  # m: a position in the camera's room
+Point = Annotated[tuple[Room, Room, Room], FromList]  # metres
+MarkerCoordinate = Annotated[float, Field(ge=-0.5, le=0.5)]  # m: a marker on a hand-held tool, from its centre
+MarkerPoint = Annotated[tuple[MarkerCoordinate, MarkerCoordinate, MarkerCoordinate], FromList]
+Seconds = ordered_range(gt=0, le=60)  # [low, high] s of a hand's turn or a finger's occlusion: under a minute
+PositiveList = Annotated[list[Annotated[float, Field(gt=0, le=1000)]], AfterValidator(_non_empty)]  # non-empty
 
 
 class CameraParams(Section):
     """AHAT-like pinhole camera (docs/references.md: 512 x 512); the world frame is the camera frame shifted by origin_m."""
 
-    width: int = Field(ge=16)
-    height: int = Field(ge=16)
-    focal_px: float = Field(gt=0)  # our choice: 11 mm spheres at 0.5 m give blobs of ~13-20 px (references: 10-20)
+    width: int = Field(ge=16, le=IMAGE_MAX_PX)
+    height: int = Field(ge=16, le=IMAGE_MAX_PX)
+    focal_px: float = Field(gt=0, le=FOCAL_MAX_PX)  # our choice: 11 mm spheres at 0.5 m give blobs of ~13-20 px (references: 10-20)
     origin_m: Point  # camera centre in the world frame (T_world_cam)
 
 
 class FrameParams(Section):
     """IR reflectivity and depth synthesis (our choices; docs/references.md: IR raw 0-1000, depth in mm along the ray)."""
 
-    ir_background: float = Field(ge=0)
-    ir_noise_std: float = Field(ge=0)
-    marker_ir: float = Field(gt=0)  # retro-reflective spheres saturate (clipped at 1000 by the detector)
-    marker_ir_std: float = Field(ge=0)
-    depth_noise_mm: float = Field(ge=0)  # per pixel, ToF noise
-    depth_bias_std_mm: float = Field(ge=0)  # per marker and frame (multipath on the sphere)
-    frame_depth_bias_std_mm: float = Field(ge=0)  # per frame, common to all pixels (ToF offset drift)
-    background_depth_mm: float = Field(ge=0, le=65535)  # beyond the detector's depth window; uint16 mm
+    ir_background: float = Field(ge=0, le=IR_MAX)
+    ir_noise_std: float = Field(ge=0, le=IR_MAX)
+    marker_ir: float = Field(gt=0, le=IR_MAX)  # retro-reflective spheres saturate (clipped at 1000 by the detector)
+    marker_ir_std: float = Field(ge=0, le=IR_MAX)
+    depth_noise_mm: float = Field(ge=0, le=1000)  # per pixel, ToF noise; a metre of it leaves no depth to read
+    depth_bias_std_mm: float = Field(ge=0, le=1000)  # per marker and frame (multipath on the sphere); same bound
+    frame_depth_bias_std_mm: float = Field(ge=0, le=1000)  # per frame, common to all pixels (ToF offset drift); same
+    background_depth_mm: float = Field(ge=0, le=DEPTH_MAX_MM)  # beyond the detector's depth window; uint16 mm
     supersampling: int = Field(ge=1, le=8)
-    phantom_radius_px: PositiveRange
-    phantom_depth_mm: PositiveRange
-    phantom_elongation: OrderedRange  # axis ratio (major / minor) of non-round reflections, >= 1
-
-    @model_validator(mode="after")
-    def _elongation(self):
-        if self.phantom_elongation[0] < 1:
-            raise KeyRule("phantom_elongation", f"an axis ratio (major / minor) is >= 1, got {list(self.phantom_elongation)}")
-        return self
+    phantom_radius_px: ordered_range(gt=0, le=IMAGE_MAX_PX / 2)  # no reflection larger than the frame
+    phantom_depth_mm: ordered_range(gt=0, le=DEPTH_MAX_MM)
+    phantom_elongation: ordered_range(ge=1, le=100)  # axis ratio (major / minor) of non-round reflections, >= 1
 
 
 class DetectionParams(Section):
@@ -80,19 +75,19 @@ class DetectionParams(Section):
     (shape_measure "pixel", split_touching; see :mod:`poseintegrity.tracking.detection`)."""
 
     threshold: int = Field(ge=0, le=255)  # on the 8-bit image
-    ir_clip: float = Field(gt=0)  # raw IR clipped here, then scaled to 8 bit
-    min_area: float = Field(ge=0)
-    max_area: float = Field(gt=0)
+    ir_clip: float = Field(gt=0, le=IR_MAX)  # raw IR clipped here, then scaled to 8 bit
+    min_area: float = Field(ge=0, le=IMAGE_MAX_PX**2)  # px^2: at most the whole frame
+    max_area: float = Field(gt=0, le=IMAGE_MAX_PX**2)
     min_circularity: float = Field(ge=0, le=1)
     min_convexity: float = Field(ge=0, le=1)
-    depth_min_mm: float = Field(ge=0)
-    depth_max_mm: float = Field(gt=0)  # published 900; AHAT reaches ~1 m and markers at 0.9 m read up to 0.9 m + noise
+    depth_min_mm: float = Field(ge=0, le=DEPTH_MAX_MM)
+    depth_max_mm: float = Field(gt=0, le=DEPTH_MAX_MM)  # published 900; AHAT reaches ~1 m and markers at 0.9 m read up to 0.9 m + noise
     depth_window: int = Field(ge=0, le=5)  # median over a (2w+1)^2 window at the centroid
-    depth_offset_mm: float = Field(ge=0)  # sphere radius: the depth hits the surface, we want the centre
+    depth_offset_mm: float = Field(ge=0, le=100)  # sphere radius: the depth hits the surface, we want the centre; 100 mm is no marker
     shape_measure: Literal["contour", "pixel"]  # "contour": the published polygon form; "pixel": ours
     split_touching: bool  # split a blob made of two touching marker images
-    split_max_residual_px: float = Field(gt=0)  # RMS boundary residual of each of the two circles
-    depth_split_mm: float = Field(gt=0)  # a depth jump inside a blob this large: two markers, one behind
+    split_max_residual_px: float = Field(gt=0, le=100)  # RMS boundary residual of each of the two circles; 100 px fits any blob
+    depth_split_mm: float = Field(gt=0, le=1000)  # a depth jump inside a blob this large: two markers, one behind
 
     @model_validator(mode="after")
     def _ranges(self):
@@ -108,7 +103,7 @@ class MatchingParams(Section):
 
     tolerance_m: float = Field(gt=0, le=0.1)
     gate_m: float = Field(gt=0, le=1.0)  # around the filter's predicted marker positions
-    min_markers: int = Field(ge=3)
+    min_markers: int = Field(ge=3, le=100)  # the filter's state grows by 3 per marker: 100 is no hand-held tool
     distinct_m: float = Field(gt=0, le=0.1)  # inter-marker distances of all tools must differ by more than this
 
 
@@ -118,19 +113,21 @@ class FilterParams(Section):
     The innovation gate and the restart after repeated rejections are ours too."""
 
     alpha: float = Field(gt=0, le=1)
-    beta: float = Field(ge=0)  # 2 is optimal for Gaussian priors
-    kappa: float | None  # None: 3 - N; N + kappa > 0 is checked against the marker count (TrackParams)
-    sigma_r: float = Field(gt=0)  # m, eq. 16
-    sigma_omega: float = Field(gt=0)  # rad/s, eq. 16
-    sigma_c: float = Field(gt=0)  # m/s^2, eq. 8
-    sigma_alpha: float = Field(gt=0)  # rad/s^2, eq. 9
-    init_std_omega: float = Field(gt=0)
-    init_std_velocity: float = Field(gt=0)
-    max_position_std: float = Field(gt=0)
+    beta: float = Field(ge=0, le=100)  # 2 is optimal for Gaussian priors; 100 weights the centre point alone
+    # None: 3 - N; N + kappa > 0 is checked against the marker count (TrackParams); beyond +-1000 one sigma point
+    # holds nearly all the weight
+    kappa: float | None = Field(ge=-1000, le=1000)
+    sigma_r: float = Field(gt=0, le=1)  # m, eq. 16; a metre of measurement noise: a marker anywhere in the room
+    sigma_omega: float = Field(gt=0, le=ANGULAR_MAX)  # rad/s, eq. 16
+    sigma_c: float = Field(gt=0, le=ACCEL_MAX)  # m/s^2, eq. 8
+    sigma_alpha: float = Field(gt=0, le=10 * ACCEL_MAX)  # rad/s^2, eq. 9; 10^4 rad/s^2 spins a hand up in 10 ms
+    init_std_omega: float = Field(gt=0, le=ANGULAR_MAX)  # rad/s
+    init_std_velocity: float = Field(gt=0, le=100)  # m/s: faster than any hand
+    max_position_std: float = Field(gt=0, le=100)  # m: restart when the position spread exceeds it; beyond a room
     dt: float = Field(gt=0, le=0.1)  # filter clock: predictions in steps of at most dt
-    restart_after_s: float = Field(gt=0)
-    innovation_gate_chi2: float = Field(gt=0)  # per marker, 3 dof: chi2.ppf(1 - 1e-4, 3)
-    restart_after_rejections: int = Field(ge=1)  # consecutive frames whose every marker failed the gate
+    restart_after_s: float = Field(gt=0, le=SECONDS_MAX)
+    innovation_gate_chi2: float = Field(gt=0, le=1000)  # per marker, 3 dof: chi2.ppf(1 - 1e-4, 3); 1000 gates nothing
+    restart_after_rejections: int = Field(ge=1, le=FRAMES_MAX)  # consecutive frames whose every marker failed the gate
 
 
 # The sigmas Black and Salcudean published (docs/references.md): sigma_r^2 = 0.00025, sigma_omega^2 = 0.1,
@@ -141,27 +138,33 @@ PAPER_SIGMAS = {"sigma_r": math.sqrt(0.00025), "sigma_omega": math.sqrt(0.1), "s
 class MotionParams(Section):
     """Simulation of section II-F (all our choices; the paper published none of them)."""
 
-    duration_s: float = Field(gt=0)
-    sim_dt: float = Field(gt=0, le=0.01)
+    duration_s: float = Field(gt=0, le=SECONDS_MAX)
+    sim_dt: float = Field(gt=0, le=0.01)  # with duration_s at most MAX_SIM_STEPS steps (checked below)
     home_m: Point
-    accel_std: float = Field(ge=0)  # m/s^2, random linear acceleration (OU)
-    accel_tau_s: float = Field(gt=0)
-    spring_hz: float = Field(ge=0)  # keeps the tool in front of the camera
-    damping: float = Field(ge=0)
-    omega_std: float = Field(ge=0)  # rad/s, body angular velocity (OU) of the accuracy runs
-    omega_tau_s: float = Field(gt=0)
-    frame_interval_s: float = Field(gt=0)  # paper: 45.98 +- 7.67 ms
-    frame_jitter_s: float = Field(ge=0)
+    accel_std: float = Field(ge=0, le=ACCEL_MAX)  # m/s^2, random linear acceleration (OU)
+    accel_tau_s: float = Field(gt=0, le=SECONDS_MAX)
+    spring_hz: float = Field(ge=0, le=100)  # keeps the tool in front of the camera; 100 Hz is a vibration, not a hand
+    damping: float = Field(ge=0, le=100)  # damping ratio of that spring: 1 is critical, 100 a tool stuck in honey
+    omega_std: float = Field(ge=0, le=ANGULAR_MAX)  # rad/s, body angular velocity (OU) of the accuracy runs
+    omega_tau_s: float = Field(gt=0, le=SECONDS_MAX)
+    frame_interval_s: float = Field(gt=0, le=10)  # paper: 45.98 +- 7.67 ms; a frame every 10 s tracks nothing
+    frame_jitter_s: float = Field(ge=0, le=10)
     p_gyro_2: float = Field(ge=0, le=1)  # P_2: two gyro samples per frame, else three (P_3 = 1 - P_2)
-    gyro_noise_std: float = Field(ge=0)  # rad/s
+    gyro_noise_std: float = Field(ge=0, le=ANGULAR_MAX)  # rad/s
     p_occlusion: float = Field(ge=0, le=1)  # P_o per marker and frame
     p_phantom: float = Field(ge=0, le=1)  # P_p per phantom slot and frame
-    max_phantoms: int = Field(ge=0)
+    max_phantoms: int = Field(ge=0, le=1000)  # phantom slots per frame: each a blob to render, detect and reject
     phantom_round_fraction: float = Field(ge=0, le=1)
-    occlusions: list[tuple[float, float]]  # (start_s, duration_s): all markers hidden
+    # (start_s, duration_s): all markers hidden; inside duration_s (checked below)
+    occlusions: list[Annotated[tuple[Annotated[float, Field(ge=0, le=SECONDS_MAX)],
+                                     Annotated[float, Field(gt=0, le=SECONDS_MAX)]], FromList]]
 
     @model_validator(mode="after")
     def _times(self):
+        steps = self.duration_s / self.sim_dt
+        if steps > MAX_SIM_STEPS:
+            raise KeyRule("sim_dt", f"duration_s / sim_dt = {steps:.3g} simulation steps, more than {MAX_SIM_STEPS:g} "
+                                    f"(GBs of trajectory): raise sim_dt or shorten duration_s, got {self.sim_dt:g}")
         if self.frame_interval_s <= 4 * self.sim_dt:
             raise KeyRule("frame_interval_s", f"must exceed 4 sim_dt ({4 * self.sim_dt:g} s): frames are at least 4 grid steps apart, got {self.frame_interval_s:g}")
         for k, (start, duration) in enumerate(self.occlusions):
@@ -178,39 +181,40 @@ class HandMotionParams(Section):
     translation is the OU walk of ``motion`` with a larger acceleration; brief per-marker occlusions (a finger
     passing over a marker) instead of the i.i.d. P_o of ``motion``.  All our choices (see params.yaml)."""
 
-    turn_s: PositiveRange  # duration of one full turn, s (uniform)
-    pause_s: NonNegativeRange  # between turns, s (uniform)
-    wobble_std: float = Field(ge=0)  # rad/s, OU angular velocity added throughout (hand tremor, re-grip)
-    accel_std: float = Field(ge=0)  # m/s^2, the OU linear acceleration of the large motions
-    occlusion_rate_hz: float = Field(ge=0)  # per marker
-    occlusion_s: PositiveRange  # duration of a brief occlusion, s (uniform)
+    turn_s: Seconds  # duration of one full turn, s (uniform)
+    pause_s: ordered_range(ge=0, le=60)  # between turns, s (uniform); under a minute
+    wobble_std: float = Field(ge=0, le=ANGULAR_MAX)  # rad/s, OU angular velocity added throughout (hand tremor, re-grip)
+    accel_std: float = Field(ge=0, le=ACCEL_MAX)  # m/s^2, the OU linear acceleration of the large motions
+    occlusion_rate_hz: float = Field(ge=0, le=1000)  # per marker; more than one occlusion a millisecond is no finger
+    occlusion_s: Seconds  # duration of a brief occlusion, s (uniform)
 
 
 class EvaluationParams(Section):
     """Section III on our simulation."""
 
-    success_frames: int = Field(ge=1)  # paper: 10 000 frames of large motion
-    success_omega_std: float = Field(ge=0)  # rad/s, motion (b): the stress test, OU spin of this spread
+    success_frames: int = Field(ge=1, le=FRAMES_MAX)  # paper: 10 000 frames of large motion
+    success_omega_std: float = Field(ge=0, le=ANGULAR_MAX)  # rad/s, motion (b): the stress test, OU spin of this spread
     correct_tolerance_m: float = Field(gt=0, le=0.1)  # per matched point; a wrong match is off by >= 35 mm
-    lag_max_ms: float = Field(gt=0)
-    sigma_scales: PositiveList  # noise-vs-lag sweep of sigma_c and sigma_alpha
-    timing_repeats: int = Field(ge=1)
-    sweep_distances_m: PositiveList  # small-blob sweep; inside the detector's depth window (TrackParams)
-    sweep_focal_px: float = Field(gt=0)
-    sweep_poses: int = Field(ge=1)  # random tool orientations per distance
-    sweep_phantoms: int = Field(ge=1)  # elongated phantoms rendered for the rejection rate
-    replay_s: float = Field(gt=0)  # seconds of recording written as PNG frames and replayed from disk
-    multi_tool_frames: int = Field(ge=1)  # frames of the two-tool and phantom-rich runs
-    phantom_rich_max: int = Field(ge=0)  # phantoms per frame (binomial, p_phantom) in the phantom-rich scene
-    second_tool: list[Point]  # m; checked against markers_body (TrackParams)
+    lag_max_ms: float = Field(gt=0, le=60_000)  # lags searched up to this; a minute is no lag
+    sigma_scales: PositiveList  # noise-vs-lag sweep of sigma_c and sigma_alpha (each scale at most 1000)
+    timing_repeats: int = Field(ge=1, le=FRAMES_MAX)
+    # small-blob sweep; inside the detector's depth window (TrackParams)
+    sweep_distances_m: Annotated[list[Annotated[float, Field(gt=0, le=DEPTH_MAX_MM / 1000)]], AfterValidator(_non_empty)]
+    sweep_focal_px: float = Field(gt=0, le=FOCAL_MAX_PX)
+    sweep_poses: int = Field(ge=1, le=10_000)  # random tool orientations per distance; each renders a frame
+    sweep_phantoms: int = Field(ge=1, le=100_000)  # elongated phantoms rendered for the rejection rate
+    replay_s: float = Field(gt=0, le=600)  # s of recording written as PNG frames and replayed: 10 min ~ GBs of PNGs
+    multi_tool_frames: int = Field(ge=1, le=FRAMES_MAX)  # frames of the two-tool and phantom-rich runs
+    phantom_rich_max: int = Field(ge=0, le=1000)  # phantoms per frame (binomial, p_phantom) in the phantom-rich scene
+    second_tool: list[MarkerPoint]  # m; checked against markers_body (TrackParams)
 
 
 class TrackParams(Section):
     """The ``track`` section of params.yaml."""
 
     seed: Seed
-    markers_body: list[Point]  # m, body frame (docs/references.md)
-    drop_marker: int = Field(ge=0)  # the marker removed for the 3-marker variant (params.yaml says why)
+    markers_body: list[MarkerPoint]  # m, body frame (docs/references.md)
+    drop_marker: int = Field(ge=0, le=100)  # the marker removed for the 3-marker variant (params.yaml says why); an index of markers_body
     camera: CameraParams
     frames: FrameParams
     detection: DetectionParams
