@@ -212,7 +212,7 @@ class FittedModel:
 
     def __post_init__(self) -> None:
         if self.status not in FIT_STATUSES:
-            raise ValueError(f"unknown fit status {self.status!r}; expected one of {FIT_STATUSES}")
+            raise ArgumentError(f"unknown fit status {self.status!r}; expected one of {FIT_STATUSES}")
 
     @property
     def has_curve(self) -> bool:
