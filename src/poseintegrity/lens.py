@@ -24,7 +24,7 @@ import cv2
 import numpy as np
 import yaml
 
-from poseintegrity.errors import PoseIntegrityError
+from poseintegrity.errors import ArgumentError, PoseIntegrityError, check_array, check_intrinsics
 
 DISTORTION_MODEL = "plumb_bob"  # ROS's name of OpenCV's 5-coefficient model
 # cv2.undistortPoints stops when the re-distorted estimate is within eps px of the pixel: 1e-10 px, as 1e-14 lies
@@ -45,12 +45,26 @@ class CameraFileError(PoseIntegrityError):
 
 @dataclass(frozen=True)
 class Camera:
-    """A camera with a lens: K (3, 3) px, dist (5,) = (k1, k2, p1, p2, k3), image width and height (px)."""
+    """A camera with a lens: K (3, 3) px, dist (5,) = (k1, k2, p1, p2, k3), image width and height (px).
+
+    Checked once when made (:class:`~poseintegrity.errors.ArgumentError` naming the field): K a finite pinhole
+    matrix [[fx, s, cx], [0, fy, cy], [0, 0, 1]] with fx, fy > 0; dist 5 finite numbers; width and height positive
+    integers. Every function taking a Camera (board pose, target model, undistortion) relies on it; a zero or NaN
+    K would otherwise give NaN points or a pose hundreds of mm off reported as ok. Whether the lens folds the image
+    is checked where a camera is read from a file (:func:`read_camera_yaml`, :func:`check_folding`).
+    """
 
     K: np.ndarray
     dist: np.ndarray
     width: int
     height: int
+
+    def __post_init__(self) -> None:
+        check_intrinsics("Camera.K", self.K)
+        check_array("Camera.dist", self.dist, shape=(5,))
+        for name, value in (("width", self.width), ("height", self.height)):
+            if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)) or value < 1:
+                raise ArgumentError(f"Camera.{name}: expected a positive integer (pixels), got {value!r}")
 
     def undistort(self, points_px: np.ndarray) -> np.ndarray:
         """(n, 2) sensor pixels -> (n, 2) pixels of the ideal pinhole camera with the same K (OpenCV's iterative

@@ -11,6 +11,8 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
+from poseintegrity.errors import ArgumentError
+
 NAN_POSE = np.full((4, 4), np.nan)  # the documented value of a pose that could not be estimated
 NAN_POSE.flags.writeable = False  # shared: a caller that fills a pose in copies it first
 
@@ -27,6 +29,8 @@ def pose_matrix(R: np.ndarray, t: np.ndarray) -> np.ndarray:
 
 def inverse(T: np.ndarray) -> np.ndarray:
     """T_b_a of T_a_b (..., 4, 4), rigid: (R^T, -R^T t)."""
+    if np.shape(T)[-2:] != (4, 4):
+        raise ArgumentError(f"T: expected a pose (4, 4) or a stack (..., 4, 4), got shape {np.shape(T)}")
     R_t = np.swapaxes(T[..., :3, :3], -1, -2)
     return pose_matrix(R_t, -(R_t @ T[..., :3, 3, None])[..., 0])
 
@@ -55,6 +59,9 @@ def pose_errors(T_est: np.ndarray, T_true: np.ndarray) -> tuple[np.ndarray, np.n
     unit, E_r = the angle of R_est R_true^T in degrees (:func:`rotation_angle_deg`); shapes (...). NaN where either
     pose holds NaN or inf (a failed estimate, an unknown truth)."""
     T_est, T_true = np.asarray(T_est, dtype=np.float64), np.asarray(T_true, dtype=np.float64)
+    for name, T in (("T_est", T_est), ("T_true", T_true)):
+        if T.shape[-2:] != (4, 4):
+            raise ArgumentError(f"{name}: expected a pose (4, 4) or a stack (..., 4, 4), got shape {T.shape}")
     known = np.isfinite(T_est).all(axis=(-2, -1)) & np.isfinite(T_true).all(axis=(-2, -1))
     E_t = np.linalg.norm(T_est[..., :3, 3] - T_true[..., :3, 3], axis=-1)
     with np.errstate(invalid="ignore"):

@@ -8,8 +8,9 @@ writes ``<reports>/notebooks/<name>.ipynb`` and ``.html`` and ``<reports>/metric
 (:class:`poseintegrity.timing.StageTiming`). While the notebook runs, everything it prints (the progress lines of
 :mod:`poseintegrity.parallel`, tqdm bars) reaches this terminal as it comes, with one line per cell.
 
-Before any work, the ``parallel`` section is validated and a Dask scheduler at ``parallel.address`` must answer:
-both fail naming the key. The stage's previous outputs are deleted first and the notebook executes into
+Before any work, the notebook must exist, the ``parallel`` section is validated and a Dask scheduler at
+``parallel.address`` must answer: each fails naming the file or key in one line on stderr, exit status 2, no
+traceback (a failing cell exits with status 1 and the cell's error). The stage's previous outputs are deleted first and the notebook executes into
 ``<name>.partial.ipynb``, renamed when the HTML is written; the timing file comes last. So an interrupted or
 failed stage leaves nothing that looks complete (the partial notebook shows how far it got).
 """
@@ -37,7 +38,7 @@ from traitlets.config import Config  # noqa: E402
 
 from poseintegrity.config import ParamsError, load_section  # noqa: E402
 from poseintegrity.parallel import worker_count  # noqa: E402
-from poseintegrity.timing import StageTiming  # noqa: E402
+from poseintegrity.timing import StageTiming, usage_error  # noqa: E402
 
 KERNEL = "python3"  # the kernelspec `make install` writes into .venv (the Makefile points JUPYTER_PATH there)
 
@@ -139,12 +140,14 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--reports", type=Path, default=Path("reports"), help="reports_dir of the notebook")
     args = parser.parse_args(argv)
     name = args.notebook.stem
+    if not args.notebook.is_file():  # bad input: one line, exit status 2, no traceback
+        sys.exit(usage_error(f"{args.notebook}: no such notebook"))
     partial = StageOutputs(args.reports, name).partial_notebook
     try:
         record = run_stage(args.notebook, args.params, args.data, args.reports,
                            started=process_start_epoch())
     except (ParamsError, ConnectionError) as error:
-        sys.exit(f"{name}: {error}")
+        sys.exit(usage_error(f"{name}: {error}"))
     except papermill.PapermillExecutionError as error:
         sys.exit(f"{error}\n{name} failed; the notebook as far as it ran: {partial}")
     except KeyboardInterrupt:

@@ -8,7 +8,10 @@ from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
 from poseintegrity.poses import pose_errors
-from poseintegrity.localization.pnp import CLASSIC_FLAGS, FAILURES, METHODS, reprojection_errors, solve_pnp_ransac
+from poseintegrity.errors import PoseIntegrityError
+from poseintegrity.localization.pnp import (
+    CLASSIC_FLAGS, FAILURES, METHODS, reprojection_errors, solve_checked, solve_pnp_ransac,
+)
 from poseintegrity.localization.ransac import minimal_sample_size, ransac_iterations
 
 K = np.array([[700.0, 0.0, 480.0], [0.0, 700.0, 300.0], [0.0, 0.0, 1.0]])
@@ -125,7 +128,11 @@ def test_pure_outliers_never_crash():
 def test_every_failure_says_why(method, K_used, max_iterations, status, words):
     rng = np.random.default_rng(5)
     X, x = rng.uniform(-50, 50, (30, 3)), rng.uniform(0, 900, (30, 2))
-    result = solve_pnp_ransac(X, x, K_used, method, 1.0, 0.99, max_iterations, seed=1, refine_lm=True)
+    if K_used is not K:  # the public entry refuses such a K (test_bad_intrinsics_are_refused); the unchecked
+        # per-frame path still never raises and says why
+        with pytest.raises(PoseIntegrityError, match="K: "):
+            solve_pnp_ransac(X, x, K_used, method, 1.0, 0.99, max_iterations, seed=1, refine_lm=True)
+    result = solve_checked(X, x, K_used, method, 1.0, 0.99, max_iterations, seed=1, refine_lm=True)
     assert result.status == status and np.all(np.isnan(result.T_cam_model)) and result.n_inliers == 0
     for word in words:
         assert word in result.reason

@@ -188,10 +188,12 @@ def test_two_worker_processes_give_the_same_table(swept, tables, tiny, tiny_pred
 def test_pnp_variants_add_methods_without_replacing_stage_02s(tables):
     artifacts, envelopes = tables
     usac, usac_envelopes = artifacts[artifacts.method == "usac_magsac"], envelopes[envelopes.method == "usac_magsac"]
-    variants = pd.concat([usac.assign(method="sqpnp"), usac.assign(n_inliers=-1.0)])  # usac rows: stage 02's stay
+    variants = pd.concat([usac.assign(method="sqpnp"), usac.assign(n_inliers=usac.n_inliers + 1000.0)])  # usac rows:
+    # stage 02's stay (stage 05's, marked by 1000 more inliers, are left out)
     merged, merged_envelopes = with_pnp_variants(artifacts, envelopes, variants,
                                                  pd.concat([usac_envelopes.assign(method="sqpnp"), usac_envelopes]))
-    assert set(merged.method) == {"usac_magsac", "epnp", "sqpnp"} and (merged.n_inliers >= 0).all()
+    assert set(merged.method) == {"usac_magsac", "epnp", "sqpnp"}
+    assert (merged[merged.method == "usac_magsac"].n_inliers.to_numpy() == usac.n_inliers.to_numpy()).all()
     assert len(merged) == len(artifacts) * 3 // 2
     assert len(merged_envelopes) == len(envelopes) * 3 // 2
 

@@ -290,7 +290,7 @@ class BaseFunction:
         bound: scipy.optimize.least_squares' ``active_mask``), "non_physical", or "fallback" (too few distinct
         theta, the optimizer failed, or a non-finite curve).
         """
-        theta, n_inliers = valid_samples(theta, n_inliers)
+        theta, n_inliers = valid_samples(theta, n_inliers, theta_end)
         reason = too_few_samples(theta, len(self.param_names))
         if reason is not None:
             return FittedModel.failed(self.name, self.param_names, reason, theta, n_inliers)

@@ -21,6 +21,8 @@ from poseintegrity.artifact_models.fitted import FIT_STATUSES, OK, FittedModel
 from poseintegrity.artifact_models.models import distinct_theta_needed, fit_model
 from poseintegrity.artifact_models.params import FitParams
 from poseintegrity.artifact_models.series import Series, dataset_series
+from poseintegrity.errors import ArgumentError
+from poseintegrity.localization.tables import check_fig2_rmse
 from poseintegrity.parallel import Workers
 from poseintegrity.protocol import ProtocolParams
 
@@ -86,14 +88,17 @@ def fig2_rmse(
     ]
     if not tasks:
         most = max(series.n_stops for series in all_series)
-        raise ValueError(f"no dataset has k_min = {params.k_min} stops (the longest has {most}): lower fit.k_min")
+        raise ArgumentError(f"fit.k_min: no dataset has k_min = {params.k_min} stops (the longest has {most}): lower fit.k_min")
     results = workers.map(partial(_fig2_rows, params=params), tasks, desc="Fig. 2 fits (dataset, k)",
                           progress=progress)  # fmt: skip
     return pd.DataFrame([row for rows in results for row in rows], columns=COLUMNS)
 
 
 def mean_rmse(table: pd.DataFrame) -> pd.DataFrame:
-    """Fig. 2's curves: per (trajectory, model, k) the mean RMSE across datasets and the share of fits "ok"."""
+    """Fig. 2's curves: per (trajectory, model, k) the mean RMSE across datasets and the share of fits "ok".
+    ``table`` is checked (:func:`~poseintegrity.localization.tables.check_fig2_rmse`: a repeated row would shift a
+    mean)."""
+    check_fig2_rmse(table)
     return (
         table.assign(ok=table["status"] == OK)
         .groupby(["trajectory", "model", "k"], sort=True)

@@ -8,7 +8,9 @@ and ``reason`` say what happened. Statuses, from the most to the least severe (:
                     ``predict`` uses a straight line through the samples (clipped at zero inliers) instead
     "non_physical"  the fitted curve, evaluated over [first stop, range end], predicts a count that rounds below
                     zero, does not fall from the first stop to the range end (a decay is what the artifact
-                    model stands for, III-D), or exceeds LARGEST_LEVEL times the largest mean count sampled
+                    model stands for, III-D), or exceeds LARGEST_LEVEL times the largest mean count sampled; or it
+                    does not follow its own samples: its RMSE on them exceeds LACK_OF_FIT times their noise and is
+                    no better than their mean's (e.g. rising counts fitted by a decay family)
     "at_bound"      a least squares parameter ended at one of its bounds (base_functions.DecaySummary): the data
                     wanted a curve outside the family allowed, e.g. a decay longer than 20 sampled spans
     "ok"            none of these
@@ -26,11 +28,15 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from poseintegrity.errors import ArgumentError, check_scalar
+
 OK, AT_BOUND, NON_PHYSICAL, FALLBACK = "ok", "at_bound", "non_physical", "fallback"
 FIT_STATUSES = (OK, AT_BOUND, NON_PHYSICAL, FALLBACK)  # least to most severe
 LARGEST_LEVEL = 10.0  # largest count level a model may predict or a level parameter take, in largest mean counts
 NEGATIVE_COUNT = -0.5  # a prediction below this rounds to a negative inlier count
 ONE_INLIER = 0.5  # a prediction from this on rounds to at least one inlier
+LACK_OF_FIT = 3.0  # a fit's RMSE on its own samples above this many noise levels, and no better than their mean: flagged
+NO_BETTER_THAN_MEAN = 0.9  # ... "no better": RMSE at least this share of the mean's (R^2 below 0.19)
 CHECK_POINTS = 181  # grid of the physical check over [first stop, range end] (0.25 deg steps over a 45 deg arc)
 
 
@@ -39,19 +45,32 @@ def worst(statuses) -> str:
     return FIT_STATUSES[max((FIT_STATUSES.index(s) for s in statuses), default=0)]
 
 
-def valid_samples(theta: np.ndarray, n_inliers: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def valid_samples(theta: np.ndarray, n_inliers: np.ndarray, theta_end: float | None = None
+                  ) -> tuple[np.ndarray, np.ndarray]:
     """Drop samples that cannot be counts: non-finite theta or n, and negative n.
 
     theta : (m,) float, the independent variable (deg for arcs, mm for lines)
     n_inliers : (m,) float, inlier counts (0 is a valid count: a failed frame)
-    Returns the kept (theta, n_inliers), both (m',) float.
+    theta_end : when given (every fitter passes its range end), checked: a finite number not before the first
+        valid sample (a NaN or early range end would skip the physical check of the fit)
+    Returns the kept (theta, n_inliers), both (m',) float. :class:`~poseintegrity.errors.ArgumentError` naming the
+    argument when theta and n_inliers differ in length, hold something other than numbers, or theta_end is bad.
     """
-    theta = np.asarray(theta, dtype=float).ravel()
-    n_inliers = np.asarray(n_inliers, dtype=float).ravel()
+    try:
+        theta = np.asarray(theta, dtype=float).ravel()
+        n_inliers = np.asarray(n_inliers, dtype=float).ravel()
+    except (TypeError, ValueError) as error:
+        raise ArgumentError(f"theta, n_inliers: expected numbers ({error})") from None
     if theta.shape != n_inliers.shape:
-        raise ValueError(f"theta {theta.shape} and n_inliers {n_inliers.shape} differ in length")
+        raise ArgumentError(f"theta {theta.shape} and n_inliers {n_inliers.shape} differ in length")
     keep = np.isfinite(theta) & np.isfinite(n_inliers) & (n_inliers >= 0)
-    return theta[keep], n_inliers[keep]
+    theta, n_inliers = theta[keep], n_inliers[keep]
+    if theta_end is not None:
+        check_scalar("theta_end", theta_end)
+        if theta.size and theta_end < theta.min():
+            raise ArgumentError(f"theta_end: the range end {theta_end:g} lies before the first sample "
+                                f"{theta.min():g}: the fit could not be checked up to it")
+    return theta, n_inliers
 
 
 def line_fit(x: np.ndarray, y: np.ndarray) -> tuple[float, float]:
@@ -84,8 +103,11 @@ def largest_mean_count(theta: np.ndarray, n_inliers: np.ndarray) -> float:
 
 def check_grid(theta: np.ndarray, theta_end: float) -> np.ndarray:
     """The points of the physical check: [first sampled theta, theta_end] : (CHECK_POINTS,) (the first sample alone
-    when it lies at or past the range end)."""
+    when it lies at the range end). ArgumentError when theta_end is not finite or lies before the first sample."""
     first = float(np.min(theta))
+    if not (np.isfinite(theta_end) and theta_end >= first):
+        raise ArgumentError(f"theta_end: expected a finite range end at or after the first sample {first:g}, "
+                            f"got {theta_end!r}")
     return np.linspace(first, theta_end, CHECK_POINTS) if theta_end > first else np.array([first])
 
 
@@ -120,6 +142,26 @@ def physical_problems(curve: Callable[[np.ndarray], np.ndarray], grid: np.ndarra
         problems.append(f"count {f[high]:.3g} at theta {grid[high]:.4g} > {LARGEST_LEVEL:g} x the largest mean "
                         f"count sampled ({n_max:.4g})")
     return problems
+
+
+def lack_of_fit(curve: Callable[[np.ndarray], np.ndarray], theta: np.ndarray, n_inliers: np.ndarray) -> str | None:
+    """Why a finite curve does not follow its own samples; None if it does.
+
+    Flagged when its RMSE on the samples exceeds LACK_OF_FIT noise levels and is at least NO_BETTER_THAN_MEAN of
+    the RMSE of their mean (the curve explains almost nothing of them). Noise: the pooled standard deviation of the
+    counts at a repeated theta, at least sqrt(mean count) (counting noise) and 1 inlier.
+    """
+    rmse = float(np.sqrt(np.mean((curve(theta) - n_inliers) ** 2)))
+    theta_u, index = np.unique(theta, return_inverse=True)
+    means = np.bincount(index, weights=n_inliers) / np.bincount(index)
+    repeats = theta.size - theta_u.size
+    pooled = float(np.sqrt(np.sum((n_inliers - means[index]) ** 2) / repeats)) if repeats else 0.0
+    noise = max(pooled, float(np.sqrt(max(n_inliers.mean(), 0.0))), 1.0)
+    flat = float(np.sqrt(np.mean((n_inliers - n_inliers.mean()) ** 2)))
+    if rmse > LACK_OF_FIT * noise and rmse >= NO_BETTER_THAN_MEAN * flat:
+        return (f"lack of fit: RMSE {rmse:.3g} on its own samples > {LACK_OF_FIT:g} x their noise {noise:.3g} and no "
+                f"better than their mean's {flat:.3g}")
+    return None
 
 
 @dataclass(frozen=True)
@@ -170,7 +212,7 @@ class FittedModel:
 
     def __post_init__(self) -> None:
         if self.status not in FIT_STATUSES:
-            raise ValueError(f"unknown fit status {self.status!r}; expected one of {FIT_STATUSES}")
+            raise ArgumentError(f"unknown fit status {self.status!r}; expected one of {FIT_STATUSES}")
 
     @property
     def has_curve(self) -> bool:
@@ -212,6 +254,7 @@ class FittedModel:
             return cls.failed(name, tuple(params), broken, theta, n_inliers)
         with np.errstate(all="ignore"):
             problems = physical_problems(curve, grid, largest_mean_count(theta, n_inliers))
+            problems += [poor] if (poor := lack_of_fit(curve, theta, n_inliers)) else []
         bounds = [f"at bound: {', '.join(at_bound)}"] if at_bound else []
         status = NON_PHYSICAL if problems else AT_BOUND if at_bound else OK
         return cls(

@@ -103,7 +103,7 @@ def fit_mlp(
     whole iteration budget, and a net from scratch that fits 4 stops may predict -5e10 inliers at 45 deg.
     """
     name = "mlp_pretrained" if pretrain else "mlp_scratch"
-    theta, n_inliers = valid_samples(theta, n_inliers)
+    theta, n_inliers = valid_samples(theta, n_inliers, theta_end)
     reason = too_few_samples(theta, DISTINCT_THETA)
     if reason is not None:
         return FittedModel.failed(name, PARAM_NAMES, reason, theta, n_inliers)

@@ -8,6 +8,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from poseintegrity.errors import ArgumentError
+
 from poseintegrity.artifact_models.base_functions import LEAST_SQUARES
 from poseintegrity.artifact_models.fitted import FittedModel
 from poseintegrity.artifact_models.mlp import DISTINCT_THETA, fit_mlp
@@ -38,9 +40,11 @@ def fit_model(
     theta_end : end of the trajectory range: the fitted curve is checked up to it (fitted.py), the MLP scales its
     input by it and puts its artificial points there
     rng : seeds the MLP weights (unused by base functions)
+    Refused (:class:`~poseintegrity.errors.ArgumentError` naming the argument): an unknown name, theta and n_inliers
+    of different lengths, a theta_end that is not finite or lies before the first valid sample.
     """
     if name in LEAST_SQUARES:
         return LEAST_SQUARES[name].fit(theta, n_inliers, theta_end=theta_end, max_nfev=params.max_nfev)
     if name in MLP_RECIPES:
         return fit_mlp(theta, n_inliers, theta_end=theta_end, mlp=params.mlp, rng=rng, pretrain=MLP_RECIPES[name])
-    raise ValueError(f"unknown artifact model {name!r}; expected one of {MODEL_NAMES}")
+    raise ArgumentError(f"name: unknown artifact model {name!r}; expected one of {MODEL_NAMES}")

@@ -11,6 +11,8 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from poseintegrity.errors import ArgumentError
+from poseintegrity.localization.tables import TableError, check_artifacts
 from poseintegrity.protocol import ProtocolParams
 
 VARIABLE = {"arc": "theta_deg", "line": "x_mm"}  # independent variable of the artifact model per trajectory
@@ -49,19 +51,17 @@ def dataset_series(artifacts: pd.DataFrame, pnp_method: str, protocol: ProtocolP
     """Split the artifacts table into one :class:`Series` per (trajectory, dataset) for ``pnp_method``, each
     ending where ``protocol`` ends its trajectory type.
 
-    Checked on read (ValueError naming the dataset): the columns of stage 02's table, a known trajectory type, stops
-    in order of theta, theta finite inside [0, range end] (a table rendered for another protocol would otherwise be
-    fitted and searched over the wrong range).
+    Checked on read (:class:`~poseintegrity.localization.tables.TableError` naming the table, column and row, or
+    ArgumentError naming the dataset): the columns of stage 02's table, rows, one row per (dataset, stop, image,
+    method) (a duplicated row would count twice in every fit), integer stops and images, finite positions, counts
+    >= 0, a known trajectory type, stops in order of theta, theta inside [0, range end] (a table rendered for
+    another protocol would otherwise be fitted and searched over the wrong range).
     """
-    missing = [column for column in REQUIRED_COLUMNS if column not in artifacts.columns]
-    if missing:
-        raise ValueError(f"the artifacts table lacks columns {missing} (stage 02 writes {list(REQUIRED_COLUMNS)})")
+    check_artifacts(artifacts, columns=REQUIRED_COLUMNS)
     rows = artifacts[artifacts["method"] == pnp_method]
     if rows.empty:
-        raise ValueError(f"no rows with method {pnp_method!r}; methods present: {sorted(artifacts['method'].unique())}")
-    unknown = set(rows["trajectory"]) - set(VARIABLE)
-    if unknown:
-        raise ValueError(f"unknown trajectory type(s) {sorted(unknown)}; expected {sorted(VARIABLE)}")
+        raise TableError(f"the artifacts table: no rows with method {pnp_method!r}; methods present: "
+                         f"{sorted(artifacts['method'].unique())}")
     series = []
     for (trajectory, dataset), group in rows.groupby(["trajectory", "dataset"], sort=True):
         group = group.sort_values(["stop", "image"], kind="stable")
@@ -79,16 +79,16 @@ def dataset_series(artifacts: pd.DataFrame, pnp_method: str, protocol: ProtocolP
 
 
 def _check(series: Series) -> None:
-    """ValueError unless ``series`` has finite theta in [0, theta_end] whose per-stop mean increases with the stop."""
+    """ArgumentError unless ``series`` has finite theta in [0, theta_end] whose per-stop mean increases with the stop."""
     variable = VARIABLE[series.trajectory]
     where = f"dataset {series.dataset} ({series.trajectory}, {variable})"
     if not np.all(np.isfinite(series.theta)):
-        raise ValueError(f"{where}: non-finite {variable}")
+        raise ArgumentError(f"{where}: non-finite {variable}")
     stops, index = np.unique(series.stop, return_inverse=True)
     per_stop = np.bincount(index, weights=series.theta) / np.bincount(index)
     if np.any(np.diff(per_stop) <= 0):
-        raise ValueError(f"{where}: {variable} does not increase with the stop: {np.round(per_stop, 3).tolist()}")
+        raise ArgumentError(f"{where}: {variable} does not increase with the stop: {np.round(per_stop, 3).tolist()}")
     if series.theta.min() < 0 or series.theta.max() > series.theta_end:
-        raise ValueError(f"{where}: spans {series.theta.min():g} .. {series.theta.max():g}, outside [0, "
+        raise ArgumentError(f"{where}: spans {series.theta.min():g} .. {series.theta.max():g}, outside [0, "
                          f"{series.theta_end:g}] (the protocol's range end): was stage 02's table made with another "
                          f"protocol?")

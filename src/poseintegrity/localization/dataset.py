@@ -11,10 +11,10 @@ What is checked before any work, each failure a :class:`DatasetError` naming the
 - ``index.parquet`` readable, with a ``dataset`` and a ``path`` column; no dataset or folder named twice; every
   folder it names exists; every dataset folder on disk is in it (a folder left out would be skipped silently);
 - ``meta.json`` readable and holding what stages 02 and 05 read (:class:`Meta`): the dataset's name as in the
-  index, its world and trajectory, the board, two model images, masks and a rigid finite relative pose;
+  index, its world and trajectory, the board (a dictionary OpenCV knows, its marker ids inside it), two model images, masks and a rigid finite relative pose;
 - ``camera.yaml`` readable, every field valid (positive focal lengths, the plumb_bob model, a lens that does not
   fold the image);
-- ``frames.parquet`` readable, with its columns, one row per (stop, image) and per file, finite stop positions,
+- ``frames.parquet`` readable, with its columns, at least one row, one row per (stop, image) and per file, finite stop positions,
   and every image file present.
 
 A frame's own ground-truth pose is checked per frame (:func:`pose_problem`): a bad one flags that frame's rows
@@ -28,12 +28,13 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Literal
 
+import cv2
 import numpy as np
 import pandas as pd
 import pyarrow
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
-from poseintegrity.errors import PoseIntegrityError
+from poseintegrity.errors import ArgumentError, PoseIntegrityError
 from poseintegrity.lens import Camera, CameraFileError, read_camera_yaml
 
 INDEX_COLUMNS = ("dataset", "path")
@@ -61,6 +62,16 @@ def pose_problem(values: Any) -> str | None:
     return None
 
 
+def aruco_dictionary(name: object) -> int:
+    """OpenCV's id of the predefined ArUco dictionary ``name`` ("DICT_4X4_50", ...);
+    :class:`~poseintegrity.errors.ArgumentError` naming it and the known names otherwise."""
+    value = getattr(cv2.aruco, name, None) if isinstance(name, str) and name.startswith("DICT_") else None
+    if isinstance(value, bool) or not isinstance(value, int):
+        known = sorted(key for key in dir(cv2.aruco) if key.startswith("DICT_"))
+        raise ArgumentError(f"board.dictionary: unknown ArUco dictionary {name!r}; OpenCV knows {', '.join(known)}")
+    return value
+
+
 def _pose(values: Any, which: str) -> list[list[float]]:
     problem = pose_problem(values)
     if problem:
@@ -83,6 +94,21 @@ class BoardMeta(_Read):
     marker_length_mm: float = Field(gt=0)
     separation_mm: float = Field(ge=0)
     first_id: int = Field(ge=0)
+
+    @field_validator("dictionary")
+    @classmethod
+    def _known(cls, name: str) -> str:
+        aruco_dictionary(name)  # an unknown name would fail only when stage 02 builds the board
+        return name
+
+    @model_validator(mode="after")
+    def _ids_in_dictionary(self) -> "BoardMeta":
+        size = cv2.aruco.getPredefinedDictionary(aruco_dictionary(self.dictionary)).bytesList.shape[0]
+        last = self.first_id + self.markers_x * self.markers_y
+        if last > size:
+            raise ValueError(f"board: markers {self.first_id} .. {last - 1} do not fit {self.dictionary}, which has "
+                             f"{size} markers")
+        return self
 
 
 class ModelMeta(_Read):
@@ -213,6 +239,8 @@ def _read_meta(path: Path, name: str | None) -> dict[str, Any]:
 def _check_frames(frames: pd.DataFrame, path: Path, name: str) -> None:
     if missing := _missing_columns(frames, FRAME_TABLE_COLUMNS):
         raise DatasetError(f"dataset {name}: {path} lacks the column(s) {missing}")
+    if frames.empty:
+        raise DatasetError(f"dataset {name}: {path} has no rows (a dataset without frames would give an empty stage)")
     if frames[["dataset", "stop", "image", "file"]].isna().any().any():
         raise DatasetError(f"dataset {name}: {path} has empty dataset, stop, image or file entries")
     if others := sorted(set(frames["dataset"].astype(str)) - {name}):

@@ -22,16 +22,24 @@ Rules common to all: a tolerance is a pair (E_t mm, E_r deg) and a stop fails wh
 theta_a is the earliest crossing, each criterion linearly interpolated between the last passing stop and the first
 failing one (a criterion that is infinite at the failing stop crosses at the previous stop); a dataset whose first
 stop (the model view, IV-D; x = 0 on lines) already fails has theta_a = that stop; one that never fails is censored
-at its last stop (``censored`` True).
+at its last stop (``censored`` True). A criterion never measured at any stop (every frame's E_t NaN: the board was
+never detected) is no evidence of staying within tolerance: theta_a is then NaN (``censored`` False), flagged with a
+warning naming the dataset, unless the first stop already fails; the envelopes table's NaN is refused by the
+prediction stage (prediction.sweeps.attach_envelopes) naming the dataset.
 """
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pandas as pd
 
+from poseintegrity.errors import ArgumentError, check_array, check_increasing, check_same_length
 from poseintegrity.protocol import FAILED_FRAME_RULES, EnvelopeParams, tolerance_name
 
+ENVELOPE_INPUT = ("world", "dataset", "trajectory", "stop", "image", "theta_deg", "x_mm", "method", "status",
+                  "E_t_mm", "E_r_deg")  # what envelopes reads of an artifacts table
 COLUMNS = ["world", "dataset", "trajectory", "tolerance", "method", "rule", "theta_a", "censored"]
 
 
@@ -42,12 +50,22 @@ def actual_envelope(theta: np.ndarray, criteria: np.ndarray, bounds: np.ndarray)
     criteria : (m, b) per stop, each criterion (mean E_t, mean E_r, share of frames without a pose, ...); inf fails
                the stop and crosses at the previous one; NaN (nothing to average) never fails a stop
     bounds : (b,) the bound of each criterion
+    Returns (NaN, False) when a criterion is NaN at every stop and the first stop does not fail (nothing measured:
+    no envelope can be read). Refused (:class:`~poseintegrity.errors.ArgumentError` naming the argument): theta
+    empty, not finite or not increasing; criteria not (m, b) of theta's length; bounds not b finite numbers.
     """
-    theta = np.asarray(theta, dtype=float)
-    values = np.asarray(criteria, dtype=float)
-    bounds = np.asarray(bounds, dtype=float)
+    theta = check_increasing("theta", theta)
+    values = check_array("criteria", criteria, shape=(None, None), finite=False)
+    bounds = check_array("bounds", bounds, shape=(None,))
+    if not len(theta):
+        raise ArgumentError("theta: needs at least one stop, got none")
+    check_same_length(theta=theta, criteria=values)
+    if values.shape[1] != len(bounds):
+        raise ArgumentError(f"criteria, bounds: {values.shape[1]} criteria per stop but {len(bounds)} bounds")
     with np.errstate(invalid="ignore"):
         exceeded = np.any(values > bounds, axis=1)
+    if np.isnan(values).all(axis=0).any() and not exceeded[0]:
+        return float("nan"), False
     if not exceeded.any():
         return float(theta[-1]), True
     k = int(np.argmax(exceeded))  # first failing stop
@@ -72,7 +90,7 @@ def stop_criteria(frames: pd.DataFrame, tolerance: tuple[float, float], rule: st
     of frames without a pose.
     """
     if rule not in FAILED_FRAME_RULES:
-        raise ValueError(f"unknown failed-frame rule {rule!r}; expected one of {FAILED_FRAME_RULES}")
+        raise ArgumentError(f"rule: unknown failed-frame rule {rule!r}; expected one of {FAILED_FRAME_RULES}")
     tol = np.asarray(tolerance, dtype=float)
     posed = (frames["status"] == "ok").to_numpy()
     errors = frames[["E_t_mm", "E_r_deg"]].to_numpy(dtype=float, copy=True)
@@ -95,8 +113,13 @@ def envelopes(table: pd.DataFrame, tolerances: list[tuple[float, float]], envelo
     """theta_a per dataset, tolerance, PnP method and failed-frame rule from an artifacts table (columns
     :data:`COLUMNS`; theta_a in deg for arcs (``theta_deg``), mm for lines (``x_mm``)).
 
-    table : usable artifact rows (:func:`~poseintegrity.localization.extract.usable`)
+    table : usable artifact rows (:func:`~poseintegrity.localization.extract.usable`), checked
+        (:func:`~poseintegrity.localization.tables.check_artifacts`: columns, one row per frame and method, ...)
+    A theta_a that cannot be read (a criterion never measured, :func:`actual_envelope`) is NaN and warned about.
     """
+    from poseintegrity.localization.tables import check_artifacts  # noqa: PLC0415 (tables imports this module)
+
+    check_artifacts(table, "the artifacts table given to envelopes", columns=ENVELOPE_INPUT)
     rows = []
     for (world, dataset, trajectory, method), frames in table.groupby(["world", "dataset", "trajectory", "method"],
                                                                       sort=True):
@@ -108,7 +131,13 @@ def envelopes(table: pd.DataFrame, tolerances: list[tuple[float, float]], envelo
                 theta_a, censored = actual_envelope(theta, criteria, bounds)
                 rows.append(dict(world=world, dataset=dataset, trajectory=trajectory, tolerance=tolerance_name(tolerance),
                                  method=method, rule=rule, theta_a=theta_a, censored=censored))
-    return pd.DataFrame(rows, columns=COLUMNS)
+    result = pd.DataFrame(rows, columns=COLUMNS)
+    unknown = result[result["theta_a"].isna()]
+    if len(unknown):
+        names = sorted(set(unknown["dataset"]))
+        warnings.warn(f"envelopes: {len(unknown)} theta_a of dataset(s) {names[:5]}{' ...' if len(names) > 5 else ''} "
+                      f"are NaN: no pose error was measured at any stop (ArUco board never detected?)", stacklevel=2)
+    return result
 
 
 def headline(envelope_table: pd.DataFrame, envelope: EnvelopeParams) -> pd.DataFrame:

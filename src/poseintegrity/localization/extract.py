@@ -37,7 +37,7 @@ from poseintegrity.localization.features import cached_features, read_gray, writ
 from poseintegrity.localization.frame_artifacts import frame_artifacts
 from poseintegrity.localization.ground_truth import board_pose, make_board
 from poseintegrity.localization.params import ExtractParams
-from poseintegrity.localization.pnp import failed, solve_pnp_ransac
+from poseintegrity.localization.pnp import failed, solve_checked
 from poseintegrity.localization.ransac import minimal_sample_size, ransac_iterations
 from poseintegrity.poses import NAN_POSE, pose_errors
 from poseintegrity.localization.target_model import TargetModel, build_target_model
@@ -69,7 +69,7 @@ def localize(
     a frame has no pose ("" when it has one). The classic methods' iteration cap is sized for
     ``params.ransac_budget_inlier_ratio`` at ``params.ransac_confidence`` (ransac.py).
     """
-    result = solve_pnp_ransac(
+    result = solve_checked(  # K of a checked Camera, points of checked features: no per-frame checks
         object_points, image_points, K, method, params.reprojection_threshold_px, params.ransac_confidence,
         iteration_cap(method, params), seed, params.usac_refine_lm,
     )

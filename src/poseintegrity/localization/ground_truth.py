@@ -12,7 +12,10 @@ from typing import Any
 import cv2
 import numpy as np
 
+from poseintegrity.errors import ArgumentError
 from poseintegrity.lens import Camera
+from poseintegrity.localization.dataset import aruco_dictionary
+from poseintegrity.localization.features import as_gray8
 from poseintegrity.poses import NAN_POSE, pose_from_rvec_tvec
 
 
@@ -27,8 +30,10 @@ class BoardPose:
 
 
 def make_board(board: dict[str, Any]) -> cv2.aruco.GridBoard:
-    """The GridBoard described by a dataset's ``meta.json["board"]`` (lengths in mm)."""
-    dictionary = cv2.aruco.getPredefinedDictionary(getattr(cv2.aruco, board["dictionary"]))
+    """The GridBoard described by a dataset's ``meta.json["board"]`` (lengths in mm; checked when the dataset is
+    read, :class:`~poseintegrity.localization.dataset.BoardMeta`). An unknown dictionary name raises
+    :class:`~poseintegrity.errors.ArgumentError` naming it."""
+    dictionary = cv2.aruco.getPredefinedDictionary(aruco_dictionary(board["dictionary"]))
     n_markers = board["markers_x"] * board["markers_y"]
     ids = np.arange(board["first_id"], board["first_id"] + n_markers)
     return cv2.aruco.GridBoard(
@@ -41,7 +46,15 @@ def board_pose(image: np.ndarray, board: cv2.aruco.GridBoard, camera: Camera) ->
     lens, then solvePnP with its K).
 
     Needs at least one board marker (4 coplanar corners); otherwise a NaN pose with a status, never an error.
+    image : (h, w) uint8; colour or 16-bit images are converted, anything else refused
+    (:func:`~poseintegrity.localization.features.as_gray8`). ``camera`` is a checked
+    :class:`~poseintegrity.lens.Camera` (finite K, positive focal lengths, finite distortion).
     """
+    if not isinstance(camera, Camera):
+        raise ArgumentError(f"camera: expected a poseintegrity.lens.Camera, got {type(camera).__name__}")
+    if not isinstance(board, cv2.aruco.Board):
+        raise ArgumentError(f"board: expected a cv2.aruco board (make_board), got {type(board).__name__}")
+    image = as_gray8("image", image)
     detector_params = cv2.aruco.DetectorParameters()
     detector_params.cornerRefinementMethod = cv2.aruco.CORNER_REFINE_SUBPIX  # sub-pixel corners for pose
     detector = cv2.aruco.ArucoDetector(board.getDictionary(), detector_params)

@@ -35,6 +35,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
+from poseintegrity.errors import ArgumentError, check_array, check_intrinsics, check_scalar, check_same_length
 from poseintegrity.localization.ransac import minimal_sample_size
 from poseintegrity.poses import NAN_POSE, pose_from_rvec_tvec
 
@@ -156,9 +157,36 @@ def solve_pnp_ransac(
     refine_lm : polish a USAC pose by Levenberg-Marquardt on its inliers (the classic path refits by itself)
     Fails (see :class:`PnPResult`, :data:`FAILURES`) with fewer than 4 correspondences, collinear object points, no
     pose from OpenCV, an OpenCV error, a non-finite pose or fewer than 4 recounted inliers; never raises for bad data.
+    Arguments are checked once (:class:`~poseintegrity.errors.ArgumentError` naming the argument): finite points of
+    shape (n, 3) / (n, 2) (or (n, 1, 3) / (n, 1, 2)) and the same n; K a pinhole matrix with positive focal
+    lengths (a zero or NaN K gave a NaN pose or a wrong one); threshold_px > 0; confidence in (0, 1);
+    max_iterations >= 1; a known method.
     """
     if method not in METHODS:
-        raise ValueError(f"unknown PnP method {method!r}; expected one of {METHODS}")
+        raise ArgumentError(f"method: unknown PnP method {method!r}; expected one of {METHODS}")
+    object_points, image_points = _points("object_points", object_points, 3), _points("image_points", image_points, 2)
+    check_same_length(object_points=object_points, image_points=image_points)
+    check_intrinsics("K", K)
+    check_scalar("threshold_px", threshold_px, low=0.0, low_open=True)
+    check_scalar("confidence", confidence, low=0.0, high=1.0, low_open=True)
+    check_scalar("max_iterations", max_iterations, low=1.0)
+    return solve_checked(object_points, image_points, K, method, threshold_px, confidence, max_iterations, seed,
+                         refine_lm)
+
+
+def _points(name: str, points: object, dims: int) -> np.ndarray:
+    array = check_array(name, points)
+    if array.ndim not in (2, 3) or array.shape[-1] != dims or (array.ndim == 3 and array.shape[1] != 1):
+        raise ArgumentError(f"{name}: expected shape (n, {dims}) or (n, 1, {dims}), got {array.shape}")
+    return array.reshape(-1, dims)
+
+
+def solve_checked(
+    object_points: np.ndarray, image_points: np.ndarray, K: np.ndarray, method: str, threshold_px: float,
+    confidence: float, max_iterations: int, seed: int, refine_lm: bool,
+) -> PnPResult:
+    """:func:`solve_pnp_ransac` without its argument checks: for a per-frame loop whose K comes from a checked
+    :class:`~poseintegrity.lens.Camera` and whose points are the matches of checked features."""
     object_points = np.ascontiguousarray(object_points, dtype=np.float64).reshape(-1, 3)
     image_points = np.ascontiguousarray(image_points, dtype=np.float64).reshape(-1, 2)
     K = np.asarray(K, dtype=np.float64)

@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import math
 
+from poseintegrity.errors import ArgumentError
+
 
 def minimal_sample_size(method: str) -> int:
     """Correspondences per hypothesis of OpenCV 5's classic solvePnPRansac with that flag: 4, solved by P3P/AP3P,
@@ -25,7 +27,7 @@ def ransac_iterations(confidence: float, inlier_ratio: float, sample_size: int) 
     confidence : in (0, 1); inlier_ratio : in (0, 1] (1: every sample is all inliers, N = 1); sample_size : >= 1
     """
     if not (0 < confidence < 1 and 0 < inlier_ratio <= 1 and sample_size >= 1):
-        raise ValueError(f"ransac_iterations needs 0 < confidence < 1, 0 < inlier_ratio <= 1 and a sample size >= 1, "
+        raise ArgumentError(f"ransac_iterations needs 0 < confidence < 1, 0 < inlier_ratio <= 1 and a sample size >= 1, "
                          f"got {confidence}, {inlier_ratio}, {sample_size}")
     all_inliers = inlier_ratio**sample_size
     return 1 if all_inliers >= 1 else math.ceil(math.log1p(-confidence) / math.log1p(-all_inliers))

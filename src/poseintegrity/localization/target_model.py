@@ -15,6 +15,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
+from poseintegrity.errors import ArgumentError, check_array, check_image, check_intrinsics, check_pose, check_scalar
 from poseintegrity.lens import Camera
 from poseintegrity.localization.features import Features
 from poseintegrity.localization.matching import match_ratio_test
@@ -41,7 +42,13 @@ def triangulate(K: np.ndarray, T_cam1_cam0: np.ndarray, x0: np.ndarray, x1: np.n
     """Linear (DLT) triangulation: (n, 3) points in camera-0 coordinates from pixels x0, x1 (n, 2).
 
     Projection matrices P0 = K [I | 0] and P1 = K [R | t] with (R, t) of T_cam1_cam0 (camera 0 -> camera 1).
+    Checked once (ArgumentError naming the argument): K a pinhole matrix, T_cam1_cam0 a rigid transform, x0 and x1
+    finite (n, 2) of the same n.
     """
+    K, T_cam1_cam0 = check_intrinsics("K", K), check_pose("T_cam1_cam0", T_cam1_cam0)
+    x0, x1 = check_array("x0", x0, shape=(None, 2)), check_array("x1", x1, shape=(None, 2))
+    if len(x0) != len(x1):
+        raise ArgumentError(f"x0 and x1: lengths must agree, got {len(x0)} and {len(x1)}")
     P0 = K @ np.hstack([np.eye(3), np.zeros((3, 1))])
     P1 = K @ T_cam1_cam0[:3, :]
     X_h = cv2.triangulatePoints(P0, P1, x0.T.astype(np.float64), x1.T.astype(np.float64))
@@ -78,6 +85,14 @@ def build_target_model(
     images and its keypoints lie inside both masks. An empty model (no texture, no overlap) is returned
     as such; every frame then fails with ``too_few_matches``.
     """
+    if not isinstance(camera, Camera):
+        raise ArgumentError(f"camera: expected a poseintegrity.lens.Camera, got {type(camera).__name__}")
+    check_pose("T_cam1_cam0", T_cam1_cam0)
+    check_pose("T_cam0_board", T_cam0_board)
+    for index, mask in enumerate(masks):
+        check_image(f"masks[{index}]", mask)
+    check_scalar("ratio", ratio, low=0.0, high=1.0, low_open=True)
+    check_scalar("max_reprojection_px", max_reprojection_px, low=0.0, low_open=True)
     K = np.asarray(camera.K, dtype=np.float64)
     pairs = match_ratio_test(features[0].descriptors, features[1].descriptors, ratio)
     raw0 = features[0].points[pairs[:, 0]].astype(np.float64)

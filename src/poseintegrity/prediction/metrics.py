@@ -12,23 +12,32 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from poseintegrity.errors import check_same_length
+
 CURVE_KEYS = ["predictor", "method", "trajectory", "tolerance", "operating_point"]
 
 
 def safe_path_length(theta_p: np.ndarray, theta_a: np.ndarray) -> np.ndarray:
-    """Eq. (3): SPL = min(theta_p, theta_a). (m,), (m,) -> (m,), deg or mm; NaN where theta_p is NaN."""
-    return np.minimum(np.asarray(theta_p, dtype=float), np.asarray(theta_a, dtype=float))
+    """Eq. (3): SPL = min(theta_p, theta_a). (m,), (m,) -> (m,), deg or mm; NaN where theta_p or theta_a is NaN.
+    ArgumentError naming both when their lengths differ."""
+    theta_p, theta_a = np.asarray(theta_p, dtype=float), np.asarray(theta_a, dtype=float)
+    if theta_p.shape != theta_a.shape:
+        check_same_length(theta_p=np.atleast_1d(theta_p), theta_a=np.atleast_1d(theta_a))
+    return np.minimum(theta_p, theta_a)
 
 
 def incursion(theta_p: np.ndarray, theta_a: np.ndarray) -> np.ndarray:
     """An incursion of eq. (4): theta_p > theta_a, the predictor lets the robot past the actual envelope.
 
-    (m,), (m,) -> (m,) float: 1.0 incursion, 0.0 none, NaN where theta_p is NaN (a flagged row).
+    (m,), (m,) -> (m,) float: 1.0 incursion, 0.0 none, NaN where theta_p is NaN (a flagged row) or theta_a is NaN
+    (an unknown envelope: no incursion can be told, never 0). ArgumentError naming both when their lengths differ.
     A censored theta_a (no failure observed up to the last stop) still counts: theta_p never exceeds the range
     end, which is the last stop in our datasets, so this cannot invent an incursion there.
     """
     theta_p, theta_a = np.asarray(theta_p, dtype=float), np.asarray(theta_a, dtype=float)
-    return np.where(np.isnan(theta_p), np.nan, (theta_p > theta_a).astype(float))
+    if theta_p.shape != theta_a.shape:
+        check_same_length(theta_p=np.atleast_1d(theta_p), theta_a=np.atleast_1d(theta_a))
+    return np.where(np.isnan(theta_p) | np.isnan(theta_a), np.nan, (theta_p > theta_a).astype(float))
 
 
 def with_metrics(table: pd.DataFrame) -> pd.DataFrame:

@@ -32,6 +32,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from poseintegrity.errors import ArgumentError, check_array, check_increasing, check_scalar
 from poseintegrity.seeding import keyed_rng
 from poseintegrity.artifact_models import FIT_STATUSES, FitParams, FittedModel, fit_model
 from poseintegrity.artifact_models.fitted import OK
@@ -65,9 +66,15 @@ def boundaries(
 
     predict : f, (m,) float -> (m,) float inlier counts;  thresholds : (T,) float n_t
     n_grid : scan points (``predict.n_grid``)
+    Refused (:class:`~poseintegrity.errors.ArgumentError` naming the argument): n_grid not an integer >= 2,
+    theta_start or theta_end not finite, an empty range; a non-finite n_t is flagged ("bad_threshold"), not refused.
     """
+    if isinstance(n_grid, (bool, np.bool_)) or not isinstance(n_grid, (int, np.integer)) or n_grid < 2:
+        raise ArgumentError(f"n_grid: expected an integer >= 2 (scan points), got {n_grid!r}")
+    check_scalar("theta_start", theta_start)
+    check_scalar("theta_end", theta_end)
     if not theta_end > theta_start:
-        raise ValueError(f"empty search range [{theta_start}, {theta_end}]")
+        raise ArgumentError(f"theta_start, theta_end: empty search range [{theta_start}, {theta_end}]")
     n_t = np.atleast_1d(np.asarray(thresholds, dtype=float))
     theta = np.linspace(theta_start, theta_end, n_grid)
     f = np.asarray(predict(theta), dtype=float)
@@ -173,12 +180,19 @@ def long_range(
 
 
 def next_step_stops(theta_p: np.ndarray, theta_i: float, theta_b: float) -> np.ndarray:
-    """III-E's rule: stop the robot when theta_p < theta_i + theta_b. (T,) float -> (T,) bool (True: stop)."""
+    """III-E's rule: stop the robot when theta_p < theta_i + theta_b. (T,) float -> (T,) bool (True: stop).
+    theta_i and theta_b must be finite (ArgumentError naming them): a NaN would never stop the robot."""
+    check_scalar("theta_i", theta_i)
+    check_scalar("theta_b", theta_b, low=0.0)
     return np.asarray(theta_p, dtype=float) < theta_i + theta_b
 
 
 def sampling_interval(theta_stops: np.ndarray) -> float:
-    """theta_b of the next-step predictor: the dataset's sampling interval (median gap between stops)."""
+    """theta_b of the next-step predictor: the dataset's sampling interval (median gap between stops).
+    theta_stops : (s,) at least 2 finite increasing stop positions (ArgumentError naming it otherwise)."""
+    theta_stops = check_increasing("theta_stops", theta_stops)
+    if len(theta_stops) < 2:
+        raise ArgumentError(f"theta_stops: a sampling interval needs at least 2 stops, got {len(theta_stops)}")
     return float(np.median(np.diff(theta_stops)))
 
 

@@ -20,6 +20,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from poseintegrity.errors import ArgumentError
 from poseintegrity.artifact_models import FitParams, fit_model
 from poseintegrity.prediction.params import PredictParams, UncertaintyParams
 from poseintegrity.prediction.predictors import NO_FIT, envelope_prediction, next_step_stops
@@ -71,9 +72,9 @@ class NextStepSupervisor:
 
     def __post_init__(self) -> None:
         if self.stop_on_lower_bound and self.uncertainty is None:
-            raise ValueError("stop_on_lower_bound needs an uncertainty method (uncertainty=None)")
+            raise ArgumentError("stop_on_lower_bound needs an uncertainty method (uncertainty=None)")
         if not (np.isfinite(self.n_t) and self.theta_b > 0 and np.isfinite(self.theta_end)):
-            raise ValueError(f"need a finite n_t, theta_b > 0 and a finite theta_end; got {self.n_t}, "
+            raise ArgumentError(f"need a finite n_t, theta_b > 0 and a finite theta_end; got {self.n_t}, "
                              f"{self.theta_b}, {self.theta_end}")  # fmt: skip
 
     @classmethod
@@ -99,11 +100,11 @@ class NextStepSupervisor:
         """
         counts = np.atleast_1d(np.asarray(n_inliers, dtype=float)).ravel()
         if not np.isfinite(theta):
-            raise ValueError(f"theta must be finite, got {theta}")
+            raise ArgumentError(f"theta must be finite, got {theta}")
         if counts.size == 0 or not np.all(np.isfinite(counts)):
-            raise ValueError(f"n_inliers must be finite counts (0 for a failed frame), got {n_inliers}")
+            raise ArgumentError(f"n_inliers must be finite counts (0 for a failed frame), got {n_inliers}")
         if self.theta and theta < self.theta[-1]:
-            raise ValueError(f"theta must not decrease: {theta} after {self.theta[-1]}")
+            raise ArgumentError(f"theta must not decrease: {theta} after {self.theta[-1]}")
         self.theta.extend([float(theta)] * counts.size)
         self.n_inliers.extend(counts.tolist())
         samples_theta, samples_n = np.asarray(self.theta), np.asarray(self.n_inliers)

@@ -28,8 +28,9 @@ import pandas as pd
 
 from poseintegrity.artifact_models import FitParams
 from poseintegrity.artifact_models.fitted import OK
-from poseintegrity.artifact_models.series import Series, dataset_series
+from poseintegrity.artifact_models.series import REQUIRED_COLUMNS, Series, dataset_series
 from poseintegrity.parallel import Workers
+from poseintegrity.localization.tables import TableError, check_artifacts, check_envelopes
 from poseintegrity.prediction.metrics import with_metrics
 from poseintegrity.prediction.params import PredictParams
 from poseintegrity.prediction.predictors import (
@@ -166,8 +167,14 @@ def with_pnp_variants(
     """Stage 02's (artifacts, envelopes) with stage 05's tables of the other PnP methods added (Fig. 6).
 
     A method already in ``artifacts`` keeps stage 02's rows; an envelope (dataset, trajectory, tolerance, method
-    and, when the tables have one, failed-frame rule) present in both keeps stage 02's.
+    and, when the tables have one, failed-frame rule) present in both keeps stage 02's. Each of the four tables is
+    checked first (:mod:`poseintegrity.localization.tables`: a duplicated row inside one of them is refused naming
+    it, never silently dropped or counted twice).
     """
+    check_artifacts(artifacts, "the artifacts table (stage 02)", columns=REQUIRED_COLUMNS)
+    check_artifacts(variants, "the PnP variants table (stage 05)", columns=REQUIRED_COLUMNS)
+    check_envelopes(envelopes, "the envelopes table (stage 02)")
+    check_envelopes(variant_envelopes, "the PnP variants' envelopes table (stage 05)")
     extra = variants[~variants["method"].isin(artifacts["method"].unique())]
     keys = ["dataset", "trajectory", "tolerance", "method", *(["rule"] if "rule" in envelopes.columns else [])]
     return (
@@ -187,26 +194,36 @@ def attach_envelopes(theta_p: pd.DataFrame, envelopes: pd.DataFrame, protocol: P
     Checked on read (ValueError): the envelopes' columns, one envelope per dataset, trajectory, method and tolerance
     (a duplicated row would count a dataset twice in every curve), their tolerances are those of ``protocol`` (a
     tolerance the params name would otherwise find no row, and its figures would silently be NaN), theta_a in
-    [0, range end].
+    [0, range end], and an envelope for every (dataset, trajectory, method) of ``theta_p`` (one missing would
+    drop that dataset from every curve): :class:`~poseintegrity.localization.tables.TableError` naming them.
     """
     missing = [column for column in ENVELOPE_COLUMNS if column not in envelopes.columns]
     if missing:
-        raise ValueError(f"the envelopes table lacks columns {missing} (stage 02 writes {list(ENVELOPE_COLUMNS)})")
+        raise TableError(f"the envelopes table lacks columns {missing} (stage 02 writes {list(ENVELOPE_COLUMNS)})")
     keys = ["dataset", "trajectory", "method"]
     repeated = envelopes[envelopes.duplicated([*keys, "tolerance"], keep=False)]
     if len(repeated):
         row = repeated.iloc[0]
-        raise ValueError(f"the envelopes table holds {len(repeated)} rows for the same dataset, trajectory, method and "
+        raise TableError(f"the envelopes table holds {len(repeated)} rows for the same dataset, trajectory, method and "
                          f"tolerance, e.g. {row.dataset} ({row.trajectory}, {row.method}, {row.tolerance}): one "
                          f"failed-frame rule's rows are expected (localization.envelope.headline)")
     if set(envelopes["tolerance"]) != set(protocol.tolerance_names):
-        raise ValueError(f"the envelopes have tolerances {sorted(set(envelopes['tolerance']))}, protocol.tolerances "
+        raise TableError(f"the envelopes have tolerances {sorted(set(envelopes['tolerance']))}, protocol.tolerances "
                          f"are {protocol.tolerance_names}: was stage 02 run with another protocol?")
     end = envelopes["trajectory"].map(protocol.range_end)
     outside = envelopes[~envelopes["theta_a"].between(0.0, end)]
     if len(outside):
         row = outside.iloc[0]
-        raise ValueError(f"{len(outside)} envelopes lie outside [0, the protocol's range end], e.g. {row.dataset} "
+        raise TableError(f"{len(outside)} envelopes lie outside [0, the protocol's range end], e.g. {row.dataset} "
                          f"({row.trajectory}, {row.tolerance}, {row.method}): theta_a = {row.theta_a}")
+    check_envelopes(envelopes, "the envelopes table")
+    wanted = theta_p[keys].drop_duplicates()
+    absent = wanted.merge(envelopes[keys].drop_duplicates(), on=keys, how="left", indicator=True)
+    absent = absent[absent["_merge"] == "left_only"]
+    if len(absent):
+        shown = ", ".join(f"{row.dataset} ({row.trajectory}, {row.method})" for row in absent.head(5).itertuples())
+        raise TableError(f"the envelopes table has no envelope for {len(absent)} (dataset, trajectory, method) of the "
+                         f"predictions, e.g. {shown}: they would be dropped from every curve (was stage 02 run on "
+                         f"other datasets?)")
     table = theta_p.merge(envelopes[[*keys, "world", "tolerance", "theta_a", "censored"]], on=keys, how="inner")
     return with_metrics(table)

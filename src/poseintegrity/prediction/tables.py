@@ -178,9 +178,11 @@ def rule_metrics(theta_p: pd.DataFrame, envelopes: pd.DataFrame, protocol: Proto
     <rule>.<predictor>.<tolerance>.{max_mean_spl_zero_incursion, best_operating_point} on the arcs of the paper's PnP
     path, and <rule>.<predictor>.relative_improvement over static (mean of the tolerances).
 
-    theta_p : :func:`~.sweeps.sweep` rows of one world; envelopes : its stage-02 envelopes, every rule
+    theta_p : :func:`~.sweeps.sweep` rows (those of datasets without an envelope, e.g. of another world, are left
+    out); envelopes : one world's stage-02 envelopes, every rule
     """
     metrics: dict = {}
+    theta_p = theta_p[theta_p["dataset"].isin(envelopes["dataset"])]  # this world's rows (other worlds' are left out)
     for rule in FAILED_FRAME_RULES:
         best = best_table(operating_curves(attach_envelopes(theta_p, envelopes[envelopes["rule"] == rule]
                                                             .drop(columns="rule"), protocol)))

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 
 import pandas as pd
 
+from poseintegrity.errors import ArgumentError
 from poseintegrity.artifact_models import FitParams, FittedModel
 from poseintegrity.artifact_models.series import Series, dataset_series
 from poseintegrity.prediction.params import PredictParams
@@ -117,7 +118,7 @@ def tail_fits(
     series = {s.dataset: s for s in dataset_series(artifacts, method, protocol) if s.trajectory == "arc"}
     missing = [d for d in datasets if d not in series]
     if missing:
-        raise ValueError(f"datasets {missing} are not arcs of {method!r} in the artifacts table")
+        raise ArgumentError(f"datasets {missing} are not arcs of {method!r} in the artifacts table")
     k = protocol.stops_sampled("arc")
     thresholds = predict.thresholds
     result = []

@@ -36,8 +36,10 @@ from pathlib import Path
 import cv2
 import numpy as np
 import pandas as pd
+from pydantic import ValidationError
 
 from poseintegrity.errors import PoseIntegrityError
+from poseintegrity.localization.dataset import DatasetError, Meta
 from poseintegrity.lens import Camera, write_camera_yaml
 from poseintegrity.parallel import Workers
 from poseintegrity.poses import inverse
@@ -325,6 +327,17 @@ def _flat(T: np.ndarray) -> list[float]:
     return [float(v) for v in T.ravel()]
 
 
+def check_meta(meta: dict, dataset: str) -> None:
+    """:class:`~poseintegrity.localization.dataset.DatasetError` naming the dataset and the field unless ``meta``
+    holds what stage 02 reads from meta.json (:class:`~poseintegrity.localization.dataset.Meta`: an ArUco dictionary
+    OpenCV knows, a rigid model baseline, ...): stage 01 never writes a dataset stage 02 would refuse."""
+    try:
+        Meta.model_validate(meta)
+    except ValidationError as error:
+        lines = [f"  {'.'.join(map(str, item['loc']))}: {item['msg']}" for item in error.errors()]
+        raise DatasetError(f"dataset {dataset}: its meta.json would have invalid values:\n" + "\n".join(lines)) from None
+
+
 def finish_dataset(params: GenerateParams, root: Path, plan: DatasetPlan, trip: Trip, route: Route,
                    scene: catalog.Scene, camera: Camera) -> dict:
     """Once its images are written: the dataset's frames.parquet, meta.json and camera.yaml (``camera``: the world's
@@ -357,6 +370,7 @@ def finish_dataset(params: GenerateParams, root: Path, plan: DatasetPlan, trip: 
         "distance_mm": trip.distance_mm,
         "true_camera": {"K": truth.K.tolist(), "dist": truth.dist.tolist()},  # a diagnostic: stage 02 never reads it
     }
+    check_meta(meta, plan.dataset)
     (tmp / "meta.json").write_text(json.dumps(meta, indent=1))
     write_camera_yaml(tmp / "camera.yaml", camera, CAMERA_NAME)
     shutil.rmtree(final, ignore_errors=True)
