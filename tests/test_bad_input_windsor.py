@@ -23,7 +23,7 @@ from poseintegrity.localization.dataset import BoardMeta  # noqa: E402
 from poseintegrity.localization.features import ImageReadError, as_gray8, read_gray  # noqa: E402
 from poseintegrity.localization.ground_truth import board_pose, make_board  # noqa: E402
 from poseintegrity.localization.pnp import solve_pnp_ransac  # noqa: E402
-from poseintegrity.localization.tables import check_artifacts, check_envelopes, read_envelopes  # noqa: E402
+from poseintegrity.tables import check_artifacts, check_envelopes, read_envelopes  # noqa: E402
 from poseintegrity.localization.target_model import triangulate  # noqa: E402
 from poseintegrity.poses import pose_errors  # noqa: E402
 from poseintegrity.prediction.metrics import incursion, safe_path_length  # noqa: E402

@@ -47,6 +47,71 @@ def test_every_notebook_has_a_stage_running_it_through_the_stage_runner():
         assert {f"reports/metrics/timing/{notebook.stem}.json": {"cache": False}} in stage["outs"]
 
 
+def _imported_modules(source: str, package: str = "") -> set[str]:
+    """Modules of poseintegrity that ``source`` imports (absolute, or relative to ``package``), at any depth."""
+    import ast
+
+    def nodes(tree):  # every node, without the bodies of `if TYPE_CHECKING:` (annotations only, never run)
+        for child in ast.iter_child_nodes(tree):
+            if isinstance(child, ast.If) and "TYPE_CHECKING" in ast.unparse(child.test):
+                yield from (n for orelse in child.orelse for n in [orelse, *nodes(orelse)])
+                continue
+            yield child
+            yield from nodes(child)
+
+    found = set()
+    for node in nodes(ast.parse(source)):
+        if isinstance(node, ast.Import):
+            found |= {alias.name for alias in node.names if alias.name.startswith("poseintegrity")}
+        elif isinstance(node, ast.ImportFrom):
+            base = node.module or ""
+            if node.level:
+                base = ".".join(package.split(".")[: len(package.split(".")) - node.level + 1] + ([base] if base else []))
+            if base.startswith("poseintegrity"):
+                found |= {base} | {f"{base}.{alias.name}" for alias in node.names}
+    return found
+
+
+def _module_file(module: str) -> Path | None:
+    path = ROOT / "src" / Path(*module.split("."))
+    return path / "__init__.py" if path.is_dir() else path.with_suffix(".py") if path.with_suffix(".py").exists() else None
+
+
+NOT_FOLLOWED = ("config.py", "__init__.py")  # config imports every section's schema; a package __init__ re-exports
+
+
+def _import_closure(notebook: Path) -> set[Path]:
+    """The source files of poseintegrity whose code a notebook runs: the modules it imports and theirs (a static
+    walk of import statements, function-level ones included). Not followed: a package's ``__init__`` (its
+    re-exports load code a stage need not run) and ``config`` (it imports every section's schema; a stage depends
+    on its own section's schema through its subpackage)."""
+    cells = json.loads(notebook.read_text())["cells"]
+    todo = _imported_modules("\n".join("".join(c["source"]) for c in cells if c["cell_type"] == "code"))
+    files: set[Path] = set()
+    while todo:
+        path = _module_file(todo.pop())
+        if path is None or path in files:
+            continue
+        files.add(path)
+        if path.name not in NOT_FOLLOWED:
+            package = ".".join(path.relative_to(ROOT / "src").with_suffix("").parts[:-1])
+            todo |= _imported_modules(path.read_text(), package)
+    return {path for path in files if path.name != "__init__.py"}
+
+
+def test_every_stage_depends_on_every_source_file_its_notebook_runs():
+    """A change to a module a stage runs re-runs the stage: the import closure of each notebook (static) lies
+    inside the stage's source deps, so dvc.lock cannot call results current that another version of the code made."""
+    missing = {}
+    for notebook in NOTEBOOKS:
+        deps = [ROOT / d for d in DVC["stages"][notebook.stem]["deps"] if str(d).startswith("src/")]
+        closure = _import_closure(notebook)
+        assert len(closure) > 5, notebook.name  # the walk found the package
+        if lost := sorted(str(f.relative_to(ROOT)) for f in closure if not any(f == d or d in f.parents for d in deps)):
+            missing[notebook.stem] = lost
+    assert not missing, f"stages run source files they do not depend on in dvc.yaml: {missing}"
+
+
 def test_no_stage_depends_on_an_executed_notebook():
     for name, stage in DVC["stages"].items():
         assert not any(str(d).startswith("reports/notebooks") for d in stage.get("deps", [])), name

@@ -32,10 +32,11 @@ def _describe(value: object) -> str:
 
 
 def check_array(name: str, value: object, *, shape: Sequence[int | None] | None = None, min_rows: int = 0,
-                dtype: str = "float", finite: bool = True, max_abs: float = 1e12) -> np.ndarray:
+                dtype: str = "float", finite: bool = True, max_abs: float = 1e12, allow_nan: bool = False) -> np.ndarray:
     """``value`` as a numpy array, checked once: ``shape`` (``None`` for any length, e.g. ``(None, 3)``), at least
     ``min_rows`` rows, numeric ``dtype`` kind (``"float"`` converts any real numbers to float64, ``"int"`` needs
-    integers), finite entries no larger than ``max_abs`` in magnitude (1e300 is not a coordinate).
+    integers), finite entries no larger than ``max_abs`` in magnitude (1e300 is not a coordinate); with
+    ``allow_nan`` a NaN entry passes (where NaN is the documented "unknown", e.g. a flagged theta_p).
 
     Raises :class:`ArgumentError` naming ``name`` and what was found.
     """
@@ -57,7 +58,7 @@ def check_array(name: str, value: object, *, shape: Sequence[int | None] | None 
     if array.ndim and len(array) < min_rows:
         raise ArgumentError(f"{name}: needs at least {min_rows} rows, got {len(array)}")
     if finite and array.size and array.dtype.kind == "f":
-        bad = ~np.isfinite(array) | (np.abs(array) > max_abs)
+        bad = ~(np.abs(array) <= max_abs) & ~(allow_nan & np.isnan(array))
         if bad.any():
             index = tuple(int(i) for i in np.argwhere(bad)[0])
             raise ArgumentError(f"{name}: entries must be finite and at most {max_abs:g} in magnitude, "

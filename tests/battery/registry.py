@@ -146,11 +146,14 @@ def _any_flag(result: Any) -> bool:
 
 # ------------------------------------------------------------------------------------------------- registry
 # A tracker frame with fewer points is a partial update; NaN rows and points 1e300 m away are dropped detections.
+GRAY8_CONVERSIONS = {"image": {"uint16", "three_channel", "four_channel"}}  # converted once, documented (as_gray8)
+FEWER = {"empty", "one_element", "one_fewer"}  # fewer items: a smaller answer
+UNKNOWN_POSITION = {"theta_p": {"nan"}, "theta_a": {"nan"}}  # NaN in, NaN (the unknown) out: documented
 TRACKER_ACCEPTS = {"points": {"one_element", "one_fewer", "nan", "inf", "huge"}}
 
 
 def _entries() -> list[EntryPoint]:
-    from poseintegrity import config, lens, poses
+    from poseintegrity import config, lens, poses, tables, timing
     from poseintegrity.artifact_models.models import fit_model
     from poseintegrity.localization import dataset, envelope, features, ground_truth, matching, pnp, target_model
     from poseintegrity.prediction import metrics, predictors, supervisor
@@ -172,13 +175,14 @@ def _entries() -> list[EntryPoint]:
         # ---- localization
         EntryPoint("localization.detect_features",
                    lambda a: features.detect_features(a["image"], P().extract.clahe, P().extract.sift),
-                   lambda tmp: {"image": loc()["image"]}, {"image": "image"}),
+                   lambda tmp: {"image": loc()["image"]}, {"image": "image"}, accepts=GRAY8_CONVERSIONS),
         EntryPoint("localization.decode_gray", lambda a: features.read_gray(a["path"]),
                    lambda tmp: {"path": _png(tmp)}, {"path": "file"}),
         EntryPoint("localization.match_ratio_test",
                    lambda a: matching.match_ratio_test(a["query"], a["train"], 0.8),
                    lambda tmp: {"query": _descriptors(0), "train": _descriptors(1)},
-                   {"query": "points", "train": "points"}),
+                   {"query": "points", "train": "points"},
+                   accepts={"query": FEWER, "train": FEWER}),  # fewer descriptors: fewer (or no) matches
         EntryPoint("localization.solve_pnp_ransac",
                    lambda a: pnp.solve_pnp_ransac(a["object_points"], a["image_points"], a["K"], "usac_magsac", 2.0,
                                                   0.999, 1000, 0, True),
@@ -186,7 +190,7 @@ def _entries() -> list[EntryPoint]:
                    {"object_points": "points", "image_points": "points", "K": "matrix"}, flagged=_status_not_ok),
         EntryPoint("localization.board_pose", lambda a: ground_truth.board_pose(a["image"], loc()["board"], a["camera"]),
                    lambda tmp: {"image": loc()["image"], "camera": loc()["camera"]}, {"image": "image"},
-                   flagged=_status_not_ok),
+                   flagged=_status_not_ok, accepts=GRAY8_CONVERSIONS),
         EntryPoint("localization.triangulate",
                    lambda a: target_model.triangulate(a["K"], a["T_cam1_cam0"], a["x0"], a["x1"]),
                    lambda tmp: _two_views(), {"K": "matrix", "T_cam1_cam0": "matrix", "x0": "points", "x1": "points"}),
@@ -194,7 +198,9 @@ def _entries() -> list[EntryPoint]:
                    lambda a: envelope.actual_envelope(a["theta"], a["criteria"], a["bounds"]),
                    lambda tmp: {"theta": np.arange(0.0, 40, 2.5), "criteria": np.c_[np.linspace(0.1, 3, 16),
                                 np.linspace(0.1, 4, 16)], "bounds": np.array([2.0, 3.0])},
-                   {"theta": "array", "criteria": "points", "bounds": "array"}),
+                   {"theta": "array", "criteria": "points", "bounds": "array"},
+                   # NaN: nothing to average at a stop; inf and 1e300: an error that fails the stop (documented)
+                   accepts={"criteria": {"nan", "inf", "huge"}}),
         EntryPoint("localization.load_index", lambda a: dataset.load_index(a["index"].parents[1]),
                    lambda tmp: {"index": _dataset_dir(tmp)}, {"index": "file"}, names={"index": "index.parquet"}),
         EntryPoint("localization.load_dataset",
@@ -202,14 +208,16 @@ def _entries() -> list[EntryPoint]:
                    lambda tmp: {"meta": _dataset_dir(tmp).parent / "ds_arc" / "meta.json"}, {"meta": "file"},
                    names={"meta": "meta.json"}),
         EntryPoint("poses.pose_errors", lambda a: poses.pose_errors(a["T_est"], a["T_true"]),
-                   lambda tmp: {"T_est": loc()["T"], "T_true": loc()["T"]}, {"T_est": "matrix", "T_true": "matrix"}),
+                   lambda tmp: {"T_est": loc()["T"], "T_true": loc()["T"]}, {"T_est": "matrix", "T_true": "matrix"},
+                   accepts={"T_est": {"nan", "inf"}, "T_true": {"nan", "inf"}}),  # an unknown pose: NaN errors
         # ---- artifact models
         EntryPoint("artifact_models.fit_model",
                    lambda a: fit_model("emg", a["theta"], a["n_inliers"], theta_end=a["theta_end"], params=P().fit,
                                        rng=np.random.default_rng(0)),
                    lambda tmp: {"theta": inlier_series()[0], "n_inliers": inlier_series()[1], "theta_end": 60.0},
                    {"theta": "array", "n_inliers": "array", "theta_end": "scalar"}, flagged=_status_not_ok,
-                   accepts={"n_inliers": {"nan"}}),  # a NaN count is a sample without a pose: documented as dropped
+                   # samples with a non-finite theta or count are dropped, any shape is flattened (documented)
+                   accepts={"n_inliers": {"nan", "inf", "wrong_ndim"}, "theta": {"nan", "inf", "wrong_ndim"}}),
         # ---- prediction
         EntryPoint("prediction.boundaries",
                    lambda a: predictors.boundaries(lambda x: 300.0 - 5.0 * x, a["thresholds"], a["theta_start"],
@@ -217,17 +225,20 @@ def _entries() -> list[EntryPoint]:
                    lambda tmp: {"thresholds": np.array([15.0, 30.0]), "theta_start": 0.0, "theta_end": 60.0,
                                 "n_grid": 50},
                    {"thresholds": "array", "theta_start": "scalar", "theta_end": "scalar", "n_grid": "scalar"},
-                   flagged=lambda b: bool(np.isin(b.status, ["non_finite", "bad_threshold"]).any())),
+                   flagged=lambda b: bool(np.isin(b.status, ["non_finite", "bad_threshold"]).any()),
+                   # fewer thresholds: fewer answers; n_t 1e300 lies above every count: below_at_start (documented)
+                   accepts={"thresholds": FEWER | {"huge"}}),
         EntryPoint("prediction.safe_path_length", lambda a: metrics.safe_path_length(a["theta_p"], a["theta_a"]),
                    lambda tmp: {"theta_p": np.array([5.0, 9.0]), "theta_a": np.array([7.0, 8.0])},
-                   {"theta_p": "array", "theta_a": "array"}, accepts={"theta_p": {"nan"}}),
+                   {"theta_p": "array", "theta_a": "array"}, accepts=UNKNOWN_POSITION),
         EntryPoint("prediction.incursion", lambda a: metrics.incursion(a["theta_p"], a["theta_a"]),
                    lambda tmp: {"theta_p": np.array([5.0, 9.0]), "theta_a": np.array([7.0, 8.0])},
-                   {"theta_p": "array", "theta_a": "array"}),
+                   {"theta_p": "array", "theta_a": "array"}, accepts=UNKNOWN_POSITION),
         EntryPoint("prediction.NextStepSupervisor.update",
                    lambda a: _supervisor().update(a["theta"], a["n_inliers"]),
                    lambda tmp: {"theta": 2.5, "n_inliers": np.array([200.0, 210.0])},
                    {"theta": "scalar", "n_inliers": "array"},
+                   accepts={"n_inliers": {"one_element", "one_fewer"}},  # fewer images at this stop
                    flagged=lambda d: d.status in ("non_finite", "bad_threshold") or d.fit_status not in ("ok", "no_fit")),
         # ---- tracking
         EntryPoint("tracking.detect_markers",
@@ -282,9 +293,19 @@ def _entries() -> list[EntryPoint]:
                                                        {"probe": tracking_frame()["geometry"]}, P().track),
                    lambda tmp: {"file": _recording_dir(tmp) / "ir" / "000001.png"}, {"file": "file"},
                    names={"file": "000001.png"}, flagged=_any_flag),
-        # ---- stage tables
-        EntryPoint("stage table: envelopes", lambda a: envelope.headline(a["table"], P().protocol.envelope),
+        # ---- stage tables and the files they are written to
+        EntryPoint("tables.check_envelopes", lambda a: tables.check_envelopes(a["table"]),
                    lambda tmp: {"table": _envelope_table()}, {"table": "table"}),
+        EntryPoint("tables.check_artifacts", lambda a: tables.check_artifacts(a["table"]),
+                   lambda tmp: {"table": _artifacts_table()}, {"table": "table"}),
+        EntryPoint("tables.read_envelopes", lambda a: tables.read_envelopes(a["path"]),
+                   lambda tmp: {"path": _parquet(tmp, "envelopes.parquet", _envelope_table())}, {"path": "file"}),
+        EntryPoint("tables.read_artifacts", lambda a: tables.read_artifacts(a["path"]),
+                   lambda tmp: {"path": _parquet(tmp, "artifacts.parquet", _artifacts_table())}, {"path": "file"}),
+        # ---- command lines: one line naming the file, exit status 2, no traceback
+        EntryPoint("python -m poseintegrity.timing", lambda a: _cli(timing.main, [str(a["path"].parent)], a["path"]),
+                   lambda tmp: {"path": _timing_file(tmp)}, {"path": "file"}, flagged=_cli_refused,
+                   accepts={"path": {"missing"}}),  # a folder without timing files yet: said, exit 0
     ]
     return entries
 
@@ -376,6 +397,59 @@ def _dataset_dir(tmp: Path) -> Path:
     rows = [synthetic.write_dataset(data_dir, "ds_arc", np.random.default_rng(0), stops=(10.0,), images_per_stop=1)]
     synthetic.write_index(data_dir, rows)
     return data_dir / "datasets" / "index.parquet"
+
+
+def _parquet(tmp: Path, name: str, table: pd.DataFrame) -> Path:
+    folder = tmp / "tables"
+    folder.mkdir(parents=True, exist_ok=True)
+    table.to_parquet(folder / name)
+    return folder / name
+
+
+def _artifacts_table() -> pd.DataFrame:
+    rows = [dict(world="main", dataset=dataset, trajectory="arc", stop=stop, image=0, theta_deg=2.5 * stop,
+                 x_mm=0.0, method="usac_magsac", status="ok", n_inliers=100.0 - 10 * stop, E_t_mm=0.2, E_r_deg=0.1)
+            for dataset in ("scene_1_arc000", "scene_1_arc001") for stop in range(3)]
+    return pd.DataFrame(rows)
+
+
+def _timing_file(tmp: Path) -> Path:
+    from poseintegrity.timing import StageTiming
+
+    folder = tmp / "timing"
+    folder.mkdir(parents=True, exist_ok=True)
+    StageTiming("01_generate_datasets", 12.0, "local", 2, None, "2026-11-25T10:00:00").write(folder / "01.json")
+    return folder / "01.json"
+
+
+@dataclass(frozen=True)
+class CommandResult:
+    status: int
+    stderr: str
+    names_the_file: bool
+
+
+def _cli(main, argv: list[str], path: Path) -> CommandResult:
+    """Run a command line's main in-process: its exit status and what it wrote on stderr."""
+    import contextlib
+    import io
+
+    stderr = io.StringIO()
+    with contextlib.redirect_stderr(stderr), contextlib.redirect_stdout(io.StringIO()):
+        try:
+            main(argv)
+            status = 0
+        except SystemExit as exit_:
+            status = exit_.code if isinstance(exit_.code, int) else 1
+            stderr.write("" if isinstance(exit_.code, int) or exit_.code is None else str(exit_.code))
+    text = stderr.getvalue()
+    return CommandResult(status, text, Path(path).name in text)
+
+
+def _cli_refused(result: CommandResult) -> bool:
+    """Exit status 2 with one line naming the file, no traceback."""
+    lines = result.stderr.strip().splitlines()
+    return result.status == 2 and len(lines) == 1 and result.names_the_file and "Traceback" not in result.stderr
 
 
 def _envelope_table() -> pd.DataFrame:

@@ -22,7 +22,7 @@ from poseintegrity.artifact_models.models import distinct_theta_needed, fit_mode
 from poseintegrity.artifact_models.params import FitParams
 from poseintegrity.artifact_models.series import Series, dataset_series
 from poseintegrity.errors import ArgumentError
-from poseintegrity.localization.tables import check_fig2_rmse
+from poseintegrity.tables import check_fig2_rmse
 from poseintegrity.parallel import Workers
 from poseintegrity.protocol import ProtocolParams
 
@@ -96,7 +96,7 @@ def fig2_rmse(
 
 def mean_rmse(table: pd.DataFrame) -> pd.DataFrame:
     """Fig. 2's curves: per (trajectory, model, k) the mean RMSE across datasets and the share of fits "ok".
-    ``table`` is checked (:func:`~poseintegrity.localization.tables.check_fig2_rmse`: a repeated row would shift a
+    ``table`` is checked (:func:`~poseintegrity.tables.check_fig2_rmse`: a repeated row would shift a
     mean)."""
     check_fig2_rmse(table)
     return (

@@ -37,6 +37,7 @@ NEGATIVE_COUNT = -0.5  # a prediction below this rounds to a negative inlier cou
 ONE_INLIER = 0.5  # a prediction from this on rounds to at least one inlier
 LACK_OF_FIT = 3.0  # a fit's RMSE on its own samples above this many noise levels, and no better than their mean: flagged
 NO_BETTER_THAN_MEAN = 0.9  # ... "no better": RMSE at least this share of the mean's (R^2 below 0.19)
+MAX_THETA = 1e6  # |theta| and range ends beyond a million deg or mm are not a trajectory
 CHECK_POINTS = 181  # grid of the physical check over [first stop, range end] (0.25 deg steps over a 45 deg arc)
 
 
@@ -66,7 +67,7 @@ def valid_samples(theta: np.ndarray, n_inliers: np.ndarray, theta_end: float | N
     keep = np.isfinite(theta) & np.isfinite(n_inliers) & (n_inliers >= 0)
     theta, n_inliers = theta[keep], n_inliers[keep]
     if theta_end is not None:
-        check_scalar("theta_end", theta_end)
+        check_scalar("theta_end", theta_end, low=-MAX_THETA, high=MAX_THETA)
         if theta.size and theta_end < theta.min():
             raise ArgumentError(f"theta_end: the range end {theta_end:g} lies before the first sample "
                                 f"{theta.min():g}: the fit could not be checked up to it")

@@ -8,10 +8,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from poseintegrity.errors import ArgumentError
+from poseintegrity.errors import ArgumentError, check_scalar
 
 from poseintegrity.artifact_models.base_functions import LEAST_SQUARES
-from poseintegrity.artifact_models.fitted import FittedModel
+from poseintegrity.artifact_models.fitted import MAX_THETA, FittedModel
 from poseintegrity.artifact_models.mlp import DISTINCT_THETA, fit_mlp
 from poseintegrity.artifact_models.params import FitParams
 
@@ -41,8 +41,11 @@ def fit_model(
     input by it and puts its artificial points there
     rng : seeds the MLP weights (unused by base functions)
     Refused (:class:`~poseintegrity.errors.ArgumentError` naming the argument): an unknown name, theta and n_inliers
-    of different lengths, a theta_end that is not finite or lies before the first valid sample.
+    of different lengths, a theta_end that is not a finite number within 1e6 or lies before the first valid sample.
+    Accepted: samples with a non-finite theta or count (dropped, as frames without a measurement), theta and
+    n_inliers of any shape with the same number of entries (flattened).
     """
+    check_scalar("theta_end", theta_end, low=-MAX_THETA, high=MAX_THETA)
     if name in LEAST_SQUARES:
         return LEAST_SQUARES[name].fit(theta, n_inliers, theta_end=theta_end, max_nfev=params.max_nfev)
     if name in MLP_RECIPES:

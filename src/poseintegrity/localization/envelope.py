@@ -114,10 +114,10 @@ def envelopes(table: pd.DataFrame, tolerances: list[tuple[float, float]], envelo
     :data:`COLUMNS`; theta_a in deg for arcs (``theta_deg``), mm for lines (``x_mm``)).
 
     table : usable artifact rows (:func:`~poseintegrity.localization.extract.usable`), checked
-        (:func:`~poseintegrity.localization.tables.check_artifacts`: columns, one row per frame and method, ...)
+        (:func:`~poseintegrity.tables.check_artifacts`: columns, one row per frame and method, ...)
     A theta_a that cannot be read (a criterion never measured, :func:`actual_envelope`) is NaN and warned about.
     """
-    from poseintegrity.localization.tables import check_artifacts  # noqa: PLC0415 (tables imports this module)
+    from poseintegrity.tables import check_artifacts  # noqa: PLC0415 (tables imports this module)
 
     check_artifacts(table, "the artifacts table given to envelopes", columns=ENVELOPE_INPUT)
     rows = []

@@ -8,6 +8,25 @@ from __future__ import annotations
 
 import numpy as np
 
+from poseintegrity.errors import ArgumentError, check_scalar
+
+MAX_DESCRIPTOR = 1e6  # SIFT components are at most 512 (OpenCV scales the unit vector by 512 and clips at 0.2 of it)
+
+
+def _descriptors(name: str, values: object) -> np.ndarray:
+    """float32 (n, d) descriptors; checked without a float64 copy (a frame has thousands)."""
+    try:
+        array = np.asarray(values) if isinstance(values, (np.ndarray, list, tuple)) else None
+    except ValueError:  # a ragged list
+        array = None
+    if array is None or array.dtype.kind not in "iuf" or array.ndim != 2:
+        found = f"shape {array.shape} and dtype {array.dtype}" if array is not None else type(values).__name__
+        raise ArgumentError(f"{name}: expected (n, d) descriptors of real numbers, got {found}")
+    array = array.astype(np.float32, copy=False)
+    if array.size and not np.abs(array).max() <= MAX_DESCRIPTOR:  # False for NaN
+        raise ArgumentError(f"{name}: descriptors must be finite and at most {MAX_DESCRIPTOR:g}")
+    return array
+
 
 def match_ratio_test(query: np.ndarray, train: np.ndarray, ratio: float) -> np.ndarray:
     """Nearest-neighbour matches that pass the ratio test.
@@ -17,11 +36,15 @@ def match_ratio_test(query: np.ndarray, train: np.ndarray, ratio: float) -> np.n
     nearest (Lowe 2004, section 7.1), L2 distance.
     Returns (k, 2) int: rows of (query index, train index); (0, 2) when the query is empty or the train
     set has fewer than the 2 descriptors a ratio test needs.
+    Refused (:class:`~poseintegrity.errors.ArgumentError` naming the argument): descriptors that are not a 2-D array
+    of finite real numbers, query and train of different descriptor lengths, a ratio outside (0, 1].
     """
+    query, train = _descriptors("query", query), _descriptors("train", train)
+    if query.shape[1] != train.shape[1]:
+        raise ArgumentError(f"query, train: descriptors of {query.shape[1]} and {train.shape[1]} values cannot be compared")
+    check_scalar("ratio", ratio, low=0.0, high=1.0, low_open=True)
     if len(query) == 0 or len(train) < 2:
         return np.empty((0, 2), dtype=np.intp)
-    query = np.asarray(query, dtype=np.float32)
-    train = np.asarray(train, dtype=np.float32)
     d2 = query @ train.T  # (n, m): squared distances up to the per-row constant ||q||^2
     d2 *= -2.0
     d2 += np.einsum("ij,ij->i", train, train)[None, :]

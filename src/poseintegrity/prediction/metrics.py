@@ -12,15 +12,21 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from poseintegrity.errors import check_same_length
+from poseintegrity.errors import check_array, check_same_length
 
 CURVE_KEYS = ["predictor", "method", "trajectory", "tolerance", "operating_point"]
 
 
+def _positions(name: str, values: object) -> np.ndarray:
+    """Trajectory positions (deg or mm) as floats: numbers within 1e12 or NaN (unknown), anything else refused."""
+    return check_array(name, values, allow_nan=True)
+
+
 def safe_path_length(theta_p: np.ndarray, theta_a: np.ndarray) -> np.ndarray:
     """Eq. (3): SPL = min(theta_p, theta_a). (m,), (m,) -> (m,), deg or mm; NaN where theta_p or theta_a is NaN.
-    ArgumentError naming both when their lengths differ."""
-    theta_p, theta_a = np.asarray(theta_p, dtype=float), np.asarray(theta_a, dtype=float)
+    ArgumentError naming both when their lengths differ, or naming one that holds something other than numbers
+    (NaN is the documented unknown; inf, 1e300 and booleans are refused)."""
+    theta_p, theta_a = _positions("theta_p", theta_p), _positions("theta_a", theta_a)
     if theta_p.shape != theta_a.shape:
         check_same_length(theta_p=np.atleast_1d(theta_p), theta_a=np.atleast_1d(theta_a))
     return np.minimum(theta_p, theta_a)
@@ -32,9 +38,10 @@ def incursion(theta_p: np.ndarray, theta_a: np.ndarray) -> np.ndarray:
     (m,), (m,) -> (m,) float: 1.0 incursion, 0.0 none, NaN where theta_p is NaN (a flagged row) or theta_a is NaN
     (an unknown envelope: no incursion can be told, never 0). ArgumentError naming both when their lengths differ.
     A censored theta_a (no failure observed up to the last stop) still counts: theta_p never exceeds the range
-    end, which is the last stop in our datasets, so this cannot invent an incursion there.
+    end, which is the last stop in our datasets, so this cannot invent an incursion there. Arguments are refused as
+    by :func:`safe_path_length`.
     """
-    theta_p, theta_a = np.asarray(theta_p, dtype=float), np.asarray(theta_a, dtype=float)
+    theta_p, theta_a = _positions("theta_p", theta_p), _positions("theta_a", theta_a)
     if theta_p.shape != theta_a.shape:
         check_same_length(theta_p=np.atleast_1d(theta_p), theta_a=np.atleast_1d(theta_a))
     return np.where(np.isnan(theta_p) | np.isnan(theta_a), np.nan, (theta_p > theta_a).astype(float))

@@ -35,7 +35,7 @@ import numpy as np
 from poseintegrity.errors import ArgumentError, check_array, check_increasing, check_scalar
 from poseintegrity.seeding import keyed_rng
 from poseintegrity.artifact_models import FIT_STATUSES, FitParams, FittedModel, fit_model
-from poseintegrity.artifact_models.fitted import OK
+from poseintegrity.artifact_models.fitted import MAX_THETA, OK
 from poseintegrity.artifact_models.series import Series
 
 BISECTION_XTOL = 1e-9  # theta units; the root refinement of :func:`boundaries`
@@ -67,15 +67,18 @@ def boundaries(
     predict : f, (m,) float -> (m,) float inlier counts;  thresholds : (T,) float n_t
     n_grid : scan points (``predict.n_grid``)
     Refused (:class:`~poseintegrity.errors.ArgumentError` naming the argument): n_grid not an integer >= 2,
-    theta_start or theta_end not finite, an empty range; a non-finite n_t is flagged ("bad_threshold"), not refused.
+    theta_start or theta_end not finite within 1e6, an empty range, thresholds not a number or (T,) array of numbers;
+    a non-finite n_t is flagged ("bad_threshold"), not refused; no thresholds give an empty answer.
     """
     if isinstance(n_grid, (bool, np.bool_)) or not isinstance(n_grid, (int, np.integer)) or n_grid < 2:
         raise ArgumentError(f"n_grid: expected an integer >= 2 (scan points), got {n_grid!r}")
-    check_scalar("theta_start", theta_start)
-    check_scalar("theta_end", theta_end)
+    check_scalar("theta_start", theta_start, low=-MAX_THETA, high=MAX_THETA)
+    check_scalar("theta_end", theta_end, low=-MAX_THETA, high=MAX_THETA)
     if not theta_end > theta_start:
         raise ArgumentError(f"theta_start, theta_end: empty search range [{theta_start}, {theta_end}]")
-    n_t = np.atleast_1d(np.asarray(thresholds, dtype=float))
+    n_t = np.atleast_1d(check_array("thresholds", thresholds, finite=False))
+    if n_t.ndim != 1:
+        raise ArgumentError(f"thresholds: expected a number or a (T,) array of n_t, got shape {n_t.shape}")
     theta = np.linspace(theta_start, theta_end, n_grid)
     f = np.asarray(predict(theta), dtype=float)
     bad = ~np.isfinite(f)

@@ -20,11 +20,15 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from poseintegrity.errors import ArgumentError
+from poseintegrity.errors import ArgumentError, check_array, check_scalar
 from poseintegrity.artifact_models import FitParams, fit_model
+from poseintegrity.artifact_models.fitted import MAX_THETA
 from poseintegrity.prediction.params import PredictParams, UncertaintyParams
 from poseintegrity.prediction.predictors import NO_FIT, envelope_prediction, next_step_stops
 from poseintegrity.prediction.uncertainty import prediction_interval
+
+
+MAX_COUNT = 1e7  # inlier counts: more matches than a 100-megapixel image has keypoints is not a count
 
 
 @dataclass(frozen=True)
@@ -96,13 +100,13 @@ class NextStepSupervisor:
 
         theta : float, the current stop (>= the previous one; equal = more images at the same stop)
         n_inliers : float or (m,) counts of the images at this stop (0 for a frame that failed to localize)
-        Raises ValueError on a NaN theta or count, or on a theta smaller than the previous stop.
+        Raises :class:`~poseintegrity.errors.ArgumentError` on a theta that is not a finite number within 1e6, on
+        counts that are not one or more finite numbers in [0, 1e7], or on a theta smaller than the previous stop.
         """
-        counts = np.atleast_1d(np.asarray(n_inliers, dtype=float)).ravel()
-        if not np.isfinite(theta):
-            raise ArgumentError(f"theta must be finite, got {theta}")
-        if counts.size == 0 or not np.all(np.isfinite(counts)):
-            raise ArgumentError(f"n_inliers must be finite counts (0 for a failed frame), got {n_inliers}")
+        theta = check_scalar("theta", theta, low=-MAX_THETA, high=MAX_THETA)
+        counts = np.atleast_1d(check_array("n_inliers", n_inliers, max_abs=MAX_COUNT))
+        if counts.ndim != 1 or counts.size == 0 or (counts < 0).any():
+            raise ArgumentError(f"n_inliers: expected one or more counts >= 0 (0 for a failed frame), got {n_inliers!r:.80}")
         if self.theta and theta < self.theta[-1]:
             raise ArgumentError(f"theta must not decrease: {theta} after {self.theta[-1]}")
         self.theta.extend([float(theta)] * counts.size)

@@ -30,7 +30,7 @@ from poseintegrity.artifact_models import FitParams
 from poseintegrity.artifact_models.fitted import OK
 from poseintegrity.artifact_models.series import REQUIRED_COLUMNS, Series, dataset_series
 from poseintegrity.parallel import Workers
-from poseintegrity.localization.tables import TableError, check_artifacts, check_envelopes
+from poseintegrity.tables import TableError, check_artifacts, check_envelopes
 from poseintegrity.prediction.metrics import with_metrics
 from poseintegrity.prediction.params import PredictParams
 from poseintegrity.prediction.predictors import (
@@ -168,7 +168,7 @@ def with_pnp_variants(
 
     A method already in ``artifacts`` keeps stage 02's rows; an envelope (dataset, trajectory, tolerance, method
     and, when the tables have one, failed-frame rule) present in both keeps stage 02's. Each of the four tables is
-    checked first (:mod:`poseintegrity.localization.tables`: a duplicated row inside one of them is refused naming
+    checked first (:mod:`poseintegrity.tables`: a duplicated row inside one of them is refused naming
     it, never silently dropped or counted twice).
     """
     check_artifacts(artifacts, "the artifacts table (stage 02)", columns=REQUIRED_COLUMNS)
@@ -195,7 +195,7 @@ def attach_envelopes(theta_p: pd.DataFrame, envelopes: pd.DataFrame, protocol: P
     (a duplicated row would count a dataset twice in every curve), their tolerances are those of ``protocol`` (a
     tolerance the params name would otherwise find no row, and its figures would silently be NaN), theta_a in
     [0, range end], and an envelope for every (dataset, trajectory, method) of ``theta_p`` (one missing would
-    drop that dataset from every curve): :class:`~poseintegrity.localization.tables.TableError` naming them.
+    drop that dataset from every curve): :class:`~poseintegrity.tables.TableError` naming them.
     """
     missing = [column for column in ENVELOPE_COLUMNS if column not in envelopes.columns]
     if missing:

@@ -10,8 +10,8 @@ required column is missing, the table is empty, a key repeats (a duplicated row 
 Fig. 2 and every SPL curve), a column has the wrong dtype or a value outside its range, or an expected dataset is
 absent. The package functions that take these tables (envelopes, dataset_series, attach_envelopes,
 with_pnp_variants, mean_rmse) call them once on what they are given; the ``read_*`` functions read a file and
-check it. Hand-written on purpose: pandas' own duplicated/isna/between cost a few ms on a paper-scale table, where
-pandera's import alone costs far more (docs/errors.md).
+check it, and the notebooks read every table through them. Hand-written with pandas (no new dependency): checking a
+75 600-row artifacts table takes ~80 ms.
 """
 
 from __future__ import annotations
