@@ -145,9 +145,11 @@ def read_table(path: str | Path) -> pd.DataFrame:
         raise TableError(f"{path}: cannot read: {error}") from None
 
 
-def read_artifacts(path: str | Path, datasets: Iterable[str] | None = None) -> pd.DataFrame:
-    """``artifacts.parquet`` / ``pnp_variants.parquet``, checked (:func:`check_artifacts`)."""
-    return check_artifacts(read_table(path), str(path), datasets=datasets)
+def read_artifacts(path: str | Path, datasets: Iterable[str] | None = None,
+                   columns: Iterable[str] = ARTIFACT_COLUMNS) -> pd.DataFrame:
+    """``artifacts.parquet`` / ``pnp_variants.parquet``, checked (:func:`check_artifacts`) for the ``columns`` its
+    reader uses (the fits read ``artifact_models.series.REQUIRED_COLUMNS``)."""
+    return check_artifacts(read_table(path), str(path), columns=columns, datasets=datasets)
 
 
 def read_envelopes(path: str | Path, datasets: Iterable[str] | None = None) -> pd.DataFrame:

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from poseintegrity import PoseIntegrityError
 from poseintegrity.artifact_models.base_functions import emg
 from poseintegrity.artifact_models.fitted import FIT_STATUSES
 from poseintegrity.prediction import NO_FIT, NextStepSupervisor
@@ -32,12 +33,14 @@ def test_the_supervisor_of_the_params(tiny):
 
 def test_bad_input_raises_with_a_clear_message(tiny):
     supervisor = make(tiny)
-    with pytest.raises(ValueError, match="theta must be finite"):
+    with pytest.raises(PoseIntegrityError, match="theta: expected a finite number"):
         supervisor.update(float("nan"), 100.0)
-    with pytest.raises(ValueError, match="n_inliers must be finite"):
+    with pytest.raises(PoseIntegrityError, match="n_inliers: entries must be finite"):
         supervisor.update(2.25, [100.0, np.nan])
+    with pytest.raises(PoseIntegrityError, match="n_inliers: expected one or more counts >= 0"):
+        supervisor.update(2.25, [100.0, -1.0])
     supervisor.update(4.5, 100.0)
-    with pytest.raises(ValueError, match="theta must not decrease"):
+    with pytest.raises(PoseIntegrityError, match="theta must not decrease"):
         supervisor.update(2.25, 100.0)
     with pytest.raises(ValueError, match="needs an uncertainty method"):
         NextStepSupervisor(n_t=30.0, theta_b=2.25, theta_end=45.0, fit=tiny.fit, rng=np.random.default_rng(0),
