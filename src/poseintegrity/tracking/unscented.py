@@ -52,6 +52,19 @@ MAX_ABS_MEASUREMENT = 1e6  # a measurement vector longer than this (metres, rad/
 
 
 @numba.njit(cache=True)
+def observed_count_and_norm2(observed, z):  # pragma: no cover - compiled
+    """(number of observed markers, z . z): the two numbers :meth:`UnscentedMarkerFilter.update` checks its
+    arguments by, in one compiled call (cheaper per step than two numpy reductions)."""
+    count = 0
+    for flag in observed:
+        count += flag
+    norm2 = 0.0
+    for value in z:
+        norm2 += value * value
+    return count, norm2
+
+
+@numba.njit(cache=True)
 def health_code(x, P_diag, n_position_rows, max_position_std):  # pragma: no cover - compiled
     """Divergence test of the filters: 0 healthy, 1 NaN/inf in x (N,) or P_diag (N,), 2 a marker standard
     deviation sqrt(max P_diag[:n_position_rows]) above max_position_std (m); see ``DIVERGENCE_REASONS``."""
@@ -194,12 +207,15 @@ class UnscentedMarkerFilter:
                 z = z.astype(np.float64)
             except (TypeError, ValueError):
                 raise ArgumentError(f"z: expected real numbers, got {type(z).__name__} {z!r:.60}") from None
-        m = 3 * int(np.count_nonzero(observed)) + 3 * bool(gyro)
-        if z.shape != (m,):
+        if z.ndim != 1:
+            raise ArgumentError(f"z: expected a vector of measured rows, got shape {z.shape}")
+        count, norm2 = observed_count_and_norm2(observed, z)
+        m = 3 * count + 3 * bool(gyro)
+        if z.shape[0] != m:
             raise ArgumentError(f"z: expected shape ({m},) (3 per observed marker{' + 3 gyro rates' if gyro else ''}), got {z.shape}")
-        if not z @ z <= MAX_ABS_MEASUREMENT**2:  # one dot product (cheap per step): False for NaN, inf and 1e300
+        if not norm2 <= MAX_ABS_MEASUREMENT**2:  # False for NaN, inf and 1e300
             raise ArgumentError(f"z: must be finite with a norm of at most {MAX_ABS_MEASUREMENT:g} (m, rad/s), "
-                                f"got norm {float(np.sqrt(z @ z))!r}")
+                                f"got norm {float(np.sqrt(norm2))!r}")
         return self._update(z, observed, bool(gyro))
 
     def _update(self, z: np.ndarray, observed: np.ndarray, gyro: bool) -> bool:
