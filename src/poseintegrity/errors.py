@@ -13,6 +13,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence, Sized
 from numbers import Real
+from pathlib import Path
 
 import numpy as np
 
@@ -131,6 +132,24 @@ def check_increasing(name: str, values: object, *, strict: bool = True) -> np.nd
         raise ArgumentError(f"{name}: must {'increase' if strict else 'not decrease'}, got {float(values[i])!r} "
                             f"then {float(values[i + 1])!r} at index {i + 1}")
     return values
+
+
+def read_text_file(path: Path, error: type[PoseIntegrityError], what: str = "file") -> str:
+    """The UTF-8 text of a small input file (a table, a tool list); ``error`` naming the file when it cannot be read,
+    is empty, is not UTF-8 or holds NUL bytes (a binary file given by mistake)."""
+    try:
+        data = Path(path).read_bytes()
+    except OSError as problem:
+        raise error(f"{path}: cannot read the {what} ({problem.strerror or problem})") from None
+    if not data.strip():
+        raise error(f"{path}: the {what} is empty")
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as problem:
+        raise error(f"{path}: not UTF-8 text (byte {problem.start}); is it a binary file?") from None
+    if "\x00" in text:
+        raise error(f"{path}: contains NUL bytes; is it a binary file?")
+    return text
 
 
 def check_same_length(**arrays: Sized) -> int:

@@ -202,10 +202,10 @@ def test_a_folder_mixing_recordings_or_without_manifest_is_refused(tmp_path):
 
 
 @pytest.mark.parametrize("name, content, message", [
-    ("frames.csv", b"", "frames.csv: the file is empty"),
+    ("frames.csv", b"", r"frames.csv: the table \(expected a header t_s,ir,depth .*\) is empty"),
     ("frames.csv", bytes(range(256)) * 4, "frames.csv: (not UTF-8|contains NUL)"),
     ("frames.csv", b"t_s,ir,depth\n", "frames.csv: lists no frames"),
-    ("gyro.csv", b"", "gyro.csv: the file is empty"),
+    ("gyro.csv", b"", r"gyro.csv: the table \(expected a header t_s,wx,wy,wz .*\) is empty"),
     ("gyro.csv", b"\xff\xfe" + "t_s,wx,wy,wz\n".encode("utf-16-le"), "gyro.csv: not UTF-8"),
     ("gyro.csv", b"t_s,wx,wy,wz\n0.01,0,0,0\n0.01,0,0,0\n", "gyro.csv: timestamps must increase; they repeat at row 1"),
 ])

@@ -54,7 +54,7 @@ import numpy as np
 import pandas as pd
 from scipy.spatial.transform import Rotation
 
-from poseintegrity.errors import ArgumentError, PoseIntegrityError, check_array
+from poseintegrity.errors import ArgumentError, PoseIntegrityError, check_array, read_text_file
 from poseintegrity.tracking.detection import detect_markers, validate_frame
 from poseintegrity.tracking.params import TrackParams
 from poseintegrity.tracking.tools import MultiToolTracker
@@ -84,15 +84,7 @@ def _read_table(path: Path, columns: list[str], numeric: tuple[str, ...] = ()) -
     an empty, binary or non-UTF-8 file, raises :class:`RecordingError` naming the file."""
     if not path.is_file():
         raise RecordingError(f"{path} is missing")
-    data = path.read_bytes()
-    if not data.strip():
-        raise RecordingError(f"{path}: the file is empty; expected a header {','.join(columns)} and one row per sample")
-    try:
-        text = data.decode("utf-8")
-    except UnicodeDecodeError as error:
-        raise RecordingError(f"{path}: not UTF-8 text (byte {error.start}); is it a binary file?") from None
-    if "\x00" in text:
-        raise RecordingError(f"{path}: contains NUL bytes; is it a binary file?")
+    text = read_text_file(path, RecordingError, f"table (expected a header {','.join(columns)} and one row per sample)")
     try:
         table = pd.read_csv(io.StringIO(text))
     except (ValueError, pd.errors.ParserError) as error:  # EmptyDataError is a ValueError

@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from poseintegrity.errors import ArgumentError, PoseIntegrityError, check_array
+from poseintegrity.errors import ArgumentError, PoseIntegrityError, check_array, read_text_file
 from poseintegrity.tracking.geometry import pairwise_distances, tool_geometry_problem
 from poseintegrity.tracking.params import FilterParams, MatchingParams
 from poseintegrity.tracking.tracker import FrameResult, MarkerTracker, check_points, check_rates, check_timestamp
@@ -113,18 +113,7 @@ def read_tools(path: str | Path, distinct_m: float) -> dict[str, np.ndarray]:
     path = Path(path)
     if path.suffix.lower() not in (".json", ".csv"):
         raise ToolError(f"{path}: tool files are .json or .csv, got {path.suffix!r}")
-    try:
-        data = path.read_bytes()
-    except OSError as error:
-        raise ToolError(f"{path}: cannot read the tool file ({error.strerror or error})") from None
-    if not data.strip():
-        raise ToolError(f"{path}: the tool file is empty")
-    try:
-        text = data.decode("utf-8")
-    except UnicodeDecodeError as error:
-        raise ToolError(f"{path}: not UTF-8 text (byte {error.start}); is it a binary file?") from None
-    if "\x00" in text:
-        raise ToolError(f"{path}: contains NUL bytes; is it a binary file?")
+    text = read_text_file(path, ToolError, "tool file")
     try:
         pairs = _tool_pairs_json(path, text) if path.suffix.lower() == ".json" else _tool_pairs_csv(path, text)
     except ToolError:
