@@ -149,6 +149,8 @@ def _any_flag(result: Any) -> bool:
 GRAY8_CONVERSIONS = {"image": {"uint16", "three_channel", "four_channel"}}  # converted once, documented (as_gray8)
 FEWER = {"empty", "one_element", "one_fewer"}  # fewer items: a smaller answer
 UNKNOWN_POSITION = {"theta_p": {"nan"}, "theta_a": {"nan"}}  # NaN in, NaN (the unknown) out: documented
+# a series' samples with a non-finite theta or count are dropped (documented); fewer thresholds: fewer answers
+SERIES_ACCEPTS = {"theta": {"nan", "inf"}, "n_inliers": {"nan", "inf"}, "thresholds": FEWER | {"huge"}}
 TRACKER_ACCEPTS = {"points": {"one_element", "one_fewer", "nan", "inf", "huge"}}
 
 
@@ -240,6 +242,23 @@ def _entries() -> list[EntryPoint]:
                    {"theta": "scalar", "n_inliers": "array"},
                    accepts={"n_inliers": {"one_element", "one_fewer"}},  # fewer images at this stop
                    flagged=lambda d: d.status in ("non_finite", "bad_threshold") or d.fit_status not in ("ok", "no_fit")),
+        EntryPoint("prediction.long_range",
+                   lambda a: predictors.long_range(_series(a["theta"], a["n_inliers"]), 4, "emg", a["thresholds"],
+                                                   P().fit, np.random.default_rng(0), 64),
+                   lambda tmp: {"theta": inlier_series()[0], "n_inliers": inlier_series()[1],
+                                "thresholds": np.array([15.0, 30.0])},
+                   {"theta": "array", "n_inliers": "array", "thresholds": "array"},
+                   flagged=lambda r: _boundaries_flagged(r.prediction) or r.fitted is None or r.fitted.status != "ok",
+                   accepts=SERIES_ACCEPTS),
+        EntryPoint("prediction.next_step",
+                   lambda a: predictors.next_step(_series(a["theta"], a["n_inliers"]), 4, "emg", a["thresholds"],
+                                                  P().fit, 0, "usac_magsac", 64),
+                   lambda tmp: {"theta": inlier_series()[0], "n_inliers": inlier_series()[1],
+                                "thresholds": np.array([15.0, 30.0])},
+                   {"theta": "array", "n_inliers": "array", "thresholds": "array"},
+                   flagged=lambda r: bool((~np.isin(r.fit_status, ["ok"])).any()
+                                          or (~np.isin(r.prediction.status, ["stopped", "end_of_path"])).any()),
+                   accepts=SERIES_ACCEPTS),
         # ---- tracking
         EntryPoint("tracking.detect_markers",
                    lambda a: _warned(detection.detect_markers, a["ir"], a["depth_mm"], a["unproject"],
@@ -288,6 +307,14 @@ def _entries() -> list[EntryPoint]:
                      lambda tmp, name=name: {"file": _recording_dir(tmp) / name}, {"file": "file"},
                      names={"file": name}, accepts={"file": {"missing"}} if name == "gyro.csv" else {})
           for name in ("frames.csv", "gyro.csv", "lut_x.npy")],
+        EntryPoint("tracking.RecordingWriter",
+                   lambda a: _write_recording(a["folder"], a["t"], a["ir"], a["depth_mm"], a["gyro_t"], a["gyro"]),
+                   lambda tmp: {"folder": tmp / "written", "t": 0.046, "ir": tracking_frame()["ir"],
+                                "depth_mm": tracking_frame()["depth"], "gyro_t": np.array([0.01, 0.02]),
+                                "gyro": np.zeros((2, 3))},
+                   {"t": "timestamp", "ir": "image", "depth_mm": "image", "gyro_t": "array", "gyro": "points"},
+                   # 8/16-bit frames, any clock; a NaN rate is kept and flagged bad_gyro when tracked
+                   accepts={"ir": {"uint16"}, "depth_mm": {"uint16"}, "t": {"negative"}, "gyro": {"nan"}}),
         EntryPoint("tracking.track_recording",
                    lambda a: recording.track_recording(recording.read_recording(a["file"].parents[1]),
                                                        {"probe": tracking_frame()["geometry"]}, P().track),
@@ -300,6 +327,8 @@ def _entries() -> list[EntryPoint]:
                    lambda tmp: {"table": _artifacts_table()}, {"table": "table"}),
         EntryPoint("tables.read_envelopes", lambda a: tables.read_envelopes(a["path"]),
                    lambda tmp: {"path": _parquet(tmp, "envelopes.parquet", _envelope_table())}, {"path": "file"}),
+        EntryPoint("tables.read_fig2_rmse", lambda a: tables.read_fig2_rmse(a["path"]),
+                   lambda tmp: {"path": _parquet(tmp, "fig2_rmse.parquet", _fig2_table())}, {"path": "file"}),
         EntryPoint("tables.read_artifacts", lambda a: tables.read_artifacts(a["path"]),
                    lambda tmp: {"path": _parquet(tmp, "artifacts.parquet", _artifacts_table())}, {"path": "file"}),
         # ---- command lines: one line naming the file, exit status 2, no traceback
@@ -397,6 +426,33 @@ def _dataset_dir(tmp: Path) -> Path:
     rows = [synthetic.write_dataset(data_dir, "ds_arc", np.random.default_rng(0), stops=(10.0,), images_per_stop=1)]
     synthetic.write_index(data_dir, rows)
     return data_dir / "datasets" / "index.parquet"
+
+
+def _series(theta: np.ndarray, n_inliers: np.ndarray):
+    from poseintegrity.artifact_models.series import Series
+
+    theta = np.asarray(theta)  # the stops of the valid series (3 images each), as long as theta has entries
+    stop = np.arange(theta.shape[0]) // 3 if theta.dtype.kind in "iuf" and theta.ndim == 1 else theta
+    return Series("scene_1_arc000", "arc", stop, theta, n_inliers, 45.0)
+
+
+def _boundaries_flagged(b) -> bool:
+    return bool(np.isin(b.status, ["non_finite", "bad_threshold", "too_few_stops"]).any())
+
+
+def _write_recording(folder: Path, t, ir, depth_mm, gyro_t, gyro) -> Path:
+    from poseintegrity.tracking.recording import RecordingWriter, read_recording
+
+    writer = RecordingWriter(folder, tracking_frame()["lut"])
+    writer.add_frame(0.0, tracking_frame()["ir"], tracking_frame()["depth"])
+    writer.add_frame(t, ir, depth_mm)
+    writer.close(gyro_t, gyro)
+    return read_recording(folder)
+
+
+def _fig2_table() -> pd.DataFrame:
+    return pd.DataFrame([dict(trajectory="arc", dataset=f"scene_1_arc00{i}", k=4, model="emg", rmse=5.0 + i,
+                              status="ok", reason="ok", n_samples=12) for i in range(2)])
 
 
 def _parquet(tmp: Path, name: str, table: pd.DataFrame) -> Path:

@@ -11,7 +11,8 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from poseintegrity.errors import ArgumentError
+from poseintegrity.errors import ArgumentError, check_array, check_same_length, check_scalar
+from poseintegrity.artifact_models.fitted import MAX_THETA
 from poseintegrity.tables import TableError, check_artifacts
 from poseintegrity.protocol import ProtocolParams
 
@@ -33,6 +34,22 @@ class Series:
     theta: np.ndarray
     n_inliers: np.ndarray
     theta_end: float
+
+    def __post_init__(self) -> None:
+        """Checked once when made (every predictor takes a Series): theta and n_inliers (m,) numbers (NaN / inf are
+        samples without a measurement, dropped by the fits), stop (m,) integers >= 0 that never decrease, theta_end
+        a finite number within 1e6; :class:`~poseintegrity.errors.ArgumentError` naming the field otherwise."""
+        theta = check_array("Series.theta", self.theta, shape=(None,), finite=False)
+        n_inliers = check_array("Series.n_inliers", self.n_inliers, shape=(None,), finite=False)
+        stop = check_array("Series.stop", self.stop, shape=(None,), dtype="int")
+        check_same_length(**{"Series.theta": theta, "Series.n_inliers": n_inliers, "Series.stop": stop})
+        if (stop < 0).any() or (np.diff(stop) < 0).any():
+            raise ArgumentError("Series.stop: expected stop indices >= 0 in stop order")
+        if (np.abs(theta[np.isfinite(theta)]) > MAX_THETA).any():
+            raise ArgumentError(f"Series.theta: positions beyond +-{MAX_THETA:g} are not a trajectory")
+        check_scalar("Series.theta_end", self.theta_end, low=-MAX_THETA, high=MAX_THETA)
+        object.__setattr__(self, "theta", theta)
+        object.__setattr__(self, "n_inliers", n_inliers)
 
     @property
     def n_stops(self) -> int:

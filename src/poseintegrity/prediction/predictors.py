@@ -50,6 +50,14 @@ class Boundaries:
     status: np.ndarray
 
 
+def _thresholds(thresholds: object) -> np.ndarray:
+    """Thresholds n_t as a float (T,) array (a NaN one is flagged by the predictors, not refused)."""
+    n_t = np.atleast_1d(check_array("thresholds", thresholds, finite=False))
+    if n_t.ndim != 1:
+        raise ArgumentError(f"thresholds: expected a number or a (T,) array of n_t, got shape {n_t.shape}")
+    return n_t
+
+
 def boundaries(
     predict: Callable[[np.ndarray], np.ndarray],
     thresholds: np.ndarray,
@@ -76,9 +84,7 @@ def boundaries(
     check_scalar("theta_end", theta_end, low=-MAX_THETA, high=MAX_THETA)
     if not theta_end > theta_start:
         raise ArgumentError(f"theta_start, theta_end: empty search range [{theta_start}, {theta_end}]")
-    n_t = np.atleast_1d(check_array("thresholds", thresholds, finite=False))
-    if n_t.ndim != 1:
-        raise ArgumentError(f"thresholds: expected a number or a (T,) array of n_t, got shape {n_t.shape}")
+    n_t = _thresholds(thresholds)
     theta = np.linspace(theta_start, theta_end, n_grid)
     f = np.asarray(predict(theta), dtype=float)
     bad = ~np.isfinite(f)
@@ -223,6 +229,7 @@ def next_step(
     "bad_threshold". Fits stop once every threshold has stopped. A threshold's fit status is the most severe
     status among the fits it went by (up to and including the one that stopped it): its path relied on each.
     """
+    thresholds = _thresholds(thresholds)
     stops, theta_stops = stop_positions(series)
     no_fit = np.full(np.shape(thresholds), NO_FIT)
     if stops.size < max(k0, 2):

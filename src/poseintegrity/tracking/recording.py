@@ -54,7 +54,7 @@ import numpy as np
 import pandas as pd
 from scipy.spatial.transform import Rotation
 
-from poseintegrity.errors import ArgumentError, PoseIntegrityError, check_array, read_text_file
+from poseintegrity.errors import ArgumentError, PoseIntegrityError, check_array, check_increasing, check_same_length, read_text_file
 from poseintegrity.tracking.detection import detect_markers, validate_frame
 from poseintegrity.tracking.params import TrackParams
 from poseintegrity.tracking.tools import MultiToolTracker
@@ -275,9 +275,16 @@ class RecordingWriter:
         the recording into place (replacing the old one if overwrite was given)."""
         if self.closed:
             raise RecordingError(f"{self.folder}: the recording is already closed")
+        if (gyro_t is None) != (gyro is None):
+            raise ArgumentError("gyro_t, gyro: give both (sample times and rates) or neither")
+        if gyro_t is not None:  # checked before anything is written
+            gyro_t = check_increasing("gyro_t", gyro_t)
+            if not len(gyro_t) or np.abs(gyro_t).max() > MAX_ABS_TIME_S:
+                raise ArgumentError(f"gyro_t: expected one or more sample times within +-{MAX_ABS_TIME_S:g} s")
+            gyro = check_array("gyro", gyro, shape=(None, 3), allow_nan=True)  # NaN: flagged bad_gyro when tracked
+            check_same_length(gyro_t=gyro_t, gyro=gyro)
         pd.DataFrame(self.rows, columns=["t_s", "ir", "depth"]).to_csv(self.staging / "frames.csv", index=False, float_format="%.17g")
         if gyro_t is not None:
-            gyro = check_array("gyro", gyro, shape=(len(np.atleast_1d(gyro_t)), 3), finite=False)
             table = pd.DataFrame({"t_s": gyro_t, "wx": gyro[:, 0], "wy": gyro[:, 1], "wz": gyro[:, 2]})
             table.to_csv(self.staging / "gyro.csv", index=False, float_format="%.17g")
         write_manifest(self.staging, self.run_id)
