@@ -191,7 +191,7 @@ def test_valid_files_still_load_unchanged():
     assert scene.distance_mm == 300.0 and type(scene.distance_mm) is float
     assert scene.glenoid_tilt_deg == (0.0, 25.0)
     assert params.protocol.tolerances == [(2.0, 3.0), (4.0, 10.0)]
-    assert params.generate.scapula.mesh == ROOT / "assets" / "scapula_left.stl"
+    assert params.generate.scapula.mesh == ROOT / "src" / "poseintegrity" / "assets" / "scapula_left.stl"
     assert params.generate.calibration.distance_mm == (250.0, 450.0)
     assert params.protocol.pnp_method == "usac_magsac" and params.fit.k_max is None
     assert params.track.filter.kappa is None and params.track.motion.occlusions == [(20.0, 2.0)]

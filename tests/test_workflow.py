@@ -197,8 +197,7 @@ def test_dvc_lock_was_written_by_the_committed_sources():
     assert not changed, f"sources changed since dvc.lock was written (re-run make repro): {changed}"
 
 
-SHIPPED = ["src", "notebooks", "benchmarks", "docs", "assets/README.md", "README.md", "params.yaml", "dvc.yaml",
-           "Makefile"]
+SHIPPED = ["src", "notebooks", "benchmarks", "docs", "README.md", "params.yaml", "dvc.yaml", "Makefile"]
 def test_outside_references_finds_what_a_clone_cannot_follow():
     text = "see NOTES_ELSEWHERE.md, ../../elsewhere/papers and /home/someone/data; README.md and ../params.yaml are fine"
     assert outside_references(text, ROOT / "tests") == ["NOTES_ELSEWHERE.md", "../../elsewhere", "/home/someone"]

@@ -16,10 +16,18 @@ What reading refuses, each with a :class:`ParamsError` naming the file: bytes th
 offset and line), invalid YAML, a key written twice in one mapping (YAML would silently keep the last; the error
 names the dotted key and both lines), an ``extends`` that is not a file path, names a missing file or closes a
 cycle (the chain is named), and a file that is not a mapping.
+
+The project's published values travel with the package: :func:`load_params` without a path reads the packaged copy
+``poseintegrity/params.yaml`` (identical to the repository's ``params.yaml``, which a test checks), and the public
+functions that take a params section use it when none is given, so ``detect_markers(ir, depth, lut)`` works in a
+fresh notebook; a section passed explicitly (or ``load_params("my_params.yaml")``) overrides it. The packaged copy's
+file paths (``generate.scapula.mesh``, texture files) are relative to the package directory, where no asset lies:
+rendering a world (stage 01) needs the repository and its ``params.yaml``.
 """
 
 from __future__ import annotations
 
+from functools import cache
 from pathlib import Path
 from typing import Any
 
@@ -37,6 +45,7 @@ from poseintegrity.schema import KeyRule
 from poseintegrity.tracking.params import TrackParams
 
 
+PACKAGED_PARAMS = Path(__file__).with_name("params.yaml")  # a copy of the repository's params.yaml, shipped as package data
 PROTOCOL_READERS = ("protocol", "generate", "extract", "fit", "predict")  # sections checked against ``protocol``
 
 
@@ -198,10 +207,21 @@ def _read_chain(path: Path, chain: tuple[Path, ...]) -> tuple[Any, Path]:
     return merge(base, raw), base_dir
 
 
-def load_params(path: str | Path = "params.yaml") -> Params:
-    """Read and validate a whole params file (``params.yaml`` or an overlay on it)."""
+def load_params(path: str | Path | None = None) -> Params:
+    """Read and validate a whole params file (``params.yaml`` or an overlay on it); without a path, the project's
+    published defaults (:func:`default_params`)."""
+    if path is None:
+        return default_params()
     raw, base_dir = read_raw(path)
     return parse_params(raw, source=str(path), base_dir=base_dir)
+
+
+@cache
+def default_params() -> Params:
+    """The packaged copy of ``params.yaml`` (:data:`PACKAGED_PARAMS`), validated once per process: the default of
+    every public function that takes a params section. Frozen, so one instance is shared safely."""
+    raw, base_dir = read_raw(PACKAGED_PARAMS)
+    return parse_params(raw, source=str(PACKAGED_PARAMS), base_dir=base_dir)
 
 
 def load_section(path: str | Path, section: str) -> BaseModel:

@@ -43,14 +43,22 @@ class KeyRule(PoseIntegrityError):
         self.key = key
 
 
+PACKAGE_PREFIX = "poseintegrity:"  # a file shipped with the package (poseintegrity/assets), wherever it is installed
+
+
 def _resolve(path: Path, info: ValidationInfo) -> Path:
-    """A relative path made relative to the params root directory (validation context ``base_dir``, set by
-    :func:`poseintegrity.config.load_section`); unchanged without one."""
+    """``poseintegrity:<path>`` made a path inside the installed package; another relative path made relative to
+    the params root directory (validation context ``base_dir``, set by :func:`poseintegrity.config.load_section`),
+    unchanged without one."""
+    text = path.as_posix()
+    if text.startswith(PACKAGE_PREFIX):
+        return Path(__file__).parent / text.removeprefix(PACKAGE_PREFIX)
     base = (info.context or {}).get("base_dir")
     return path if path.is_absolute() or base is None else Path(base) / path
 
 
-ProjectPath = Annotated[Path, Strict(False), AfterValidator(_resolve)]  # a file named in params.yaml, relative to its directory
+# a file named in params.yaml: relative to its directory, or poseintegrity:<path> inside the package
+ProjectPath = Annotated[Path, Strict(False), AfterValidator(_resolve)]
 
 
 def _worker_count(n_jobs: int) -> int:

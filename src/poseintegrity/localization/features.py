@@ -17,6 +17,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
+from poseintegrity.defaults import published
 from poseintegrity.errors import ArgumentError, check_image
 from poseintegrity.localization.dataset import DatasetError
 from poseintegrity.localization.params import ClaheParams, SiftParams
@@ -109,11 +110,14 @@ def equalize(image: np.ndarray, clahe: ClaheParams) -> np.ndarray:
     return cv2.createCLAHE(clipLimit=clahe.clip_limit, tileGridSize=grid).apply(image)
 
 
-def detect_features(image: np.ndarray, clahe: ClaheParams, sift: SiftParams) -> Features:
+def detect_features(image: np.ndarray, clahe: ClaheParams | None = None, sift: SiftParams | None = None) -> Features:
     """CLAHE, then SIFT detectAndCompute on the whole image. No keypoints gives empty arrays.
 
     image : (h, w) uint8; colour or 16-bit images are converted, anything else refused (:func:`as_gray8`).
+    clahe, sift : ``extract.clahe`` / ``extract.sift``; None takes the published defaults (params.yaml).
     """
+    clahe = published("extract.clahe") if clahe is None else clahe
+    sift = published("extract.sift") if sift is None else sift
     image = as_gray8("image", image)
     detector = cv2.SIFT_create(
         sift.n_features, sift.n_octave_layers, sift.contrast_threshold, sift.edge_threshold, sift.sigma,

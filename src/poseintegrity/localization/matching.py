@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from poseintegrity.defaults import published
 from poseintegrity.errors import ArgumentError, check_scalar
 
 MAX_DESCRIPTOR = 1e6  # SIFT components are at most 512 (OpenCV scales the unit vector by 512 and clips at 0.2 of it)
@@ -28,12 +29,13 @@ def _descriptors(name: str, values: object) -> np.ndarray:
     return array
 
 
-def match_ratio_test(query: np.ndarray, train: np.ndarray, ratio: float) -> np.ndarray:
+def match_ratio_test(query: np.ndarray, train: np.ndarray, ratio: float | None = None) -> np.ndarray:
     """Nearest-neighbour matches that pass the ratio test.
 
     query : (n, 128) float32 descriptors (the frame), train : (m, 128) float32 descriptors (the model).
     A query descriptor is kept when its nearest train descriptor is closer than ``ratio`` times the second
-    nearest (Lowe 2004, section 7.1), L2 distance.
+    nearest (Lowe 2004, section 7.1), L2 distance; ratio None takes ``extract.ratio_test`` of the published
+    defaults (params.yaml).
     Returns (k, 2) int: rows of (query index, train index); (0, 2) when the query is empty or the train
     set has fewer than the 2 descriptors a ratio test needs.
     Refused (:class:`~poseintegrity.errors.ArgumentError` naming the argument): descriptors that are not a 2-D array
@@ -42,6 +44,7 @@ def match_ratio_test(query: np.ndarray, train: np.ndarray, ratio: float) -> np.n
     query, train = _descriptors("query", query), _descriptors("train", train)
     if query.shape[1] != train.shape[1]:
         raise ArgumentError(f"query, train: descriptors of {query.shape[1]} and {train.shape[1]} values cannot be compared")
+    ratio = published("extract.ratio_test") if ratio is None else ratio
     check_scalar("ratio", ratio, low=0.0, high=1.0, low_open=True)
     if len(query) == 0 or len(train) < 2:
         return np.empty((0, 2), dtype=np.intp)

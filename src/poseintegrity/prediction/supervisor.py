@@ -1,6 +1,6 @@
 """The next-step predictor as a component of a robot loop (Windsor et al. III-E; the live trials of V-C).
 
-    params = load_params("params.yaml")
+    params = load_params()                          # the published defaults, or load_params("mine.yaml")
     supervisor = NextStepSupervisor.from_params(params, "arc", n_t=15, theta_b=2.25, rng=rng)
     for theta, n_inliers in stops:                  # the robot pauses at each stop and localizes
         decision = supervisor.update(theta, n_inliers)

@@ -1,8 +1,8 @@
 """The anatomical scapula phantom (Windsor et al. IV-B, Fig. 3-4): a left human scapula mesh, scaled to an adult,
 and the prepared phantom "pre-drilled for implant placement" with an oversized hole in the glenoid.
 
-The mesh is ``assets/scapula_left.stl`` ("Upper Limb Bones (Left)" by HandOT, CC BY-SA 3.0; see
-``assets/README.md``), read with trimesh; the hole is a boolean difference computed by manifold3d (through trimesh).
+The mesh is ``poseintegrity/assets/scapula_left.stl`` ("Upper Limb Bones (Left)" by HandOT, CC BY-SA 3.0; see
+``poseintegrity/assets/README.md``), read with trimesh; the hole is a boolean difference computed by manifold3d (through trimesh).
 Everything that can be wrong with the mesh or the hole is found here, before any rendering, and raised as a
 :class:`MeshError` naming the params key and the file.
 

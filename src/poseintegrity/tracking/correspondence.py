@@ -21,6 +21,7 @@ from itertools import combinations, permutations
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
+from poseintegrity.defaults import published
 from poseintegrity.errors import ArgumentError, check_array
 from poseintegrity.tracking.geometry import pairwise_distances
 from poseintegrity.tracking.kabsch import kabsch_residuals
@@ -205,12 +206,13 @@ def match_gated(points: np.ndarray, predicted: np.ndarray, *, gate_m: float) -> 
 def match_markers(
     points: np.ndarray,
     geometry: np.ndarray,
-    previous: np.ndarray | None,
-    matching: MatchingParams,
+    previous: np.ndarray | None = None,
+    matching: MatchingParams | None = None,
 ) -> np.ndarray:
     """For each geometry marker (m, 3) the index of its measured point among points (n, 3), or -1.
 
-    previous : (m, 3) predicted marker positions (metres, world) or None; matching : ``track.matching``.  With a prediction the gated
+    previous : (m, 3) predicted marker positions (metres, world) or None; matching : ``track.matching`` (None: the
+    published defaults, params.yaml).  With a prediction the gated
     optimal assignment is tried first and kept if it rigidly matches at least min_markers markers and no
     other permutation of the same points fits the geometry better (Alg. 3 on those points).
     Otherwise voting (Alg. 2) fixes the confident matches and brute force (Alg. 3) fills the rest from the
@@ -227,6 +229,7 @@ def match_markers(
     geometry = check_array("geometry", geometry, shape=(None, 3), min_rows=3, max_abs=MAX_ABS_M)
     if previous is not None:
         previous = check_array("previous", previous, shape=geometry.shape, finite=False)
+    matching = published("track.matching") if matching is None else matching
     return match_markers_unchecked(points, geometry, previous, matching)
 
 

@@ -29,6 +29,7 @@ import warnings
 import cv2
 import numpy as np
 
+from poseintegrity.defaults import published
 from poseintegrity.errors import PoseIntegrityError
 from poseintegrity.tracking.geometry import transform_points
 from poseintegrity.tracking.params import DetectionParams
@@ -302,18 +303,19 @@ def detect_markers(
     ir: np.ndarray,
     depth_mm: np.ndarray,
     unproject: np.ndarray,
-    detection: DetectionParams,
+    detection: DetectionParams | None = None,
     T_world_cam: np.ndarray | None = None,
 ) -> np.ndarray:
     """Marker centres (n, 3), metres, in the world frame, from one IR + depth frame (section II-B).
 
     ir : (H, W) uint8 or uint16 reflectivity; depth_mm : (H, W) millimetres along each pixel's ray
     (0 or NaN = invalid); unproject : (3, 3) pinhole K or (H, W, 2) unit-plane LUT, lut[v, u] = (x, y);
-    detection : the detector's constants (``track.detection``); T_world_cam : (4, 4) extrinsics, identity if
+    detection : the detector's constants (``track.detection``; None: the published defaults); T_world_cam : (4, 4) extrinsics, identity if
     None.  depth_offset_mm is added along the ray (the sphere radius: from the reflecting surface to the centre).
     Blobs without a valid depth are dropped.  An unusable frame (see :func:`validate_frame`) gives an
     empty (0, 3) array and a ``RuntimeWarning`` naming the reason; it never raises.
     """
+    detection = published("track.detection") if detection is None else detection
     reason = validate_frame(ir, depth_mm, unproject)
     if reason:
         warnings.warn(f"detect_markers: {reason}", RuntimeWarning, stacklevel=2)

@@ -54,6 +54,7 @@ import numpy as np
 import pandas as pd
 from scipy.spatial.transform import Rotation
 
+from poseintegrity.defaults import published
 from poseintegrity.errors import ArgumentError, PoseIntegrityError, check_array, check_increasing, check_same_length, read_text_file
 from poseintegrity.tracking.detection import detect_markers, validate_frame
 from poseintegrity.tracking.params import TrackParams
@@ -308,7 +309,8 @@ class RecordingWriter:
             self.discard()
 
 
-def track_recording(recording: Recording, tools: dict[str, np.ndarray], params: TrackParams, gyro_tool: str | None = None) -> pd.DataFrame:
+def track_recording(recording: Recording, tools: dict[str, np.ndarray], params: TrackParams | None = None,
+                    gyro_tool: str | None = None) -> pd.DataFrame:
     """Pose table of a recording: one row per frame and tool, in time order.
 
     Columns: t_s, frame, tool, flag, n_points, n_matched, x_mm / y_mm / z_mm and qx / qy / qz / qw (filtered
@@ -316,7 +318,9 @@ def track_recording(recording: Recording, tools: dict[str, np.ndarray], params: 
     the frames (events in time order; a gyro sample at the time of a frame comes after it).
     A frame in which nothing is detected is a row flagged no_points (the filter keeps predicting and picks the
     tool up again on the next good frame).  Bad tools or a gyro_tool naming no tool raise ToolError.
+    params : ``track`` (detection, matching, filter); None takes the published defaults (params.yaml).
     """
+    params = published("track") if params is None else params
     tracker = MultiToolTracker(tools, params.filter, params.matching, gyro_tool)  # checks tools and gyro_tool
     if recording.gyro is None and gyro_tool is not None:
         tracker = MultiToolTracker(tools, params.filter, params.matching, None)

@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from poseintegrity.defaults import published
 from poseintegrity.errors import ArgumentError, PoseIntegrityError, check_array, read_text_file
 from poseintegrity.tracking.geometry import pairwise_distances, tool_geometry_problem
 from poseintegrity.tracking.params import FilterParams, MatchingParams
@@ -135,11 +136,15 @@ class MultiToolTracker:
     Tools are matched in turn; the points a tool matched are withheld from the tools after it, so one
     reflection is never two tools' marker.  gyro_tool : the tool that carries the gyro (None: no gyro).
     The tools are checked once by :func:`check_tools` (ToolError: none, duplicated names, < 3 markers, ...);
-    a gyro_tool that names no tool raises ToolError.  A frame with no point left for a tool (nothing detected,
+    a gyro_tool that names no tool raises ToolError.  filter_params, matching : ``track.filter`` /
+    ``track.matching``; None takes the published defaults (params.yaml).  A frame with no point left for a tool (nothing detected,
     or every point taken by the tools before it) gives that tool a flagged result ("no_points"), never an error.
     """
 
-    def __init__(self, tools: dict[str, np.ndarray], filter_params: FilterParams, matching: MatchingParams, gyro_tool: str | None = None):
+    def __init__(self, tools: dict[str, np.ndarray], filter_params: FilterParams | None = None,
+                 matching: MatchingParams | None = None, gyro_tool: str | None = None):
+        filter_params = published("track.filter") if filter_params is None else filter_params
+        matching = published("track.matching") if matching is None else matching
         tools = check_tools(tools, matching.distinct_m)
         if gyro_tool is not None and gyro_tool not in tools:
             raise ToolError(f"gyro_tool: {gyro_tool!r} names no tool; the tools are {list(tools)}")

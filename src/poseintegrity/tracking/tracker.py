@@ -33,6 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from poseintegrity.defaults import published
 from poseintegrity.errors import check_array, check_scalar
 from poseintegrity.poses import NAN_POSE
 from poseintegrity.tracking.correspondence import match_markers_unchecked
@@ -90,16 +91,19 @@ class MarkerTracker:
     """SR-UKF (or another :class:`UnscentedMarkerFilter`) fed by matched marker frames and a gyro.
 
     markers_body : (m, 3) geometry, metres.  use_gyro : fuse gyro samples (else they only advance time).
+    filter_params, matching : ``track.filter`` / ``track.matching``; None takes the published defaults (params.yaml).
     """
 
     def __init__(
         self,
         markers_body: np.ndarray,
-        filter_params: FilterParams,
-        matching: MatchingParams,
+        filter_params: FilterParams | None = None,
+        matching: MatchingParams | None = None,
         use_gyro: bool = True,
         filter_cls: type[UnscentedMarkerFilter] = SquareRootUKF,
     ):
+        filter_params = published("track.filter") if filter_params is None else filter_params
+        matching = published("track.matching") if matching is None else matching
         self.filter = filter_cls(markers_body, filter_params)  # refuses < 3, non-finite or collinear markers
         self.markers_body = self.filter.markers_body
         self.params = filter_params
