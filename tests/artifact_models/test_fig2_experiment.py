@@ -18,7 +18,7 @@ from poseintegrity.artifact_models import (
     status_counts,
 )
 from poseintegrity.artifact_models.fitted import OK
-from poseintegrity.artifact_models.models import distinct_theta_needed
+from poseintegrity.artifact_models.names import distinct_theta_needed
 
 
 @pytest.fixture(scope="module")

@@ -10,7 +10,7 @@ from pydantic import ValidationError
 
 from params_cases import refusal
 from poseintegrity.artifact_models import BASE_FUNCTIONS, MODEL_NAMES
-from poseintegrity.artifact_models.models import distinct_theta_needed
+from poseintegrity.artifact_models.names import distinct_theta_needed
 from poseintegrity.artifact_models.params import ModelName
 from poseintegrity.config import load_params
 

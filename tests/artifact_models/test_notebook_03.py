@@ -13,7 +13,7 @@ import pytest
 
 from artifact_models.tiny import TINY_PARAMS
 from poseintegrity.artifact_models import FIT_STATUSES
-from poseintegrity.artifact_models.models import distinct_theta_needed
+from poseintegrity.artifact_models.names import distinct_theta_needed
 from poseintegrity.artifact_models.synthetic import synthetic_artifacts
 
 ROOT = Path(__file__).resolve().parents[2]

@@ -6,6 +6,7 @@
     base_functions.py  eq. 1 (scaled EMG) and four other decays, fitted by bounded least squares; beside them (ours)
                        eq. 1 with a free Gaussian width (emg_free_width)
     mlp.py             the 3 x 10 tanh MLP (IV-E), from scratch or EMG-pretrained + fine-tuned (III-D)
+    names.py           MODEL_NAMES, and the fewest stops each model can be fitted to
     models.py          fit_model(name, ...): one entry point for all of them
     series.py          Series: one dataset's samples (theta, n_inliers per image, in stop order)
     fig2.py            the Fig. 2 experiment on the stage-02 artifacts table
@@ -25,7 +26,8 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
         "fig2": ["at_sampled_stops", "fig2_rmse", "fit_first_stops", "fits_metrics", "mean_rmse", "status_counts"],
         "fitted": ["FIT_STATUSES", "FallbackLine", "FittedModel"],
         "mlp": ["fit_mlp"],
-        "models": ["MODEL_NAMES", "fit_model"],
+        "models": ["fit_model"],
+        "names": ["MODEL_NAMES", "distinct_theta_needed"],
         "params": ["FitParams", "MLPParams"],
         "series": ["Series", "dataset_series"],
     },

@@ -18,7 +18,8 @@ import pandas as pd
 
 from poseintegrity.seeding import keyed_rng
 from poseintegrity.artifact_models.fitted import FIT_STATUSES, OK, FittedModel
-from poseintegrity.artifact_models.models import distinct_theta_needed, fit_model
+from poseintegrity.artifact_models.models import fit_model
+from poseintegrity.artifact_models.names import distinct_theta_needed
 from poseintegrity.artifact_models.params import FitParams
 from poseintegrity.artifact_models.series import Series, dataset_series
 from poseintegrity.errors import ArgumentError

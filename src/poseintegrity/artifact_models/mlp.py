@@ -24,10 +24,10 @@ from poseintegrity.artifact_models.base_functions import EMG
 from poseintegrity.artifact_models.fitted import FittedModel, too_few_samples, valid_samples
 from poseintegrity.artifact_models.lbfgs import minimize_mse
 from poseintegrity.artifact_models.mlp_net import forward, mse
+from poseintegrity.artifact_models.names import MLP_DISTINCT_THETA
 from poseintegrity.artifact_models.params import MLPParams
 
 PARAM_NAMES = ("loss", "evaluations")  # FittedModel.params of an MLP: final scaled MSE, loss evaluations
-DISTINCT_THETA = 2  # distinct theta both recipes need (the EMG starting curve of the pretraining needs 2)
 
 
 def initial_weights(hidden_layers: int, hidden_units: int, seed: int) -> np.ndarray:
@@ -96,7 +96,7 @@ def fit_mlp(
     theta : (m,) float, deg or mm;  n_inliers : (m,) counts (NaN and negative samples are dropped)
     theta_end : end of the range (deg or mm): input scaling, pretraining grid, artificial points (theta_end, 0)
     rng : draws the seed of the initial weights (same rng state -> bit-identical model)
-    The status (fitted.py) is "fallback" with fewer than DISTINCT_THETA distinct theta (the EMG starting curve
+    The status (fitted.py) is "fallback" with fewer than MLP_DISTINCT_THETA distinct theta (the EMG starting curve
     needs 2; the scratch recipe uses the same rule so that both recipes see the same data) or a non-finite loss
     or output, "non_physical" when the trained net predicts a negative count, no decay or an absurd level over
     [first stop, theta_end], else "ok". A finite loss alone says nothing: the short fine-tune always uses its
@@ -104,7 +104,7 @@ def fit_mlp(
     """
     name = "mlp_pretrained" if pretrain else "mlp_scratch"
     theta, n_inliers = valid_samples(theta, n_inliers, theta_end)
-    reason = too_few_samples(theta, DISTINCT_THETA)
+    reason = too_few_samples(theta, MLP_DISTINCT_THETA)
     if reason is not None:
         return FittedModel.failed(name, PARAM_NAMES, reason, theta, n_inliers)
     curve = MLPCurve(

@@ -12,17 +12,9 @@ from poseintegrity.errors import ArgumentError, check_scalar
 
 from poseintegrity.artifact_models.base_functions import LEAST_SQUARES
 from poseintegrity.artifact_models.fitted import MAX_THETA, FittedModel
-from poseintegrity.artifact_models.mlp import DISTINCT_THETA, fit_mlp
+from poseintegrity.artifact_models.mlp import fit_mlp
+from poseintegrity.artifact_models.names import MLP_RECIPES, MODEL_NAMES
 from poseintegrity.artifact_models.params import FitParams
-
-MLP_RECIPES = {"mlp_scratch": False, "mlp_pretrained": True}  # name -> pretrain on the EMG curve?
-MODEL_NAMES: tuple[str, ...] = (*LEAST_SQUARES, *MLP_RECIPES)
-
-
-def distinct_theta_needed(name: str) -> int:
-    """Fewest distinct theta (stops) model ``name`` can be fitted to: its parameter count for a base function
-    (eq. 1 has 3, the free-width EMG 4), 2 for the MLP recipes; with fewer its fit is a "fallback" (fitted.py)."""
-    return len(LEAST_SQUARES[name].param_names) if name in LEAST_SQUARES else DISTINCT_THETA
 
 
 def fit_model(

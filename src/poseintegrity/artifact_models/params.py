@@ -11,6 +11,7 @@ from typing import Literal
 
 from pydantic import Field, ValidationInfo, model_validator
 
+from poseintegrity.artifact_models.names import distinct_theta_needed
 from poseintegrity.schema import KeyRule, Seed, Section, distinct
 
 ModelName = Literal[
@@ -44,7 +45,7 @@ class FitParams(Section):
 
     models: distinct(ModelName) = Field(min_length=1, description="artifact models compared in Fig. 2")
     k_min: int = Field(ge=2, le=100, description="fewest stops (from the start) used for a fit; a model needing more"
-                                                 " (models.distinct_theta_needed) joins Fig. 2 at its own count")
+                                                 " (names.distinct_theta_needed) joins Fig. 2 at its own count")
     k_max: int | None = Field(ge=2, le=100, description="most stops used for a fit; null = all stops")
     max_nfev: int = Field(ge=10, le=ITERATIONS, description="least squares evaluation budget per base-function fit")
     seed: Seed = Field(description="seed of every random draw of the stage (MLP initial weights)")
@@ -52,8 +53,6 @@ class FitParams(Section):
 
     @model_validator(mode="after")
     def _check_ranges(self, info: ValidationInfo) -> FitParams:
-        from poseintegrity.artifact_models.models import distinct_theta_needed  # models.py imports this module
-
         if self.k_max is not None and self.k_max < self.k_min:
             raise KeyRule("k_max", f"must be null or >= k_min ({self.k_min}), got {self.k_max}")
         needs = {name: distinct_theta_needed(name) for name in self.models}

@@ -14,6 +14,8 @@ from typing import Annotated, Literal
 import numpy as np
 from pydantic import Field, ValidationInfo, model_validator
 
+from poseintegrity.artifact_models.base_functions import LEAST_SQUARES
+from poseintegrity.artifact_models.names import distinct_theta_needed
 from poseintegrity.artifact_models.params import ModelName
 from poseintegrity.schema import KeyRule, Seed, Section, distinct
 
@@ -83,8 +85,6 @@ class PredictParams(Section):
 
     @model_validator(mode="after")
     def _check(self, info: ValidationInfo) -> PredictParams:
-        from poseintegrity.artifact_models.models import LEAST_SQUARES, distinct_theta_needed  # no import cycle
-
         protocol = (info.context or {}).get("protocol")
         for key in ("tolerance_fig6_fig7", "live_tolerance"):
             if protocol is not None and getattr(self, key) not in protocol.tolerance_names:
