@@ -46,6 +46,7 @@ import os
 import shutil
 import uuid
 import warnings
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -271,9 +272,11 @@ class RecordingWriter:
             raise RecordingError(f"{self.staging}: cannot write frame {name}")
         self.rows.append({"t_s": t, "ir": f"ir/{name}", "depth": f"depth/{name}"})
 
-    def close(self, gyro_t: np.ndarray | None = None, gyro: np.ndarray | None = None) -> None:
-        """Write frames.csv, gyro.csv if given (times (G,) s, rates (G, 3) rad/s) and the manifest, then move
-        the recording into place (replacing the old one if overwrite was given)."""
+    def close(self, gyro_t: np.ndarray | None = None, gyro: np.ndarray | None = None,
+              tables: dict[str, pd.DataFrame] | None = None) -> None:
+        """Write frames.csv, gyro.csv if given (times (G,) s, rates (G, 3) rad/s), the extra ``tables``
+        ({file name: table}, e.g. the headset's camera poses of a converted recording) and the manifest, then
+        move the recording into place (replacing the old one if overwrite was given)."""
         if self.closed:
             raise RecordingError(f"{self.folder}: the recording is already closed")
         if (gyro_t is None) != (gyro is None):
@@ -284,10 +287,15 @@ class RecordingWriter:
                 raise ArgumentError(f"gyro_t: expected one or more sample times within +-{MAX_ABS_TIME_S:g} s")
             gyro = check_array("gyro", gyro, shape=(None, 3), allow_nan=True)  # NaN: flagged bad_gyro when tracked
             check_same_length(gyro_t=gyro_t, gyro=gyro)
+        for name in tables or {}:
+            if name in ("frames.csv", "gyro.csv") or Path(name).name != name or not name.endswith(".csv"):
+                raise ArgumentError(f"tables: {name!r} must be a plain .csv file name other than frames.csv and gyro.csv")
         pd.DataFrame(self.rows, columns=["t_s", "ir", "depth"]).to_csv(self.staging / "frames.csv", index=False, float_format="%.17g")
         if gyro_t is not None:
             table = pd.DataFrame({"t_s": gyro_t, "wx": gyro[:, 0], "wy": gyro[:, 1], "wz": gyro[:, 2]})
             table.to_csv(self.staging / "gyro.csv", index=False, float_format="%.17g")
+        for name, table in (tables or {}).items():
+            table.to_csv(self.staging / name, index=False, float_format="%.17g")
         write_manifest(self.staging, self.run_id)
         old = self.folder.parent / f".{self.folder.name}.old-{self.run_id}"
         if self.folder.exists():
@@ -310,7 +318,7 @@ class RecordingWriter:
 
 
 def track_recording(recording: Recording, tools: dict[str, np.ndarray], params: TrackParams | None = None,
-                    gyro_tool: str | None = None) -> pd.DataFrame:
+                    gyro_tool: str | None = None, progress: Callable[[int], object] | None = None) -> pd.DataFrame:
     """Pose table of a recording: one row per frame and tool, in time order.
 
     Columns: t_s, frame, tool, flag, n_points, n_matched, x_mm / y_mm / z_mm and qx / qy / qz / qw (filtered
@@ -319,6 +327,7 @@ def track_recording(recording: Recording, tools: dict[str, np.ndarray], params: 
     A frame in which nothing is detected is a row flagged no_points (the filter keeps predicting and picks the
     tool up again on the next good frame).  Bad tools or a gyro_tool naming no tool raise ToolError.
     params : ``track`` (detection, matching, filter); None takes the published defaults (params.yaml).
+    progress : called with 1 after each frame (e.g. a tqdm bar's ``update``).
     """
     params = published("track") if params is None else params
     tracker = MultiToolTracker(tools, params.filter, params.matching, gyro_tool)  # checks tools and gyro_tool
@@ -353,4 +362,6 @@ def track_recording(recording: Recording, tools: dict[str, np.ndarray], params: 
                 "x_mm": T[0, 3] * 1000.0, "y_mm": T[1, 3] * 1000.0, "z_mm": T[2, 3] * 1000.0,
                 "qx": q[0], "qy": q[1], "qz": q[2], "qw": q[3],
             })
+        if progress is not None:
+            progress(1)
     return pd.DataFrame(rows)
