@@ -177,6 +177,8 @@ HL2SS_BREAKS = {
                        r"rm_depth_ahat\.bin: packet timestamps must increase; packet 2 has"),
     "uv2xy_nan": (lambda p: _calibration(p, "uv2xy.bin", lambda a: a.__setitem__(5, np.nan)), None,
                   r"uv2xy\.bin: the lookup table has 1 non-finite pixel\(s\), e\.g\. \(u 2, v 0\)"),
+    "uv2xy_unmapped": (lambda p: _calibration(p, "uv2xy.bin", lambda a: a.__setitem__(slice(10, 12), 0.0)), None,
+                       r"uv2xy\.bin: 1 pixel\(s\) of the lookup table have no ray .*\(u 5, v 0\)"),
     "uv2xy_truncated": (lambda p: _calibration(p, "uv2xy.bin", lambda a: None, cut=8), None, r"uv2xy\.bin: 2097144 bytes, expected 2097152"),
     "scale_zero": (lambda p: _calibration(p, "scale.bin", lambda a: a.__setitem__(0, 0.0)), None, r"scale\.bin: the depth scale must be"),
 }

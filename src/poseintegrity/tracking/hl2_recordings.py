@@ -14,7 +14,8 @@ conventions: docs/recorded-data.md):
   a row-major 4 x 4 for column vectors).  :func:`convert_stream_recorder`.
 - hl2ss (jdibenes/hl2ss), its recorder's ``rm_depth_ahat.bin``: a header (magic ``HL2SSV23``, port, user data,
   the stream configuration) and packets (ticks, payload, optional float32 4 x 4 rig -> world pose for row
-  vectors); the calibration folder ``rm_depth_ahat`` (uv2xy.bin, extrinsics.bin, scale.bin).  Only frames sent
+  vectors); the calibration folder ``rm_depth_ahat`` (uv2xy.bin: (x, y) on z = 1 sampled at the integer image
+  point (u, v), where StreamRecorder samples (u + 0.5, v + 0.5); extrinsics.bin, scale.bin).  Only frames sent
   uncompressed (AB profile RAW, depth profile SAME) can be read: an H.264 / HEVC or Zdepth stream needs a video
   decoder and is refused.  :func:`convert_hl2ss`.
 
@@ -330,7 +331,9 @@ def read_hl2ss_calibration(folder: str | Path) -> tuple[np.ndarray, np.ndarray, 
             raise RecordingError(f"{folder / name}: {len(data)} bytes, expected {4 * count} ({count} float32)")
         arrays[name] = np.frombuffer(data, "<f4").astype(float)
     uv2xy = arrays["uv2xy.bin"].reshape(*AHAT_SHAPE, 2)
-    lut = unit_plane_from_rays(np.concatenate([uv2xy, np.ones(AHAT_SHAPE + (1,))], axis=-1), folder / "uv2xy.bin")
+    # hl2ss leaves (0, 0) where the headset's mapping failed: no ray (z = 0), refused by unit_plane_from_rays
+    z = np.where((uv2xy == 0).all(axis=-1, keepdims=True), 0.0, 1.0)
+    lut = unit_plane_from_rays(np.concatenate([uv2xy, z], axis=-1), folder / "uv2xy.bin")
     extrinsics = arrays["extrinsics.bin"].reshape(4, 4)
     if not np.isfinite(extrinsics).all():
         raise RecordingError(f"{folder / 'extrinsics.bin'}: non-finite entries {extrinsics.tolist()}")
