@@ -22,7 +22,7 @@ def simulated_frames(params, n_frames: int, seed: int = 0) -> tuple[np.ndarray, 
     """(unit-plane LUT (H, W, 2), [(ticks, ir uint16, depth uint16 mm)]) of the first n_frames of a simulated
     recording (the tool moving, seeded)."""
     frames = []
-    simulate(params, np.random.default_rng(seed), duration_s=2.0, n_frames=n_frames,
+    simulate(params, np.random.default_rng(seed), duration_s=0.05 * n_frames + 1.0, n_frames=n_frames,
              sink=lambda t, ir, depth: frames.append((T0_TICKS + round(t * 1e7), ir.copy(), depth.copy())))
     camera = params.camera
     return unit_plane_lut(intrinsics(camera), camera.width, camera.height), frames

@@ -19,7 +19,7 @@ conventions: docs/recorded-data.md):
   uncompressed (AB profile RAW, depth profile SAME) can be read: an H.264 / HEVC or Zdepth stream needs a video
   decoder and is refused.  :func:`convert_hl2ss`.
 
-What the conversion writes: IR = AB (uint16, unchanged), depth = millimetres along the pixel's ray (uint16,
+What the conversion writes (frames as .npy by default, see ``frame_format``): IR = AB (uint16, unchanged), depth = millimetres along the pixel's ray (uint16,
 0 = invalid: Research Mode's invalid AHAT readings, >= 4090, become 0), the unit-plane lookup table
 lut[v, u] = (x / z, y / z), t_s = seconds since the first frame (integer ticks / 1e7), and ``camera_poses.csv``
 (t_s, ticks, has_pose, T00..T33: T_world_cam = rig2world @ inv(rig -> camera)) when the recording has poses;
@@ -221,9 +221,11 @@ def read_stream_recorder_poses(capture: Path) -> tuple[np.ndarray, np.ndarray] |
     return ticks, rig_to_world @ np.linalg.inv(rig_to_cam)
 
 
-def convert_stream_recorder(capture: str | Path, folder: str | Path, overwrite: bool = False) -> Path:
+def convert_stream_recorder(capture: str | Path, folder: str | Path, overwrite: bool = False, frame_format: str = "npy") -> Path:
     """Convert the AHAT stream of a StreamRecorder capture folder into a recording folder (module docstring) and
-    return ``folder``.  Frames are read and checked one by one while written; an error leaves no folder."""
+    return ``folder``.  Frames are read and checked one by one while written; an error leaves no folder.
+    frame_format : "npy" (default: as large as the PGM frames, fast to replay) or "png" (smaller, replayed at
+    the speed of PNG decoding), see :class:`~poseintegrity.tracking.recording.RecordingWriter`."""
     capture = Path(capture)
     if not capture.is_dir():
         raise RecordingError(f"{capture}: the StreamRecorder capture folder does not exist")
@@ -233,7 +235,7 @@ def convert_stream_recorder(capture: str | Path, folder: str | Path, overwrite: 
         lut = read_stream_recorder_lut(capture / f"{STREAM_RECORDER_SENSOR}_lut.bin", first_depth.shape)
         poses = read_stream_recorder_poses(capture)
         ticks = np.array([f[0] for f in frames])
-        writer = stack.enter_context(RecordingWriter(folder, lut, overwrite=overwrite))
+        writer = stack.enter_context(RecordingWriter(folder, lut, overwrite=overwrite, frame_format=frame_format))
         for t, depth_name, ab_name in frames:
             depth, ab = (decode_pgm(read(name), f"{where}/{name}") for name in (depth_name, ab_name))
             _write_frame(writer, ticks[0], t, ab, depth_mm(depth), f"{where}/{ab_name}", f"{where}/{depth_name}")
@@ -344,15 +346,16 @@ def read_hl2ss_calibration(folder: str | Path) -> tuple[np.ndarray, np.ndarray, 
     return lut, extrinsics, scale
 
 
-def convert_hl2ss(recording: str | Path, calibration: str | Path, folder: str | Path, overwrite: bool = False) -> Path:
+def convert_hl2ss(recording: str | Path, calibration: str | Path, folder: str | Path, overwrite: bool = False,
+                  frame_format: str = "npy") -> Path:
     """Convert an hl2ss ``rm_depth_ahat.bin`` with its calibration folder into a recording folder (module
     docstring) and return ``folder``.  Depth becomes millimetres (raw * 1000 / scale); the packet poses (mode 1)
-    give camera_poses.csv.  An error leaves no folder."""
+    give camera_poses.csv.  An error leaves no folder.  frame_format : as for :func:`convert_stream_recorder`."""
     recording = Path(recording)
     lut, extrinsics, scale = read_hl2ss_calibration(calibration)
     cam_to_rig = np.linalg.inv(extrinsics)
     ticks, poses = [], []
-    with RecordingWriter(folder, lut, overwrite=overwrite) as writer:
+    with RecordingWriter(folder, lut, overwrite=overwrite, frame_format=frame_format) as writer:
         for k, (t, depth, ab, pose) in enumerate(read_hl2ss_ahat(recording)):
             if ticks and t <= ticks[-1]:
                 raise RecordingError(f"{recording}: packet timestamps must increase; packet {k} has {t} after {ticks[-1]}")

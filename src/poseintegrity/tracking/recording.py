@@ -220,16 +220,18 @@ def load_image(path: Path) -> np.ndarray | None:
 
 def frame_problem(recording: Recording, k: int) -> tuple[str, np.ndarray, np.ndarray]:
     """(why frame k cannot be used or "", ir, depth_mm) of a recording, reading its two files."""
-    row = recording.frames.iloc[k]
-    ir, depth = load_image(recording.folder / row.ir), load_image(recording.folder / row.depth)
-    unreadable = [name for name, image in ((row.ir, ir), (row.depth, depth)) if image is None]
+    ir_name, depth_name = recording.frames.ir.iat[k], recording.frames.depth.iat[k]  # not .iloc[k]: 0.3 ms a frame
+    ir, depth = load_image(recording.folder / ir_name), load_image(recording.folder / depth_name)
+    unreadable = [name for name, image in ((ir_name, ir), (depth_name, depth)) if image is None]
     if unreadable:
         return f"cannot decode {', '.join(map(str, unreadable))}", np.zeros((0, 0)), np.zeros((0, 0))
     return validate_frame(ir, depth, recording.lut), ir, depth
 
 
 class RecordingWriter:
-    """Writes a recording folder (16-bit PNG frames) that :func:`read_recording` reads.
+    """Writes a recording folder that :func:`read_recording` reads: frames as 16-bit PNG (``frame_format="png"``,
+    smaller) or ``.npy`` (``"npy"``, as large as the raw frames but ~50 x faster to read: a 512 x 512 frame
+    decodes in ~5 ms as PNG, ~0.1 ms as .npy, so a replay from PNG is bounded by the decoding).
 
     The frames go into a temporary sibling folder; :meth:`close` writes frames.csv, gyro.csv and, last, the
     manifest, then moves the folder into place by renames, so ``folder`` only ever holds a whole recording.
@@ -238,8 +240,11 @@ class RecordingWriter:
     lut : (H, W, 2) unit-plane lookup table; every frame must be (H, W).
     """
 
-    def __init__(self, folder: str | Path, lut: np.ndarray, overwrite: bool = False):
+    def __init__(self, folder: str | Path, lut: np.ndarray, overwrite: bool = False, frame_format: str = "png"):
         self.folder = Path(folder)
+        if frame_format not in ("png", "npy"):
+            raise ArgumentError(f"frame_format: expected 'png' or 'npy', got {frame_format!r}")
+        self.frame_format = frame_format
         if self.folder.exists() and not self.folder.is_dir():
             raise RecordingError(f"{self.folder}: exists and is not a folder")
         if self.folder.is_dir() and any(self.folder.iterdir()) and not overwrite:
@@ -267,8 +272,11 @@ class RecordingWriter:
             if not isinstance(image, np.ndarray) or image.shape != self.lut.shape[:2] or image.dtype not in (np.uint8, np.uint16):
                 raise ArgumentError(f"{name}: expected a {self.lut.shape[:2]} uint16 image like the lookup table, got "
                                     f"{type(image).__name__} {getattr(image, 'shape', '')} {getattr(image, 'dtype', '')}")
-        name = f"{len(self.rows):06d}.png"
-        if not (cv2.imwrite(str(self.staging / "ir" / name), ir) and cv2.imwrite(str(self.staging / "depth" / name), depth_mm)):
+        name = f"{len(self.rows):06d}.{self.frame_format}"
+        if self.frame_format == "npy":
+            np.save(self.staging / "ir" / name, ir)
+            np.save(self.staging / "depth" / name, depth_mm)
+        elif not (cv2.imwrite(str(self.staging / "ir" / name), ir) and cv2.imwrite(str(self.staging / "depth" / name), depth_mm)):
             raise RecordingError(f"{self.staging}: cannot write frame {name}")
         self.rows.append({"t_s": t, "ir": f"ir/{name}", "depth": f"depth/{name}"})
 
