@@ -6,8 +6,9 @@ SR-UKF (Alg. 5) of every tool of a tool file, frame by frame, into a pose table.
 
 RECORDING is a recording folder of our layout (``--format folder``, the default), a StreamRecorder capture folder
 (``stream-recorder``) or an hl2ss ``rm_depth_ahat.bin`` (``hl2ss``, with ``--calibration``, hl2ss's calibration
-folder); the last two are converted into a temporary recording folder first
-(:mod:`~poseintegrity.tracking.hl2_recordings`; convert once with its functions to replay a recording often).
+folder); the last two are converted into a temporary recording folder first,
+beside the output and deleted afterwards (:mod:`~poseintegrity.tracking.hl2_recordings`, about 1 MB per frame;
+convert once with its functions to replay a recording often).
 The table (one row per frame and tool: t_s, frame, tool, flag, n_points, n_matched, x/y/z_mm, qx..qw, in the
 camera frame; :func:`~poseintegrity.tracking.recording.track_recording`) is written to ``--out`` through a
 temporary file and a rename; a progress bar runs on stderr and a summary per tool is printed: tracked (flag ok or
@@ -92,7 +93,7 @@ def main(argv: list[str] | None = None) -> None:
     if args.format == "hl2ss" and args.calibration is None:
         sys.exit(usage_error(f"{args.recording}: an hl2ss recording needs --calibration (hl2ss's calibration folder)"))
     try:
-        with tempfile.TemporaryDirectory(prefix="replay-") as workdir:
+        with tempfile.TemporaryDirectory(prefix=".replay-", dir=args.out.parent) as workdir:  # ~1 MB a frame: beside the output
             table = _replay(args, Path(workdir))
     except PoseIntegrityError as error:
         sys.exit(usage_error(" ".join(str(error).split())))  # one line
