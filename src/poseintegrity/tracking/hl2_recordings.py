@@ -274,50 +274,56 @@ def _pose_table(ticks: np.ndarray, T_world_cam: np.ndarray) -> pd.DataFrame:
 
 
 # --------------------------------------------------------------------------------------------------------- hl2ss
-def _unpack(data: bytes, offset: int, fmt: str, path: Path, field: str) -> tuple:
+def _unpack(file, fmt: str, path: Path, field: str) -> tuple:
+    """The next struct ``fmt`` of an open file; RecordingError if the file ends inside it."""
     size = struct.calcsize(fmt)
-    if offset + size > len(data):
-        raise RecordingError(f"{path}: the file ends inside {field} (byte {offset} of {len(data)}): a truncated recording")
-    return struct.unpack_from(fmt, data, offset)
+    data = file.read(size)
+    if len(data) < size:
+        raise RecordingError(f"{path}: the file ends inside {field} ({len(data)} of {size} bytes): a truncated recording")
+    return struct.unpack(fmt, data)
 
 
 def read_hl2ss_ahat(path: str | Path) -> Iterator[tuple[int, np.ndarray, np.ndarray, np.ndarray | None]]:
     """(ticks, depth (512, 512) uint16, AB (512, 512) uint16, rig -> world pose (4, 4) float for row vectors or
-    None) per packet of an hl2ss ``rm_depth_ahat.bin``.  The header and its configuration are checked first."""
+    None) per packet of an hl2ss ``rm_depth_ahat.bin``, read one packet at a time (a raw recording is ~1 MB a
+    frame).  The header and its configuration are checked before the first packet."""
     path = Path(path)
-    data = _read_bytes(path, "hl2ss recording")
-    if not data:
-        raise RecordingError(f"{path}: the hl2ss recording is empty (0 bytes)")
-    magic, port, user_size = _unpack(data, 0, "<8sHI", path, "the header")
-    if magic != HL2SS_MAGIC:
-        raise RecordingError(f"{path}: header magic is {magic!r}, expected {HL2SS_MAGIC!r} (another hl2ss version, or not an hl2ss file)")
-    if port != HL2SS_PORT_AHAT:
-        raise RecordingError(f"{path}: header port is {port}, not the RM depth AHAT stream ({HL2SS_PORT_AHAT})")
-    offset = 14 + user_size
-    mode, _divisor, profile_z, profile_ab, _level, _bitrate, n_options = _unpack(data, offset, "<BBBBBIB", path, "the configuration")
-    offset += 10 + 16 * n_options
-    if mode not in (0, 1):
-        raise RecordingError(f"{path}: configuration mode is {mode}; a frame stream is mode 0 or 1")
-    if profile_ab != HL2SS_RAW or profile_z != HL2SS_DEPTH_SAME:
-        raise RecordingError(f"{path}: configuration profile_z {profile_z}, profile_ab {profile_ab}: the frames are compressed "
-                             f"(H.264 / HEVC or Zdepth); only uncompressed frames (profile_ab RAW 255, profile_z SAME 0) are read")
-    pixels = AHAT_SHAPE[0] * AHAT_SHAPE[1]
-    payload_size = HL2SS_PAYLOAD_PREFIX + 4 * pixels + HL2SS_METADATA
-    pose_size = 64 if mode == 1 else 0
-    k = 0
-    while offset < len(data):
-        ticks, size = _unpack(data, offset, "<QI", path, f"the header of packet {k}")
-        if size != payload_size:
-            raise RecordingError(f"{path}: packet {k} has a payload of {size} bytes; an uncompressed AHAT frame has {payload_size}")
-        start = offset + 12
-        end = start + size + pose_size
-        if end > len(data):
-            raise RecordingError(f"{path}: packet {k} is truncated ({len(data) - start} of {size + pose_size} bytes): an interrupted recording")
-        depth = np.frombuffer(data, "<u2", pixels, start + HL2SS_PAYLOAD_PREFIX).reshape(AHAT_SHAPE)
-        ab = np.frombuffer(data, "<u2", pixels, start + HL2SS_PAYLOAD_PREFIX + 2 * pixels).reshape(AHAT_SHAPE)
-        pose = np.frombuffer(data, "<f4", 16, start + size).reshape(4, 4).astype(float) if pose_size else None
-        yield ticks, depth, ab, pose
-        offset, k = end, k + 1
+    try:
+        file = path.open("rb")
+    except OSError as error:
+        raise RecordingError(f"{path}: cannot read the hl2ss recording ({error.strerror or error})") from None
+    with file:
+        if not file.peek(1):
+            raise RecordingError(f"{path}: the hl2ss recording is empty (0 bytes)")
+        magic, port, user_size = _unpack(file, "<8sHI", path, "the header")
+        if magic != HL2SS_MAGIC:
+            raise RecordingError(f"{path}: header magic is {magic!r}, expected {HL2SS_MAGIC!r} (another hl2ss version, or not an hl2ss file)")
+        if port != HL2SS_PORT_AHAT:
+            raise RecordingError(f"{path}: header port is {port}, not the RM depth AHAT stream ({HL2SS_PORT_AHAT})")
+        _unpack(file, f"<{user_size}s", path, "the user data of the header")
+        mode, _divisor, profile_z, profile_ab, _level, _bitrate, n_options = _unpack(file, "<BBBBBIB", path, "the configuration")
+        _unpack(file, f"<{2 * n_options}Q", path, "the encoder options of the configuration")
+        if mode not in (0, 1):
+            raise RecordingError(f"{path}: configuration mode is {mode}; a frame stream is mode 0 or 1")
+        if profile_ab != HL2SS_RAW or profile_z != HL2SS_DEPTH_SAME:
+            raise RecordingError(f"{path}: configuration profile_z {profile_z}, profile_ab {profile_ab}: the frames are compressed "
+                                 f"(H.264 / HEVC or Zdepth); only uncompressed frames (profile_ab RAW 255, profile_z SAME 0) are read")
+        pixels = AHAT_SHAPE[0] * AHAT_SHAPE[1]
+        payload_size = HL2SS_PAYLOAD_PREFIX + 4 * pixels + HL2SS_METADATA
+        pose_size = 64 if mode == 1 else 0
+        k = 0
+        while file.peek(1):
+            ticks, size = _unpack(file, "<QI", path, f"the header of packet {k}")
+            if size != payload_size:
+                raise RecordingError(f"{path}: packet {k} has a payload of {size} bytes; an uncompressed AHAT frame has {payload_size}")
+            data = file.read(size + pose_size)
+            if len(data) < size + pose_size:
+                raise RecordingError(f"{path}: packet {k} is truncated ({len(data)} of {size + pose_size} bytes): an interrupted recording")
+            depth = np.frombuffer(data, "<u2", pixels, HL2SS_PAYLOAD_PREFIX).reshape(AHAT_SHAPE)
+            ab = np.frombuffer(data, "<u2", pixels, HL2SS_PAYLOAD_PREFIX + 2 * pixels).reshape(AHAT_SHAPE)
+            pose = np.frombuffer(data, "<f4", 16, size).reshape(4, 4).astype(float) if pose_size else None
+            yield ticks, depth, ab, pose
+            k += 1
 
 
 def read_hl2ss_calibration(folder: str | Path) -> tuple[np.ndarray, np.ndarray, float]:
