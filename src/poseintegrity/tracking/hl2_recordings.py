@@ -61,6 +61,7 @@ HL2SS_PAYLOAD_PREFIX = 8  # bytes before the depth image in an AHAT payload (ski
 HL2SS_METADATA = 8  # the sensor ticks (uint64) after the AB image
 POSE_COLUMNS = [f"T{i}{j}" for i in range(4) for j in range(4)]
 _PGM_NAME = re.compile(r"^(\d+)(_ab)?\.pgm$")
+_PGM_FIELD = re.compile(rb"\s*(#[^\n]*\n\s*)*(\S+)")  # a header field after whitespace and '#' comments
 
 
 # ------------------------------------------------------------------------------------------------ StreamRecorder
@@ -72,7 +73,7 @@ def decode_pgm(data: bytes, name: str) -> np.ndarray:
         raise RecordingError(f"{name}: the PGM file is empty (0 bytes)")
     fields, position = [], 0
     while len(fields) < 4:  # magic, width, height, maxval, separated by whitespace (and '#' comments)
-        match = re.compile(rb"\s*(#[^\n]*\n\s*)*(\S+)").match(data, position)
+        match = _PGM_FIELD.match(data, position)
         if match is None:
             raise RecordingError(f"{name}: PGM header ends after {len(fields)} of its 4 fields (magic, width, height, maxval)")
         fields.append(match.group(2))
