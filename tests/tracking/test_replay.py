@@ -143,3 +143,11 @@ def test_bad_input_is_one_line_naming_the_file_exit_2_and_no_output(recorded, to
     lines = stderr.strip().splitlines()
     assert status == 2 and len(lines) == 1 and name in lines[0] and "Traceback" not in stderr, stderr
     assert not out.exists() and not list(tmp_path.glob(".poses*"))
+
+
+def test_a_gyro_tool_without_gyro_samples_is_said_and_tracks_without_gyro(recorded, tools, tmp_path):
+    folder = _own_layout(tmp_path / "rec", recorded)
+    status, _, stderr = _run([folder, "--tools", tools, "--gyro-tool", "probe", "--out", tmp_path / "poses.csv", "--params", TINY_PARAMS])
+    assert status == 0 and "no gyro.csv, so --gyro-tool probe fused nothing" in stderr
+    expected = track_recording(read_recording(folder), {"probe": GEOMETRY}, PARAMS)
+    assert list(pd.read_csv(tmp_path / "poses.csv").flag) == list(expected.flag)

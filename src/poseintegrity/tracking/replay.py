@@ -73,7 +73,10 @@ def _replay(args: argparse.Namespace, workdir: Path) -> pd.DataFrame:
         folder = convert_hl2ss(args.recording, args.calibration, workdir / "converted")
     recording = read_recording(folder)
     with tqdm(total=len(recording.frames), desc="replay", unit="frame", file=sys.stderr, disable=None) as bar:
-        return track_recording(recording, tools, params, args.gyro_tool, progress=bar.update)
+        table = track_recording(recording, tools, params, args.gyro_tool, progress=bar.update)  # checks gyro_tool first
+    if args.gyro_tool is not None and recording.gyro is None:
+        print(f"{args.recording}: no gyro.csv, so --gyro-tool {args.gyro_tool} fused nothing (tracked without gyro)", file=sys.stderr)
+    return table
 
 
 def main(argv: list[str] | None = None) -> None:
