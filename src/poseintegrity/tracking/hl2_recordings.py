@@ -19,9 +19,9 @@ conventions: docs/recorded-data.md):
   uncompressed (AB profile RAW, depth profile SAME) can be read: an H.264 / HEVC or Zdepth stream needs a video
   decoder and is refused.  :func:`convert_hl2ss`.
 
-What the conversion writes (frames as .npy by default, see ``frame_format``): IR = AB (uint16, unchanged), depth = millimetres along the pixel's ray (uint16,
-0 = invalid: Research Mode's invalid AHAT readings, >= 4090, become 0), the unit-plane lookup table
-lut[v, u] = (x / z, y / z), t_s = seconds since the first frame (integer ticks / 1e7), and ``camera_poses.csv``
+What the conversion writes (frames as .npy by default, see ``frame_format``): IR = AB (uint16, unchanged),
+depth = millimetres along the pixel's ray (uint16, 0 = invalid: Research Mode's invalid AHAT readings, >= 4090,
+become 0), the unit-plane lookup table lut[v, u] = (x / z, y / z), t_s = seconds since the first frame (integer ticks / 1e7), and ``camera_poses.csv``
 (t_s, ticks, has_pose, T00..T33: T_world_cam = rig2world @ inv(rig -> camera)) when the recording has poses;
 marker poses stay in the camera frame.  AHAT depth aliases beyond about 1 m (a marker at 1.1 m reads ~0.1 m);
 it is not unwrapped (the detector's depth window keeps 100-900 mm).

@@ -1,6 +1,6 @@
 """Recorded frames as input: a folder converted from a HoloLens 2 recorder (:mod:`hl2_recordings`: StreamRecorder,
-hl2ss) or written by :class:`RecordingWriter` from our simulation is read and run through detection (II-B) -> correspondence (II-D) -> Kabsch (Alg. 4) -> SR-UKF
-(Alg. 5), giving a pose table.
+hl2ss) or written by :class:`RecordingWriter` from our simulation is read and run through detection (II-B) ->
+correspondence (II-D) -> Kabsch (Alg. 4) -> SR-UKF (Alg. 5), giving a pose table.
 
 Folder layout:
 - ``frames.csv``: one row per marker frame, columns ``t_s`` (seconds, finite, increasing), ``ir`` and ``depth``
