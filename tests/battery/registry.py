@@ -322,13 +322,15 @@ def _entries() -> list[EntryPoint]:
                    names={"file": "000001.png"}, flagged=_any_flag),
         # ---- HoloLens 2 recordings, converted (a frame without a headset pose is flagged in camera_poses.csv)
         *[EntryPoint(f"tracking.convert_stream_recorder[{Path(name).name}]",
-                     lambda a: hl2_recordings.convert_stream_recorder(_capture_of(a["file"]), _capture_of(a["file"]).parent / "converted", overwrite=True),
+                     lambda a: hl2_recordings.convert_stream_recorder(_capture_of(a["file"]), _capture_of(a["file"]).parent / "converted",
+                                                                      overwrite=True),
                      lambda tmp, name=name: {"file": _stream_recorder_capture(tmp) / name}, {"file": "file"},
                      names={"file": Path(name).name}, flagged=_pose_missing)
           for name in ("Depth AHaT/1000.pgm", "Depth AHaT/1000_ab.pgm", "Depth AHaT_lut.bin", "Depth AHaT_extrinsics.txt",
                        "Depth AHaT_rig2world.txt")],
         *[EntryPoint(f"tracking.convert_hl2ss[{Path(name).name}]",
-                     lambda a: hl2_recordings.convert_hl2ss(_hl2ss_of(a["file"]) / "rm_depth_ahat.bin", _hl2ss_of(a["file"]) / "calibration",
+                     lambda a: hl2_recordings.convert_hl2ss(_hl2ss_of(a["file"]) / "rm_depth_ahat.bin",
+                                                            _hl2ss_of(a["file"]) / "calibration",
                                                             _hl2ss_of(a["file"]).parent / "converted", overwrite=True),
                      lambda tmp, name=name: {"file": _hl2ss_recording(tmp) / name}, {"file": "file"},
                      names={"file": Path(name).name}, flagged=_pose_missing)
