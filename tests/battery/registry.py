@@ -159,7 +159,7 @@ def _entries() -> list[EntryPoint]:
     from poseintegrity.artifact_models.models import fit_model
     from poseintegrity.localization import dataset, envelope, features, ground_truth, matching, pnp, target_model
     from poseintegrity.prediction import metrics, predictors, supervisor
-    from poseintegrity.tracking import correspondence, detection, recording, tools
+    from poseintegrity.tracking import correspondence, detection, hl2_recordings, recording, replay, tools
     from poseintegrity.tracking.kabsch import kabsch as kabsch_fit
 
     P = params
@@ -320,6 +320,22 @@ def _entries() -> list[EntryPoint]:
                                                        {"probe": tracking_frame()["geometry"]}, P().track),
                    lambda tmp: {"file": _recording_dir(tmp) / "ir" / "000001.png"}, {"file": "file"},
                    names={"file": "000001.png"}, flagged=_any_flag),
+        # ---- HoloLens 2 recordings, converted (a frame without a headset pose is flagged in camera_poses.csv)
+        *[EntryPoint(f"tracking.convert_stream_recorder[{Path(name).name}]",
+                     lambda a: hl2_recordings.convert_stream_recorder(_capture_of(a["file"]), _capture_of(a["file"]).parent / "converted",
+                                                                      overwrite=True),
+                     lambda tmp, name=name: {"file": _stream_recorder_capture(tmp) / name}, {"file": "file"},
+                     names={"file": Path(name).name}, flagged=_pose_missing)
+          for name in ("Depth AHaT/1000.pgm", "Depth AHaT/1000_ab.pgm", "Depth AHaT_lut.bin", "Depth AHaT_extrinsics.txt",
+                       "Depth AHaT_rig2world.txt")],
+        *[EntryPoint(f"tracking.convert_hl2ss[{Path(name).name}]",
+                     lambda a: hl2_recordings.convert_hl2ss(_hl2ss_of(a["file"]) / "rm_depth_ahat.bin",
+                                                            _hl2ss_of(a["file"]) / "calibration",
+                                                            _hl2ss_of(a["file"]).parent / "converted", overwrite=True),
+                     lambda tmp, name=name: {"file": _hl2ss_recording(tmp) / name}, {"file": "file"},
+                     names={"file": Path(name).name}, flagged=_pose_missing)
+          for name in ("rm_depth_ahat.bin", "calibration/rm_depth_ahat/uv2xy.bin", "calibration/rm_depth_ahat/extrinsics.bin",
+                       "calibration/rm_depth_ahat/scale.bin")],
         # ---- stage tables and the files they are written to
         EntryPoint("tables.check_envelopes", lambda a: tables.check_envelopes(a["table"]),
                    lambda tmp: {"table": _envelope_table()}, {"table": "table"}),
@@ -332,6 +348,11 @@ def _entries() -> list[EntryPoint]:
         EntryPoint("tables.read_artifacts", lambda a: tables.read_artifacts(a["path"]),
                    lambda tmp: {"path": _parquet(tmp, "artifacts.parquet", _artifacts_table())}, {"path": "file"}),
         # ---- command lines: one line naming the file, exit status 2, no traceback
+        EntryPoint("python -m poseintegrity.tracking.replay",
+                   lambda a: _cli(replay.main, [str(a["tools"].parent / "recording"), "--tools", str(a["tools"]), "--out",
+                                                str(a["tools"].parent / "poses.csv"), "--params", str(TINY_PARAMS)], a["tools"]),
+                   lambda tmp: {"tools": _recording_dir(tmp).parent / _tools_json(tmp).name}, {"tools": "file"},
+                   flagged=_cli_refused),
         EntryPoint("python -m poseintegrity.timing", lambda a: _cli(timing.main, [str(a["path"].parent)], a["path"]),
                    lambda tmp: {"path": _timing_file(tmp)}, {"path": "file"}, flagged=_cli_refused,
                    accepts={"path": {"missing"}}),  # a folder without timing files yet: said, exit 0
@@ -407,6 +428,41 @@ def _camera_yaml(tmp: Path) -> Path:
 def _tools_json(tmp: Path) -> Path:
     geometry = tracking_frame()["geometry"]
     return _write(tmp, "tools.json", json.dumps({"tools": [{"name": "probe", "markers_body": geometry.tolist()}]}))
+
+
+def _hl2_frames() -> list:
+    frame = tracking_frame()
+    return [(1000 + 460_000 * k, frame["ir"], frame["depth"]) for k in range(3)]  # 46 ms apart, in 100 ns ticks
+
+
+def _stream_recorder_capture(tmp: Path) -> Path:
+    from tracking.hl2_writers import write_stream_recorder
+
+    return write_stream_recorder(tmp / "capture", tracking_frame()["lut"], _hl2_frames(), rig_to_cam=np.eye(4),
+                                 rig_to_world=[np.eye(4)] * 3)
+
+
+def _capture_of(file: Path) -> Path:
+    return next(p for p in Path(file).parents if p.name == "capture")
+
+
+def _hl2ss_recording(tmp: Path) -> Path:
+    from tracking.hl2_writers import write_hl2ss
+
+    (tmp / "hl2ss").mkdir(parents=True, exist_ok=True)
+    write_hl2ss(tmp / "hl2ss" / "rm_depth_ahat.bin", tmp / "hl2ss" / "calibration", tracking_frame()["lut"], _hl2_frames(),
+                np.eye(4), [np.eye(4)] * 3)
+    return tmp / "hl2ss"
+
+
+def _hl2ss_of(file: Path) -> Path:
+    return next(p for p in Path(file).parents if p.name == "hl2ss")
+
+
+def _pose_missing(folder: Path) -> bool:
+    """A converted recording with frames the headset could not locate (no pose in camera_poses.csv)."""
+    poses = Path(folder) / "camera_poses.csv"
+    return not poses.is_file() or not pd.read_csv(poses).has_pose.all()
 
 
 def _recording_copy(tmp: Path, name: str) -> Path:

@@ -2,6 +2,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from poseintegrity.errors import PoseIntegrityError
 from poseintegrity.tracking.evaluation import recording_replay
 from poseintegrity.tracking.frames import intrinsics, render_frame, unit_plane_lut
 from poseintegrity.tracking.geometry import MARKER_DIAMETER_M
@@ -86,3 +87,21 @@ def test_a_gyro_rate_that_is_not_a_number_is_refused_naming_its_row(tmp_path):
     pd.DataFrame({"t_s": [0.01, 0.02], "wx": [0.1, "0.2 rad/s"], "wy": [0.0, 0.0], "wz": [0.0, 0.0]}).to_csv(tmp_path / "gyro.csv", index=False)
     with pytest.raises(RecordingError, match="wx of row 1 is not a number"):
         read_recording(tmp_path)
+
+
+def test_npy_frames_replay_as_the_png_frames_and_an_unknown_format_is_refused(tmp_path):
+    camera = PARAMS.camera
+    lut = unit_plane_lut(intrinsics(camera), camera.width, camera.height)
+    rng = np.random.default_rng(0)
+    frames = [render_frame(GEOMETRY + [0.01 * k, 0.0, 0.45], [], camera, PARAMS.frames, MARKER_DIAMETER_M / 2, rng) for k in range(3)]
+    tables = []
+    for frame_format in ("png", "npy"):
+        with RecordingWriter(tmp_path / frame_format, lut, frame_format=frame_format) as writer:
+            for k, (ir, depth) in enumerate(frames):
+                writer.add_frame(0.046 * k, ir, depth)
+            writer.close()
+        assert len(list((tmp_path / frame_format / "ir").glob(f"*.{frame_format}"))) == 3
+        tables.append(track_recording(read_recording(tmp_path / frame_format), {"tool": GEOMETRY}, PARAMS))
+    pd.testing.assert_frame_equal(tables[0], tables[1])
+    with pytest.raises(PoseIntegrityError, match="frame_format: expected 'png' or 'npy', got 'jpg'"):
+        RecordingWriter(tmp_path / "jpg", lut, frame_format="jpg")

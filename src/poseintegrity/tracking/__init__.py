@@ -16,6 +16,8 @@ Module map (paper section -> module):
     II-F  errors         :mod:`errors`          (the paper's per-axis / Euler RMS beside norm / geodesic)
     loop                 :mod:`tracker`         (+ innovation gate, ours), :mod:`tools` (several tools, ours)
     input                :mod:`recording`       (a folder of recorded frames -> pose table)
+                         :mod:`hl2_recordings`  (HoloLens 2 AHAT recordings of StreamRecorder and hl2ss -> a recording folder)
+                         :mod:`replay`          (command line: a recording + a tool file -> pose table and summary)
     peers                :mod:`peers`           (filterpy, pykalman)
     III   results        :mod:`evaluation`
 """
@@ -29,9 +31,11 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
     submod_attrs={
         "correspondence": ["match_brute_force", "match_frobenius", "match_gated", "match_markers", "match_voting"],
         "detection": ["detect_markers", "validate_frame"],
+        "hl2_recordings": ["convert_hl2ss", "convert_stream_recorder", "read_hl2ss_ahat", "read_hl2ss_calibration"],
         "kabsch": ["kabsch", "pose_from_points"],
         "params": ["TrackParams"],
         "recording": ["Recording", "RecordingError", "RecordingWriter", "read_recording", "track_recording"],
+        "replay": ["replay_summary"],
         "srukf": ["SquareRootUKF"],
         "tools": ["MultiToolTracker", "ToolError", "read_tools", "write_tools"],
         "tracker": ["MarkerTracker"],
