@@ -121,6 +121,8 @@ def test_a_model_needing_more_stops_than_sampled_is_refused(tiny_raw):
     tiny_raw["fit"].update(models=["exponential", "mlp_pretrained"], k_min=2)  # 2-parameter models only
     tiny_raw["predict"]["models"].update(long_range="exponential", next_step="exponential",
                                          long_range_free_width="exponential", next_step_free_width="exponential")
+    tiny_raw["predict"]["model_choice"] = ["exponential"]
+    assert "predict.model_choice.1" in refusal(tiny_raw, "predict.model_choice", ["exponential", "emg"])
     assert "predict.models.long_range" in refusal(tiny_raw, "predict.models.long_range", "emg")
     assert "predict.models.next_step" in refusal(tiny_raw, "predict.models.next_step", "gaussian")
 
@@ -133,6 +135,17 @@ def test_the_free_width_emg_fits_the_stops_sampled_and_no_fewer(tiny_raw):
     tiny_raw["protocol"]["sampled_stops"]["arc"] = 3
     tiny_raw["fit"].update(models=["emg", "exponential"])
     tiny_raw["predict"]["models"].update(long_range_free_width="emg", next_step_free_width="emg")
+    tiny_raw["predict"]["model_choice"] = ["emg", "exponential"]
     for key in ("predict.models.long_range_free_width", "predict.models.next_step_free_width"):
         message = refusal(tiny_raw, key, "emg_free_width")
         assert key in message and "needs 4 stops" in message
+
+
+@pytest.mark.parametrize(("value", "expected"), [
+    (["emg", "mlp_pretrained"], "predict.model_choice.1"),  # the MLP is a predictor of its own, not a base function
+    (["emg", "emg"], "predict.model_choice"),  # distinct
+    ([], "predict.model_choice"),
+    (["emg", "cubic"], "predict.model_choice.1"),
+])
+def test_model_choice_names_least_squares_base_functions(tiny_raw, value, expected):
+    assert expected in refusal(tiny_raw, "predict.model_choice", value)

@@ -17,7 +17,7 @@ from poseintegrity.prediction import FITTED_PREDICTORS, FREE_WIDTH_PREDICTORS, N
 ROOT = Path(__file__).resolve().parents[2]
 NOTEBOOK = ROOT / "notebooks" / "04_predictor_sweeps.ipynb"
 FIGURES = ["04_fig5_long_range.png", "04_fig6_pnp.png", "04_fig7_straight_line.png", "04_fig8_next_step.png",
-           "04_free_width.png", "04_loso.png", "04_relative_thresholds.png", "04_tails.png",
+           "04_free_width.png", "04_loso.png", "04_model_choice.png", "04_relative_thresholds.png", "04_tails.png",
            "04_uncertainty.png"]  # fmt: skip
 
 
@@ -40,7 +40,9 @@ def test_notebook_runs_on_tiny_params(tmp_path, tiny):
     metrics = json.loads((tmp_path / "reports" / "metrics" / "predictors.json").read_text())
     for predictor in ("static", "long_range", "mlp", "next_step", *FREE_WIDTH_PREDICTORS):
         assert set(protocol.tolerance_names) <= set(metrics[predictor])
-    assert {"straight_line", "pnp", "loso", "live", "fit_status", "tails", "envelope_rules"} <= set(metrics)
+    assert {"straight_line", "pnp", "loso", "live", "fit_status", "tails", "envelope_rules",
+            "model_choice"} <= set(metrics)
+    assert set(metrics["model_choice"]["main"]) == set(tiny.predict.model_choice)  # every candidate, scored
     validation = json.loads((tmp_path / "reports" / "metrics" / "validation.json").read_text())
     for predictor in ("static", "long_range", "mlp", "next_step"):  # the keys
         for tolerance in protocol.tolerance_names:

@@ -64,6 +64,10 @@ class PredictParams(Section):
     )
     n_grid: int = Field(ge=16, le=GRID, description="grid points of the theta_p crossing scan per fitted curve")
     models: PredictorModels
+    model_choice: distinct(ModelName) = Field(
+        min_length=1, description="ours: least squares base functions compared as the long range predictor's model "
+        "(model_choice.py), in-sample and held out, so that a user picks predict.models from their own data"
+    )
     live_n_t: int = Field(ge=1, le=GRID, description="fixed n_t of the simulated live trials (paper: 15, from Table III), one of"
                                             " the swept n_t_min .. n_t_max")
     live_tolerance: str = Field(min_length=1, description="tolerance of the simulated live trials (paper: 4mm_10deg), one of"
@@ -114,6 +118,13 @@ class PredictParams(Section):
             if fewest is not None and distinct_theta_needed(model) > fewest:
                 raise KeyRule(f"models.{predictor}", f"model {model!r} needs {distinct_theta_needed(model)} stops, "
                                                      f"more than protocol.sampled_stops gives ({fewest})")
+        for index, model in enumerate(self.model_choice):
+            if model not in LEAST_SQUARES:
+                raise KeyRule(f"model_choice.{index}", f"must name a least squares base function (one of "
+                                                       f"{sorted(LEAST_SQUARES)}), got {model!r}")
+            if fewest is not None and distinct_theta_needed(model) > fewest:
+                raise KeyRule(f"model_choice.{index}", f"model {model!r} needs {distinct_theta_needed(model)} stops, "
+                                                       f"more than protocol.sampled_stops gives ({fewest})")
         if self.uncertainty.method == "covariance" and self.models.long_range not in LEAST_SQUARES:
             raise KeyRule("uncertainty.method", f"covariance needs a least squares long_range model (one of "
                                                 f"{sorted(LEAST_SQUARES)}), got {self.models.long_range!r}: use "

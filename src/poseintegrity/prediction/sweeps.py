@@ -61,7 +61,7 @@ OPERATING_POINT_KEY = {"static": "best_size", "long_range_relative": "best_fract
                        "next_step_relative": "best_fraction"}  # predictors.json name of the best operating point
 
 
-def _rows(
+def prediction_rows(
     predictor: str, model: str, method: str, series: Series, operating_point: np.ndarray, found: Boundaries,
     fit_status: str | np.ndarray, reason: str | np.ndarray,
 ) -> pd.DataFrame:  # fmt: skip
@@ -75,7 +75,7 @@ def _rows(
     )  # fmt: skip
 
 
-def _fit_of(answer: LongRange) -> tuple[str, str]:
+def fit_of(answer: LongRange) -> tuple[str, str]:
     """(fit_status, reason) of a long range answer; NO_FIT when there were too few stops to fit."""
     return (answer.fitted.status, answer.fitted.reason) if answer.fitted else (NO_FIT, "too few stops")
 
@@ -100,14 +100,14 @@ def predict_dataset(
     fractions = predict.relative_thresholds
     both = np.concatenate([n_t, relative_thresholds(series, fractions)])
     sizes = predict.static_sizes(series.theta_end)
-    tables = [_rows("static", "", method, series, sizes, static_baseline(sizes), NO_FIT, "no fit: one size for all")]
+    tables = [prediction_rows("static", "", method, series, sizes, static_baseline(sizes), NO_FIT, "no fit: one size for all")]
     answer = long_range(series, k, models.long_range, both, fit, fit_rng(predict.seed, method, series, k), predict.n_grid)
     absolute, relative = _split(answer.prediction, n_t.size)
-    fit_status, reason = _fit_of(answer)
-    tables.append(_rows("long_range", models.long_range, method, series, n_t, absolute, fit_status, reason))
+    fit_status, reason = fit_of(answer)
+    tables.append(prediction_rows("long_range", models.long_range, method, series, n_t, absolute, fit_status, reason))
     if method != protocol.pnp_method:  # Fig. 6: the long range predictor alone on the other PnP methods
         return pd.concat(tables, ignore_index=True)
-    tables.append(_rows("long_range_relative", models.long_range, method, series, fractions, relative, fit_status,
+    tables.append(prediction_rows("long_range_relative", models.long_range, method, series, fractions, relative, fit_status,
                         reason))  # fmt: skip
 
     interval = prediction_interval(
@@ -118,20 +118,20 @@ def predict_dataset(
     no_interval = np.isnan(interval.lower) & ~np.isnan(absolute.theta_p)
     lower = Boundaries(interval.lower, np.where(no_interval, "no_interval", absolute.status))
     lower_reason = interval.reason if fit_status == OK else f"{reason}; interval: {interval.reason}"
-    tables.append(_rows("long_range_lower", models.long_range, method, series, n_t, lower, fit_status, lower_reason))
+    tables.append(prediction_rows("long_range_lower", models.long_range, method, series, n_t, lower, fit_status, lower_reason))
     for predictor, model in (("mlp", models.mlp), ("long_range_free_width", models.long_range_free_width)):
         other = long_range(series, k, model, n_t, fit, fit_rng(predict.seed, method, series, k), predict.n_grid)
-        tables.append(_rows(predictor, model, method, series, n_t, other.prediction, *_fit_of(other)))
+        tables.append(prediction_rows(predictor, model, method, series, n_t, other.prediction, *fit_of(other)))
     step = next_step(series, k, models.next_step, both, fit, predict.seed, method, predict.n_grid)
     step_absolute, step_relative = _split(step.prediction, n_t.size)
     status_absolute, status_relative = _split(step.fit_status, n_t.size)
     reason_absolute, reason_relative = _split(step.fit_reason, n_t.size)
-    tables.append(_rows("next_step", models.next_step, method, series, n_t, step_absolute, status_absolute,
+    tables.append(prediction_rows("next_step", models.next_step, method, series, n_t, step_absolute, status_absolute,
                         reason_absolute))  # fmt: skip
-    tables.append(_rows("next_step_relative", models.next_step, method, series, fractions, step_relative,
+    tables.append(prediction_rows("next_step_relative", models.next_step, method, series, fractions, step_relative,
                         status_relative, reason_relative))  # fmt: skip
     free = next_step(series, k, models.next_step_free_width, n_t, fit, predict.seed, method, predict.n_grid)
-    tables.append(_rows("next_step_free_width", models.next_step_free_width, method, series, n_t, free.prediction,
+    tables.append(prediction_rows("next_step_free_width", models.next_step_free_width, method, series, n_t, free.prediction,
                         free.fit_status, free.fit_reason))  # fmt: skip
     return pd.concat(tables, ignore_index=True)
 

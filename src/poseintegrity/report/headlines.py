@@ -109,7 +109,7 @@ def _predictor_rows() -> list[Headline]:
                           else f"... {label}", fmt="{:.1%}")
                  for status, label in FIT_STATUS_LABELS.items()]
     rows.append(Headline("predictors", "live.n_flagged_fits", "simulated live trials that went by a flagged fit"))
-    return rows + _free_width_rows() + _rule_rows()
+    return rows + _free_width_rows() + _model_choice_rows() + _rule_rows()
 
 
 def _rule_rows() -> list[Headline]:
@@ -195,6 +195,27 @@ def _free_width_rows() -> list[Headline]:
                          f"predict.tail_n_t_max, {label}"),
                 Headline("predictors", f"tails.{predictor}.{tolerance}.datasets", "... which arcs"),
             ]
+    return rows
+
+
+def _model_choice_rows() -> list[Headline]:
+    """Ours: every least squares base function as the long range predictor's model (prediction/model_choice.py), on
+    each world: in-sample max mean SPL at zero incursion and the held-out figures of the leave-one-scene-out choice."""
+    rows = []
+    for world in ("main", "validation"):
+        for tolerance in paper.TOLERANCES:
+            label = paper.TOLERANCE_LABELS[tolerance]
+            for model, name in MODEL_LABELS.items():
+                if model.startswith("mlp"):
+                    continue
+                key = f"model_choice.{world}.{model}.{tolerance}"
+                rows += [
+                    Headline("predictors", f"{key}.max_mean_spl_zero_incursion",
+                             f"ours, model choice, {world} world: long range on {name}, {label}: max mean SPL at zero "
+                             f"incursion (deg)"),
+                    Headline("predictors", f"{key}.heldout_mean_spl", "... held out (leave one scene out): mean SPL (deg)"),
+                    Headline("predictors", f"{key}.heldout_incursion_rate", "... held out: R_i"),
+                ]
     return rows
 
 
