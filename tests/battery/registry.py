@@ -159,6 +159,7 @@ def _entries() -> list[EntryPoint]:
     from poseintegrity.artifact_models.models import fit_model
     from poseintegrity.localization import dataset, envelope, features, ground_truth, matching, pnp, target_model
     from poseintegrity.prediction import metrics, predictors, supervisor
+    from poseintegrity.recorded import __main__ as recorded_cli, export, materialize, reader
     from poseintegrity.tracking import correspondence, detection, recording, tools
     from poseintegrity.tracking.kabsch import kabsch as kabsch_fit
 
@@ -320,6 +321,23 @@ def _entries() -> list[EntryPoint]:
                                                        {"probe": tracking_frame()["geometry"]}, P().track),
                    lambda tmp: {"file": _recording_dir(tmp) / "ir" / "000001.png"}, {"file": "file"},
                    names={"file": "000001.png"}, flagged=_any_flag),
+        # ---- recorded datasets: every file of the folder (an image lies one folder down)
+        *[EntryPoint(f"recorded.read_recorded[{Path(name).name}]",
+                     lambda a, name=name: reader.read_recorded(a["file"].parents[name.count("/")]),
+                     lambda tmp, name=name: {"file": _recorded_dir(tmp) / name}, {"file": "file"})
+          for name in RECORDED_FILES],
+        EntryPoint("recorded.materialize", lambda a: materialize.materialize([a["file"].parent], a["file"].parents[2]),
+                   lambda tmp: {"file": _recorded_dir(tmp) / "stops.csv"}, {"file": "file"}),
+        EntryPoint("recorded.export_dataset",
+                   lambda a: export.export_dataset(a["meta"].parents[2], f"datasets/{a['meta'].parent.name}",
+                                                   a["meta"].parents[2] / "exported"),
+                   lambda tmp: {"meta": _dataset_dir(tmp).parent / "ds_arc" / "meta.json"}, {"meta": "file"}),
+        *[EntryPoint(f"python -m poseintegrity.recorded validate [{Path(name).name}]",
+                     lambda a, name=name: _cli(recorded_cli.main,
+                                               ["validate", str(a["file"].parents[name.count("/")])], a["file"]),
+                     lambda tmp, name=name: {"file": _recorded_dir(tmp) / name}, {"file": "file"},
+                     flagged=_cli_listed)
+          for name in RECORDED_FILES],
         # ---- stage tables and the files they are written to
         EntryPoint("tables.check_envelopes", lambda a: tables.check_envelopes(a["table"]),
                    lambda tmp: {"table": _envelope_table()}, {"table": "table"}),
@@ -402,6 +420,18 @@ def _camera_yaml(tmp: Path) -> Path:
     path = tmp / "camera.yaml"
     write_camera_yaml(path, localization_scene()["camera"], "battery")
     return path
+
+
+RECORDED_FILES = ("dataset.yaml", "camera.yaml", "board.yaml", "model.csv", "stops.csv", "images/s00_i00.png",
+                  "model/mask_1.png")
+
+
+def _recorded_dir(tmp: Path) -> Path:
+    """A recorded dataset folder: the one-image stage-01 dataset of :func:`_dataset_dir` exported."""
+    from poseintegrity.recorded.export import export_dataset
+
+    index = _dataset_dir(tmp)
+    return export_dataset(index.parents[1], "datasets/ds_arc", tmp / "recorded")
 
 
 def _tools_json(tmp: Path) -> Path:
@@ -506,6 +536,14 @@ def _cli_refused(result: CommandResult) -> bool:
     """Exit status 2 with one line naming the file, no traceback."""
     lines = result.stderr.strip().splitlines()
     return result.status == 2 and len(lines) == 1 and result.names_the_file and "Traceback" not in result.stderr
+
+
+def _cli_listed(result: CommandResult) -> bool:
+    """Exit status 2, the file named, one line per problem each naming its file (a path), no traceback: what
+    ``validate`` prints, every problem of the folder at once."""
+    lines = result.stderr.strip().splitlines()
+    return (result.status == 2 and result.names_the_file and "Traceback" not in result.stderr
+            and all("/" in line for line in lines))
 
 
 def _envelope_table() -> pd.DataFrame:

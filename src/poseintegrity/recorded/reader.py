@@ -178,7 +178,7 @@ def _board(path: Path, problems: _Problems) -> dict[str, Any] | None:
     return None
 
 
-def _table(path: Path, required: tuple[str, ...], optional: tuple[str, ...]) -> list[tuple[int, dict[str, str]]]:
+def read_table(path: Path, required: tuple[str, ...], optional: tuple[str, ...]) -> list[tuple[int, dict[str, str]]]:
     """(line number, row) of a CSV table with a header; its columns checked."""
     text = read_text_file(path, RecordedFormatError, "table")
     reader = csv.DictReader(io.StringIO(text))
@@ -267,10 +267,10 @@ def read_recorded(folder: str | Path) -> Recorded:
         found.add(f"{folder / 'board.yaml'}: a board with ground_truth: poses (say ground_truth: board to use it)")
 
     model_path, stops_path = folder / "model.csv", folder / "stops.csv"
-    model_rows = found.check(_table, model_path, ("file",), ("mask", "T_cam_ref")) or []
+    model_rows = found.check(read_table, model_path, ("file",), ("mask", "T_cam_ref")) or []
     if model_rows and len(model_rows) != 2:
         found.add(f"{model_path}: expected 2 rows (the model pair, III-B), got {len(model_rows)}")
-    stop_rows = found.check(_table, stops_path, ("file", "stop"), ("theta_deg", "x_mm", "T_cam_ref")) or []
+    stop_rows = found.check(read_table, stops_path, ("file", "stop"), ("theta_deg", "x_mm", "T_cam_ref")) or []
 
     listed: set[Path] = set()
     board_image = None
@@ -293,7 +293,7 @@ def read_recorded(folder: str | Path) -> Recorded:
                 found.add(problem)
         else:
             found.add(f"{stops_path}, line {line}: field file is empty")
-    for path in sorted(folder.rglob("*")):
+    for path in sorted(folder.rglob("*")) if model_rows and stop_rows else ():  # both tables read: all listed
         if path.is_file() and path.suffix.lower() in IMAGE_SUFFIXES and path.resolve() not in listed:
             found.add(f"{path}: extra image, listed in neither stops.csv nor model.csv")
 
