@@ -9,7 +9,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-sys.path.insert(0, str(Path(__file__).parents[1] / "localization"))  # --import-mode=importlib: loc_synthetic
+sys.path[:0] = [str(Path(__file__).parents[1] / "localization"), str(Path(__file__).parent)]  # importlib mode:
+# loc_synthetic and recorded_tools importable
 import loc_synthetic as synthetic  # noqa: E402
 
 from poseintegrity.config import load_params  # noqa: E402

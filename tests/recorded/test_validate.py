@@ -5,8 +5,6 @@ stop positions."""
 
 from __future__ import annotations
 
-import contextlib
-import io
 import shutil
 from pathlib import Path
 
@@ -14,19 +12,8 @@ import cv2
 import numpy as np
 import pytest
 
-from poseintegrity.recorded.__main__ import main
 from poseintegrity.recorded.reader import RecordedFormatError, read_recorded
-
-
-def run(argv: list[str]) -> tuple[int, str, str]:
-    out, err = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-        try:
-            main(argv)
-            status = 0
-        except SystemExit as exit_:
-            status = exit_.code
-    return status, out.getvalue(), err.getvalue()
+from recorded_tools import run
 
 
 @pytest.fixture
