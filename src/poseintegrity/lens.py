@@ -10,8 +10,8 @@ ideal point (x, y) = (X / Z, Y / Z) reaches the sensor at
 
 with ``dist = (k1, k2, p1, p2, k3)``. Recorded cameras may instead carry ROS's "rational_polynomial" model,
 ``dist = (k1, k2, p1, p2, k3, k4, k5, k6)``, whose radial factor is the ratio
-``(1 + k1 r^2 + k2 r^4 + k3 r^6) / (1 + k4 r^2 + k5 r^4 + k6 r^6)`` (OpenCV's 8-coefficient model). Stage 01 renders through the true lens; the pipeline (stages 02 and 05) only
-knows the lens as a calibration estimated it (``camera.yaml``) and undistorts every keypoint and board corner with it
+``(1 + k1 r^2 + k2 r^4 + k3 r^6) / (1 + k4 r^2 + k5 r^4 + k6 r^6)`` (OpenCV's 8-coefficient model). Stage 01
+renders through the true lens; the pipeline (stages 02 and 05) only knows the lens as a calibration estimated it (``camera.yaml``) and undistorts every keypoint and board corner with it
 (:meth:`Camera.undistort`) before any geometry, so that everything after is a pinhole camera of the same K.
 """
 
@@ -181,8 +181,8 @@ def _matrix(info: dict, key: str, rows: int, cols: int, path: Path) -> np.ndarra
 def read_camera_yaml(path: str | Path) -> Camera:
     """A camera from ``camera.yaml`` (ROS camera_info / camera_calibration_parsers layout, docs/references.md
     "Camera calibration file"): image_width, image_height, camera_matrix, distortion_model plumb_bob with 5
-    distortion_coefficients, or rational_polynomial with 8 (the projection and rectification matrices are not needed by a monocular pipeline and
-    are not read). :class:`CameraFileError` naming the file and the field otherwise."""
+    distortion_coefficients, or rational_polynomial with 8 (the projection and rectification matrices are not needed
+    by a monocular pipeline and are not read). :class:`CameraFileError` naming the file and the field otherwise."""
     path = Path(path)
     try:
         info: Any = yaml.safe_load(path.read_text())

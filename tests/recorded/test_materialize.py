@@ -71,8 +71,8 @@ def test_colour_16_bit_and_tiff_images_are_converted_once(exported, materialized
             cv2.imwrite(str(folder / file), cv2.cvtColor(gray, cv2.COLOR_GRAY2BGR if kind == "bgr" else cv2.COLOR_GRAY2BGRA))
     (folder / "stops.csv").write_text((folder / "stops.csv").read_text().replace("s01_i00.png", "s01_i00.tif"))
     materialize([folder], tmp_path / "data")
-    for file, target in (("images/s00_i00.png", "images/s000_i000.png"), ("images/s01_i00.png", "images/s001_i000.png"),
-                         ("model/image_1.png", "model/image_1.png")):
+    for file, target in (("images/s00_i00.png", "images/s00_i00.png"), ("images/s01_i00.png", "images/s01_i00.png"),
+                         ("model/image_1.png", "model/model_1.png")):
         expected = cv2.imread(str(exported / "line_r" / file), cv2.IMREAD_UNCHANGED)
         assert np.array_equal(cv2.imread(str(tmp_path / "data/datasets/line_r" / target), cv2.IMREAD_UNCHANGED),
                               expected)

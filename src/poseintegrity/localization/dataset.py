@@ -21,7 +21,8 @@ What is checked before any work, each failure a :class:`DatasetError` naming the
   and every image file present.
 
 A frame's own pose is checked per frame (:func:`pose_problem`): a bad one flags that frame's rows
-(status ``bad_pose``; a recorded frame without a known pose holds None instead, and is not flagged) instead of stopping the stage, as a bad frame image does (``bad_image``, extract.py).
+(status ``bad_pose``; a recorded frame without a known pose holds None instead, and is not flagged) instead of
+stopping the stage, as a bad frame image does (``bad_image``, extract.py).
 """
 
 from __future__ import annotations

@@ -19,7 +19,8 @@ workers of the ``parallel`` section (:class:`~poseintegrity.parallel.Workers`):
 A frame whose image is unusable gives rows with status ``bad_image``, one whose exact pose in frames.parquet is not a
 finite rigid transform rows with status ``bad_pose`` (a damaged file: no error is reported); a frame without a pose
 gives its PnP status; a recorded frame whose pose is not known (None in frames.parquet, board ground truth) is not
-flagged and its ``_exact`` errors are NaN. The ``reason`` column says why for every row whose status is not "ok" (empty otherwise). Neither is evidence about localization: :func:`usable` drops them before
+flagged and its ``_exact`` errors are NaN. The ``reason`` column says why for every row whose status is not "ok"
+(empty otherwise). Neither is evidence about localization: :func:`usable` drops them before
 envelopes and summaries.
 """
 

@@ -1,12 +1,13 @@
 """Write checked recorded datasets into the layout stage 02 reads (``data_dir/datasets/``:
 :mod:`poseintegrity.localization.dataset`), so that ``load_dataset`` and ``extract_dataset`` read them unchanged.
 
-Per dataset: ``meta.json`` (dataset, world, trajectory, ``ground_truth``, board, model pair), ``camera.yaml`` (as
-read, rewritten by :func:`poseintegrity.lens.write_camera_yaml`), ``frames.parquet`` (T_cam_board: the recorded pose
-T_cam_ref, None where none was recorded), ``model/image_<k>.png``, ``model/mask_<k>.png`` (all 255 where the folder
-gives no mask) and ``images/s<stop>_i<image>.png``. Images are converted once, to the 8-bit gray PNG the pipeline
-reads (:func:`poseintegrity.recorded.reader.read_image`); an 8-bit gray PNG is copied byte for byte. Every folder is
-checked before anything is written; each dataset is written into a staging folder and renamed when complete, and
+Per dataset, named as stage 01 names them: ``meta.json`` (dataset, world, trajectory, ``ground_truth``, board,
+model pair), ``camera.yaml`` (as read, rewritten by :func:`poseintegrity.lens.write_camera_yaml`), ``frames.parquet``
+(T_cam_board: the recorded pose T_cam_ref, None where none was recorded), ``model/model_<k>.png``,
+``model/mask_<k>.png`` (all 255 where the folder gives no mask) and ``images/s<stop>_i<image>.png``. The index
+row names the dataset its own scene (a recording is one scene). Images are converted once, to the 8-bit gray PNG the
+pipeline reads (:func:`poseintegrity.recorded.reader.read_image`); an 8-bit gray PNG is copied byte for byte. Every
+folder is checked before anything is written; each dataset is written into a staging folder and renamed when complete, and
 ``index.parquet`` is removed first and written last, so an interrupted run leaves nothing that looks complete.
 """
 
@@ -39,8 +40,8 @@ def write_dataset(recorded: Recorded, root: Path) -> dict:
     with staged(root / recorded.name) as tmp:
         (tmp / "model").mkdir()
         (tmp / "images").mkdir()
-        model = {"images": [f"model/image_{k}.png" for k in range(2)], "masks": [f"model/mask_{k}.png" for k in range(2)],
-                 "T_cam1_cam0": recorded.T_cam1_cam0.tolist()}
+        model = {"images": [f"model/model_{k}.png" for k in range(2)],
+                 "masks": [f"model/mask_{k}.png" for k in range(2)], "T_cam1_cam0": recorded.T_cam1_cam0.tolist()}
         if recorded.ground_truth == "poses":
             model["T_cam0_ref"] = recorded.T_cam0_ref.tolist()
         for k, (image, mask) in enumerate(zip(recorded.model_images, recorded.model_masks)):
@@ -52,7 +53,7 @@ def write_dataset(recorded: Recorded, root: Path) -> dict:
                 _write_image(recorded.folder / mask, tmp / model["masks"][k])
         rows = []
         for frame in recorded.frames:
-            file = f"images/s{frame.stop:03d}_i{frame.image:03d}.png"
+            file = f"images/s{frame.stop:02d}_i{frame.image:02d}.png"
             _write_image(recorded.folder / frame.file, tmp / file)
             rows.append({"dataset": recorded.name, "stop": frame.stop, "image": frame.image,
                          "theta_deg": frame.theta_deg, "x_mm": frame.x_mm, "file": file,
@@ -64,8 +65,8 @@ def write_dataset(recorded: Recorded, root: Path) -> dict:
             meta["board"] = recorded.board
         (tmp / "meta.json").write_text(json.dumps(meta, indent=1))
         write_camera_yaml(tmp / "camera.yaml", recorded.camera, recorded.name)
-    return {"dataset": recorded.name, "world": recorded.world, "trajectory": recorded.trajectory,
-            "n_frames": len(recorded.frames), "path": f"datasets/{recorded.name}"}
+    return {"dataset": recorded.name, "world": recorded.world, "scene": recorded.name,
+            "trajectory": recorded.trajectory, "n_frames": len(recorded.frames), "path": f"datasets/{recorded.name}"}
 
 
 def materialize(folders: list[str | Path], data_dir: str | Path) -> pd.DataFrame:
@@ -94,3 +95,19 @@ def materialize(folders: list[str | Path], data_dir: str | Path) -> pd.DataFrame
     index = pd.DataFrame([write_dataset(dataset, root) for dataset in datasets])
     index.to_parquet(root / "index.parquet", index=False)
     return index
+
+
+def recorded_folders(source: str | Path) -> list[Path]:
+    """The recorded dataset folders in ``source`` (a folder of them, params ``generate.source``), by name; hidden
+    folders (a staging folder left by an interrupted export) are skipped."""
+    return sorted(path for path in Path(source).iterdir() if path.is_dir() and not path.name.startswith("."))
+
+
+def materialize_source(source: str | Path, data_dir: str | Path) -> pd.DataFrame:
+    """Stage 01 with a recorded source: every dataset folder of ``source`` materialized into ``data_dir/datasets``
+    (:func:`materialize`); returns the index."""
+    source = Path(source)
+    if not source.is_dir():
+        raise RecordedFormatError(f"{source}: not a folder (generate.source names a folder of recorded dataset "
+                                  f"folders)")
+    return materialize(recorded_folders(source), data_dir)
