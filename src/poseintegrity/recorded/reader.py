@@ -23,9 +23,9 @@ import yaml
 from pydantic import ValidationError
 
 from poseintegrity.errors import PoseIntegrityError, read_text_file
+from poseintegrity.grayscale import as_gray8
 from poseintegrity.lens import Camera, read_camera_yaml
 from poseintegrity.localization.dataset import BoardMeta, pose_problem
-from poseintegrity.localization.features import as_gray8
 from poseintegrity.localization.ground_truth import board_pose, make_board
 from poseintegrity.recorded.geometry import distance_mm, relative_pose, viewing_angle_deg
 
@@ -78,7 +78,7 @@ class Recorded:
 
 def read_image(path: Path) -> tuple[np.ndarray, bool]:
     """(image, converted): the image file as the pipeline reads it, (h, w) uint8, and whether it had to be converted
-    (colour -> gray by OpenCV's weights, 16 bit -> its high byte: :func:`poseintegrity.localization.features.as_gray8`);
+    (colour -> gray by OpenCV's weights, 16 bit -> its high byte: :func:`poseintegrity.grayscale.as_gray8`);
     :class:`RecordedFormatError` naming the file when it is empty, damaged or of another kind."""
     try:
         data = path.read_bytes()
