@@ -1,0 +1,44 @@
+"""Stage 01 with ``generate.source`` a folder of recorded datasets: the notebook materializes them instead of
+rendering (no calibration, no robot), and stage 02 reads the result as it reads rendered data; a source that is not
+a folder is refused naming the key."""
+
+from __future__ import annotations
+
+import json
+
+import papermill
+import pytest
+
+from poseintegrity.config import ParamsError, load_params
+from poseintegrity.localization.dataset import load_dataset, load_index
+from repository import ROOT
+
+
+def overlay(tmp_path, source) -> str:
+    path = tmp_path / "params.yaml"
+    path.write_text(f"extends: {ROOT / 'tests' / 'params_tiny.yaml'}\ngenerate:\n  source: {source}\n")
+    return str(path)
+
+
+def test_a_source_that_is_not_a_folder_is_refused_naming_the_key(tmp_path):
+    with pytest.raises(ParamsError, match="generate.source"):
+        load_params(overlay(tmp_path, tmp_path / "no_such_folder"))
+    assert load_params(overlay(tmp_path, tmp_path)).generate.source == tmp_path
+
+
+@pytest.mark.notebook
+def test_stage_01_materializes_a_recorded_source(exported, rendered_dir, tmp_path):
+    papermill.execute_notebook(
+        str(ROOT / "notebooks" / "01_generate_datasets.ipynb"), str(tmp_path / "01.ipynb"), kernel_name="python3",
+        progress_bar=False, cwd=str(ROOT),
+        parameters={"params_path": overlay(tmp_path, exported), "data_dir": str(tmp_path / "data"),
+                    "reports_dir": str(tmp_path / "reports")})
+    index = load_index(tmp_path / "data")
+    assert list(index["dataset"]) == ["arc_r", "line_r"] and list(index["world"]) == ["main", "main"]
+    columns = ["stop", "image", "theta_deg", "x_mm"]
+    for name in index["dataset"]:
+        again = load_dataset(tmp_path / "data", f"datasets/{name}").frames[columns]
+        assert again.equals(load_dataset(rendered_dir, f"datasets/{name}").frames[columns])
+    metrics = json.loads((tmp_path / "reports" / "metrics" / "generate.json").read_text())
+    assert metrics["source"] == str(exported) and metrics["n_datasets"] == 2 and metrics["n_images"] == 6 + 2 + 2 * 2
+    assert not (tmp_path / "data" / "calibration" / "main").exists()  # nothing rendered or calibrated
