@@ -21,9 +21,11 @@ the board's (``board.getObjPoints()``) or the external tracking system's. A trac
 inverse. Stops: ``stop`` is an integer >= 0, rows of one stop follow each other (stop never decreases down the file),
 each row one image (the image index is its order within the stop); stops may be irregularly spaced and hold one
 image or many. ``theta_deg`` (arcs) is the viewing angle of the image: when the column or a cell is empty it is
-computed from the poses, as the angle of the rotation between the model pose (model image 0) and the image's pose
-(III-B, IV-D); ``x_mm`` (lines) likewise is the distance of the camera centre from the model's. The position the
-trajectory does not vary (x_mm of an arc, theta_deg of a line) is taken from the table or the poses, else 0. A
+computed from the poses, as the angle of the rotation between the model pose (model image 0, where M_t was created)
+and the image's pose (III-D); ``x_mm`` (lines) likewise is the distance of the camera centre from the trajectory's
+first position (V-A; the first stop's mean camera centre). The position a trajectory does not vary is taken from the
+table, else as stage 01 records it: x_mm 0 for arcs, and for lines theta_deg the viewing angle of the first stop
+(the line's offset from the model view, IV-D), 0 without poses. A
 stop's mean position must increase strictly with its index. Without T_cam1_cam0 in dataset.yaml the model pair's
 relative pose is T_cam1_ref inv(T_cam0_ref).
 

@@ -11,8 +11,9 @@ from poseintegrity.poses import inverse, rotation_angle_deg
 
 
 def viewing_angle_deg(T_cam0_ref: np.ndarray, T_cam_ref: np.ndarray) -> np.ndarray:
-    """theta_i (...,) deg: the angle of the rotation between the model pose (camera 0 of the model pair) and pose i
-    (IV-D: the arcs' viewing angle is measured from the model view). T_cam_ref: (4, 4) or (n, 4, 4)."""
+    """theta_i (...,) deg: the angle of the rotation between the model pose (camera 0 of the model pair, where M_t
+    was created) and pose i (III-D: "the absolute magnitude of the difference in the camera orientations").
+    T_cam_ref: (4, 4) or (n, 4, 4)."""
     return rotation_angle_deg(np.asarray(T_cam_ref)[..., :3, :3], np.asarray(T_cam0_ref)[:3, :3])
 
 
@@ -21,9 +22,11 @@ def camera_centre(T_cam_ref: np.ndarray) -> np.ndarray:
     return inverse(np.asarray(T_cam_ref, dtype=np.float64))[..., :3, 3]
 
 
-def distance_mm(T_cam0_ref: np.ndarray, T_cam_ref: np.ndarray) -> np.ndarray:
-    """x_i (...,) mm: the distance of camera i's centre from the model camera's (IV-D lines)."""
-    return np.linalg.norm(camera_centre(T_cam_ref) - camera_centre(T_cam0_ref), axis=-1)
+def distance_mm(origin_mm: np.ndarray, T_cam_ref: np.ndarray) -> np.ndarray:
+    """x_i (...,) mm: the distance of camera i's centre from ``origin_mm`` (3,), a point of the reference frame (for
+    lines the trajectory's first position, V-A: "the 3D camera translation between the first position of the
+    trajectory and position i")."""
+    return np.linalg.norm(camera_centre(T_cam_ref) - np.asarray(origin_mm, dtype=np.float64), axis=-1)
 
 
 def relative_pose(T_cam0_ref: np.ndarray, T_cam1_ref: np.ndarray) -> np.ndarray:

@@ -27,7 +27,7 @@ from poseintegrity.grayscale import as_gray8
 from poseintegrity.lens import Camera, read_camera_yaml
 from poseintegrity.localization.dataset import BoardMeta, pose_problem
 from poseintegrity.localization.ground_truth import board_pose, make_board
-from poseintegrity.recorded.geometry import distance_mm, relative_pose, viewing_angle_deg
+from poseintegrity.recorded.geometry import camera_centre, distance_mm, relative_pose, viewing_angle_deg
 
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".tif", ".tiff")
 TRAJECTORIES = ("arc", "line")
@@ -326,27 +326,44 @@ def read_recorded(folder: str | Path) -> Recorded:
                     T_cam0_ref, frames)
 
 
+def _computed(rows: list[tuple[int, dict[str, str]]], poses: list | None, T_cam0_ref: np.ndarray | None,
+              trajectory: str) -> list[dict[str, float]]:
+    """Per row, the positions its pose gives ({} without poses). Arcs: theta_i, the rotation angle between the model
+    pose and pose i (III-D), and x 0 (stage 01 records none). Lines: x_i, the distance of camera i's centre from the
+    trajectory's first position (V-A: the first stop's mean camera centre), and theta the viewing angle of that first
+    position (the line's offset from the model view, IV-D), constant along the line."""
+    if not poses or T_cam0_ref is None or any(pose is None for pose in poses):
+        return [{} for _ in rows]
+    stack = np.stack(poses)
+    first = np.array([row.get("stop") == rows[0][1].get("stop") for _, row in rows])
+    if trajectory == "arc":
+        return [{"theta_deg": float(theta), "x_mm": 0.0} for theta in viewing_angle_deg(T_cam0_ref, stack)]
+    origin = camera_centre(stack[first]).mean(axis=0)
+    offset = float(np.mean(viewing_angle_deg(T_cam0_ref, stack[first])))
+    return [{"theta_deg": offset, "x_mm": float(x)} for x in distance_mm(origin, stack)]
+
+
 def _frames(rows: list[tuple[int, dict[str, str]]], poses: list | None, T_cam0_ref: np.ndarray | None,
             settings: dict[str, Any], path: Path, found: _Problems) -> tuple[Frame, ...]:
-    """The stops.csv rows resolved: stop and image indices, theta_deg and x_mm given or computed from the poses."""
+    """The stops.csv rows resolved: stop and image indices, theta_deg and x_mm given or computed from the poses
+    (:func:`_computed`)."""
     position_column = "theta_deg" if settings["trajectory"] == "arc" else "x_mm"
-    computed = {"theta_deg": viewing_angle_deg, "x_mm": distance_mm}
+    computed = _computed(rows, poses, T_cam0_ref, settings["trajectory"])
     frames, previous, counts = [], -1, {}
     for index, (line, row) in enumerate(rows):
         where = f"{path}, line {line}"
         stop = _number(row.get("stop", ""), f"{where}: field stop", found, integer=True)
-        pose = poses[index] if poses else None
         values = {}
         for column in ("theta_deg", "x_mm"):
             if row.get(column):
                 values[column] = _number(row[column], f"{where}: field {column}", found)
-            elif pose is not None and T_cam0_ref is not None:
-                values[column] = float(computed[column](T_cam0_ref, pose))
+            elif column in computed[index]:
+                values[column] = computed[index][column]
             elif column == position_column:
                 found.add(f"{where}: field {column} is empty and there is no pose to compute it from")
                 values[column] = None
             else:
-                values[column] = 0.0  # the position an arc (line) does not vary, not recorded
+                values[column] = 0.0  # the position an arc (line) does not vary, neither recorded nor computable
         if stop is None or None in values.values():
             continue
         if stop < previous:
@@ -354,7 +371,8 @@ def _frames(rows: list[tuple[int, dict[str, str]]], poses: list | None, T_cam0_r
                       f"follow each other, stops in increasing order)")
         previous = max(previous, stop)
         counts[stop] = counts.get(stop, 0) + 1
-        frames.append(Frame(row["file"], stop, counts[stop] - 1, values["theta_deg"], values["x_mm"], pose))
+        frames.append(Frame(row["file"], stop, counts[stop] - 1, values["theta_deg"], values["x_mm"],
+                            poses[index] if poses else None))
     means = {stop: np.mean([getattr(f, position_column) for f in frames if f.stop == stop]) for stop in counts}
     ordered = sorted(means)
     for before, after in zip(ordered, ordered[1:]):
