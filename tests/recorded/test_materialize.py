@@ -79,6 +79,21 @@ def test_colour_16_bit_and_tiff_images_are_converted_once(exported, materialized
                               expected)
 
 
+def test_a_jpeg_image_is_decoded_as_opencv_decodes_it(exported, tmp_path):
+    """A stop stored as JPEG (lossy): materialized, its pixels are cv2.imdecode's of the JPEG bytes (the reference),
+    written as a lossless PNG."""
+    folder = copy(exported, tmp_path, "line_r")
+    gray = cv2.imread(str(folder / "images/s01_i00.png"), cv2.IMREAD_UNCHANGED)
+    (folder / "images/s01_i00.png").unlink()
+    data = cv2.imencode(".jpg", gray, [cv2.IMWRITE_JPEG_QUALITY, 90])[1].tobytes()
+    (folder / "images/s01_i00.jpg").write_bytes(data)
+    (folder / "stops.csv").write_text((folder / "stops.csv").read_text().replace("s01_i00.png", "s01_i00.jpg"))
+    materialize([folder], tmp_path / "data")
+    expected = cv2.imdecode(np.frombuffer(data, np.uint8), cv2.IMREAD_UNCHANGED)
+    again = cv2.imread(str(tmp_path / "data/datasets/line_r/images/s01_i00.png"), cv2.IMREAD_UNCHANGED)
+    assert np.array_equal(again, expected) and not np.array_equal(expected, gray)  # lossy, yet read as OpenCV reads
+
+
 def test_pose_ground_truth_replaces_the_board(rendered_dir, exported, extract_params, workers, tmp_path):
     """ground_truth: poses, no board.yaml: M_t is placed by model image 0's pose, E_t/E_r are measured against the
     recorded (here exact) poses, so they equal the _exact columns, and stay near the board-truth run's."""

@@ -141,7 +141,8 @@ def import_rosbag(bag: str | Path, image_topic: str, info_topic: str, stops: str
                 if count - 1 in wanted:
                     images[count - 1] = image_from_message(reader.deserialize(raw, connection.msgtype),
                                                            f"{bag}, topic {image_topic}, message {count - 1}")
-    except (AnyReaderError, Ros1ReaderError, Ros2ReaderError, SerdeError, TypesysError, OSError) as error:
+    except (AnyReaderError, Ros1ReaderError, Ros2ReaderError, SerdeError, TypesysError, OSError,
+            UnicodeDecodeError) as error:  # rosbags' ROS 1 reader decodes a non-bag file's first line unguarded
         raise RecordedFormatError(f"{bag}: cannot read the bag ({type(error).__name__}: {error})") from None
     if missing := [f"{stops}, line {line}: field index: message {index} is not on topic {image_topic} (it has "
                    f"{count})" for index, (line, _) in wanted.items() if index not in images]:
