@@ -148,6 +148,27 @@ def test_pose_ground_truth_needs_poses_on_every_row(folder):
     assert "stops.csv, line 3: field T_cam_ref is empty" in line
 
 
+@pytest.mark.parametrize("file, old, new, words", [
+    ("stops.csv", "images/s00_i01.png,0,", "images/s00_i01.png,0,1.0,", "stops.csv, line 3: 1 cell(s) more than"),
+    ("stops.csv", "images/s00_i01.png,0,", "images/s00_i01.png,zero,", "stops.csv, line 3: field stop: expected"),
+    ("stops.csv", "images/s01_i00.png,1,25.0,", "images/s01_i00.png,1,nan,", "line 4: field theta_deg: expected a fin"),
+    ("dataset.yaml", "T_cam1_cam0:", "T_cam1_cam0: [[1, 2], [3]]\nunused:", "dataset.yaml: unknown field(s) unused"),
+    ("dataset.yaml", "world: main", "world: main\ncolour: red", "dataset.yaml: unknown field(s) colour"),
+    ("board.yaml", "markers_x: 3", "markers_x: 0", "board.yaml: field markers_x"),
+    ("board.yaml", "dictionary: DICT_4X4_50", "dictionary: DICT_9X9_1", "board.yaml: field dictionary"),
+])
+def test_bad_table_and_yaml_fields(folder, file, old, new, words):
+    edit(folder / file, old, new)
+    assert any(words in line for line in problems_of(folder))
+
+
+def test_ragged_model_baseline_is_refused_naming_the_field(folder):
+    text = (folder / "dataset.yaml").read_text()
+    (folder / "dataset.yaml").write_text(text.split("T_cam1_cam0:")[0] + "T_cam1_cam0: [[1, 2], [3]]\n")
+    [line] = problems_of(folder)
+    assert "dataset.yaml: field T_cam1_cam0 is not 16 numbers" in line
+
+
 def test_not_a_folder(tmp_path):
     [line] = problems_of(tmp_path / "nothing")
     assert "nothing: not a folder" in line

@@ -155,7 +155,8 @@ def _settings(path: Path, problems: _Problems) -> dict[str, Any] | None:
         ok = False
     T = content.get("T_cam1_cam0")
     if T is not None:
-        flat = np.ravel(T).tolist() if isinstance(T, list) else T
+        rows = isinstance(T, list) and all(isinstance(row, list) for row in T)  # 4 rows of 4, or 16 numbers
+        flat = [value for row in T for value in row] if rows else T
         if not isinstance(flat, list) or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in flat):
             problems.add(f"{path}: field T_cam1_cam0 must be 16 numbers (row-major), got {T!r:.60}")
             ok = False
@@ -190,10 +191,13 @@ def read_table(path: Path, required: tuple[str, ...], optional: tuple[str, ...])
         lines.append(f"{path}: unknown column(s) {', '.join(unknown)}; known: {', '.join(required + optional)}")
     if lines:
         raise RecordedFormatError(lines)
-    rows = [(reader.line_num, {k: (v or "").strip() for k, v in row.items() if k is not None}) for row in reader]
+    rows = [(reader.line_num, row) for row in reader]
     if not rows:
         raise RecordedFormatError([f"{path}: no rows"])
-    return rows
+    if extra := [f"{path}, line {line}: {len(row[None])} cell(s) more than the header's {len(columns)} columns"
+                 for line, row in rows if None in row]:  # csv.DictReader files surplus cells under None
+        raise RecordedFormatError(extra)
+    return [(line, {key: (value or "").strip() for key, value in row.items()}) for line, row in rows]
 
 
 def _image_problem(folder: Path, relative: str, where: str, camera: Camera | None) -> str | None:
