@@ -1,6 +1,6 @@
 """Stage 01 with ``generate.source`` a folder of recorded datasets: the notebook materializes them instead of
-rendering (no calibration, no robot), and stage 02 reads the result as it reads rendered data; a source that is not
-a folder is refused naming the key."""
+rendering (no calibration, no robot), and the stage 02 notebook runs on the result as on rendered data; a source that
+is not a folder is refused naming the key."""
 
 from __future__ import annotations
 
@@ -27,12 +27,13 @@ def test_a_source_that_is_not_a_folder_is_refused_naming_the_key(tmp_path):
 
 
 @pytest.mark.notebook
-def test_stage_01_materializes_a_recorded_source(exported, rendered_dir, tmp_path):
-    papermill.execute_notebook(
-        str(ROOT / "notebooks" / "01_generate_datasets.ipynb"), str(tmp_path / "01.ipynb"), kernel_name="python3",
-        progress_bar=False, cwd=str(ROOT),
-        parameters={"params_path": overlay(tmp_path, exported), "data_dir": str(tmp_path / "data"),
-                    "reports_dir": str(tmp_path / "reports")})
+def test_stage_01_materializes_a_recorded_source_that_stage_02_reads(exported, rendered_dir, tmp_path):
+    parameters = {"params_path": overlay(tmp_path, exported), "data_dir": str(tmp_path / "data"),
+                  "reports_dir": str(tmp_path / "reports")}
+    for notebook in ("01_generate_datasets", "02_extract_artifacts"):
+        papermill.execute_notebook(str(ROOT / "notebooks" / f"{notebook}.ipynb"), str(tmp_path / f"{notebook}.ipynb"),
+                                   kernel_name="python3", progress_bar=False, cwd=str(ROOT), parameters=parameters)
+    assert (tmp_path / "reports" / "metrics" / "artifacts.json").is_file()
     index = load_index(tmp_path / "data")
     assert list(index["dataset"]) == ["arc_r", "line_r"] and list(index["world"]) == ["main", "main"]
     columns = ["stop", "image", "theta_deg", "x_mm"]
