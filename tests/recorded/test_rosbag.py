@@ -100,6 +100,10 @@ def test_an_index_the_topic_does_not_have_and_a_damaged_bag(exported, tmp_path):
     stops.write_text(stops.read_text().replace("\n3,", "\n7,"))
     with pytest.raises(RecordedFormatError, match=r"bag_stops.csv, line 5: field index: message 7 is not on topic"):
         import_rosbag(bag, "/camera/image", "/camera/camera_info", stops, tmp_path / "out", trajectory="line")
+    stops.write_text(stops.read_text().replace("\n7,", "\n2,"))
+    with pytest.raises(RecordedFormatError, match=r"bag_stops.csv, line 5: field index: message 2 is named on line 4"):
+        import_rosbag(bag, "/camera/image", "/camera/camera_info", stops, tmp_path / "out", trajectory="line")
+    _, stops = bag_inputs(folder, tmp_path)  # a good table again
     damaged = tmp_path / "damaged.bag"
     damaged.write_bytes(b"#ROSBAG V2.0\n" + bytes(64))
     with pytest.raises(RecordedFormatError, match="damaged.bag: cannot read the bag"):

@@ -169,6 +169,14 @@ def test_ragged_model_baseline_is_refused_naming_the_field(folder):
     assert "dataset.yaml: field T_cam1_cam0 is not 16 numbers" in line
 
 
+def test_export_command(rendered_dir, tmp_path):
+    status, out, _ = run(["export", str(rendered_dir), "--out", str(tmp_path / "out")])
+    assert status == 0 and "exported 2 dataset(s)" in out
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["arc_r", "line_r"]
+    status, out, err = run(["export", str(tmp_path / "nothing"), "--out", str(tmp_path / "out2")])
+    assert status == 2 and len(err.strip().splitlines()) == 1 and "index.parquet is missing" in err
+
+
 def test_not_a_folder(tmp_path):
     [line] = problems_of(tmp_path / "nothing")
     assert "nothing: not a folder" in line

@@ -95,6 +95,11 @@ def _bag_stops(path: Path) -> list[tuple[int, int, dict[str, str]]]:
                             f"got {row['stop']!r}")
         else:
             rows.append((line, int(row["index"]), row))
+    seen: dict[int, int] = {}
+    for line, index, _ in rows:
+        if index in seen:
+            problems.append(f"{path}, line {line}: field index: message {index} is named on line {seen[index]} too")
+        seen.setdefault(index, line)
     for stop in MODEL_STOPS:
         if sum(row["stop"] == stop for _, _, row in rows) != 1:
             problems.append(f"{path}: field stop: exactly one row must be {stop} (the model pair, III-B)")
