@@ -5,6 +5,8 @@ is not a folder is refused naming the key."""
 from __future__ import annotations
 
 import json
+import shutil
+from pathlib import Path
 
 import papermill
 import pytest
@@ -27,8 +29,15 @@ def test_a_source_that_is_not_a_folder_is_refused_naming_the_key(tmp_path):
 
 
 @pytest.mark.notebook
-def test_stage_01_materializes_a_recorded_source_that_stage_02_reads(exported, rendered_dir, tmp_path):
-    parameters = {"params_path": overlay(tmp_path, exported), "data_dir": str(tmp_path / "data"),
+@pytest.mark.parametrize("ground_truth", ["board", "poses"])
+def test_stage_01_materializes_a_recorded_source_that_stage_02_reads(exported, rendered_dir, tmp_path, ground_truth):
+    source = Path(shutil.copytree(exported, tmp_path / "recorded"))
+    if ground_truth == "poses":  # the exported exact poses become the ground truth, the boards go
+        for folder in source.iterdir():
+            (folder / "board.yaml").unlink()
+            settings = folder / "dataset.yaml"
+            settings.write_text(settings.read_text().replace("ground_truth: board", "ground_truth: poses"))
+    parameters = {"params_path": overlay(tmp_path, source), "data_dir": str(tmp_path / "data"),
                   "reports_dir": str(tmp_path / "reports")}
     for notebook in ("01_generate_datasets", "02_extract_artifacts"):
         papermill.execute_notebook(str(ROOT / "notebooks" / f"{notebook}.ipynb"), str(tmp_path / f"{notebook}.ipynb"),
@@ -41,5 +50,5 @@ def test_stage_01_materializes_a_recorded_source_that_stage_02_reads(exported, r
         again = load_dataset(tmp_path / "data", f"datasets/{name}").frames[columns]
         assert again.equals(load_dataset(rendered_dir, f"datasets/{name}").frames[columns])
     metrics = json.loads((tmp_path / "reports" / "metrics" / "generate.json").read_text())
-    assert metrics["source"] == str(exported) and metrics["n_datasets"] == 2 and metrics["n_images"] == 6 + 2 + 2 * 2
+    assert metrics["source"] == str(source) and metrics["n_datasets"] == 2 and metrics["n_images"] == 6 + 2 + 2 * 2
     assert not (tmp_path / "data" / "calibration" / "main").exists()  # nothing rendered or calibrated
