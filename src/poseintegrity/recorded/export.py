@@ -10,7 +10,6 @@ shortest round-tripping repr, so materializing the export gives back the same nu
 
 from __future__ import annotations
 
-import csv
 import shutil
 from pathlib import Path
 
@@ -18,6 +17,7 @@ import numpy as np
 import yaml
 
 from poseintegrity.localization.dataset import load_dataset, load_index
+from poseintegrity.recorded.reader import write_table
 from poseintegrity.recorded.staging import staged
 
 
@@ -40,18 +40,13 @@ def export_dataset(data_dir: str | Path, folder: str | Path, out: str | Path) ->
                     "T_cam1_cam0": dataset.model_baseline().ravel().tolist()}
         (tmp / "dataset.yaml").write_text(yaml.safe_dump(settings, sort_keys=False))
         (tmp / "board.yaml").write_text(yaml.safe_dump(dict(meta["board"]), sort_keys=False))
-        with open(tmp / "model.csv", "w", newline="") as table:
-            writer = csv.writer(table)
-            exact = meta["model"].get("exact_T_cam_board")
-            writer.writerow(["file", "mask"] + (["T_cam_ref"] if exact else []))
-            for k, (image, mask) in enumerate(zip(meta["model"]["images"], meta["model"]["masks"])):
-                writer.writerow([image, mask] + ([_pose_text(exact[k])] if exact else []))
-        with open(tmp / "stops.csv", "w", newline="") as table:
-            writer = csv.writer(table)
-            writer.writerow(["file", "stop", "theta_deg", "x_mm", "T_cam_ref"])
-            for frame in dataset.frames.itertuples():
-                writer.writerow([frame.file, int(frame.stop), repr(float(frame.theta_deg)), repr(float(frame.x_mm)),
-                                 _pose_text(frame.T_cam_board)])
+        exact = meta["model"].get("exact_T_cam_board")
+        write_table(tmp / "model.csv", ["file", "mask"] + (["T_cam_ref"] if exact else []),
+                    [[image, mask] + ([_pose_text(exact[k])] if exact else [])
+                     for k, (image, mask) in enumerate(zip(meta["model"]["images"], meta["model"]["masks"]))])
+        write_table(tmp / "stops.csv", ["file", "stop", "theta_deg", "x_mm", "T_cam_ref"],
+                    [[frame.file, int(frame.stop), repr(float(frame.theta_deg)), repr(float(frame.x_mm)),
+                      _pose_text(frame.T_cam_board)] for frame in dataset.frames.itertuples()])
     return Path(out) / dataset.name
 
 

@@ -200,6 +200,14 @@ def read_table(path: Path, required: tuple[str, ...], optional: tuple[str, ...])
     return [(line, {key: (value or "").strip() for key, value in row.items()}) for line, row in rows]
 
 
+def write_table(path: Path, header: list[str], rows: list[list]) -> None:
+    """A CSV table as :func:`read_table` reads it: the header, then one line per row."""
+    with open(path, "w", newline="") as table:
+        writer = csv.writer(table)
+        writer.writerow(header)
+        writer.writerows(rows)
+
+
 def _image_problem(folder: Path, relative: str, where: str, camera: Camera | None) -> str | None:
     path = folder / relative
     if Path(relative).is_absolute() or ".." in Path(relative).parts:

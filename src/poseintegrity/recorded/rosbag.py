@@ -17,7 +17,6 @@ is written atomically and is not checked here: ``python -m poseintegrity.recorde
 
 from __future__ import annotations
 
-import csv
 from pathlib import Path
 
 import cv2
@@ -25,8 +24,8 @@ import numpy as np
 import yaml
 
 from poseintegrity.errors import PoseIntegrityError, read_text_file
-from poseintegrity.lens import Camera, write_camera_yaml
-from poseintegrity.recorded.reader import TRAJECTORIES, RecordedFormatError, read_table
+from poseintegrity.lens import DISTORTION_MODELS, Camera, write_camera_yaml
+from poseintegrity.recorded.reader import TRAJECTORIES, RecordedFormatError, read_table, write_table
 from poseintegrity.recorded.staging import staged
 
 IMAGE_TYPES = ("sensor_msgs/msg/Image", "sensor_msgs/msg/CompressedImage")
@@ -69,14 +68,13 @@ def image_from_message(message, where: str) -> tuple[bytes, str]:
 def camera_from_info(message, where: str) -> Camera:
     """The camera of a CameraInfo message (plumb_bob: 5 coefficients, rational_polynomial: 8)."""
     model = message.distortion_model
-    coefficients = {"plumb_bob": 5, "rational_polynomial": 8}
-    if model not in coefficients:
+    if model not in DISTORTION_MODELS:
         raise RecordedFormatError(f"{where}: field distortion_model {model!r} is neither plumb_bob nor "
                                   f"rational_polynomial")
     dist = np.asarray(_field(message, "d", "D"), dtype=np.float64)
-    if len(dist) != coefficients[model]:
+    if len(dist) != DISTORTION_MODELS[model]:
         raise RecordedFormatError(f"{where}: field D holds {len(dist)} coefficients, {model} has "
-                                  f"{coefficients[model]}")
+                                  f"{DISTORTION_MODELS[model]}")
     try:
         return Camera(np.asarray(_field(message, "k", "K"), dtype=np.float64).reshape(3, 3), dist,
                       int(message.width), int(message.height))
@@ -167,18 +165,11 @@ def import_rosbag(bag: str | Path, image_topic: str, info_topic: str, stops: str
                 model_rows[row["stop"]] = [file, "", cells[2]]
             else:
                 stop_rows.append([file, row["stop"], *cells])
-        _write_csv(tmp / "model.csv", ["file", "mask", "T_cam_ref"], [model_rows[stop] for stop in MODEL_STOPS])
-        _write_csv(tmp / "stops.csv", ["file", "stop", "theta_deg", "x_mm", "T_cam_ref"], stop_rows)
+        write_table(tmp / "model.csv", ["file", "mask", "T_cam_ref"], [model_rows[stop] for stop in MODEL_STOPS])
+        write_table(tmp / "stops.csv", ["file", "stop", "theta_deg", "x_mm", "T_cam_ref"], stop_rows)
         write_camera_yaml(tmp / "camera.yaml", camera, out.name)
         settings = {"trajectory": trajectory, "ground_truth": "board" if board else "poses", "world": world}
         (tmp / "dataset.yaml").write_text(yaml.safe_dump(settings, sort_keys=False))
         if board_text is not None:
             (tmp / "board.yaml").write_text(board_text)
     return out
-
-
-def _write_csv(path: Path, header: list[str], rows: list[list[str]]) -> None:
-    with open(path, "w", newline="") as table:
-        writer = csv.writer(table)
-        writer.writerow(header)
-        writer.writerows(rows)
