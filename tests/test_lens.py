@@ -203,6 +203,27 @@ def test_lenses_of_machine_vision_cameras_pass(dist):
 def test_params_naming_folding_coefficients_are_refused_with_their_key(tiny_raw):
     assert "generate.camera.distortion" in refusal(tiny_raw, "generate.camera.distortion", [-0.6, 0.0, 0.0, 0.0, 0.0])
 
+RATIONAL = Camera(CAMERA.K, np.array([0.12, -0.05, 0.0002, -0.0001, 0.01, 0.18, -0.04, 0.006]), CAMERA.width,
+                  CAMERA.height)  # a rational_polynomial lens (8 coefficients), barrel like CAMERA's
+
+
+def test_rational_polynomial_lens_is_opencvs_eight_coefficient_model():
+    """distort and undistort of an 8-coefficient lens agree with cv2.projectPoints given the same 8 numbers."""
+    points = rays_in_view(RATIONAL, 500, seed=2)
+    ideal = project(points, RATIONAL.K, None)
+    sensor = project(points, RATIONAL.K, RATIONAL.dist)
+    assert np.abs(RATIONAL.distort(ideal) - sensor).max() < 1e-9
+    assert np.abs(RATIONAL.undistort(sensor) - ideal).max() < 1e-6
+    assert np.abs(sensor - ideal).max() > 1.0  # the lens does bend rays
+
+
+def test_rational_polynomial_camera_yaml_round_trips(tmp_path):
+    check_folding(RATIONAL.K, RATIONAL.dist, RATIONAL.width, RATIONAL.height)
+    write_camera_yaml(tmp_path / "camera.yaml", RATIONAL, "rational")
+    assert "distortion_model: rational_polynomial" in (tmp_path / "camera.yaml").read_text()
+    read = read_camera_yaml(tmp_path / "camera.yaml")
+    assert np.array_equal(read.dist, RATIONAL.dist) and np.array_equal(read.K, RATIONAL.K)
+
 
 # --- camera.yaml ----------------------------------------------------------------------------------------------------
 
@@ -274,7 +295,8 @@ BAD_FILES = [  # (what is wrong, the file's text, the field the error names)
     ("NaN in K", edited(ROS_FILE, "487.2, 0, 1023.7", ".nan, 0, 1023.7"), "camera_matrix"),
     ("inf in dist", edited(ROS_FILE, "-0.0598, 0.0196", "-0.0598, .inf"), "distortion_coefficients"),
     ("a word in dist", edited(ROS_FILE, "-0.0598, 0.0196", "-0.0598, barrel"), "distortion_coefficients"),
-    ("unknown model", edited(ROS_FILE, "plumb_bob", "rational_polynomial"), "distortion_model"),
+    ("rational model with 5 coefficients", edited(ROS_FILE, "plumb_bob", "rational_polynomial"),
+     "distortion_coefficients"),
     ("fisheye model", edited(ROS_FILE, "plumb_bob", "equidistant"), "distortion_model"),
     ("four coefficients", edited(edited(ROS_FILE, "cols: 5", "cols: 4"), ", -0.00011, 0]", ", -0.00011]"),
      "distortion_coefficients"),

@@ -8,8 +8,10 @@ ideal point (x, y) = (X / Z, Y / Z) reaches the sensor at
     x_d = x radial + 2 p1 x y + p2 (r^2 + 2 x^2),   y_d = y radial + p1 (r^2 + 2 y^2) + 2 p2 x y
     u = fx x_d + cx,   v = fy y_d + cy
 
-with ``dist = (k1, k2, p1, p2, k3)``. Stage 01 renders through the true lens; the pipeline (stages 02 and 05) only
-knows the lens as a calibration estimated it (``camera.yaml``) and undistorts every keypoint and board corner with it
+with ``dist = (k1, k2, p1, p2, k3)``. Recorded cameras may instead carry ROS's "rational_polynomial" model,
+``dist = (k1, k2, p1, p2, k3, k4, k5, k6)``, whose radial factor is the ratio
+``(1 + k1 r^2 + k2 r^4 + k3 r^6) / (1 + k4 r^2 + k5 r^4 + k6 r^6)`` (OpenCV's 8-coefficient model). Stage 01
+renders through the true lens; the pipeline (stages 02 and 05) only knows the lens as a calibration estimated it (``camera.yaml``) and undistorts every keypoint and board corner with it
 (:meth:`Camera.undistort`) before any geometry, so that everything after is a pinhole camera of the same K.
 """
 
@@ -26,7 +28,7 @@ import yaml
 
 from poseintegrity.errors import ArgumentError, PoseIntegrityError, check_array, check_intrinsics
 
-DISTORTION_MODEL = "plumb_bob"  # ROS's name of OpenCV's 5-coefficient model
+DISTORTION_MODELS = {"plumb_bob": 5, "rational_polynomial": 8}  # ROS's names -> number of OpenCV coefficients
 # cv2.undistortPoints stops when the re-distorted estimate is within eps px of the pixel: 1e-10 px, as 1e-14 lies
 # below the float64 resolution of pixel coordinates (~1e-13 px at 1000 px) and kept it iterating to its 100 steps
 # (0.76 s for the 968 x 608 sensor maps, 0.13 s now); round trips through cv2.projectPoints to < 1e-9 px
@@ -45,10 +47,11 @@ class CameraFileError(PoseIntegrityError):
 
 @dataclass(frozen=True)
 class Camera:
-    """A camera with a lens: K (3, 3) px, dist (5,) = (k1, k2, p1, p2, k3), image width and height (px).
+    """A camera with a lens: K (3, 3) px, dist (5,) = (k1, k2, p1, p2, k3) (plumb_bob) or (8,) = (k1, k2, p1, p2,
+    k3, k4, k5, k6) (rational_polynomial), image width and height (px).
 
     Checked once when made (:class:`~poseintegrity.errors.ArgumentError` naming the field): K a finite pinhole
-    matrix [[fx, s, cx], [0, fy, cy], [0, 0, 1]] with fx, fy > 0; dist 5 finite numbers; width and height positive
+    matrix [[fx, s, cx], [0, fy, cy], [0, 0, 1]] with fx, fy > 0; dist 5 or 8 finite numbers; width and height positive
     integers. Every function taking a Camera (board pose, target model, undistortion) relies on it; a zero or NaN
     K would otherwise give NaN points or a pose hundreds of mm off reported as ok. Whether the lens folds the image
     is checked where a camera is read from a file (:func:`read_camera_yaml`, :func:`check_folding`).
@@ -61,7 +64,10 @@ class Camera:
 
     def __post_init__(self) -> None:
         check_intrinsics("Camera.K", self.K)
-        check_array("Camera.dist", self.dist, shape=(5,))
+        dist = check_array("Camera.dist", self.dist, shape=(None,))
+        if len(dist) not in DISTORTION_MODELS.values():
+            raise ArgumentError(f"Camera.dist: expected 5 (plumb_bob) or 8 (rational_polynomial) coefficients, "
+                                f"got {len(dist)}")
         for name, value in (("width", self.width), ("height", self.height)):
             if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)) or value < 1:
                 raise ArgumentError(f"Camera.{name}: expected a positive integer (pixels), got {value!r}")
@@ -113,11 +119,19 @@ class Camera:
 
 def distort_normalized(x: np.ndarray, y: np.ndarray, dist: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The Brown-Conrady model on normalized ideal coordinates (module docstring): (x_d, y_d), each like x."""
-    k1, k2, p1, p2, k3 = np.asarray(dist, dtype=float)
+    p1, p2 = np.asarray(dist, dtype=float)[2:4]
     r2 = x * x + y * y
-    radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3))
+    radial = radial_factor(r2, dist)
     return (x * radial + 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x),
             y * radial + p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y)
+
+
+def radial_factor(r2: np.ndarray, dist: np.ndarray) -> np.ndarray:
+    """The radial factor of the lens at squared normalized radius ``r2`` (module docstring): the polynomial of
+    plumb_bob, or the ratio of polynomials of rational_polynomial (8 coefficients)."""
+    k1, k2, _, _, k3, *rational = np.asarray(dist, dtype=float)
+    k4, k5, k6 = rational or (0.0, 0.0, 0.0)
+    return (1.0 + r2 * (k1 + r2 * (k2 + r2 * k3))) / (1.0 + r2 * (k4 + r2 * (k5 + r2 * k6)))
 
 
 def check_folding(K: np.ndarray, dist: np.ndarray, width: int, height: int) -> None:
@@ -128,9 +142,8 @@ def check_folding(K: np.ndarray, dist: np.ndarray, width: int, height: int) -> N
     K, dist = np.asarray(K, dtype=float), np.asarray(dist, dtype=float)
     corners = np.array([[0.0, 0.0], [width - 1.0, 0.0], [0.0, height - 1.0], [width - 1.0, height - 1.0]])
     r_corner = float(np.max(np.hypot((corners[:, 0] - K[0, 2]) / K[0, 0], (corners[:, 1] - K[1, 2]) / K[1, 1])))
-    k1, k2, p1, p2, k3 = dist
     r = np.linspace(0.0, 4.0 * r_corner, FOLD_SAMPLES)
-    r_d = r * (1.0 + k1 * r**2 + k2 * r**4 + k3 * r**6)
+    r_d = r * radial_factor(r**2, dist)
     reached = np.flatnonzero(r_d >= r_corner)
     slope = np.diff(r_d)
     if not reached.size or np.any(slope[: reached[0]] <= 0):
@@ -168,8 +181,8 @@ def _matrix(info: dict, key: str, rows: int, cols: int, path: Path) -> np.ndarra
 def read_camera_yaml(path: str | Path) -> Camera:
     """A camera from ``camera.yaml`` (ROS camera_info / camera_calibration_parsers layout, docs/references.md
     "Camera calibration file"): image_width, image_height, camera_matrix, distortion_model plumb_bob with 5
-    distortion_coefficients (the projection and rectification matrices are not needed by a monocular pipeline and
-    are not read). :class:`CameraFileError` naming the file and the field otherwise."""
+    distortion_coefficients, or rational_polynomial with 8 (the projection and rectification matrices are not needed
+    by a monocular pipeline and are not read). :class:`CameraFileError` naming the file and the field otherwise."""
     path = Path(path)
     try:
         info: Any = yaml.safe_load(path.read_text())
@@ -189,10 +202,11 @@ def read_camera_yaml(path: str | Path) -> Camera:
     if not (K[0, 0] > 0 and K[1, 1] > 0 and K[1, 0] == 0 and np.array_equal(K[2], [0.0, 0.0, 1.0])):
         raise CameraFileError(f"{path}: field camera_matrix must be [fx, s, cx, 0, fy, cy, 0, 0, 1] with fx, fy > 0, "
                               f"got {K.ravel().tolist()}")
-    if info.get("distortion_model") != DISTORTION_MODEL:
-        raise CameraFileError(f"{path}: field distortion_model must be {DISTORTION_MODEL!r} (OpenCV's k1 k2 p1 p2 k3), "
-                              f"got {info.get('distortion_model')!r}")
-    dist = _matrix(info, "distortion_coefficients", 1, 5, path).ravel()
+    model = info.get("distortion_model")
+    if not isinstance(model, str) or model not in DISTORTION_MODELS:
+        raise CameraFileError(f"{path}: field distortion_model must be 'plumb_bob' (OpenCV's k1 k2 p1 p2 k3) or "
+                              f"'rational_polynomial' (k1 k2 p1 p2 k3 k4 k5 k6), got {model!r}")
+    dist = _matrix(info, "distortion_coefficients", 1, DISTORTION_MODELS[model], path).ravel()
     try:
         check_folding(K, dist, *size)
     except LensError as error:
@@ -207,8 +221,9 @@ def write_camera_yaml(path: str | Path, camera: Camera, name: str) -> None:
     info = {
         "image_width": int(camera.width), "image_height": int(camera.height), "camera_name": name,
         "camera_matrix": {"rows": 3, "cols": 3, "data": K.ravel().tolist()},
-        "distortion_model": DISTORTION_MODEL,
-        "distortion_coefficients": {"rows": 1, "cols": 5, "data": np.asarray(camera.dist, dtype=float).tolist()},
+        "distortion_model": next(name for name, n in DISTORTION_MODELS.items() if n == len(camera.dist)),
+        "distortion_coefficients": {"rows": 1, "cols": len(camera.dist),
+                                    "data": np.asarray(camera.dist, dtype=float).tolist()},
         "rectification_matrix": {"rows": 3, "cols": 3, "data": np.eye(3).ravel().tolist()},
         "projection_matrix": {"rows": 3, "cols": 4, "data": np.hstack([K, np.zeros((3, 1))]).ravel().tolist()},
     }

@@ -159,6 +159,7 @@ def _entries() -> list[EntryPoint]:
     from poseintegrity.artifact_models.models import fit_model
     from poseintegrity.localization import dataset, envelope, features, ground_truth, matching, pnp, target_model
     from poseintegrity.prediction import metrics, predictors, supervisor
+    from poseintegrity.recorded import __main__ as recorded_cli, export, geometry, materialize, reader, rosbag
     from poseintegrity.tracking import correspondence, detection, hl2_recordings, recording, replay, tools
     from poseintegrity.tracking.kabsch import kabsch as kabsch_fit
 
@@ -336,6 +337,42 @@ def _entries() -> list[EntryPoint]:
                      names={"file": Path(name).name}, flagged=_pose_missing)
           for name in ("rm_depth_ahat.bin", "calibration/rm_depth_ahat/uv2xy.bin", "calibration/rm_depth_ahat/extrinsics.bin",
                        "calibration/rm_depth_ahat/scale.bin")],
+        # ---- recorded datasets: every file of the folder (an image lies one folder down)
+        *[EntryPoint(f"recorded.read_recorded[{Path(name).name}]",
+                     lambda a, name=name: reader.read_recorded(a["file"].parents[name.count("/")]),
+                     lambda tmp, name=name: {"file": _recorded_dir(tmp) / name}, {"file": "file"})
+          for name in RECORDED_FILES],
+        EntryPoint("recorded.read_image", lambda a: reader.read_image(a["path"]), lambda tmp: {"path": _png(tmp)},
+                   {"path": "file"}),
+        EntryPoint("recorded.viewing_angle_deg", lambda a: geometry.viewing_angle_deg(a["T_cam0_ref"], a["T_cam_ref"]),
+                   lambda tmp: {"T_cam0_ref": loc()["T"], "T_cam_ref": loc()["T"]},
+                   {"T_cam0_ref": "matrix", "T_cam_ref": "matrix"}),
+        EntryPoint("recorded.distance_mm", lambda a: geometry.distance_mm(a["origin_mm"], a["T_cam_ref"]),
+                   lambda tmp: {"origin_mm": np.zeros(3), "T_cam_ref": loc()["T"]},
+                   {"origin_mm": "array", "T_cam_ref": "matrix"}),
+        EntryPoint("recorded.relative_pose", lambda a: geometry.relative_pose(a["T_cam0_ref"], a["T_cam1_ref"]),
+                   lambda tmp: {"T_cam0_ref": loc()["T"], "T_cam1_ref": loc()["T"]},
+                   {"T_cam0_ref": "matrix", "T_cam1_ref": "matrix"}),
+        *[EntryPoint(f"recorded.import_rosbag[{name}]",
+                     lambda a, name=name: rosbag.import_rosbag(
+                         a["file"] if name == "bag" else a["file"].parent / "run.bag", "/camera/image",
+                         "/camera/camera_info", a["file"] if name == "stops" else a["file"].parent / "stops.csv",
+                         a["file"].parent / "imported", trajectory="arc"),
+                     lambda tmp, name=name: {"file": _bag_dir(tmp) / ("run.bag" if name == "bag" else "stops.csv")},
+                     {"file": "file"})
+          for name in ("bag", "stops")],
+        EntryPoint("recorded.materialize", lambda a: materialize.materialize([a["file"].parent], a["file"].parents[2]),
+                   lambda tmp: {"file": _recorded_dir(tmp) / "stops.csv"}, {"file": "file"}),
+        EntryPoint("recorded.export_dataset",
+                   lambda a: export.export_dataset(a["meta"].parents[2], f"datasets/{a['meta'].parent.name}",
+                                                   a["meta"].parents[2] / "exported"),
+                   lambda tmp: {"meta": _dataset_dir(tmp).parent / "ds_arc" / "meta.json"}, {"meta": "file"}),
+        *[EntryPoint(f"python -m poseintegrity.recorded validate [{Path(name).name}]",
+                     lambda a, name=name: _cli(recorded_cli.main,
+                                               ["validate", str(a["file"].parents[name.count("/")])], a["file"]),
+                     lambda tmp, name=name: {"file": _recorded_dir(tmp) / name}, {"file": "file"},
+                     flagged=_cli_listed)
+          for name in RECORDED_FILES],
         # ---- stage tables and the files they are written to
         EntryPoint("tables.check_envelopes", lambda a: tables.check_envelopes(a["table"]),
                    lambda tmp: {"table": _envelope_table()}, {"table": "table"}),
@@ -423,6 +460,30 @@ def _camera_yaml(tmp: Path) -> Path:
     path = tmp / "camera.yaml"
     write_camera_yaml(path, localization_scene()["camera"], "battery")
     return path
+
+
+RECORDED_FILES = ("dataset.yaml", "camera.yaml", "board.yaml", "model.csv", "stops.csv", "images/s00_i00.png",
+                  "model/mask_1.png")
+
+
+def _recorded_dir(tmp: Path) -> Path:
+    """A recorded dataset folder: the one-image stage-01 dataset of :func:`_dataset_dir` exported."""
+    from poseintegrity.recorded.export import export_dataset
+
+    index = _dataset_dir(tmp)
+    return export_dataset(index.parents[1], "datasets/ds_arc", tmp / "recorded")
+
+
+def _bag_dir(tmp: Path) -> Path:
+    """A ROS 1 bag (run.bag: the model pair and a stop as CompressedImage PNGs, a CameraInfo) and its stops.csv."""
+    from recorded_tools import write_bag
+
+    folder = tmp / "bag"
+    folder.mkdir(parents=True, exist_ok=True)
+    image = _png(tmp).read_bytes()
+    write_bag(folder / "run.bag", 1, [image] * 3, localization_scene()["camera"])
+    (folder / "stops.csv").write_text("index,stop\n0,model0\n1,model1\n2,0\n")
+    return folder
 
 
 def _tools_json(tmp: Path) -> Path:
@@ -562,6 +623,14 @@ def _cli_refused(result: CommandResult) -> bool:
     """Exit status 2 with one line naming the file, no traceback."""
     lines = result.stderr.strip().splitlines()
     return result.status == 2 and len(lines) == 1 and result.names_the_file and "Traceback" not in result.stderr
+
+
+def _cli_listed(result: CommandResult) -> bool:
+    """Exit status 2, the file named, one line per problem each naming its file (a path), no traceback: what
+    ``validate`` prints, every problem of the folder at once."""
+    lines = result.stderr.strip().splitlines()
+    return (result.status == 2 and result.names_the_file and "Traceback" not in result.stderr
+            and all("/" in line for line in lines))
 
 
 def _envelope_table() -> pd.DataFrame:

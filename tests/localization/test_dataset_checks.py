@@ -130,6 +130,13 @@ STOPS = {
                                     ["meta.json has invalid values", "world: Field required"]),
     "NaN model baseline": (lambda d: edit_meta(d, lambda m: m["model"]["T_cam1_cam0"][0].__setitem__(3, float("nan"))),
                            ["meta.json", "model.T_cam1_cam0", "the model pair's relative pose holds NaN or inf"]),
+    "board ground truth without a board": (lambda d: edit_meta(d, lambda m: m.pop("board")),
+                                           ["meta.json has invalid values", "board: needed with ground_truth board"]),
+    "pose ground truth without model image 0's pose": (
+        lambda d: edit_meta(d, lambda m: m.__setitem__("ground_truth", "poses")),
+        ["meta.json has invalid values", "model.T_cam0_ref: needed with ground_truth poses"]),
+    "unknown ground truth": (lambda d: edit_meta(d, lambda m: m.__setitem__("ground_truth", "gps")),
+                             ["meta.json has invalid values", "ground_truth"]),
     "missing camera.yaml": (lambda d: (folder(d) / "camera.yaml").unlink(), ["dataset line_a", "camera.yaml"]),
     "camera.yaml with a negative focal length": (
         lambda d: edit_camera(d, lambda c: c["camera_matrix"]["data"].__setitem__(0, -600.0)),

@@ -11,14 +11,18 @@ What is checked before any work, each failure a :class:`DatasetError` naming the
 - ``index.parquet`` readable, with a ``dataset`` and a ``path`` column; no dataset or folder named twice; every
   folder it names exists; every dataset folder on disk is in it (a folder left out would be skipped silently);
 - ``meta.json`` readable and holding what stages 02 and 05 read (:class:`Meta`): the dataset's name as in the
-  index, its world and trajectory, the board (a dictionary OpenCV knows, its marker ids inside it), two model images, masks and a rigid finite relative pose;
+  index, its world and trajectory, its ground-truth source (``ground_truth``: ``board``, the default, or ``poses``
+  for recorded data whose frames' poses come from an external system), the board (a dictionary OpenCV knows, its
+  marker ids inside it; needed with ``board``), two model images, masks and a rigid finite relative pose (and with
+  ``poses`` model image 0's pose ``T_cam0_ref``);
 - ``camera.yaml`` readable, every field valid (positive focal lengths, the plumb_bob model, a lens that does not
   fold the image);
 - ``frames.parquet`` readable, with its columns, at least one row, one row per (stop, image) and per file, finite stop positions,
   and every image file present.
 
-A frame's own ground-truth pose is checked per frame (:func:`pose_problem`): a bad one flags that frame's rows
-(status ``bad_pose``) instead of stopping the stage, as a bad frame image does (``bad_image``, extract.py).
+A frame's own pose is checked per frame (:func:`pose_problem`): a bad one flags that frame's rows
+(status ``bad_pose``; a recorded frame without a known pose holds None instead, and is not flagged) instead of
+stopping the stage, as a bad frame image does (``bad_image``, extract.py).
 """
 
 from __future__ import annotations
@@ -118,11 +122,18 @@ class ModelMeta(_Read):
     images: tuple[str, str]
     masks: tuple[str, str]
     T_cam1_cam0: list[list[float]]
+    T_cam0_ref: list[list[float]] | None = Field(
+        default=None, description="model image 0's pose in the reference frame (ground_truth poses: places M_t)")
 
     @field_validator("T_cam1_cam0", mode="before")
     @classmethod
     def _rigid(cls, pose: Any) -> Any:
         return _pose(pose, "the model pair's relative pose")
+
+    @field_validator("T_cam0_ref", mode="before")
+    @classmethod
+    def _rigid_anchor(cls, pose: Any) -> Any:
+        return None if pose is None else _pose(pose, "model image 0's pose T_cam0_ref")
 
 
 class Meta(_Read):
@@ -131,8 +142,19 @@ class Meta(_Read):
     dataset: str = Field(min_length=1)
     world: str = Field(min_length=1, description="the world the dataset belongs to (main, validation, ...)")
     trajectory: Literal["arc", "line"]
-    board: BoardMeta
+    ground_truth: Literal["board", "poses"] = Field(
+        default="board", description="board: the ArUco board detected per frame (IV-C, rendered data); poses: "
+                                     "frames.parquet's T_cam_board, from an external system (recorded data)")
+    board: BoardMeta | None = None
     model: ModelMeta
+
+    @model_validator(mode="after")
+    def _truth_source(self) -> "Meta":
+        if self.ground_truth == "board" and self.board is None:
+            raise ValueError("board: needed with ground_truth board")
+        if self.ground_truth == "poses" and self.model.T_cam0_ref is None:
+            raise ValueError("model.T_cam0_ref: needed with ground_truth poses (it places M_t in the reference frame)")
+        return self
 
 
 @dataclass(frozen=True)

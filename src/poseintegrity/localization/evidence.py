@@ -3,7 +3,7 @@
 Per frame, stages 02 and 05 need the same method-independent evidence: the image checked against its dataset's
 camera (8-bit gray, camera.yaml's size), its CLAHE + SIFT features (IV-C), the ratio-test 2D-3D correspondences
 to M_t (III-B), their image points undistorted by the calibrated lens, and the ArUco board pose (the ground truth of
-IV-C). Stage 02 computes them and stores them in one
+IV-C; none for a recorded dataset without a board, status ``no_board``). Stage 02 computes them and stores them in one
 small ``.npz`` per frame (``<features_dir>/<dataset>/images/<image>.evidence.npz``); stage 05, which runs the other
 PnP methods on the same frames, reads them back instead of decoding the image, loading its descriptors,
 matching them and detecting the board again. The entry's key hashes everything the evidence depends on (image
@@ -111,7 +111,8 @@ def frame_evidence(
         return bad_image(str(error))
     features = cached_features(image_path, features_path, params.clahe, params.sift, data=data, image=image)
     object_points, image_points = correspondences(features, model, params.ratio_test, camera)
-    aruco = board_pose(image, make_board(board), camera)
+    aruco = (board_pose(image, make_board(board), camera) if board is not None  # no board: recorded poses instead
+             else BoardPose(NAN_POSE.copy(), 0, "no_board"))
     write_npz(evidence_path, key=key, object_points=object_points, image_points=image_points,
               n_keypoints=features.n_keypoints, board_T_cam_board=aruco.T_cam_board,
               board_n_markers=aruco.n_markers, board_status=aruco.status)

@@ -11,11 +11,16 @@ workers of the ``parallel`` section (:class:`~poseintegrity.parallel.Workers`):
    matches to M_t, ArUco board pose; cached, so stage 05 reuses stage 02's), then PnP-RANSAC per method ->
    artifacts (III-C) and E_t/E_r against the ground truth, the ArUco board pose of the frame (IV-C): ``E_t_mm``,
    ``E_r_deg`` (NaN without a pose or without a detected board); against the exact renderer pose as a diagnostic:
-   ``E_t_exact_mm``, ``E_r_exact_deg``.
+   ``E_t_exact_mm``, ``E_r_exact_deg``. A recorded dataset whose meta.json says ``ground_truth: poses``
+   (:mod:`poseintegrity.recorded`) has no board: M_t is placed by model image 0's pose ``model.T_cam0_ref``, the
+   frames' poses of frames.parquet are the ground truth of E_t/E_r (as well as of the ``_exact`` columns), and the
+   board columns say ``no_board``.
 
 A frame whose image is unusable gives rows with status ``bad_image``, one whose exact pose in frames.parquet is not a
 finite rigid transform rows with status ``bad_pose`` (a damaged file: no error is reported); a frame without a pose
-gives its PnP status. The ``reason`` column says why for every row whose status is not "ok" (empty otherwise). Neither is evidence about localization: :func:`usable` drops them before
+gives its PnP status; a recorded frame whose pose is not known (None in frames.parquet, board ground truth) is not
+flagged and its ``_exact`` errors are NaN. The ``reason`` column says why for every row whose status is not "ok"
+(empty otherwise). Neither is evidence about localization: :func:`usable` drops them before
 envelopes and summaries.
 """
 
@@ -118,10 +123,11 @@ class FrameTask:
     features_path: Path
     evidence_path: Path
     model: StoredModel
-    board: dict[str, Any]
+    board: dict[str, Any] | None
     camera: Camera
     methods: tuple[str, ...]
     params: ExtractParams
+    ground_truth: str = "board"  # meta.json's ground_truth: "board" (IV-C) or "poses" (frames.parquet's)
 
 
 def dataset_model(dataset: Dataset, params: ExtractParams, cache_dir: Path) -> TargetModel:
@@ -138,6 +144,10 @@ def dataset_model(dataset: Dataset, params: ExtractParams, cache_dir: Path) -> T
         cached_features(dataset.path(name), cache_dir / "model" / f"{index}.npz", params.clahe, params.sift, image=image)
         for index, (name, image) in enumerate(zip(model["images"], images))
     )
+    if dataset.meta.get("ground_truth", "board") == "poses":  # recorded: M_t in the external system's frame
+        T_cam0_ref = np.asarray(dataset.meta["model"]["T_cam0_ref"], dtype=np.float64)
+        return build_target_model(features, masks, dataset.model_baseline(), T_cam0_ref, dataset.camera,
+                                  params.ratio_test, params.model_max_reprojection_px)
     anchor = board_pose(images[0], make_board(dataset.meta["board"]), dataset.camera)  # IV-C: M_t in the board frame
     if anchor.status != "ok":
         raise DatasetError(f"dataset {dataset.name}: the ArUco board is not found in model image "
@@ -177,8 +187,11 @@ def frame_rows(task: FrameTask) -> list[dict[str, Any]]:
         task.image_path, task.features_path, task.evidence_path, load_model(model.path, model.digest), model.digest,
         task.board, task.camera, task.params, frame["file"],
     )
-    truth_problem = pose_problem(frame["T_cam_board"])
-    T_cam_board = NAN_POSE if truth_problem else np.asarray(frame["T_cam_board"], dtype=np.float64).reshape(4, 4)
+    known = frame["T_cam_board"] is not None  # None: a recorded frame without a pose (board ground truth)
+    truth_problem = pose_problem(frame["T_cam_board"]) if known else None
+    T_cam_board = NAN_POSE if truth_problem or not known else np.asarray(frame["T_cam_board"],
+                                                                          dtype=np.float64).reshape(4, 4)
+    truth = T_cam_board if task.ground_truth == "poses" else evidence.board.T_cam_board
     if evidence.image_problem:
         status, reason = "bad_image", evidence.image_problem
     elif truth_problem:
@@ -199,7 +212,7 @@ def frame_rows(task: FrameTask) -> list[dict[str, Any]]:
                 evidence.object_points, evidence.image_points, evidence.n_keypoints, model.size, task.camera.K, method,
                 task.params, seed,
             )
-        E_t_mm, E_r_deg = map(float, pose_errors(T_est, aruco.T_cam_board))  # IV-C: the board is the truth
+        E_t_mm, E_r_deg = map(float, pose_errors(T_est, truth))  # IV-C: the board is the truth (or the poses)
         E_t_exact_mm, E_r_exact_deg = map(float, pose_errors(T_est, T_cam_board))
         if status in DATA_FLAGS:  # a flagged frame is no evidence: no error is reported for it
             E_t_mm = E_r_deg = np.nan
@@ -228,8 +241,8 @@ def extract_datasets(
     tasks = [
         FrameTask(
             frame, dataset.path(frame["file"]), cache_dir / Path(frame["file"]).with_suffix(".npz"),
-            cache_dir / Path(frame["file"]).with_suffix(".evidence.npz"), model, dataset.meta["board"], dataset.camera,
-            tuple(methods), params,
+            cache_dir / Path(frame["file"]).with_suffix(".evidence.npz"), model, dataset.meta.get("board"),
+            dataset.camera, tuple(methods), params, dataset.meta.get("ground_truth", "board"),
         )
         for dataset, cache_dir, model in zip(datasets, cache_dirs, models)
         for frame in dataset.frames.assign(world=dataset.meta["world"], trajectory=dataset.meta["trajectory"])

@@ -13,9 +13,9 @@ import cv2
 import numpy as np
 
 from poseintegrity.errors import ArgumentError
+from poseintegrity.grayscale import as_gray8
 from poseintegrity.lens import Camera
 from poseintegrity.localization.dataset import aruco_dictionary
-from poseintegrity.localization.features import as_gray8
 from poseintegrity.poses import NAN_POSE, pose_from_rvec_tvec
 
 
@@ -47,7 +47,7 @@ def board_pose(image: np.ndarray, board: cv2.aruco.GridBoard, camera: Camera) ->
 
     Needs at least one board marker (4 coplanar corners); otherwise a NaN pose with a status, never an error.
     image : (h, w) uint8; colour or 16-bit images are converted, anything else refused
-    (:func:`~poseintegrity.localization.features.as_gray8`). ``camera`` is a checked
+    (:func:`~poseintegrity.grayscale.as_gray8`). ``camera`` is a checked
     :class:`~poseintegrity.lens.Camera` (finite K, positive focal lengths, finite distortion).
     """
     if not isinstance(camera, Camera):

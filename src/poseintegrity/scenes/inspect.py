@@ -28,7 +28,7 @@ def target_appearance(root: Path, index: pd.DataFrame) -> pd.DataFrame:
         mask = cv2.imread(str(folder / meta["model"]["masks"][0]), cv2.IMREAD_GRAYSCALE)
         pixels = image[mask > 0].astype(float)
         rows.append({
-            "scene": scene, "targets": "+".join(meta["targets"]),
+            "scene": scene, "targets": "+".join(meta.get("targets", [])),  # none named in recorded meta.json
             "target_area_px": int((mask > 0).sum()),
             "rms_contrast": float(pixels.std() / pixels.mean()) if pixels.size else np.nan,
             "keypoints_raw": len(sift.detect(image, mask)),

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Literal
 
 import cv2
 import numpy as np
@@ -198,6 +198,9 @@ class ValidationWorld(Section):
 class GenerateParams(Section):
     """Stage 01: render the robot datasets of the main world and, if given, of the validation world."""
 
+    source: Literal["rendered"] | ProjectPath = Field(
+        description="rendered: render the datasets of this section; a folder: materialize the recorded dataset "
+                    "folders in it instead (poseintegrity.recorded, docs/recorded-data.md)")
     seed: Seed
     images_per_stop: int = Field(ge=1, le=100)
     model_baseline_mm: float = Field(gt=0, le=100)
@@ -215,6 +218,13 @@ class GenerateParams(Section):
     scenes: list[SceneSpec] = Field(min_length=1)
     textures: dict[str, ProjectPath] = Field(description="texture name -> image file replacing the procedural texture")
     validation: ValidationWorld | None = Field(description="the second world; null: the main world only")
+
+    @field_validator("source")
+    @classmethod
+    def _recorded_folder(cls, source: str | Path) -> str | Path:
+        if source != "rendered" and not Path(source).is_dir():
+            raise ValueError(f"{str(source)!r} is neither 'rendered' nor a folder (of recorded dataset folders)")
+        return source
 
     @field_validator("textures")
     @classmethod

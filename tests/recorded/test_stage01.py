@@ -1,0 +1,54 @@
+"""Stage 01 with ``generate.source`` a folder of recorded datasets: the notebook materializes them instead of
+rendering (no calibration, no robot), and the stage 02 notebook runs on the result as on rendered data; a source that
+is not a folder is refused naming the key."""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import papermill
+import pytest
+
+from poseintegrity.config import ParamsError, load_params
+from poseintegrity.localization.dataset import load_dataset, load_index
+from repository import ROOT
+
+
+def overlay(tmp_path, source) -> str:
+    path = tmp_path / "params.yaml"
+    path.write_text(f"extends: {ROOT / 'tests' / 'params_tiny.yaml'}\ngenerate:\n  source: {source}\n")
+    return str(path)
+
+
+def test_a_source_that_is_not_a_folder_is_refused_naming_the_key(tmp_path):
+    with pytest.raises(ParamsError, match="generate.source"):
+        load_params(overlay(tmp_path, tmp_path / "no_such_folder"))
+    assert load_params(overlay(tmp_path, tmp_path)).generate.source == tmp_path
+
+
+@pytest.mark.notebook
+@pytest.mark.parametrize("ground_truth", ["board", "poses"])
+def test_stage_01_materializes_a_recorded_source_that_stage_02_reads(exported, rendered_dir, tmp_path, ground_truth):
+    source = Path(shutil.copytree(exported, tmp_path / "recorded"))
+    if ground_truth == "poses":  # the exported exact poses become the ground truth, the boards go
+        for folder in source.iterdir():
+            (folder / "board.yaml").unlink()
+            settings = folder / "dataset.yaml"
+            settings.write_text(settings.read_text().replace("ground_truth: board", "ground_truth: poses"))
+    parameters = {"params_path": overlay(tmp_path, source), "data_dir": str(tmp_path / "data"),
+                  "reports_dir": str(tmp_path / "reports")}
+    for notebook in ("01_generate_datasets", "02_extract_artifacts"):
+        papermill.execute_notebook(str(ROOT / "notebooks" / f"{notebook}.ipynb"), str(tmp_path / f"{notebook}.ipynb"),
+                                   kernel_name="python3", progress_bar=False, cwd=str(ROOT), parameters=parameters)
+    assert (tmp_path / "reports" / "metrics" / "artifacts.json").is_file()
+    index = load_index(tmp_path / "data")
+    assert list(index["dataset"]) == ["arc_r", "line_r"] and list(index["world"]) == ["main", "main"]
+    columns = ["stop", "image", "theta_deg", "x_mm"]
+    for name in index["dataset"]:
+        again = load_dataset(tmp_path / "data", f"datasets/{name}").frames[columns]
+        assert again.equals(load_dataset(rendered_dir, f"datasets/{name}").frames[columns])
+    metrics = json.loads((tmp_path / "reports" / "metrics" / "generate.json").read_text())
+    assert metrics["source"] == str(source) and metrics["n_datasets"] == 2 and metrics["n_images"] == 6 + 2 + 2 * 2
+    assert not (tmp_path / "data" / "calibration" / "main").exists()  # nothing rendered or calibrated
