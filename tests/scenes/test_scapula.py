@@ -8,7 +8,8 @@ import trimesh
 
 from poseintegrity.config import ParamsError, load_params, parse_params, read_raw
 from poseintegrity.scenes.dataset import WorldError, check_world
-from poseintegrity.scenes.scapula import MeshError, read_mesh, scapula_mesh
+from poseintegrity.scenes.mesh import MeshError, read_mesh
+from poseintegrity.scenes.scapula import scapula_mesh
 
 ROOT = Path(__file__).resolve().parents[2]
 

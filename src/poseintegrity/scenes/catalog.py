@@ -17,7 +17,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import lru_cache
-from typing import TYPE_CHECKING
 
 import numpy as np
 from scipy.spatial.transform import Rotation
@@ -26,13 +25,9 @@ from poseintegrity.seeding import keyed_rng
 from poseintegrity.scenes import mesh as meshes
 from poseintegrity.scenes import textures as tex
 from poseintegrity.poses import pose_matrix
+from poseintegrity.scenes.params import TARGET_NAMES, TEXTURE_NAMES, GenerateParams, SceneSpec
 from poseintegrity.scenes.scapula import scapula_mesh
 
-if TYPE_CHECKING:
-    from poseintegrity.scenes.params import GenerateParams, SceneSpec
-
-TARGET_NAMES = ("scapula", "scapula_drilled", "block_print", "block_mosaic")
-TEXTURE_NAMES = ("block_print", "block_mosaic", "table", "clutter_a", "clutter_b", "clutter_c", "clutter_print")
 PRINTED_CLUTTER = ("clutter_a", "clutter_b", "clutter_c", "clutter_print")
 BLOCK_SIZE_MM = (72.0, 64.0, 58.0)
 STAND_RADIUS_MM = 8.0

@@ -126,7 +126,7 @@ def scenes_key(world: str) -> str:
 def check_world(params: GenerateParams, protocol: ProtocolParams, world: str = "main") -> list[catalog.Scene]:
     """Lay out every scene before any rendering, naming the key, when one cannot be rendered as the protocol
     needs; returns the scenes. Every scene is built (an unreadable mesh or a hole outside the bone raises
-    :class:`~.scapula.MeshError` here); each target must lie mostly inside both model views of its arcs and, for
+    :class:`~.mesh.MeshError` here); each target must lie mostly inside both model views of its arcs and, for
     the lines' scene, of the lines' model pair (a mesh scaled far too large or too small, or a distance that puts
     the target out of the picture). The robot's reach is checked by :func:`drive`."""
     cam = Intrinsics.from_params(params.camera)

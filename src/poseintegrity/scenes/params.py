@@ -20,15 +20,16 @@ from pydantic import Field, ValidationError, ValidationInfo, field_validator, mo
 from poseintegrity.scenes.camera_params import (
     CalibrationParams, CameraParams, CaptureParams, PrintedBoardParams, SensorParams,
 )
-from poseintegrity.scenes.catalog import TARGET_NAMES, TEXTURE_NAMES
 from poseintegrity.scenes.foam import VOXEL_MM, ReliefVolume, relief_volume
-from poseintegrity.scenes.mesh import Material
+from poseintegrity.scenes.mesh import Material, read_mesh
 from poseintegrity.scenes.robot_params import RobotParams
-from poseintegrity.scenes.scapula import read_mesh
 from poseintegrity.errors import ArgumentError
 from poseintegrity.schema import FromList, KeyRule, ProjectPath, Section, Seed, distinct
 
 NAME_PATTERN = r"^[A-Za-z0-9][A-Za-z0-9_-]*$"  # scene names make folder names (no path, no hidden .partial folder)
+
+TARGET_NAMES = ("scapula", "scapula_drilled", "block_print", "block_mosaic")  # the targets scenes/catalog.py builds
+TEXTURE_NAMES = ("block_print", "block_mosaic", "table", "clutter_a", "clutter_b", "clutter_c", "clutter_print")
 
 
 class LightParams(Section):

@@ -19,32 +19,12 @@ from typing import TYPE_CHECKING
 import numpy as np
 import trimesh
 
-from poseintegrity.errors import PoseIntegrityError
+from poseintegrity.scenes.mesh import MeshError, read_mesh
 
 if TYPE_CHECKING:
     from poseintegrity.scenes.params import ScapulaParams
 
 HOLE_VOLUME_TOLERANCE = 0.3  # the hole must remove at least 70 % of its cylinder's volume from the bone
-
-
-class MeshError(PoseIntegrityError):
-    """A mesh file or a mesh parameter cannot give a renderable, closed target."""
-
-
-def read_mesh(path: Path, key: str) -> trimesh.Trimesh:
-    """A closed, consistently wound triangle mesh from ``path``; MeshError naming ``key`` and the file otherwise."""
-    try:
-        mesh = trimesh.load(str(path), force="mesh")
-    except Exception as error:  # trimesh raises many types for a corrupt or unknown file
-        raise MeshError(f"{key}: cannot read mesh file {path}: {error}") from None
-    if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
-        raise MeshError(f"{key}: {path} holds no triangles")
-    if not (mesh.is_watertight and mesh.is_winding_consistent and mesh.is_volume):
-        raise MeshError(
-            f"{key}: {path} is not a closed manifold (watertight {mesh.is_watertight}, consistent winding "
-            f"{mesh.is_winding_consistent}, encloses a volume {mesh.is_volume}); the renderer culls back faces and "
-            "the drill hole needs a solid")
-    return mesh
 
 
 def glenoid_frame(centre_mm: np.ndarray, normal: np.ndarray) -> np.ndarray:
