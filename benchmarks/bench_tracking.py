@@ -32,15 +32,15 @@ import cv2  # noqa: E402
 import numpy as np  # noqa: E402
 
 from poseintegrity.config import load_section  # noqa: E402
-from poseintegrity.tracking.evaluation import detect_match_kabsch  # noqa: E402
-from poseintegrity.tracking.frames import draw_phantoms, intrinsics, render_frame  # noqa: E402
-from poseintegrity.tracking.geometry import MARKER_DIAMETER_M  # noqa: E402
-from poseintegrity.tracking.peers import filter_speed  # noqa: E402
-from poseintegrity.tracking.simulation import run_filter, simulate  # noqa: E402
-from poseintegrity.tracking.srukf import SquareRootUKF  # noqa: E402
-from poseintegrity.tracking.ukf import UnscentedKalmanFilter  # noqa: E402
-from poseintegrity.tracking.kabsch import kabsch, kabsch_unchecked  # noqa: E402
-from poseintegrity.tracking.tracker import MarkerTracker  # noqa: E402
+from poseintegrity.tracking.experiments.study import detect_match_kabsch  # noqa: E402
+from poseintegrity.tracking.simulation.frames import draw_phantoms, intrinsics, render_frame  # noqa: E402
+from poseintegrity.tracking.markers.geometry import MARKER_DIAMETER_M  # noqa: E402
+from poseintegrity.tracking.experiments.peers import filter_speed  # noqa: E402
+from poseintegrity.tracking.simulation.simulate import run_filter, simulate  # noqa: E402
+from poseintegrity.tracking.filter.srukf import SquareRootUKF  # noqa: E402
+from poseintegrity.tracking.filter.ukf import UnscentedKalmanFilter  # noqa: E402
+from poseintegrity.tracking.markers.kabsch import kabsch, kabsch_unchecked  # noqa: E402
+from poseintegrity.tracking.filter.tracker import MarkerTracker  # noqa: E402
 from srukf_reference import StepwiseSquareRootUKF  # noqa: E402
 from timing import paired_medians  # noqa: E402
 

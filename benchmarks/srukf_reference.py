@@ -7,9 +7,9 @@ from scipy.linalg import cho_solve
 from scipy.linalg.lapack import dgeqrf
 
 from poseintegrity.poses import pose_matrix
-from poseintegrity.tracking.cholesky import cholupdate
-from poseintegrity.tracking.model import process_model, process_noise_sqrt
-from poseintegrity.tracking.srukf import SquareRootUKF
+from poseintegrity.tracking.filter.cholesky import cholupdate
+from poseintegrity.tracking.filter.model import process_model, process_noise_sqrt
+from poseintegrity.tracking.filter.srukf import SquareRootUKF
 
 
 def tril_from_lapack_qr(A):

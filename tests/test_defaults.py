@@ -12,12 +12,12 @@ from poseintegrity.config import PACKAGED_PARAMS, default_params, load_params
 from poseintegrity.defaults import published
 from poseintegrity.localization.features import detect_features
 from poseintegrity.localization.matching import match_ratio_test
-from poseintegrity.tracking.correspondence import match_markers
-from poseintegrity.tracking.detection import detect_markers
-from poseintegrity.tracking.frames import intrinsics, render_frame, unit_plane_lut
-from poseintegrity.tracking.geometry import MARKER_DIAMETER_M
-from poseintegrity.tracking.tools import MultiToolTracker
-from poseintegrity.tracking.tracker import MarkerTracker
+from poseintegrity.tracking.markers.correspondence import match_markers
+from poseintegrity.tracking.markers.detection import detect_markers
+from poseintegrity.tracking.simulation.frames import intrinsics, render_frame, unit_plane_lut
+from poseintegrity.tracking.markers.geometry import MARKER_DIAMETER_M
+from poseintegrity.tracking.filter.multi_tool import MultiToolTracker
+from poseintegrity.tracking.filter.tracker import MarkerTracker
 
 from tracking.track_section import GEOMETRY
 

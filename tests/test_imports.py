@@ -27,7 +27,7 @@ def test_every_exported_name_resolves_to_its_module(name):
 
 def test_loading_params_does_not_import_torch_or_the_stage_code():
     code = ("import sys; from poseintegrity.config import load_params; load_params('params.yaml'); "
-            "print(sorted(m for m in ('torch', 'poseintegrity.tracking.srukf', "
+            "print(sorted(m for m in ('torch', 'poseintegrity.tracking.filter.srukf', "
             "'poseintegrity.localization.extract', 'poseintegrity.prediction.sweeps') if m in sys.modules))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
                          cwd=ROOT)

@@ -5,7 +5,7 @@ import re
 
 import pytest
 
-from poseintegrity.report import paper
+from poseintegrity import paper_results as paper
 from poseintegrity.report.headlines import HEADLINES, SECTIONS
 from poseintegrity.report.summary import render_summary
 from repository import ROOT, outside_references

@@ -68,8 +68,8 @@ def inlier_series() -> tuple[np.ndarray, np.ndarray]:
 
 @cache
 def tracking_frame() -> dict[str, Any]:
-    from poseintegrity.tracking.frames import intrinsics, render_frame, unit_plane_lut
-    from poseintegrity.tracking.geometry import MARKER_DIAMETER_M
+    from poseintegrity.tracking.simulation.frames import intrinsics, render_frame, unit_plane_lut
+    from poseintegrity.tracking.markers.geometry import MARKER_DIAMETER_M
 
     track = params().track
     geometry = np.array(track.markers_body)
@@ -81,7 +81,7 @@ def tracking_frame() -> dict[str, Any]:
 
 
 def _tracker():
-    from poseintegrity.tracking.tracker import MarkerTracker
+    from poseintegrity.tracking.filter.tracker import MarkerTracker
 
     track = params().track
     tracker = MarkerTracker(np.array(track.markers_body), track.filter, track.matching)
@@ -90,8 +90,8 @@ def _tracker():
 
 
 def _filter(cls_name: str):
-    from poseintegrity.tracking.srukf import SquareRootUKF
-    from poseintegrity.tracking.ukf import UnscentedKalmanFilter
+    from poseintegrity.tracking.filter.srukf import SquareRootUKF
+    from poseintegrity.tracking.filter.ukf import UnscentedKalmanFilter
 
     cls = SquareRootUKF if cls_name == "srukf" else UnscentedKalmanFilter
     track = params().track
@@ -107,7 +107,7 @@ def _write(folder: Path, name: str, text: str) -> Path:
 
 
 def _recording_dir(tmp: Path) -> Path:
-    from poseintegrity.tracking.recording import RecordingWriter
+    from poseintegrity.tracking.io.recording import RecordingWriter
 
     frame = tracking_frame()
     folder = tmp / "recording"
@@ -160,8 +160,12 @@ def _entries() -> list[EntryPoint]:
     from poseintegrity.localization import dataset, envelope, features, ground_truth, matching, pnp, target_model
     from poseintegrity.prediction import metrics, predictors, supervisor
     from poseintegrity.recorded import __main__ as recorded_cli, export, geometry, materialize, reader, rosbag
-    from poseintegrity.tracking import correspondence, detection, hl2_recordings, recording, replay, tools
-    from poseintegrity.tracking.kabsch import kabsch as kabsch_fit
+    from poseintegrity.tracking import replay
+    from poseintegrity.tracking.io import hl2_recordings, recording
+    from poseintegrity.tracking.filter import multi_tool
+    from poseintegrity.tracking.io import tool_files
+    from poseintegrity.tracking.markers import correspondence, detection
+    from poseintegrity.tracking.markers.kabsch import kabsch as kabsch_fit
 
     P = params
     loc = localization_scene
@@ -297,10 +301,10 @@ def _entries() -> list[EntryPoint]:
                    lambda tmp: {"z": tracking_frame()["markers"].ravel(), "observed": np.ones(4, bool)},
                    {"z": "array", "observed": "array"}, flagged=lambda ok: ok is False,
                    accepts={"observed": {"bool"}}),  # all True: every marker observed, a valid mask
-        EntryPoint("tracking.read_tools", lambda a: tools.read_tools(a["path"], P().track.matching.distinct_m),
+        EntryPoint("tracking.read_tools", lambda a: tool_files.read_tools(a["path"], P().track.matching.distinct_m),
                    lambda tmp: {"path": _tools_json(tmp)}, {"path": "file"}),
         EntryPoint("tracking.MultiToolTracker",
-                   lambda a: tools.MultiToolTracker(a["tools"], P().track.filter, P().track.matching).frame(
+                   lambda a: multi_tool.MultiToolTracker(a["tools"], P().track.filter, P().track.matching).frame(
                        0.0, a["points"]),
                    lambda tmp: {"tools": {"probe": tracking_frame()["geometry"]}, "points": tracking_frame()["markers"]},
                    {"points": "points"}, flagged=_any_flag, accepts=TRACKER_ACCEPTS),
@@ -558,7 +562,7 @@ def _boundaries_flagged(b) -> bool:
 
 
 def _write_recording(folder: Path, t, ir, depth_mm, gyro_t, gyro) -> Path:
-    from poseintegrity.tracking.recording import RecordingWriter, read_recording
+    from poseintegrity.tracking.io.recording import RecordingWriter, read_recording
 
     writer = RecordingWriter(folder, tracking_frame()["lut"])
     writer.add_frame(0.0, tracking_frame()["ir"], tracking_frame()["depth"])

@@ -1,6 +1,6 @@
 """Writers of the two HoloLens 2 recorders' AHAT formats for the tests, written from their definitions
 (docs/references.md, "HoloLens 2 AHAT recordings") independently of the readers in
-poseintegrity.tracking.hl2_recordings: StreamRecorder's PGM frames, lookup table, extrinsics and rig2world files,
+poseintegrity.tracking.io.hl2_recordings: StreamRecorder's PGM frames, lookup table, extrinsics and rig2world files,
 and hl2ss's rm_depth_ahat.bin with its calibration folder."""
 
 from __future__ import annotations
@@ -12,8 +12,8 @@ from pathlib import Path
 
 import numpy as np
 
-from poseintegrity.tracking.frames import intrinsics, unit_plane_lut
-from poseintegrity.tracking.simulation import simulate
+from poseintegrity.tracking.simulation.frames import intrinsics, unit_plane_lut
+from poseintegrity.tracking.simulation.simulate import simulate
 
 T0_TICKS = 133_456_789_012_345_678  # a FILETIME of 2023 in 100 ns ticks, beyond float64's exact integers
 

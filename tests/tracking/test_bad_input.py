@@ -9,14 +9,16 @@ import pandas as pd
 import pytest
 
 from poseintegrity.errors import PoseIntegrityError
-from poseintegrity.tracking.frames import intrinsics, render_frame, unit_plane_lut
-from poseintegrity.tracking.geometry import MARKER_DIAMETER_M
-from poseintegrity.tracking.kabsch import kabsch, pose_from_points
-from poseintegrity.tracking.recording import RecordingError, RecordingWriter, read_recording, track_recording, write_manifest
-from poseintegrity.tracking.srukf import SquareRootUKF
-from poseintegrity.tracking.tools import MultiToolTracker, ToolError, read_tools
-from poseintegrity.tracking.tracker import MarkerTracker
-from poseintegrity.tracking.ukf import UnscentedKalmanFilter
+from poseintegrity.tracking.simulation.frames import intrinsics, render_frame, unit_plane_lut
+from poseintegrity.tracking.markers.geometry import MARKER_DIAMETER_M
+from poseintegrity.tracking.markers.kabsch import kabsch, pose_from_points
+from poseintegrity.tracking.io.recording import RecordingError, RecordingWriter, read_recording, track_recording, write_manifest
+from poseintegrity.tracking.filter.srukf import SquareRootUKF
+from poseintegrity.tracking.filter.multi_tool import MultiToolTracker
+from poseintegrity.tracking.io.tool_files import read_tools
+from poseintegrity.tracking.markers.tools import ToolError
+from poseintegrity.tracking.filter.tracker import MarkerTracker
+from poseintegrity.tracking.filter.ukf import UnscentedKalmanFilter
 
 from tracking.track_section import GEOMETRY, TRACK
 from tracking.track_section import TINY as PARAMS

@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from poseintegrity.tracking.cholesky import cholupdate, lower_factor
+from poseintegrity.tracking.filter.cholesky import cholupdate, lower_factor
 
 
 def _spd(rng, n):

@@ -3,7 +3,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
-from poseintegrity.tracking.correspondence import (
+from poseintegrity.tracking.markers.correspondence import (
     match_brute_force,
     match_frobenius,
     match_gated,

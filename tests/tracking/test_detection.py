@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from poseintegrity.tracking.detection import detect_markers, validate_frame
-from poseintegrity.tracking.frames import Phantom, intrinsics, render_frame, unit_plane_lut
-from poseintegrity.tracking.geometry import MARKER_DIAMETER_M
+from poseintegrity.tracking.markers.detection import detect_markers, validate_frame
+from poseintegrity.tracking.simulation.frames import Phantom, intrinsics, render_frame, unit_plane_lut
+from poseintegrity.tracking.markers.geometry import MARKER_DIAMETER_M
 
 from tracking.track_section import GEOMETRY, TRACK
 

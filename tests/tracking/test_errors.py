@@ -3,7 +3,7 @@ import pandas as pd
 from scipy.spatial.transform import Rotation
 
 from poseintegrity.poses import pose_errors, pose_matrix
-from poseintegrity.tracking.errors import EULER_SEQUENCE, axis_errors, error_columns, rms_summary
+from poseintegrity.tracking.simulation.errors import EULER_SEQUENCE, axis_errors, error_columns, rms_summary
 
 
 def _poses(rotvecs, positions):

@@ -1,9 +1,9 @@
 import numpy as np
 import pandas as pd
 
-from poseintegrity.tracking.detection_sweep import small_blob_sweep, sweep_summary
-from poseintegrity.tracking.errors import rms
-from poseintegrity.tracking.evaluation import (
+from poseintegrity.tracking.experiments.small_blobs import small_blob_sweep, sweep_summary
+from poseintegrity.tracking.simulation.errors import rms
+from poseintegrity.tracking.experiments.study import (
     FilterRun,
     accuracy_runs,
     agreement_runs,
@@ -19,7 +19,7 @@ from poseintegrity.tracking.evaluation import (
     ten_metre_jump,
     two_tools_success,
 )
-from poseintegrity.tracking.simulation import run_filter, run_no_filter, simulate
+from poseintegrity.tracking.simulation.simulate import run_filter, run_no_filter, simulate
 
 from tracking.track_section import TINY
 

@@ -4,10 +4,10 @@ from pykalman.sqrt.unscented import Moments, moments2points, unscented_filter_co
 from scipy.spatial.transform import Rotation
 
 from poseintegrity.errors import PoseIntegrityError
-from poseintegrity.tracking.peers import additive_model, correlated_state, filterpy_filter, pykalman_time_update
-from poseintegrity.tracking.srukf import SquareRootUKF
-from poseintegrity.tracking.ukf import UnscentedKalmanFilter
-from poseintegrity.tracking.unscented import unscented_weights
+from poseintegrity.tracking.experiments.peers import additive_model, correlated_state, filterpy_filter, pykalman_time_update
+from poseintegrity.tracking.filter.srukf import SquareRootUKF
+from poseintegrity.tracking.filter.ukf import UnscentedKalmanFilter
+from poseintegrity.tracking.filter.unscented import unscented_weights
 
 from tracking.track_section import GEOMETRY, TRACK
 
@@ -128,7 +128,7 @@ def test_time_update_agrees_with_pykalman_square_root_ukf():
 
 def test_our_update_is_the_kalman_update_and_pykalmans_is_not():
     # h is linear (rows of the state), so the exact update is x + K (z - x[rows]) with K = P H^T (H P H^T + R)^-1;
-    # pykalman solves its gain with the transposed triangular factor (poseintegrity.tracking.peers), so it is not
+    # pykalman solves its gain with the transposed triangular factor (poseintegrity.tracking.experiments.peers), so it is not
     settings, _, R = additive_model(GEOMETRY, TRACK.filter, 1e-3)
     prior = correlated_state(GEOMETRY, settings, np.random.default_rng(4))
     x0, P = prior.x.copy(), prior.covariance()

@@ -3,8 +3,8 @@ import pytest
 from scipy import stats
 from scipy.spatial.transform import Rotation
 
-from poseintegrity.tracking.frames import background_quantiles, draw_phantoms, intrinsics, ir_image, render_frame
-from poseintegrity.tracking.geometry import MARKER_DIAMETER_M
+from poseintegrity.tracking.simulation.frames import background_quantiles, draw_phantoms, intrinsics, ir_image, render_frame
+from poseintegrity.tracking.markers.geometry import MARKER_DIAMETER_M
 
 from tracking.track_section import GEOMETRY, TRACK
 

@@ -4,7 +4,7 @@ from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
 
-from poseintegrity.tracking.kabsch import kabsch, kabsch_residuals, pose_from_points
+from poseintegrity.tracking.markers.kabsch import kabsch, kabsch_residuals, pose_from_points
 
 from tracking.track_section import GEOMETRY
 

@@ -1,7 +1,7 @@
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from poseintegrity.tracking.motion import brief_occlusions, sample_sensors, simulate_hand_motion, simulate_trajectory
+from poseintegrity.tracking.simulation.motion import brief_occlusions, sample_sensors, simulate_hand_motion, simulate_trajectory
 
 from tracking.track_section import TRACK
 

@@ -3,9 +3,11 @@ import pandas as pd
 import pytest
 from scipy.spatial.transform import Rotation
 
-from poseintegrity.tracking.geometry import transform_points
-from poseintegrity.tracking.kabsch import pose_from_points
-from poseintegrity.tracking.tools import MultiToolTracker, ToolError, read_tools, write_tools
+from poseintegrity.tracking.markers.geometry import transform_points
+from poseintegrity.tracking.markers.kabsch import pose_from_points
+from poseintegrity.tracking.filter.multi_tool import MultiToolTracker
+from poseintegrity.tracking.io.tool_files import read_tools, write_tools
+from poseintegrity.tracking.markers.tools import ToolError
 
 from tracking.track_section import GEOMETRY, TRACK
 

@@ -4,10 +4,10 @@ from scipy.spatial.transform import Rotation
 
 from poseintegrity.errors import PoseIntegrityError
 
-from poseintegrity.tracking.geometry import transform_points
-from poseintegrity.tracking.kabsch import pose_from_points
+from poseintegrity.tracking.markers.geometry import transform_points
+from poseintegrity.tracking.markers.kabsch import pose_from_points
 from poseintegrity.tracking.params import PAPER_SIGMAS
-from poseintegrity.tracking.tracker import MarkerTracker
+from poseintegrity.tracking.filter.tracker import MarkerTracker
 
 from tracking.track_section import GEOMETRY, TRACK
 

@@ -1,11 +1,11 @@
 """The rows of ``reports/summary.md``: which keys of ``reports/metrics/<stage>.json`` are headline figures, what the
-papers reported for them (:mod:`poseintegrity.report.paper`) and the project's target where there is one."""
+papers reported for them (:mod:`poseintegrity.paper_results`) and the project's target where there is one."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
-from poseintegrity.report import paper
+from poseintegrity import paper_results as paper
 
 
 @dataclass(frozen=True)
@@ -50,7 +50,7 @@ def _fit_status_rows() -> list[Headline]:
 
 
 def _predictor_rows() -> list[Headline]:
-    """Tables I-III per tolerance, each row beside the paper's own value for that tolerance (report/paper.py)."""
+    """Tables I-III per tolerance, each row beside the paper's own value for that tolerance (paper_results.py)."""
     names = {"static": "static baseline", "mlp": "MLP", "long_range": "long range (EMG, eq. 1)",
              "next_step": "next step"}
     rows = []

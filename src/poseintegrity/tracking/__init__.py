@@ -4,22 +4,28 @@ detection, point correspondence, Kabsch, square-root UKF with gyro fusion, and t
 sections II-F and III.  Recorded frames (a HoloLens 2 recording) go through :func:`read_recording` and
 :func:`track_recording`; several tools through :class:`MultiToolTracker`.
 
-Module map (paper section -> module):
-    II-B  detection      :mod:`detection`       (threshold, contours, shape tests, touching-blob split, depth, unprojection)
-          small blobs    :mod:`detection_sweep` (ours: keep rate of 8-20 px markers, phantom rejection)
-    II-B  sensor frames  :mod:`frames`          (AHAT-like IR + depth synthesis, ours)
-    II-D  Alg. 1, 2, 3   :mod:`correspondence`  (+ gated optimal assignment)
-    Alg. 4               :mod:`kabsch`
-    II-E  eqs. 3-30      :mod:`model`           (state, process model, P_proc, P_mes)
-    Alg. 5               :mod:`srukf`, :mod:`cholesky`, :mod:`unscented`; reference :mod:`ukf`
-    II-F  simulation     :mod:`motion` (motion (a) paper-like and (b) stress), :mod:`simulation`
-    II-F  errors         :mod:`errors`          (the paper's per-axis / Euler RMS beside norm / geodesic)
-    loop                 :mod:`tracker`         (+ innovation gate, ours), :mod:`tools` (several tools, ours)
-    input                :mod:`recording`       (a folder of recorded frames -> pose table)
-                         :mod:`hl2_recordings`  (HoloLens 2 AHAT recordings of StreamRecorder and hl2ss -> a recording folder)
-                         :mod:`replay`          (command line: a recording + a tool file -> pose table and summary)
-    peers                :mod:`peers`           (filterpy, pykalman)
-    III   results        :mod:`evaluation`
+Sub-packages (paper section -> module):
+    markers/      II-B  detection       :mod:`.markers.detection` (threshold, contours, shape tests, touching-blob split,
+                                        depth, unprojection)
+                  II-D  Alg. 1, 2, 3    :mod:`.markers.correspondence` (+ gated optimal assignment)
+                  Alg. 4                :mod:`.markers.kabsch`
+                  II-B  tool geometry   :mod:`.markers.geometry`, :mod:`.markers.tools` (several tools, ours)
+    filter/       II-E  eqs. 3-30       :mod:`.filter.model` (state, process model, P_proc, P_mes)
+                  Alg. 5                :mod:`.filter.srukf`, :mod:`.filter.cholesky`, :mod:`.filter.unscented`;
+                                        reference :mod:`.filter.ukf`
+                  loop                  :mod:`.filter.tracker` (+ innovation gate, ours), :mod:`.filter.multi_tool`
+    simulation/   II-B  sensor frames   :mod:`.simulation.frames` (AHAT-like IR + depth synthesis, ours)
+                  II-F  motion          :mod:`.simulation.motion` (motion (a) paper-like and (b) stress),
+                                        :mod:`.simulation.simulate` (a simulated recording through the pipeline)
+                  II-F  errors          :mod:`.simulation.errors` (the paper's per-axis / Euler RMS beside norm /
+                                        geodesic)
+    io/           input                 :mod:`.io.recording` (a folder of recorded frames -> pose table),
+                                        :mod:`.io.hl2_recordings` (HoloLens 2 AHAT recordings of StreamRecorder
+                                        and hl2ss -> a recording folder), :mod:`.io.tool_files`
+    experiments/  III   results         stage 06's experiments, one module each; :mod:`.experiments.peers` (filterpy,
+                                        pykalman), :mod:`.experiments.small_blobs` (ours: 8-20 px markers)
+    params        the ``track`` section of params.yaml
+    replay        command line: a recording + a tool file -> pose table and summary
 """
 
 import lazy_loader
@@ -29,16 +35,19 @@ import lazy_loader
 __getattr__, __dir__, __all__ = lazy_loader.attach(
     __name__,
     submod_attrs={
-        "correspondence": ["match_brute_force", "match_frobenius", "match_gated", "match_markers", "match_voting"],
-        "detection": ["detect_markers", "validate_frame"],
-        "hl2_recordings": ["convert_hl2ss", "convert_stream_recorder", "read_hl2ss_ahat", "read_hl2ss_calibration"],
-        "kabsch": ["kabsch", "pose_from_points"],
+        "markers.correspondence": ["match_brute_force", "match_frobenius", "match_gated", "match_markers",
+                                   "match_voting"],
+        "markers.detection": ["detect_markers", "validate_frame"],
+        "markers.kabsch": ["kabsch", "pose_from_points"],
+        "markers.tools": ["ToolError", "check_tools"],
+        "filter.srukf": ["SquareRootUKF"],
+        "filter.ukf": ["UnscentedKalmanFilter"],
+        "filter.tracker": ["MarkerTracker"],
+        "filter.multi_tool": ["MultiToolTracker"],
+        "io.hl2_recordings": ["convert_hl2ss", "convert_stream_recorder", "read_hl2ss_ahat", "read_hl2ss_calibration"],
+        "io.recording": ["Recording", "RecordingError", "RecordingWriter", "read_recording", "track_recording"],
+        "io.tool_files": ["read_tools", "write_tools"],
         "params": ["TrackParams"],
-        "recording": ["Recording", "RecordingError", "RecordingWriter", "read_recording", "track_recording"],
         "replay": ["replay_summary"],
-        "srukf": ["SquareRootUKF"],
-        "tools": ["MultiToolTracker", "ToolError", "read_tools", "write_tools"],
-        "tracker": ["MarkerTracker"],
-        "ukf": ["UnscentedKalmanFilter"],
     },
 )

@@ -16,7 +16,7 @@ import numpy as np
 from pydantic import AfterValidator, Field, model_validator
 
 from poseintegrity.schema import FromList, KeyRule, Section, Seed, ordered_range
-from poseintegrity.tracking.geometry import tool_geometry_problem
+from poseintegrity.tracking.markers.geometry import tool_geometry_problem
 
 
 def _non_empty(values: list) -> list:
@@ -72,7 +72,7 @@ class FrameParams(Section):
 
 class DetectionParams(Section):
     """Detector of section II-B; constants of their public code (docs/references.md) and our two additions
-    (shape_measure "pixel", split_touching; see :mod:`poseintegrity.tracking.detection`)."""
+    (shape_measure "pixel", split_touching; see :mod:`poseintegrity.tracking.markers.detection`)."""
 
     threshold: int = Field(ge=0, le=255)  # on the 8-bit image
     ir_clip: float = Field(gt=0, le=IR_MAX)  # raw IR clipped here, then scaled to 8 bit

@@ -7,10 +7,10 @@ SR-UKF (Alg. 5) of every tool of a tool file, frame by frame, into a pose table.
 RECORDING is a recording folder of our layout (``--format folder``, the default), a StreamRecorder capture folder
 (``stream-recorder``) or an hl2ss ``rm_depth_ahat.bin`` (``hl2ss``, with ``--calibration``, hl2ss's calibration
 folder); the last two are converted into a temporary recording folder first,
-beside the output and deleted afterwards (:mod:`~poseintegrity.tracking.hl2_recordings`, about 1 MB per frame;
+beside the output and deleted afterwards (:mod:`~poseintegrity.tracking.io.hl2_recordings`, about 1 MB per frame;
 convert once with its functions to replay a recording often).
 The table (one row per frame and tool: t_s, frame, tool, flag, n_points, n_matched, x/y/z_mm, qx..qw, in the
-camera frame; :func:`~poseintegrity.tracking.recording.track_recording`) is written to ``--out`` through a
+camera frame; :func:`~poseintegrity.tracking.io.recording.track_recording`) is written to ``--out`` through a
 temporary file and a rename; a progress bar runs on stderr and a summary per tool is printed: tracked (flag ok or
 initialized), gated (the innovation gate refused the match), lost (no_points, no_markers, stale, restart,
 diverged) and bad_frame (an undecodable frame).  ``--params``: a params file whose ``track`` section is used
@@ -35,9 +35,9 @@ from poseintegrity.config import load_section
 from poseintegrity.defaults import published
 from poseintegrity.errors import PoseIntegrityError
 from poseintegrity.timing import usage_error
-from poseintegrity.tracking.hl2_recordings import convert_hl2ss, convert_stream_recorder
-from poseintegrity.tracking.recording import read_recording, track_recording
-from poseintegrity.tracking.tools import read_tools
+from poseintegrity.tracking.io.hl2_recordings import convert_hl2ss, convert_stream_recorder
+from poseintegrity.tracking.io.recording import read_recording, track_recording
+from poseintegrity.tracking.io.tool_files import read_tools
 
 FORMATS = ("folder", "stream-recorder", "hl2ss")
 SUMMARY_GROUPS = {"tracked": ("ok", "initialized"), "gated": ("gated",), "bad_frame": ("bad_frame",)}  # the rest: lost

@@ -31,7 +31,7 @@ import numpy as np
 
 from poseintegrity.defaults import published
 from poseintegrity.errors import PoseIntegrityError
-from poseintegrity.tracking.geometry import transform_points
+from poseintegrity.tracking.markers.geometry import transform_points
 from poseintegrity.tracking.params import DetectionParams
 
 MIN_METRES_DEPTH_MM = 10.0  # a median depth below this is metres, not millimetres (AHAT depth is 100-1000 mm)

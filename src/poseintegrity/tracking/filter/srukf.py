@@ -17,9 +17,9 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from poseintegrity.tracking.cholesky import lower_factor, rank1_update
-from poseintegrity.tracking.model import noise_sqrt_kernel, process_model_kernel
-from poseintegrity.tracking.unscented import UnscentedMarkerFilter, _sigma_points_kernel, health_code
+from poseintegrity.tracking.filter.cholesky import lower_factor, rank1_update
+from poseintegrity.tracking.filter.model import noise_sqrt_kernel, process_model_kernel
+from poseintegrity.tracking.filter.unscented import UnscentedMarkerFilter, _sigma_points_kernel, health_code
 
 _NO_NOISE_SQRT = np.zeros((0, 0))  # "B of eq. 30 at the current state" for the kernels
 

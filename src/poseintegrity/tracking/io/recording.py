@@ -57,10 +57,10 @@ from scipy.spatial.transform import Rotation
 
 from poseintegrity.defaults import published
 from poseintegrity.errors import ArgumentError, PoseIntegrityError, check_array, check_increasing, check_same_length, read_text_file
-from poseintegrity.tracking.detection import detect_markers, validate_frame
+from poseintegrity.tracking.markers.detection import detect_markers, validate_frame
 from poseintegrity.tracking.params import TrackParams
-from poseintegrity.tracking.tools import MultiToolTracker
-from poseintegrity.tracking.tracker import MAX_ABS_TIME_S, check_timestamp
+from poseintegrity.tracking.filter.multi_tool import MultiToolTracker
+from poseintegrity.tracking.filter.tracker import MAX_ABS_TIME_S, check_timestamp
 
 MANIFEST = "manifest.json"
 MANIFEST_FORMAT = 1
@@ -147,7 +147,7 @@ def check_manifest(folder: Path, n_frames: int) -> dict:
     path = folder / MANIFEST
     if not path.is_file():
         raise RecordingError(f"{folder}: no {MANIFEST}; the recording was not closed (an interrupted or overwritten write) "
-                             f"or comes from another recorder (seal it with poseintegrity.tracking.recording.write_manifest once checked)")
+                             f"or comes from another recorder (seal it with poseintegrity.tracking.io.recording.write_manifest once checked)")
     try:
         manifest = json.loads(path.read_text(encoding="utf-8"))
         files, sha, expected_frames = dict(manifest["files"]), dict(manifest["sha256"]), int(manifest["n_frames"])

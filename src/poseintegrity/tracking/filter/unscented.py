@@ -12,9 +12,9 @@ import numba
 import numpy as np
 
 from poseintegrity.errors import ArgumentError, check_array
-from poseintegrity.tracking.kabsch import check_kabsch_arguments, pose_from_points_unchecked
+from poseintegrity.tracking.markers.kabsch import check_kabsch_arguments, pose_from_points_unchecked
 from poseintegrity.tracking.params import FilterParams
-from poseintegrity.tracking.model import (
+from poseintegrity.tracking.filter.model import (
     centred,
     measurement_noise_std,
     measurement_rows,
@@ -145,7 +145,7 @@ class UnscentedMarkerFilter:
         """Time update over dt seconds (Alg. 5, "State Update").  Returns False if the filter diverged.
 
         noise_sqrt : (N, p) a square root B of the process covariance, P_proc = B B^T; None: eq. 30 at the
-        current state (:func:`~poseintegrity.tracking.model.process_noise_sqrt`).  A fixed B is how the filter
+        current state (:func:`~poseintegrity.tracking.filter.model.process_noise_sqrt`).  A fixed B is how the filter
         runs an additive-noise model for the comparison with pykalman.
         """
         return self.predict_steps(1, dt, noise_sqrt)

@@ -1,7 +1,7 @@
 """Simulated recordings (section II-F) and the two ways of running them: no filter and the tracker.
 
 A recording is a trajectory, its sensor timeline, and the rendered AHAT-like frames run through the detector;
-frames are not kept (a ``sink`` may receive them, e.g. a :class:`~poseintegrity.tracking.recording.RecordingWriter`).
+frames are not kept (a ``sink`` may receive them, e.g. a :class:`~poseintegrity.tracking.io.recording.RecordingWriter`).
 Every random draw comes from the generator passed in; the same generator state gives bit-identical tables.
 """
 
@@ -14,15 +14,15 @@ import numpy as np
 import pandas as pd
 from tqdm.auto import tqdm
 
-from poseintegrity.tracking.correspondence import match_markers_unchecked
-from poseintegrity.tracking.detection import detect_markers
-from poseintegrity.tracking.errors import error_columns
-from poseintegrity.tracking.frames import draw_phantoms, intrinsics, render_frame
+from poseintegrity.tracking.markers.correspondence import match_markers_unchecked
+from poseintegrity.tracking.markers.detection import detect_markers
+from poseintegrity.tracking.simulation.errors import error_columns
+from poseintegrity.tracking.simulation.frames import draw_phantoms, intrinsics, render_frame
 from poseintegrity.parallel import in_worker_task
 from poseintegrity.poses import NAN_POSE, pose_matrix
-from poseintegrity.tracking.geometry import MARKER_DIAMETER_M, transform_points
-from poseintegrity.tracking.kabsch import pose_from_points_unchecked
-from poseintegrity.tracking.motion import (
+from poseintegrity.tracking.markers.geometry import MARKER_DIAMETER_M, transform_points
+from poseintegrity.tracking.markers.kabsch import pose_from_points_unchecked
+from poseintegrity.tracking.simulation.motion import (
     SensorTimeline,
     Trajectory,
     brief_occlusions,
@@ -31,9 +31,9 @@ from poseintegrity.tracking.motion import (
     simulate_trajectory,
 )
 from poseintegrity.tracking.params import DetectionParams, FilterParams, TrackParams
-from poseintegrity.tracking.srukf import SquareRootUKF
-from poseintegrity.tracking.tracker import MarkerTracker
-from poseintegrity.tracking.unscented import UnscentedMarkerFilter
+from poseintegrity.tracking.filter.srukf import SquareRootUKF
+from poseintegrity.tracking.filter.tracker import MarkerTracker
+from poseintegrity.tracking.filter.unscented import UnscentedMarkerFilter
 
 
 @dataclass(frozen=True)
@@ -143,7 +143,7 @@ def run_no_filter(sim: Simulation, params: TrackParams) -> pd.DataFrame:
     """Kabsch per frame on the matched detections (no filter, no prediction): one row per frame.
 
     correct: at least min_markers markers matched and every matched point within correct_tolerance_m of
-    its true marker (correspondence right and pose usable).  Error columns: :func:`~poseintegrity.tracking.errors.error_columns`.
+    its true marker (correspondence right and pose usable).  Error columns: :func:`~poseintegrity.tracking.simulation.errors.error_columns`.
     """
     m, rows, poses = params.matching, [], []
     for f, points in enumerate(sim.points):

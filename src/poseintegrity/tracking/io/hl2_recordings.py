@@ -1,5 +1,5 @@
 """HoloLens 2 AHAT recordings of two public recorders, converted into our recording layout (:mod:`recording`), so
-that :func:`~poseintegrity.tracking.recording.read_recording` and ``track_recording`` replay them unchanged.
+that :func:`~poseintegrity.tracking.io.recording.read_recording` and ``track_recording`` replay them unchanged.
 
 Black and Salcudean (section II-B) detect their markers in the AHAT stream of the HoloLens 2 Research Mode: the
 active-brightness (AB) image and the depth image of the 512 x 512 short-throw camera.  Two recorders write that
@@ -26,12 +26,12 @@ become 0), the unit-plane lookup table lut[v, u] = (x / z, y / z), t_s = seconds
 marker poses stay in the camera frame.  AHAT depth aliases beyond about 1 m (a marker at 1.1 m reads ~0.1 m);
 it is not unwrapped (the detector's depth window keeps 100-900 mm).
 
-Bad input raises :class:`~poseintegrity.tracking.recording.RecordingError` naming the file, the field and the
+Bad input raises :class:`~poseintegrity.tracking.io.recording.RecordingError` naming the file, the field and the
 frame or packet: a missing, empty or truncated PGM, ``.bin`` or tar, a PGM header that is not a 16-bit P5, an AB
 frame without its depth frame (or the reverse), frames of another size than the lookup table, a lookup table
 with a non-finite entry or a pixel the headset could not map (z <= 0), timestamps that do not increase, an
 extrinsics matrix that is not rigid, an hl2ss file of another version, port, mode or encoding.  The conversion
-writes through :class:`~poseintegrity.tracking.recording.RecordingWriter`: on any error nothing is left behind.
+writes through :class:`~poseintegrity.tracking.io.recording.RecordingWriter`: on any error nothing is left behind.
 """
 
 from __future__ import annotations
@@ -47,7 +47,7 @@ import numpy as np
 import pandas as pd
 
 from poseintegrity.errors import PoseIntegrityError, check_rotation, read_text_file
-from poseintegrity.tracking.recording import RecordingError, RecordingWriter
+from poseintegrity.tracking.io.recording import RecordingError, RecordingWriter
 
 TICKS_PER_SECOND = 10_000_000  # both recorders: 100 ns ticks
 AHAT_INVALID_DEPTH = 4090  # Research Mode: an AHAT depth reading >= 4090 is invalid (StreamRecorder writes 0)
@@ -226,7 +226,7 @@ def convert_stream_recorder(capture: str | Path, folder: str | Path, overwrite: 
     """Convert the AHAT stream of a StreamRecorder capture folder into a recording folder (module docstring) and
     return ``folder``.  Frames are read and checked one by one while written; an error leaves no folder.
     frame_format : "npy" (default: as large as the PGM frames, fast to replay) or "png" (smaller, replayed at
-    the speed of PNG decoding), see :class:`~poseintegrity.tracking.recording.RecordingWriter`."""
+    the speed of PNG decoding), see :class:`~poseintegrity.tracking.io.recording.RecordingWriter`."""
     capture = Path(capture)
     if not capture.is_dir():
         raise RecordingError(f"{capture}: the StreamRecorder capture folder does not exist")

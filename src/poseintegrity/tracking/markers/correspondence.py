@@ -23,8 +23,8 @@ from scipy.optimize import linear_sum_assignment
 
 from poseintegrity.defaults import published
 from poseintegrity.errors import ArgumentError, check_array
-from poseintegrity.tracking.geometry import pairwise_distances
-from poseintegrity.tracking.kabsch import kabsch_residuals
+from poseintegrity.tracking.markers.geometry import pairwise_distances
+from poseintegrity.tracking.markers.kabsch import kabsch_residuals
 from poseintegrity.tracking.params import MatchingParams
 
 MAX_ABS_M = 1e6  # a measured or body point farther than 1000 km is not a marker

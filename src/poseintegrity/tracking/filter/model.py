@@ -13,7 +13,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from poseintegrity.tracking.kabsch import centred_cross_covariance, horn_rotation, horn_rotation_from
+from poseintegrity.tracking.markers.kabsch import centred_cross_covariance, horn_rotation, horn_rotation_from
 
 
 def state_dim(n_markers: int) -> int:
@@ -69,7 +69,7 @@ def process_model(X: np.ndarray, dt: float, ell: np.ndarray) -> np.ndarray:
     """f of eq. 10 applied to every column of X (compiled loop over the sigma points).
 
     X : (N, b) states as columns; dt : seconds; ell : (n, 3) centred geometry, metres.
-    R_k of each column comes from Kabsch (Alg. 4, via :func:`~poseintegrity.tracking.kabsch.horn_rotation`)
+    R_k of each column comes from Kabsch (Alg. 4, via :func:`~poseintegrity.tracking.markers.kabsch.horn_rotation`)
     on its own marker positions, so the rigid body constraint holds:
     r^i <- r^i + dt (c_dot + [omega]x R ell^i); omega and c_dot are unchanged.
     """

@@ -22,26 +22,26 @@ import numpy as np
 import pandas as pd
 
 from poseintegrity.seeding import keyed_rng
-from poseintegrity.tracking.correspondence import match_brute_force, match_markers_unchecked, match_voting
-from poseintegrity.tracking.detection import detect_markers
-from poseintegrity.tracking.detection_sweep import small_blob_sweep, sweep_summary
-from poseintegrity.tracking.errors import rms, rms_summary
-from poseintegrity.tracking.frames import draw_phantoms, intrinsics, render_frame, unit_plane_lut
+from poseintegrity.tracking.markers.correspondence import match_brute_force, match_markers_unchecked, match_voting
+from poseintegrity.tracking.markers.detection import detect_markers
+from poseintegrity.tracking.experiments.small_blobs import small_blob_sweep, sweep_summary
+from poseintegrity.tracking.simulation.errors import rms, rms_summary
+from poseintegrity.tracking.simulation.frames import draw_phantoms, intrinsics, render_frame, unit_plane_lut
 from poseintegrity.poses import pose_matrix
-from poseintegrity.tracking.geometry import MARKER_DIAMETER_M, transform_points
-from poseintegrity.tracking.kabsch import kabsch_unchecked, pose_from_points_unchecked
-from poseintegrity.tracking.motion import sample_sensors, simulate_trajectory
+from poseintegrity.tracking.markers.geometry import MARKER_DIAMETER_M, transform_points
+from poseintegrity.tracking.markers.kabsch import kabsch_unchecked, pose_from_points_unchecked
+from poseintegrity.tracking.simulation.motion import sample_sensors, simulate_trajectory
 from poseintegrity.parallel import Workers
-from poseintegrity.report.paper import BLACK_RESULTS
+from poseintegrity.paper_results import BLACK_RESULTS
 from poseintegrity.tracking.params import PAPER_SIGMAS, FilterParams, TrackParams
-from poseintegrity.tracking.peers import filter_speed, pykalman_time_update
-from poseintegrity.tracking.recording import RecordingWriter, read_recording, track_recording
-from poseintegrity.tracking.simulation import Simulation, T_world_cam, run_filter, run_no_filter, simulate, simulate_hand
-from poseintegrity.tracking.srukf import SquareRootUKF
-from poseintegrity.tracking.tools import MultiToolTracker
-from poseintegrity.tracking.tracker import MarkerTracker
-from poseintegrity.tracking.ukf import UnscentedKalmanFilter
-from poseintegrity.tracking.unscented import UnscentedMarkerFilter
+from poseintegrity.tracking.experiments.peers import filter_speed, pykalman_time_update
+from poseintegrity.tracking.io.recording import RecordingWriter, read_recording, track_recording
+from poseintegrity.tracking.simulation.simulate import Simulation, T_world_cam, run_filter, run_no_filter, simulate, simulate_hand
+from poseintegrity.tracking.filter.srukf import SquareRootUKF
+from poseintegrity.tracking.filter.multi_tool import MultiToolTracker
+from poseintegrity.tracking.filter.tracker import MarkerTracker
+from poseintegrity.tracking.filter.ukf import UnscentedKalmanFilter
+from poseintegrity.tracking.filter.unscented import UnscentedMarkerFilter
 
 def experiment_rng(params: TrackParams, name: str) -> np.random.Generator:
     """The generator of one experiment: keyed_rng(params.seed, name)."""
@@ -91,7 +91,7 @@ def accuracy_frames(no_filter: pd.DataFrame) -> np.ndarray:
 
 
 def summarize_accuracy(no_filter: pd.DataFrame, runs: dict[str, pd.DataFrame]) -> dict[str, dict[str, float]]:
-    """Per run (no_filter and every filter run) the RMS errors of :func:`~poseintegrity.tracking.errors.rms_summary`
+    """Per run (no_filter and every filter run) the RMS errors of :func:`~poseintegrity.tracking.simulation.errors.rms_summary`
     on the frames of :func:`accuracy_frames` (the filter rows of those marker frames)."""
     frames = accuracy_frames(no_filter)
     out = {"no_filter": rms_summary(no_filter[no_filter.frame.isin(frames)])}
@@ -113,7 +113,7 @@ def occlusion_summary(runs: dict[str, pd.DataFrame]) -> pd.DataFrame:
 
 @dataclass(frozen=True)
 class FilterRun:
-    """One run of the tracker over a recording (:func:`~poseintegrity.tracking.simulation.run_filter`).
+    """One run of the tracker over a recording (:func:`~poseintegrity.tracking.simulation.simulate.run_filter`).
 
     recording : "accuracy" (the accuracy recording) or "hand" (motion (a), 4 markers); settings : the filter's
     constants; filter_cls : the filter (SR-UKF of Alg. 5, or the plain UKF it is checked against).  Equal runs
@@ -178,7 +178,7 @@ def study_filter_runs(params: TrackParams) -> list[FilterRun]:
 
 
 def run_filter_task(sim: Simulation, params: TrackParams, run: FilterRun) -> tuple[pd.DataFrame, MarkerTracker]:
-    """:func:`~poseintegrity.tracking.simulation.run_filter` of one :class:`FilterRun` on its recording ``sim``."""
+    """:func:`~poseintegrity.tracking.simulation.simulate.run_filter` of one :class:`FilterRun` on its recording ``sim``."""
     return run_filter(sim, params, run.use_gyro, run.settings, run.filter_cls)
 
 

@@ -26,10 +26,10 @@ from filterpy.kalman import UnscentedKalmanFilter as FilterpyUKF
 from pykalman.sqrt import AdditiveUnscentedKalmanFilter
 from pykalman.sqrt.unscented import Moments, moments2points, unscented_filter_predict
 
-from poseintegrity.tracking.model import centred, process_model, process_model_reference, process_noise_sqrt, state_dim
+from poseintegrity.tracking.filter.model import centred, process_model, process_model_reference, process_noise_sqrt, state_dim
 from poseintegrity.tracking.params import FilterParams
-from poseintegrity.tracking.srukf import SquareRootUKF
-from poseintegrity.tracking.ukf import UnscentedKalmanFilter
+from poseintegrity.tracking.filter.srukf import SquareRootUKF
+from poseintegrity.tracking.filter.ukf import UnscentedKalmanFilter
 
 
 def filterpy_filter(markers_body: np.ndarray, fp: FilterParams):

@@ -36,12 +36,12 @@ import numpy as np
 from poseintegrity.defaults import published
 from poseintegrity.errors import check_array, check_scalar
 from poseintegrity.poses import NAN_POSE
-from poseintegrity.tracking.correspondence import match_markers_unchecked
-from poseintegrity.tracking.geometry import transform_points
-from poseintegrity.tracking.kabsch import pose_from_points_unchecked
+from poseintegrity.tracking.markers.correspondence import match_markers_unchecked
+from poseintegrity.tracking.markers.geometry import transform_points
+from poseintegrity.tracking.markers.kabsch import pose_from_points_unchecked
 from poseintegrity.tracking.params import FilterParams, MatchingParams
-from poseintegrity.tracking.srukf import SquareRootUKF
-from poseintegrity.tracking.unscented import UnscentedMarkerFilter
+from poseintegrity.tracking.filter.srukf import SquareRootUKF
+from poseintegrity.tracking.filter.unscented import UnscentedMarkerFilter
 
 MAX_ABS_TIME_S = 1e12  # a timestamp beyond +-1e12 s (31 700 years) is not a clock reading
 MAX_RATE_RAD_S = 100.0  # beyond any MEMS gyro's range (2000 deg/s = 35 rad/s): a sample above it is bad_gyro

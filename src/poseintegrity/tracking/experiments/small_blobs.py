@@ -1,6 +1,6 @@
 """Small blobs: does the detector keep markers that a real AHAT camera shows as 8-20 px blobs, and does it still
 reject elongated reflections?  A rendered sweep over distance and tool orientation (section II-B's detector,
-published shape measure against ours; :mod:`poseintegrity.tracking.detection`)."""
+published shape measure against ours; :mod:`poseintegrity.tracking.markers.detection`)."""
 
 from __future__ import annotations
 
@@ -10,9 +10,9 @@ import numpy as np
 import pandas as pd
 from scipy.spatial.transform import Rotation
 
-from poseintegrity.tracking.detection import detect_markers
-from poseintegrity.tracking.frames import Phantom, intrinsics, render_frame
-from poseintegrity.tracking.geometry import MARKER_DIAMETER_M, pairwise_distances
+from poseintegrity.tracking.markers.detection import detect_markers
+from poseintegrity.tracking.simulation.frames import Phantom, intrinsics, render_frame
+from poseintegrity.tracking.markers.geometry import MARKER_DIAMETER_M, pairwise_distances
 from poseintegrity.tracking.params import DetectionParams, TrackParams
 
 MEASURES = get_args(DetectionParams.model_fields["shape_measure"].annotation)  # ("contour", "pixel")

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from poseintegrity.tracking.unscented import UnscentedMarkerFilter
+from poseintegrity.tracking.filter.unscented import UnscentedMarkerFilter
 
 
 class UnscentedKalmanFilter(UnscentedMarkerFilter):
