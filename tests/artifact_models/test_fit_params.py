@@ -87,6 +87,7 @@ def test_a_model_needing_more_stops_than_sampled_is_refused_by_name(tiny_raw):
     """With 3 sampled stops on arcs the free-width EMG (4 parameters) would have no headline RMSE (nor predictor)."""
     tiny_raw["protocol"]["sampled_stops"]["arc"] = 3
     tiny_raw["predict"]["models"].update(long_range_free_width="emg", next_step_free_width="emg")
+    tiny_raw["predict"]["model_choice"] = ["emg", "exponential"]
     tiny_raw["fit"]["models"] = ["emg", "exponential"]
     message = refusal(tiny_raw, "fit.models", ["emg", "exponential", "emg_free_width"])
     assert "fit.models.2" in message and "emg_free_width" in message
