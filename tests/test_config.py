@@ -1,6 +1,5 @@
 """params.yaml validation: every bad value stops before any work, with the offending key named."""
 
-import copy
 import re
 from pathlib import Path
 

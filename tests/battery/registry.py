@@ -158,7 +158,7 @@ def _entries() -> list[EntryPoint]:
     from poseintegrity import config, lens, poses, tables, timing
     from poseintegrity.artifact_models.models import fit_model
     from poseintegrity.localization import dataset, envelope, features, ground_truth, matching, pnp, target_model
-    from poseintegrity.prediction import metrics, predictors, supervisor
+    from poseintegrity.prediction import metrics, predictors
     from poseintegrity.recorded import __main__ as recorded_cli, export, geometry, materialize, reader, rosbag
     from poseintegrity.tracking import replay
     from poseintegrity.tracking.io import hl2_recordings, recording
@@ -435,7 +435,6 @@ def _descriptors(seed: int) -> np.ndarray:
 
 
 def _two_views() -> dict[str, Any]:
-    import cv2
 
     rng = np.random.default_rng(3)
     X = rng.uniform([-20, -20, 280], [20, 20, 320], (30, 3))

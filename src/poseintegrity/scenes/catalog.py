@@ -25,7 +25,7 @@ from poseintegrity.seeding import keyed_rng
 from poseintegrity.scenes import mesh as meshes
 from poseintegrity.scenes import textures as tex
 from poseintegrity.poses import pose_matrix
-from poseintegrity.scenes.params import TARGET_NAMES, TEXTURE_NAMES, GenerateParams, SceneSpec
+from poseintegrity.scenes.params import TEXTURE_NAMES, GenerateParams, SceneSpec
 from poseintegrity.scenes.scapula import scapula_mesh
 
 PRINTED_CLUTTER = ("clutter_a", "clutter_b", "clutter_c", "clutter_print")
