@@ -23,7 +23,7 @@ import pandas as pd
 
 from poseintegrity.seeding import keyed_rng
 from poseintegrity.tracking.correspondence import match_brute_force, match_markers_unchecked, match_voting
-from poseintegrity.tracking.detection import detect_markers
+from poseintegrity.tracking.detection import detect_markers, detect_markers_unchecked
 from poseintegrity.tracking.detection_sweep import small_blob_sweep, sweep_summary
 from poseintegrity.tracking.errors import rms, rms_summary
 from poseintegrity.tracking.frames import draw_phantoms, intrinsics, render_frame, unit_plane_lut
@@ -347,7 +347,7 @@ def two_tools_success(params: TrackParams, phantom_max: int, name: str) -> pd.Da
         markers = np.vstack([true["tool1"], true["tool2"]])[~timeline.occluded[f]]
         phantoms = draw_phantoms(int(timeline.n_phantoms[f]), params.camera, params.frames, motion.phantom_round_fraction, rng)
         ir, depth = render_frame(transform_points(np.linalg.inv(T_wc), markers), phantoms, params.camera, params.frames, MARKER_DIAMETER_M / 2, rng)
-        points = detect_markers(ir, depth, K, params.detection, T_world_cam=T_wc)
+        points = detect_markers_unchecked(ir, depth, K, params.detection, T_world_cam=T_wc)  # rendered here: a usable frame
         for tool, result in tracker.frame(trajectories["tool1"].t[i], points).items():
             matched = result.assignment >= 0
             err = np.linalg.norm(points[result.assignment[matched]] - true[tool][matched], axis=1)
