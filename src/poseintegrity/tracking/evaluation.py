@@ -43,6 +43,11 @@ from poseintegrity.tracking.tracker import MarkerTracker
 from poseintegrity.tracking.ukf import UnscentedKalmanFilter
 from poseintegrity.tracking.unscented import UnscentedMarkerFilter
 
+
+TIMING_METRICS = frozenset({"filter_step_ms", "speedup_vs_filterpy", "speedup_vs_pykalman", "timing_ms"})
+"""The keys of tracking.json that are timings (machine-dependent): everything else is the same for one seed."""
+
+
 def experiment_rng(params: TrackParams, name: str) -> np.random.Generator:
     """The generator of one experiment: keyed_rng(params.seed, name)."""
     return keyed_rng(params.seed, name)
