@@ -9,6 +9,7 @@ from poseintegrity.tracking.experiments.study import (
     agreement_runs,
     experiment_rng,
     filter_agreement,
+    lag_candidates,
     normalized_lag_ms,
     study_filter_runs,
     success_rates,
@@ -30,6 +31,24 @@ def test_lag_of_a_delayed_signal_is_recovered():
     delayed = np.sin(2 * np.pi * 0.3 * (t - 0.12)) + 0.5 * np.sin(2 * np.pi * 0.7 * (t - 0.12) + 1)
     assert abs(normalized_lag_ms(t, signal, t, delayed, 500) - 120) <= 2
     assert rms(np.array([3.0, -4.0, np.nan])) == np.sqrt(12.5)
+
+
+def test_lag_candidates_hold_the_lag_that_every_exact_correlation_picks():
+    rng = np.random.default_rng(5)
+    for k in range(40):
+        a = np.cumsum(rng.normal(size=int(rng.integers(50, 4000)))) * rng.choice([1e-3, 1.0, 1e3]) + rng.choice([0.0, 450.0])
+        b = np.roll(a, int(rng.integers(0, 40))) + rng.normal(0.0, rng.choice([0.0, 0.01, 1.0]), len(a))
+        if k % 8 == 0:
+            b = np.round(b)  # plateaus: many nearly equal correlations
+        n_lags = min(300, len(a) // 2)
+        exact = []
+        for lag in range(n_lags):  # normalized_lag_ms's correlation, at every lag (NaN where a window is flat)
+            x, y = a[: len(a) - lag] - a[: len(a) - lag].mean(), b[lag:] - b[lag:].mean()
+            with np.errstate(invalid="ignore"):
+                exact.append((x @ y) / np.sqrt((x @ x) * (y @ y)))
+        exact = np.where(np.isnan(exact), -np.inf, exact)  # NaN never wins in normalized_lag_ms
+        assert int(np.argmax(exact)) in lag_candidates(a, b, n_lags)
+        assert all(exact[lag] < max(exact) for lag in set(range(n_lags)) - set(lag_candidates(a, b, n_lags)))
 
 
 def test_simulation_is_bit_identical_for_a_seed_and_the_filter_beats_no_filter_on_rotation():

@@ -36,3 +36,20 @@ def write_metrics(path: str | Path, metrics: dict[str, Any]) -> None:
     partial = path.with_name(path.name + ".partial")
     partial.write_text(json.dumps(json_ready(metrics), indent=2, sort_keys=True, allow_nan=False) + "\n")
     os.replace(partial, path)
+
+
+def metrics_differences(before: Any, after: Any, skip: frozenset[str] = frozenset(), rtol: float = 0.0, path: str = "") -> list[str]:
+    """Where two metrics (as :func:`json_ready` gives them, or read back from the file) differ: one line per
+    differing leaf ("key/sub: before -> after"), empty if they agree.  Keys in ``skip`` (at any depth, e.g. the
+    machine-dependent timings) are left out; numbers agree within the relative tolerance ``rtol`` (0: exactly),
+    null (NaN) agrees with null; everything else must be equal."""
+    if isinstance(before, dict) and isinstance(after, dict):
+        keys = sorted((set(before) | set(after)) - skip)
+        return [line for key in keys for line in metrics_differences(before.get(key, "<missing>"), after.get(key, "<missing>"),
+                                                                        skip, rtol, f"{path}/{key}")]
+    if isinstance(before, list) and isinstance(after, list) and len(before) == len(after):
+        return [line for i, (a, b) in enumerate(zip(before, after)) for line in metrics_differences(a, b, skip, rtol, f"{path}[{i}]")]
+    numbers = all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in (before, after))
+    if before == after or (numbers and abs(after - before) <= rtol * max(abs(before), abs(after))):
+        return []
+    return [f"{path or '/'}: {before!r} -> {after!r}"]

@@ -11,6 +11,32 @@ import numba
 import numpy as np
 
 
+@numba.njit(cache=True, inline="always")
+def _reflect_four_rows(W, i, k, v0, scale):  # pragma: no cover - compiled
+    """Rows i..i+3 of W (N, p) times the Householder reflection of row k, in place, as :func:`lower_factor`
+    reflects one row: each row's dot product is summed in the same order (same bits), but the four are
+    independent, so the CPU overlaps their additions instead of waiting on one chain."""
+    p = W.shape[1]
+    d0, d1, d2, d3 = W[i, k] * v0, W[i + 1, k] * v0, W[i + 2, k] * v0, W[i + 3, k] * v0
+    for j in range(k + 1, p):
+        w = W[k, j]
+        d0 += W[i, j] * w
+        d1 += W[i + 1, j] * w
+        d2 += W[i + 2, j] * w
+        d3 += W[i + 3, j] * w
+    d0, d1, d2, d3 = d0 * scale, d1 * scale, d2 * scale, d3 * scale
+    W[i, k] -= d0 * v0
+    W[i + 1, k] -= d1 * v0
+    W[i + 2, k] -= d2 * v0
+    W[i + 3, k] -= d3 * v0
+    for j in range(k + 1, p):
+        w = W[k, j]
+        W[i, j] -= d0 * w
+        W[i + 1, j] -= d1 * w
+        W[i + 2, j] -= d2 * w
+        W[i + 3, j] -= d3 * w
+
+
 @numba.njit(cache=True)
 def lower_factor(A):  # pragma: no cover - compiled
     """qr{A^T} of Alg. 5 as an LQ decomposition A = L Q by Householder reflections on the rows of A
@@ -31,7 +57,11 @@ def lower_factor(A):  # pragma: no cover - compiled
         beta = -np.sqrt(norm2) if W[k, k] >= 0.0 else np.sqrt(norm2)  # new diagonal, sign as in LAPACK's dlarfg
         v0 = W[k, k] - beta  # v = [v0, W[k, k+1:]], H = I - 2 v v^T / (v^T v)
         scale = 2.0 / (v0 * v0 + tail2)
-        for i in range(k + 1, N):
+        first = k + 1
+        for i in range(k + 1, N - 3, 4):  # four rows at a time: four sums in flight, each in the one-row order
+            _reflect_four_rows(W, i, k, v0, scale)
+            first = i + 4
+        for i in range(first, N):
             dot = W[i, k] * v0
             for j in range(k + 1, p):
                 dot += W[i, j] * W[k, j]

@@ -13,7 +13,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from poseintegrity.tracking.markers.kabsch import centred_cross_covariance, horn_rotation, horn_rotation_from
+from poseintegrity.tracking.markers.kabsch import centred_cross_covariance, centred_cross_covariance_into, horn_rotation, horn_rotation_into
 
 
 def state_dim(n_markers: int) -> int:
@@ -41,8 +41,9 @@ def process_model_kernel(X, dt, ell):  # pragma: no cover - compiled
     n = ell.shape[0]
     X_next = X.copy()
     r = np.empty((n, 3))
-    R_first = np.empty((3, 3))
-    V_first = np.eye(4)
+    R_first, R_other = np.empty((3, 3)), np.empty((3, 3))
+    V_first, V = np.eye(4), np.empty((4, 4))
+    H, N, M = np.empty((3, 3)), np.empty((4, 4)), np.empty((4, 4))  # scratch of Alg. 4, reused by every column
     for k in range(X.shape[1]):  # one sigma point per column
         if k > 0 and _same_rows(X, k, 3 * n):  # it differs from the first only in omega or c_dot: same markers, same R_k
             R = R_first
@@ -50,9 +51,12 @@ def process_model_kernel(X, dt, ell):  # pragma: no cover - compiled
             for i in range(n):
                 r[i] = X[3 * i : 3 * i + 3, k]
             # R_k by Alg. 4, recomputed every step; the Jacobi sweeps of the other columns start from column 0's
-            R, V = horn_rotation_from(centred_cross_covariance(r, ell), V_first)
+            centred_cross_covariance_into(r, ell, H)
+            R = R_first if k == 0 else R_other
+            V[:] = V_first
+            horn_rotation_into(H, V, N, M, R)
             if k == 0:
-                R_first, V_first = R, V
+                V_first[:] = V
         w = X[3 * n : 3 * n + 3, k]
         v = X[3 * n + 3 : 3 * n + 6, k]
         for i in range(n):

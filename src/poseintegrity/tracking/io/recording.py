@@ -57,7 +57,7 @@ from scipy.spatial.transform import Rotation
 
 from poseintegrity.defaults import published
 from poseintegrity.errors import ArgumentError, PoseIntegrityError, check_array, check_increasing, check_same_length, read_text_file
-from poseintegrity.tracking.markers.detection import detect_markers, validate_frame
+from poseintegrity.tracking.markers.detection import detect_markers_unchecked, validate_frame
 from poseintegrity.tracking.params import TrackParams
 from poseintegrity.tracking.filter.multi_tool import MultiToolTracker
 from poseintegrity.tracking.filter.tracker import MAX_ABS_TIME_S, check_timestamp
@@ -358,7 +358,7 @@ def track_recording(recording: Recording, tools: dict[str, np.ndarray], params: 
             results = {name: None for name in tools}
             points = np.zeros((0, 3))
         else:
-            points = detect_markers(ir, depth, recording.lut, params.detection)
+            points = detect_markers_unchecked(ir, depth, recording.lut, params.detection)  # frame_problem validated it
             results = tracker._frame(float(t), points)
         for name, result in results.items():
             T = result.T_filtered if result is not None else tracker.trackers[name].pose()

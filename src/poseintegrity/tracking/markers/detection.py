@@ -27,6 +27,7 @@ from __future__ import annotations
 import warnings
 
 import cv2
+import numba
 import numpy as np
 
 from poseintegrity.defaults import published
@@ -193,15 +194,13 @@ def split_by_depth(pixels: np.ndarray, depth_mm: np.ndarray, detection: Detectio
     depth ratio and reaches to the crescent's farthest pixel, which places its centre even when only a sliver
     shows.  Depths are the medians of each set.  A set smaller than min_area is left out.  m = 0: no depth gap.
     """
+    gap = _largest_depth_gap(compiled_depth(depth_mm), np.ascontiguousarray(pixels, dtype=np.int64), float(detection.depth_min_mm), float(detection.depth_max_mm))
+    if not gap >= detection.depth_split_mm:
+        return np.zeros((0, 2)), np.zeros(0)  # one marker (nearly every blob): decided in one compiled call
     d_all = np.asarray(depth_mm[pixels[:, 1], pixels[:, 0]], dtype=float)
     valid = np.isfinite(d_all) & (d_all >= detection.depth_min_mm) & (d_all <= detection.depth_max_mm)
-    if valid.sum() < 2:
-        return np.zeros((0, 2)), np.zeros(0)
     ordered = np.sort(d_all[valid])
-    gaps = np.diff(ordered)
-    i = int(np.argmax(gaps))
-    if gaps[i] < detection.depth_split_mm:
-        return np.zeros((0, 2)), np.zeros(0)
+    i = int(np.argmax(np.diff(ordered)))
     cut = 0.5 * (ordered[i] + ordered[i + 1])
     front, back = valid & (d_all <= cut), valid & (d_all > cut)
     centres, depths = [], []
@@ -223,6 +222,63 @@ def split_by_depth(pixels: np.ndarray, depth_mm: np.ndarray, detection: Detectio
         centres.append(pixels[back].mean(axis=0))
         depths.append(small_median(d_all[back]))
     return np.array(centres, dtype=float).reshape(-1, 2), np.array(depths)
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _is_valid_depth(d, depth_min_mm, depth_max_mm):  # pragma: no cover - compiled
+    """A depth reading (float) that is finite and within [depth_min_mm, depth_max_mm]."""
+    return np.isfinite(d) and d >= depth_min_mm and d <= depth_max_mm
+
+
+@numba.njit(cache=True, nogil=True)
+def _largest_depth_gap(depth_mm, pixels, depth_min_mm, depth_max_mm):  # pragma: no cover - compiled
+    """Largest gap (mm) between consecutive sorted valid depths of a blob's pixels (k, 2) (u, v); -inf with
+    fewer than two valid readings.  What :func:`split_by_depth` cuts at (the same subtractions, so the same bits)."""
+    values = np.empty(len(pixels))
+    n = 0
+    for i in range(len(pixels)):
+        d = float(depth_mm[pixels[i, 1], pixels[i, 0]])
+        if _is_valid_depth(d, depth_min_mm, depth_max_mm):
+            values[n] = d
+            n += 1
+    ordered = np.sort(values[:n])
+    gap = -np.inf
+    for i in range(n - 1):
+        gap = max(gap, ordered[i + 1] - ordered[i])
+    return gap
+
+
+@numba.njit(cache=True, nogil=True)
+def _window_medians(depth_mm, uv_int, w, depth_min_mm, depth_max_mm):  # pragma: no cover - compiled
+    """:func:`lookup_depth` on rounded centres uv_int (k, 2) int: per centre the median of the valid readings
+    in its (2w+1)^2 window, as :func:`small_median` computes it (the middle one or (a + b) / 2), NaN if none."""
+    H, W = depth_mm.shape
+    out = np.full(len(uv_int), np.nan)
+    values = np.empty((2 * w + 1) * (2 * w + 1))
+    for k in range(len(uv_int)):
+        u, v = uv_int[k, 0], uv_int[k, 1]
+        if not (0 <= u < W and 0 <= v < H):
+            continue
+        n = 0
+        for r in range(max(v - w, 0), min(v + w + 1, H)):
+            for c in range(max(u - w, 0), min(u + w + 1, W)):
+                d = float(depth_mm[r, c])
+                if _is_valid_depth(d, depth_min_mm, depth_max_mm):
+                    values[n] = d
+                    n += 1
+        ordered = np.sort(values[:n])
+        if n:
+            out[k] = ordered[n // 2] if n % 2 else (ordered[n // 2 - 1] + ordered[n // 2]) / 2
+    return out
+
+
+COMPILED_DEPTH_TYPES = frozenset(np.dtype(t) for t in (np.uint8, np.uint16, np.uint32, np.int16, np.int32, np.int64, np.float32, np.float64))
+
+
+def compiled_depth(depth_mm: np.ndarray) -> np.ndarray:
+    """depth_mm as the compiled readers take it: unchanged if its dtype is one of COMPILED_DEPTH_TYPES (native byte
+    order), else as float64 (what the readers convert every reading to anyway)."""
+    return depth_mm if depth_mm.dtype in COMPILED_DEPTH_TYPES and depth_mm.dtype.isnative else depth_mm.astype(np.float64)
 
 
 def detect_blobs(ir: np.ndarray, detection: DetectionParams, depth_mm: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
@@ -271,17 +327,8 @@ def lookup_depth(depth_mm: np.ndarray, uv: np.ndarray, detection: DetectionParam
 
     Valid means finite and inside [depth_min_mm, depth_max_mm] (zero, NaN and far readings are rejected).
     """
-    w = detection.depth_window
-    H, W = depth_mm.shape
-    out = np.full(len(uv), np.nan)
-    for k, (u, v) in enumerate(np.rint(uv).astype(int)):
-        if not (0 <= u < W and 0 <= v < H):
-            continue
-        patch = np.asarray(depth_mm[max(v - w, 0) : v + w + 1, max(u - w, 0) : u + w + 1], dtype=float)
-        valid = patch[np.isfinite(patch) & (patch >= detection.depth_min_mm) & (patch <= detection.depth_max_mm)]
-        if valid.size:
-            out[k] = small_median(valid)
-    return out
+    uv_int = np.ascontiguousarray(np.rint(uv).astype(np.int64).reshape(-1, 2))
+    return _window_medians(compiled_depth(depth_mm), uv_int, int(detection.depth_window), float(detection.depth_min_mm), float(detection.depth_max_mm))
 
 
 def unit_plane_coordinates(uv: np.ndarray, unproject: np.ndarray) -> np.ndarray:
@@ -320,7 +367,13 @@ def detect_markers(
     if reason:
         warnings.warn(f"detect_markers: {reason}", RuntimeWarning, stacklevel=2)
         return np.zeros((0, 3))
-    ir, depth_mm, unproject = np.asarray(ir), np.asarray(depth_mm), np.asarray(unproject, dtype=float)
+    return detect_markers_unchecked(np.asarray(ir), np.asarray(depth_mm), np.asarray(unproject, dtype=float), detection, T_world_cam)
+
+
+def detect_markers_unchecked(ir: np.ndarray, depth_mm: np.ndarray, unproject: np.ndarray, detection: DetectionParams,
+                             T_world_cam: np.ndarray | None = None) -> np.ndarray:
+    """:func:`detect_markers` on a frame known to be usable (arrays that :func:`validate_frame` accepts, unproject
+    float): the per-frame path of frames the library rendered or validated itself."""
     uv, d_split = detect_blobs(ir, detection, depth_mm)
     d_mm = np.where(np.isnan(d_split), lookup_depth(depth_mm, uv, detection), d_split)
     keep = np.isfinite(d_mm)

@@ -116,7 +116,15 @@ def horn_rotation_from(H, V0):  # pragma: no cover - compiled
     """:func:`horn_rotation` with the Jacobi sweeps started from the eigenvectors V0 (4, 4, orthogonal) of a
     nearby H (the sigma points of the filter are micrometres apart: one or two sweeps instead of five).
     Returns (R (3, 3), V (4, 4) the eigenvectors of this H's quaternion matrix)."""
-    N = np.empty((4, 4))
+    R, V = np.empty((3, 3)), V0.copy()
+    horn_rotation_into(H, V, np.empty((4, 4)), np.empty((4, 4)), R)
+    return R, V
+
+
+@numba.njit(cache=True)
+def horn_rotation_into(H, V, N, M, R):  # pragma: no cover - compiled
+    """:func:`horn_rotation_from` in place, for the filter's 25 rotations a step (no array allocated): V (4, 4)
+    holds the starting eigenvectors and receives this H's; N and M (4, 4) are scratch; R (3, 3) receives R."""
     N[0, 0] = H[0, 0] + H[1, 1] + H[2, 2]
     N[1, 1] = H[0, 0] - H[1, 1] - H[2, 2]
     N[2, 2] = -H[0, 0] + H[1, 1] - H[2, 2]
@@ -128,8 +136,7 @@ def horn_rotation_from(H, V0):  # pragma: no cover - compiled
     N[1, 3] = N[3, 1] = H[2, 0] + H[0, 2]
     N[2, 3] = N[3, 2] = H[1, 2] + H[2, 1]
     scale = 1e-30 * (1.0 + N[0, 0] ** 2 + N[1, 1] ** 2 + N[2, 2] ** 2 + N[3, 3] ** 2)
-    V = V0.copy()
-    M = np.zeros((4, 4))  # Horn's matrix in the starting basis, V^T N V (exactly N for V = I)
+    M[:] = 0.0  # Horn's matrix in the starting basis, V^T N V (exactly N for V = I)
     for a in range(4):
         for b in range(4):
             for i in range(4):
@@ -163,7 +170,6 @@ def horn_rotation_from(H, V0):  # pragma: no cover - compiled
         if M[j, j] > M[best, best]:
             best = j
     w, x, y, z = V[0, best], V[1, best], V[2, best], V[3, best]  # unit quaternion of R
-    R = np.empty((3, 3))
     R[0, 0] = w * w + x * x - y * y - z * z
     R[0, 1] = 2.0 * (x * y - w * z)
     R[0, 2] = 2.0 * (x * z + w * y)
@@ -173,20 +179,28 @@ def horn_rotation_from(H, V0):  # pragma: no cover - compiled
     R[2, 0] = 2.0 * (x * z - w * y)
     R[2, 1] = 2.0 * (y * z + w * x)
     R[2, 2] = w * w - x * x - y * y + z * z
-    return R, V
 
 
 @numba.njit(cache=True)
 def centred_cross_covariance(points_world, ell):  # pragma: no cover - compiled
     """H = P^T Q of Alg. 4 for centred body points ell (n, 3) and measured points (n, 3)."""
+    H = np.empty((3, 3))
+    centred_cross_covariance_into(points_world, ell, H)
+    return H
+
+
+@numba.njit(cache=True)
+def centred_cross_covariance_into(points_world, ell, H):  # pragma: no cover - compiled
+    """:func:`centred_cross_covariance` written into H (3, 3)."""
     n = ell.shape[0]
-    r_bar = np.zeros(3)
+    r0 = r1 = r2 = 0.0  # r_bar, summed row by row as r_bar += points_world[i] does
     for i in range(n):
-        r_bar += points_world[i]
-    r_bar /= n
-    H = np.zeros((3, 3))
+        r0 += points_world[i, 0]
+        r1 += points_world[i, 1]
+        r2 += points_world[i, 2]
+    r_bar = (r0 / n, r1 / n, r2 / n)
+    H[:] = 0.0
     for i in range(n):
         for a in range(3):
             for c in range(3):
                 H[a, c] += ell[i, a] * (points_world[i, c] - r_bar[c])
-    return H

@@ -120,7 +120,7 @@ def full_turns(t: np.ndarray, hand: HandMotionParams, rng: np.random.Generator) 
     start, axis = rng.uniform(*hand.pause_s), 0
     while start < t[-1]:
         duration = rng.uniform(*hand.turn_s)
-        inside = (t >= start) & (t < start + duration)
+        inside = slice(*np.searchsorted(t, [start, start + duration]))  # start <= t < start + duration (t increases)
         tau = t[inside] - start
         omega[inside, axis] = rng.choice([-1.0, 1.0]) * 4 * np.pi / duration * np.sin(np.pi * tau / duration) ** 2
         start += duration + rng.uniform(*hand.pause_s)

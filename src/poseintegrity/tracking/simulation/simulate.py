@@ -15,7 +15,7 @@ import pandas as pd
 from tqdm.auto import tqdm
 
 from poseintegrity.tracking.markers.correspondence import match_markers_unchecked
-from poseintegrity.tracking.markers.detection import detect_markers
+from poseintegrity.tracking.markers.detection import detect_markers_unchecked
 from poseintegrity.tracking.simulation.errors import error_columns
 from poseintegrity.tracking.simulation.frames import draw_phantoms, intrinsics, render_frame
 from poseintegrity.parallel import in_worker_task
@@ -89,7 +89,7 @@ def record(
         if sink is not None:
             sink(float(t[f]), ir, depth_mm)
         for found, detection in zip(points, detections):
-            found.append(detect_markers(ir, depth_mm, K, detection, T_world_cam=T_wc))
+            found.append(detect_markers_unchecked(ir, depth_mm, K, detection, T_world_cam=T_wc))  # rendered here: a usable frame
     occlusions = [tuple(o) for o in params.motion.occlusions]
     return [Simulation(trajectory, timeline, markers_body, t, T_true, found, inside_occlusions(t, occlusions), occlusions)
             for found in points]
