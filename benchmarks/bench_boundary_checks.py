@@ -29,7 +29,7 @@ from scipy.spatial.transform import Rotation  # noqa: E402
 
 import poseintegrity  # noqa: E402
 from poseintegrity.config import load_section  # noqa: E402
-from poseintegrity.tracking.experiments.study import detect_match_kabsch  # noqa: E402
+from poseintegrity.tracking.experiments.timing import detect_match_kabsch  # noqa: E402
 from poseintegrity.tracking.simulation.frames import draw_phantoms, intrinsics, render_frame  # noqa: E402
 from poseintegrity.tracking.markers.geometry import MARKER_DIAMETER_M, transform_points  # noqa: E402
 from poseintegrity.tracking.filter.srukf import SquareRootUKF  # noqa: E402

@@ -51,7 +51,7 @@ from poseintegrity.config import load_section  # noqa: E402
 from poseintegrity.report.metrics import metrics_differences  # noqa: E402
 from poseintegrity.tracking.markers import detection  # noqa: E402
 from poseintegrity.tracking.filter.cholesky import lower_factor  # noqa: E402
-from poseintegrity.tracking.experiments.study import TIMING_METRICS, detect_match_kabsch  # noqa: E402
+from poseintegrity.tracking.experiments.timing import TIMING_METRICS, detect_match_kabsch  # noqa: E402
 from poseintegrity.tracking.simulation.motion import full_turns  # noqa: E402
 from poseintegrity.tracking.filter.srukf import _square_root_of_spread  # noqa: E402
 from poseintegrity.tracking.filter.unscented import _sigma_points_kernel  # noqa: E402

@@ -3,23 +3,19 @@ import pandas as pd
 
 from poseintegrity.tracking.experiments.small_blobs import small_blob_sweep, sweep_summary
 from poseintegrity.tracking.simulation.errors import rms
-from poseintegrity.tracking.experiments.study import (
+from poseintegrity.tracking.experiments.accuracy import summarize_accuracy
+from poseintegrity.tracking.experiments.filter_runs import (
     FilterRun,
     accuracy_runs,
     agreement_runs,
     experiment_rng,
     filter_agreement,
-    lag_candidates,
-    normalized_lag_ms,
     study_filter_runs,
-    success_rates,
-    success_recording,
-    success_runs,
-    summarize_accuracy,
     sweep_runs,
-    ten_metre_jump,
-    two_tools_success,
 )
+from poseintegrity.tracking.experiments.lag import lag_candidates, normalized_lag_ms
+from poseintegrity.tracking.experiments.robustness import ten_metre_jump
+from poseintegrity.tracking.experiments.success import success_rates, success_recording, success_runs, two_tools_success
 from poseintegrity.tracking.simulation.simulate import run_filter, run_no_filter, simulate
 
 from tracking.track_section import TINY

@@ -3,7 +3,7 @@ import pandas as pd
 import pytest
 
 from poseintegrity.errors import PoseIntegrityError
-from poseintegrity.tracking.experiments.study import recording_replay
+from poseintegrity.tracking.experiments.robustness import recording_replay
 from poseintegrity.tracking.simulation.frames import intrinsics, render_frame, unit_plane_lut
 from poseintegrity.tracking.markers.geometry import MARKER_DIAMETER_M
 from poseintegrity.tracking.io.recording import RecordingError, RecordingWriter, read_recording, track_recording, write_manifest

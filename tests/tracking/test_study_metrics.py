@@ -12,7 +12,8 @@ from pathlib import Path
 from poseintegrity.config import load_section
 from poseintegrity.parallel import Workers
 from poseintegrity.report.metrics import json_ready, metrics_differences
-from poseintegrity.tracking.experiments.study import TIMING_METRICS, run_study
+from poseintegrity.tracking.experiments.study import run_study
+from poseintegrity.tracking.experiments.timing import TIMING_METRICS
 from tracking.track_section import ROOT, TINY
 
 BEFORE = Path(__file__).with_name("study_metrics_tiny.json")

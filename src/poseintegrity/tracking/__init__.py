@@ -22,8 +22,13 @@ Sub-packages (paper section -> module):
     io/           input                 :mod:`.io.recording` (a folder of recorded frames -> pose table),
                                         :mod:`.io.hl2_recordings` (HoloLens 2 AHAT recordings of StreamRecorder
                                         and hl2ss -> a recording folder), :mod:`.io.tool_files`
-    experiments/  III   results         stage 06's experiments, one module each; :mod:`.experiments.peers` (filterpy,
-                                        pykalman), :mod:`.experiments.small_blobs` (ours: 8-20 px markers)
+    experiments/  III   results         stage 06's experiments, one module each: :mod:`.experiments.accuracy`
+                                        (III-A/B, occlusion), :mod:`.experiments.success` (III-C),
+                                        :mod:`.experiments.filter_runs`, :mod:`.experiments.lag`,
+                                        :mod:`.experiments.timing` (Table I), :mod:`.experiments.robustness` (ours),
+                                        :mod:`.experiments.small_blobs` (ours: 8-20 px markers),
+                                        :mod:`.experiments.peers` (filterpy, pykalman); :mod:`.experiments.study`
+                                        runs them all
     params        the ``track`` section of params.yaml
     replay        command line: a recording + a tool file -> pose table and summary
 """

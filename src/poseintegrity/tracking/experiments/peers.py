@@ -26,7 +26,9 @@ from filterpy.kalman import UnscentedKalmanFilter as FilterpyUKF
 from pykalman.sqrt import AdditiveUnscentedKalmanFilter
 from pykalman.sqrt.unscented import Moments, moments2points, unscented_filter_predict
 
-from poseintegrity.tracking.filter.model import centred, process_model, process_model_reference, process_noise_sqrt, state_dim
+from poseintegrity.tracking.filter.model import (
+    centred, process_model, process_model_reference, process_noise_sqrt, state_dim,
+)
 from poseintegrity.tracking.params import FilterParams
 from poseintegrity.tracking.filter.srukf import SquareRootUKF
 from poseintegrity.tracking.filter.ukf import UnscentedKalmanFilter
