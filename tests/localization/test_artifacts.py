@@ -139,3 +139,16 @@ def test_failure_shares_by_method_and_status():
     assert shares.loc["p3p"].sum() == pytest.approx(4 / 40) and (shares.loc["epnp"] == 0.0).all()
     table.loc[p3p[4], "status"] = "pnp_failed"  # a status of an older table is kept, not dropped
     assert failure_shares(table).loc["p3p", "pnp_failed"] == pytest.approx(1 / 40)
+
+
+def test_recorded_data_are_described_not_judged():
+    """The same values, no bar judged: the bars are what the paper's data had, a check of a rendered world only."""
+    table = world({"a": linear(1.5), "b": linear(2.2), "c": linear(0.8)})
+    args = (table, envelopes(table, PROTOCOL.tolerances, PROTOCOL.envelope), REALISM, PROTOCOL)
+    rendered, recorded = realism_metrics(*args), realism_metrics(*args, recorded=True)
+    assert "passed" in rendered and "description_only" not in rendered
+    assert "passed" not in recorded and "n_bars_passed" not in recorded and "recorded data" in recorded["description_only"]
+    same = set(rendered) - {"passed", "n_bars_passed"}
+    assert set(recorded) - {"description_only"} == same
+    assert all(np.array_equal(rendered[k], recorded[k], equal_nan=True) if isinstance(rendered[k], float)
+               else rendered[k] == recorded[k] for k in same)

@@ -12,7 +12,8 @@ import papermill
 import pytest
 
 from poseintegrity.config import ParamsError, load_params
-from poseintegrity.localization.dataset import load_dataset, load_index
+from poseintegrity.localization.dataset import load_dataset, load_index, recorded_worlds
+from poseintegrity.report.summary import render_summary
 from repository import ROOT
 
 
@@ -52,3 +53,8 @@ def test_stage_01_materializes_a_recorded_source_that_stage_02_reads(exported, r
     metrics = json.loads((tmp_path / "reports" / "metrics" / "generate.json").read_text())
     assert metrics["source"] == str(source) and metrics["n_datasets"] == 2 and metrics["n_images"] == 6 + 2 + 2 * 2
     assert not (tmp_path / "data" / "calibration" / "main").exists()  # nothing rendered or calibrated
+    assert recorded_worlds(tmp_path / "data") == {"main"} and recorded_worlds(rendered_dir) == set()
+    realism = json.loads((tmp_path / "reports" / "metrics" / "artifacts.json").read_text())["realism"]
+    assert "passed" not in realism and "recorded data" in realism["description_only"]  # described, not judged
+    summary = render_summary({"artifacts": {"realism": realism}}, [])
+    assert "Realism bars: recorded data" in summary

@@ -142,6 +142,9 @@ class Meta(_Read):
     dataset: str = Field(min_length=1)
     world: str = Field(min_length=1, description="the world the dataset belongs to (main, validation, ...)")
     trajectory: Literal["arc", "line"]
+    source: Literal["rendered", "recorded"] = Field(
+        default="rendered", description="rendered by stage 01, or recorded (poseintegrity.recorded): stage 02's realism "
+                                        "bars then describe the data instead of judging it")
     ground_truth: Literal["board", "poses"] = Field(
         default="board", description="board: the ArUco board detected per frame (IV-C, rendered data); poses: "
                                      "frames.parquet's T_cam_board, from an external system (recorded data)")
@@ -276,6 +279,14 @@ def _check_frames(frames: pd.DataFrame, path: Path, name: str) -> None:
     positions = frames[["theta_deg", "x_mm"]].to_numpy(dtype=np.float64, na_value=np.nan)
     if not np.all(np.isfinite(positions)):
         raise DatasetError(f"dataset {name}: {path} has theta_deg / x_mm values that are not finite numbers")
+
+
+def recorded_worlds(data_dir: str | Path) -> set[str]:
+    """The worlds of ``data_dir``'s datasets that hold recorded data (meta.json ``source: recorded``), checked as
+    :func:`load_index` and :func:`load_dataset` check them."""
+    index = load_index(data_dir)
+    metas = [_read_meta(Path(data_dir) / row.path / "meta.json", row.dataset) for row in index.itertuples()]
+    return {meta["world"] for meta in metas if meta.get("source", "rendered") == "recorded"}
 
 
 def load_dataset(data_dir: str | Path, folder: str | Path, name: str | None = None) -> Dataset:

@@ -19,8 +19,13 @@ from poseintegrity.localization.params import RealismParams
 from poseintegrity.protocol import ProtocolParams, tolerance_name
 
 
+DESCRIPTION_ONLY = ("recorded data: these values describe the recordings; the bars are properties of the paper's data "
+                    "that a rendered world is checked against, not a pass/fail of real data")
+
+
 def realism_metrics(
-    table: pd.DataFrame, envelope_table: pd.DataFrame, realism: RealismParams, protocol: ProtocolParams
+    table: pd.DataFrame, envelope_table: pd.DataFrame, realism: RealismParams, protocol: ProtocolParams,
+    recorded: bool = False,
 ) -> dict[str, Any]:
     """Properties of the rendered world that the paper's real datasets had (issues 3 and 10, "Realism").
 
@@ -66,6 +71,9 @@ def realism_metrics(
     - R10 (IV-E: theta_a is interpolated between stops) ``share_theta_a_on_stop_2mm3deg``: the share of uncensored
       arcs whose theta_a lies within 0.01 deg of a stop, <= 0.5
     ``n_bars_passed`` / ``n_bars`` count the bars of ``passed``.
+
+    recorded : the rows are recorded data (:mod:`poseintegrity.recorded`), not a rendered world: the same values
+    describe the data, and no bar is judged (no ``passed``, ``n_bars_passed``; ``description_only`` says why).
     """
     method, sampled = protocol.pnp_method, protocol.sampled_stops.arc
     envelope_table = headline(envelope_table, protocol.envelope)
@@ -177,6 +185,9 @@ def realism_metrics(
     )
     metrics["n_bars"] = len(metrics["passed"])
     metrics["n_bars_passed"] = int(sum(metrics["passed"].values()))
+    if recorded:
+        del metrics["passed"], metrics["n_bars_passed"]
+        metrics["description_only"] = DESCRIPTION_ONLY
     return metrics
 
 

@@ -60,7 +60,7 @@ def write_dataset(recorded: Recorded, root: Path) -> dict:
                          "T_cam_board": None if frame.T_cam_ref is None else frame.T_cam_ref.ravel().tolist()})
         pd.DataFrame(rows).to_parquet(tmp / "frames.parquet", index=False)
         meta = {"dataset": recorded.name, "world": recorded.world, "trajectory": recorded.trajectory,
-                "ground_truth": recorded.ground_truth, "model": model}
+                "source": "recorded", "ground_truth": recorded.ground_truth, "model": model}
         if recorded.board is not None:
             meta["board"] = recorded.board
         (tmp / "meta.json").write_text(json.dumps(meta, indent=1))

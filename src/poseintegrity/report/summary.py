@@ -69,6 +69,8 @@ def render_summary(metrics: dict[str, dict], timings: list[StageTiming]) -> str:
         lines += [f"## {title}", "", "| figure | ours | paper | target |", "| --- | --- | --- | --- |"]
         for h in (h for h in HEADLINES if h.stage == stage):
             lines.append(f"| {h.label} | {_fmt(lookup(metrics, stage, h.key), h.fmt)} | {h.paper} | {h.target} |")
+        described = lookup(metrics, stage, "realism.description_only")  # recorded data: no bar is judged
+        lines += ["", f"Realism bars: {described}."] if isinstance(described, str) else []
         lines.append("")
     lines += ["## Stage wall times", "", *timing_table(timings)]
     return "\n".join(lines)
