@@ -18,7 +18,7 @@ import yaml
 
 from poseintegrity.localization.dataset import load_dataset, load_index
 from poseintegrity.recorded.reader import write_table
-from poseintegrity.recorded.staging import staged
+from poseintegrity.staging import staged
 
 
 def _pose_text(values) -> str:

@@ -51,4 +51,4 @@ def relative_pose(T_cam0_ref: object, T_cam1_ref: object) -> np.ndarray:
     T0, T1 = poses("T_cam0_ref", T_cam0_ref), poses("T_cam1_ref", T_cam1_ref)
     if T0.ndim != 2 or T1.ndim != 2:
         raise ArgumentError(f"T_cam0_ref, T_cam1_ref: expected one pose (4, 4) each, got shapes {T0.shape}, {T1.shape}")
-    return T1 @ np.linalg.inv(T0)
+    return T1 @ inverse(T0)

@@ -23,7 +23,7 @@ import pandas as pd
 
 from poseintegrity.lens import write_camera_yaml
 from poseintegrity.recorded.reader import Recorded, RecordedFormatError, read_image, read_recorded
-from poseintegrity.recorded.staging import staged
+from poseintegrity.staging import staged
 
 
 def _write_image(source: Path, target: Path) -> None:

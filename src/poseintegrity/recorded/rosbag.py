@@ -26,7 +26,7 @@ import yaml
 from poseintegrity.errors import PoseIntegrityError, read_text_file
 from poseintegrity.lens import DISTORTION_MODELS, Camera, write_camera_yaml
 from poseintegrity.recorded.reader import TRAJECTORIES, RecordedFormatError, read_table, write_table
-from poseintegrity.recorded.staging import staged
+from poseintegrity.staging import staged
 
 IMAGE_TYPES = ("sensor_msgs/msg/Image", "sensor_msgs/msg/CompressedImage")
 INFO_TYPE = "sensor_msgs/msg/CameraInfo"

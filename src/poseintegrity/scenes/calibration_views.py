@@ -11,7 +11,6 @@ tilted by up to ``max_tilt_deg`` about a random axis of its plane and turned by 
 from __future__ import annotations
 
 import json
-import shutil
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
@@ -23,6 +22,7 @@ from scipy.spatial.transform import Rotation
 from poseintegrity.lens import Camera, write_camera_yaml
 from poseintegrity.calibration import Calibration, CharucoSpec, calibrate
 from poseintegrity.poses import pose_matrix
+from poseintegrity.staging import staged
 from poseintegrity.scenes import mesh, optics, renderer
 from poseintegrity.scenes.camera import true_camera
 from poseintegrity.scenes.catalog import print_errors
@@ -117,20 +117,17 @@ def write_calibration(folder: Path, session: CalibrationSession, params: Generat
                       png_flags: list[int]) -> None:
     """A world's calibration session in ``folder``: the views (``views/view_NN.png``), the estimate
     (``camera.yaml``) and ``report.json`` (the fit, the board, and the true camera beside the estimate)."""
-    tmp = folder.with_name(f".{folder.name}.partial")
-    shutil.rmtree(tmp, ignore_errors=True)
-    (tmp / "views").mkdir(parents=True)
-    for i, image in enumerate(session.images):
-        ok, encoded = cv2.imencode(".png", image, png_flags)
-        (tmp / "views" / f"view_{i:02d}.png").write_bytes(encoded.tobytes())
-    calibration, truth = session.calibration, true_camera(params.camera)
-    write_camera_yaml(tmp / "camera.yaml", calibration.camera, camera_name)
-    report = {"rms_px": calibration.rms_px, "per_view_rms_px": list(calibration.per_view_rms_px),
-              "views_used": list(calibration.views_used), "n_corners": list(calibration.n_corners),
-              "board": params.calibration.board.model_dump(),
-              "T_cam_board": [T.tolist() for T in session.T_cam_board],
-              "estimate": {"K": calibration.camera.K.tolist(), "dist": calibration.camera.dist.tolist()},
-              "true": {"K": truth.K.tolist(), "dist": truth.dist.tolist()}}
-    (tmp / "report.json").write_text(json.dumps(report, indent=1))
-    shutil.rmtree(folder, ignore_errors=True)
-    tmp.rename(folder)
+    with staged(folder) as tmp:
+        (tmp / "views").mkdir()
+        for i, image in enumerate(session.images):
+            ok, encoded = cv2.imencode(".png", image, png_flags)
+            (tmp / "views" / f"view_{i:02d}.png").write_bytes(encoded.tobytes())
+        calibration, truth = session.calibration, true_camera(params.camera)
+        write_camera_yaml(tmp / "camera.yaml", calibration.camera, camera_name)
+        report = {"rms_px": calibration.rms_px, "per_view_rms_px": list(calibration.per_view_rms_px),
+                  "views_used": list(calibration.views_used), "n_corners": list(calibration.n_corners),
+                  "board": params.calibration.board.model_dump(),
+                  "T_cam_board": [T.tolist() for T in session.T_cam_board],
+                  "estimate": {"K": calibration.camera.K.tolist(), "dist": calibration.camera.dist.tolist()},
+                  "true": {"K": truth.K.tolist(), "dist": truth.dist.tolist()}}
+        (tmp / "report.json").write_text(json.dumps(report, indent=1))

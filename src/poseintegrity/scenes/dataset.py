@@ -44,6 +44,7 @@ from poseintegrity.lens import Camera, write_camera_yaml
 from poseintegrity.parallel import Workers
 from poseintegrity.poses import inverse
 from poseintegrity.protocol import ProtocolParams
+from poseintegrity.staging import partial_folder
 from poseintegrity.scenes import catalog, optics, renderer, trajectories
 from poseintegrity.scenes.acquisition import Route, image_motion, image_pose, rotation_maps, visits
 from poseintegrity.scenes.calibration_views import CalibrationSession, calibration_session, write_calibration
@@ -285,8 +286,9 @@ def _image_files(stop: int, images_per_stop: int) -> tuple[str, ...]:
 
 
 def _partial(root: Path, dataset: str) -> Path:
-    """The hidden folder a dataset is written into, renamed to ``root / dataset`` when complete."""
-    return root / f".{dataset}.partial"
+    """The hidden folder a dataset is written into (its shots by the workers), renamed to ``root / dataset`` when
+    complete (:func:`poseintegrity.staging.partial_folder`)."""
+    return partial_folder(root / dataset)
 
 
 def take_shot(params: GenerateParams, root: Path, shot: Shot) -> None:
