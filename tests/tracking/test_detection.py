@@ -1,10 +1,13 @@
 import warnings
 
+import cv2
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from poseintegrity.tracking.markers.detection import detect_markers, validate_frame
+from poseintegrity.tracking.markers.detection import (
+    _valid_depth_range, blob_pixels, detect_markers, detect_markers_each, raw_threshold, split_by_depth, validate_frame,
+)
 from poseintegrity.tracking.simulation.frames import Phantom, intrinsics, render_frame, unit_plane_lut
 from poseintegrity.tracking.markers.geometry import MARKER_DIAMETER_M
 
@@ -142,3 +145,43 @@ def test_a_marker_partly_behind_another_is_found_at_the_depth_jump():
         split = detect_markers(ir, depth, K, DETECTION)
         assert len(merged) == 1 and _nearest(merged, markers).max() > 0.02  # one blob read as one marker: one is lost
         assert len(split) == 2 and _nearest(split, markers).max() < 0.008
+
+
+def _crowded_frames(n_frames=40):
+    """Frames where blobs touch, overlap in depth and meet phantoms: every branch of the blob analysis runs."""
+    rng = np.random.default_rng(21)
+    for _ in range(n_frames):
+        first = np.array([rng.uniform(-0.05, 0.05), rng.uniform(-0.05, 0.05), rng.uniform(0.4, 0.7)])
+        markers = np.vstack([first, first + [rng.uniform(0.002, 0.012), rng.uniform(-0.004, 0.004), rng.uniform(-0.05, 0.05)],
+                             GEOMETRY @ Rotation.random(random_state=rng).as_matrix().T + [0.1, 0.1, rng.uniform(0.4, 0.9)]])
+        phantoms = [Phantom(u=rng.uniform(20, 490), v=rng.uniform(20, 490), radius_px=rng.uniform(1.5, 4.0),
+                            elongation=rng.choice([1.0, rng.uniform(1.0, 8.0)]), angle=rng.uniform(0, np.pi),
+                            depth_mm=rng.uniform(150, 850)) for _ in range(3)]
+        yield render_frame(markers, phantoms, CAMERA, FRAMES, MARKER_DIAMETER_M / 2, rng)
+
+
+def test_several_detectors_on_one_frame_find_what_each_finds_alone():
+    detectors = [DETECTION, DETECTION.model_copy(update={"split_touching": False}), DETECTION.model_copy(update={"threshold": 180}),
+                 DETECTION.model_copy(update={"shape_measure": "contour"}), DETECTION]
+    for ir, depth in _crowded_frames():
+        together = detect_markers_each(ir, depth, K, detectors)
+        assert len(together) == len(detectors)
+        for detector, points in zip(detectors, together):
+            np.testing.assert_array_equal(points, detect_markers(ir, depth, K, detector))
+
+
+def test_a_blob_whose_box_spans_less_than_a_depth_cut_has_no_depth_split():
+    """The shortcut of the blob analysis: where the valid readings of a blob's bounding box span less than
+    depth_split_mm, split_by_depth on its pixels finds no split (and both cases occur here)."""
+    cases = {True: 0, False: 0}
+    for ir, depth in _crowded_frames():
+        mask = cv2.compare(ir, raw_threshold(DETECTION, ir.dtype), cv2.CMP_GT)
+        for contour in cv2.findContours(mask, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)[0]:
+            spread = _valid_depth_range(depth, *cv2.boundingRect(contour), DETECTION.depth_min_mm, DETECTION.depth_max_mm)
+            centres, _ = split_by_depth(blob_pixels(contour), depth, DETECTION)
+            cases[spread < DETECTION.depth_split_mm] += 1
+            if spread < DETECTION.depth_split_mm:
+                assert len(centres) == 0
+            elif len(centres):
+                cases["split"] = cases.get("split", 0) + 1
+    assert cases[True] > 50 and cases[False] > 10 and cases.get("split", 0) > 5

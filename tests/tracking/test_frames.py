@@ -1,8 +1,11 @@
 import numpy as np
+import pytest
 from scipy import stats
 from scipy.spatial.transform import Rotation
 
-from poseintegrity.tracking.simulation.frames import background_quantiles, draw_phantoms, intrinsics, ir_image, render_frame
+from poseintegrity.tracking.markers.detection import detect_markers, raw_threshold
+from poseintegrity.tracking.simulation.simulate import background_seen
+from poseintegrity.tracking.simulation.frames import _lit_pixels, background_quantiles, draw_phantoms, intrinsics, ir_image, render_frame, skip_raw
 from poseintegrity.tracking.markers.geometry import MARKER_DIAMETER_M
 
 from tracking.track_section import GEOMETRY, TRACK
@@ -122,3 +125,75 @@ def test_render_frame_ray_casts_like_the_numpy_reference():
         np.testing.assert_array_equal(ir, ref_ir)
         drawn += (ir > BACKGROUND).any()
     assert drawn >= 30  # most frames show a marker or a phantom
+
+
+def test_render_frame_with_ir_noise_off_still_matches_with_a_flat_background():
+    """The flat-background path (background_noise=False) draws the same reflections: with the IR noise off it is
+    the same image as the reference, background included."""
+    frames = FRAMES.model_copy(update={"ir_noise_std": 0.0})
+    for seed in range(10):
+        rng = np.random.default_rng(seed)
+        markers = GEOMETRY @ Rotation.random(random_state=seed).as_matrix().T + [rng.uniform(-0.2, 0.2), 0.0, rng.uniform(0.3, 0.9)]
+        phantoms = draw_phantoms(3, CAMERA, frames, 0.3, rng)
+        ir, depth = render_frame(markers, phantoms, CAMERA, frames, MARKER_DIAMETER_M / 2, np.random.default_rng(seed), False)
+        ref_ir, ref_depth = reference_render(markers, phantoms, CAMERA, frames, MARKER_DIAMETER_M / 2, np.random.default_rng(seed))
+        np.testing.assert_array_equal(depth, ref_depth)
+        np.testing.assert_array_equal(ir, ref_ir)
+
+
+@pytest.mark.parametrize("buffered", [False, True])
+def test_skip_raw_leaves_the_generator_where_random_raw_does(buffered):
+    """Skipping n raw words equals drawing them, also when a float32 draw left half a word buffered (which
+    PCG64.advance alone would drop): the next draws of every kind are the same."""
+    drawn, skipped = np.random.default_rng(5), np.random.default_rng(5)
+    for rng in (drawn, skipped):
+        rng.standard_normal(3 if buffered else 2, dtype=np.float32)
+    assert drawn.bit_generator.state["has_uint32"] == int(buffered)
+    drawn.bit_generator.random_raw(65536)
+    skip_raw(skipped, 65536)
+    assert drawn.bit_generator.state == skipped.bit_generator.state
+    np.testing.assert_array_equal(drawn.standard_normal(5, dtype=np.float32), skipped.standard_normal(5, dtype=np.float32))
+    np.testing.assert_array_equal(drawn.normal(0.0, 1.0, 5), skipped.normal(0.0, 1.0, 5))
+
+
+def test_a_flat_background_differs_only_where_nothing_reflects_and_detects_the_same():
+    """background_noise=False: the same depth, the same value on every lit pixel, rint(ir_background) elsewhere, the
+    generator in the same state afterwards, and the same detected points (the detector's threshold is far above
+    the background's largest value)."""
+    K = intrinsics(CAMERA)
+    lit_seen = 0
+    for seed in range(20):
+        rng = np.random.default_rng(seed)
+        markers = GEOMETRY @ Rotation.random(random_state=seed).as_matrix().T + [rng.uniform(-0.1, 0.1), 0.0, rng.uniform(0.35, 0.9)]
+        phantoms = draw_phantoms(int(rng.integers(0, 3)), CAMERA, FRAMES, 0.5, rng)
+        noisy_rng, flat_rng = np.random.default_rng(seed), np.random.default_rng(seed)
+        ir, depth = render_frame(markers, phantoms, CAMERA, FRAMES, MARKER_DIAMETER_M / 2, noisy_rng)
+        flat_ir, flat_depth = render_frame(markers, phantoms, CAMERA, FRAMES, MARKER_DIAMETER_M / 2, flat_rng, False)
+        np.testing.assert_array_equal(flat_depth, depth)
+        lit = depth < FRAMES.background_depth_mm  # where a marker or phantom was drawn
+        np.testing.assert_array_equal(flat_ir[lit], ir[lit])
+        assert np.all(flat_ir[~lit] == np.rint(BACKGROUND)) and np.any(ir[~lit] != np.rint(BACKGROUND))
+        assert noisy_rng.bit_generator.state == flat_rng.bit_generator.state
+        np.testing.assert_array_equal(detect_markers(flat_ir, depth, K, DETECTION), detect_markers(ir, depth, K, DETECTION))
+        lit_seen += lit.sum()
+    assert lit_seen > 1000
+
+
+def test_lit_pixels_inside_patches_are_flatnonzero_of_the_image():
+    rng = np.random.default_rng(2)
+    for _ in range(50):
+        brightness = np.zeros((64, 80), np.float32)
+        patches = []
+        for _ in range(int(rng.integers(0, 5))):
+            v0, u0 = int(rng.integers(0, 64)), int(rng.integers(0, 80))
+            v1, u1 = min(v0 + int(rng.integers(0, 20)), 64), min(u0 + int(rng.integers(0, 20)), 80)
+            brightness[v0:v1, u0:u1] = np.where(rng.random((v1 - v0, u1 - u0)) < 0.5, rng.uniform(1, 9, (v1 - v0, u1 - u0)), 0.0)
+            patches.append((v0, v1, u0, u1))
+        np.testing.assert_array_equal(_lit_pixels(brightness, np.array(patches, dtype=np.int64).reshape(-1, 4)), np.flatnonzero(brightness > 0))
+
+
+def test_the_background_is_seen_only_by_a_detector_whose_threshold_it_can_reach():
+    assert not background_seen(TRACK, [DETECTION])  # raw 870.6 against a largest background value of ~188
+    low = DETECTION.model_copy(update={"threshold": 40})  # raw 157: within the background's +-4.3 sigma
+    assert background_quantiles(BACKGROUND, NOISE).max() > raw_threshold(low, np.uint16)
+    assert background_seen(TRACK, [DETECTION, low])

@@ -15,7 +15,7 @@ from poseintegrity.poses import pose_matrix
 from poseintegrity.tracking.markers.geometry import MARKER_DIAMETER_M, transform_points
 from poseintegrity.tracking.simulation.motion import sample_sensors, simulate_trajectory
 from poseintegrity.tracking.params import TrackParams
-from poseintegrity.tracking.simulation.simulate import Simulation, T_world_cam, run_no_filter, simulate, simulate_hand
+from poseintegrity.tracking.simulation.simulate import Simulation, T_world_cam, background_seen, run_no_filter, simulate, simulate_hand
 from poseintegrity.tracking.filter.multi_tool import MultiToolTracker
 from poseintegrity.tracking.experiments.filter_runs import experiment_rng
 
@@ -98,13 +98,15 @@ def two_tools_success(params: TrackParams, phantom_max: int, name: str) -> pd.Da
     idx = timeline.frame_index[: params.evaluation.multi_tool_frames]
     K, T_wc = intrinsics(params.camera), T_world_cam(params)
     tracker = MultiToolTracker(tools, params.filter, params.matching)
+    background_noise = background_seen(params, [params.detection])
     rows = []
     for f, i in enumerate(idx):
         T = {k: pose_matrix(tr.rotation(np.array([i]))[0], tr.position[i]) for k, tr in trajectories.items()}
         true = {k: transform_points(T[k], tools[k]) for k in tools}
         markers = np.vstack([true["tool1"], true["tool2"]])[~timeline.occluded[f]]
         phantoms = draw_phantoms(int(timeline.n_phantoms[f]), params.camera, params.frames, motion.phantom_round_fraction, rng)
-        ir, depth = render_frame(transform_points(np.linalg.inv(T_wc), markers), phantoms, params.camera, params.frames, MARKER_DIAMETER_M / 2, rng)
+        ir, depth = render_frame(transform_points(np.linalg.inv(T_wc), markers), phantoms, params.camera, params.frames, MARKER_DIAMETER_M / 2, rng,
+                                 background_noise)
         points = detect_markers_unchecked(ir, depth, K, params.detection, T_world_cam=T_wc)  # rendered here: a usable frame
         for tool, result in tracker.frame(trajectories["tool1"].t[i], points).items():
             matched = result.assignment >= 0

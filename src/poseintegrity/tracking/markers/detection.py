@@ -249,6 +249,20 @@ def _largest_depth_gap(depth_mm, pixels, depth_min_mm, depth_max_mm):  # pragma:
 
 
 @numba.njit(cache=True, nogil=True)
+def _valid_depth_range(depth_mm, x0, y0, w, h, depth_min_mm, depth_max_mm):  # pragma: no cover - compiled
+    """max - min (mm) of the valid depth readings in the rectangle [x0, x0 + w) x [y0, y0 + h); -inf with fewer than
+    two.  A blob inside the rectangle has no larger gap between its sorted readings (:func:`_largest_depth_gap`):
+    its readings are a subset and rounded subtraction is monotone, so below depth_split_mm it cannot be split."""
+    low, high, n = np.inf, -np.inf, 0
+    for v in range(y0, y0 + h):
+        for u in range(x0, x0 + w):
+            d = float(depth_mm[v, u])
+            if _is_valid_depth(d, depth_min_mm, depth_max_mm):
+                low, high, n = min(low, d), max(high, d), n + 1
+    return high - low if n >= 2 else -np.inf
+
+
+@numba.njit(cache=True, nogil=True)
 def _window_medians(depth_mm, uv_int, w, depth_min_mm, depth_max_mm):  # pragma: no cover - compiled
     """:func:`lookup_depth` on rounded centres uv_int (k, 2) int: per centre the median of the valid readings
     in its (2w+1)^2 window, as :func:`small_median` computes it (the middle one or (a + b) / 2), NaN if none."""
@@ -281,6 +295,12 @@ def compiled_depth(depth_mm: np.ndarray) -> np.ndarray:
     return depth_mm if depth_mm.dtype in COMPILED_DEPTH_TYPES and depth_mm.dtype.isnative else depth_mm.astype(np.float64)
 
 
+def raw_threshold(detection: DetectionParams, dtype: np.dtype) -> float:
+    """The IR value a pixel of this dtype must exceed to be part of a blob: ``threshold`` for uint8 (already 8-bit),
+    else raw reflectivity clipped at ir_clip and scaled to 8 bit, ``threshold * ir_clip / 255``."""
+    return float(detection.threshold if np.dtype(dtype) == np.uint8 else detection.threshold * detection.ir_clip / 255.0)
+
+
 def detect_blobs(ir: np.ndarray, detection: DetectionParams, depth_mm: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Centres (k, 2) float (u, v), pixels, of the bright round blobs of an IR image (II-B), and their depth
     (k,) mm where a depth split measured it (NaN elsewhere: :func:`lookup_depth` reads it at the centre).
@@ -291,35 +311,58 @@ def detect_blobs(ir: np.ndarray, detection: DetectionParams, depth_mm: np.ndarra
     it, :func:`split_by_depth`, when depth_mm (H, W) is given), and a blob that fails the shape tests as two
     touching discs (:func:`split_two_discs`).
     """
-    d = detection
-    raw_threshold = d.threshold if ir.dtype == np.uint8 else d.threshold * d.ir_clip / 255.0
+    return detect_blobs_each(ir, [detection], depth_mm)[0]
+
+
+def detect_blobs_each(ir: np.ndarray, detections: list[DetectionParams], depth_mm: np.ndarray | None = None) -> list[tuple[np.ndarray, np.ndarray]]:
+    """:func:`detect_blobs` of one frame with each of several detectors, in order: detectors with the same threshold
+    share the mask and its contours, and those with the same shape_measure each blob's shape and moments."""
     if ir.dtype not in (np.uint8, np.uint16, np.float32, np.float64):
         ir = ir.astype(np.float64)
-    mask = cv2.compare(ir, float(raw_threshold), cv2.CMP_GT)  # 255 where brighter
-    contours, _ = cv2.findContours(mask, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
-    centres, depths = [], []
-    for contour in contours:
-        area, circularity, convexity = blob_shape(contour, d.shape_measure)
-        if not (d.min_area <= area <= 2.0 * d.max_area):
-            continue
-        if d.split_touching and depth_mm is not None:
-            uv, dd = split_by_depth(blob_pixels(contour), depth_mm, d)
-            if len(uv):
-                centres.extend(map(tuple, uv))
-                depths.extend(dd)
+    contours_at, shapes, moments = {}, {}, {}  # by threshold; by (threshold, measure, blob); by (threshold, blob)
+    results = []
+    for d in detections:
+        threshold = raw_threshold(d, ir.dtype)
+        if threshold not in contours_at:
+            mask = cv2.compare(ir, threshold, cv2.CMP_GT)  # 255 where brighter: the only use of ir
+            contours_at[threshold] = cv2.findContours(mask, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)[0]
+        centres, depths = [], []
+        depth_range = (float(d.depth_min_mm), float(d.depth_max_mm))
+        readable = compiled_depth(depth_mm) if d.split_touching and depth_mm is not None else None
+        for b, contour in enumerate(contours_at[threshold]):
+            key = (threshold, d.shape_measure, b)
+            if key not in shapes:
+                shapes[key] = blob_shape(contour, d.shape_measure)
+            area, circularity, convexity = shapes[key]
+            if not (d.min_area <= area <= 2.0 * d.max_area):
                 continue
-        if area <= d.max_area and circularity >= d.min_circularity and convexity >= d.min_convexity:
-            m = cv2.moments(contour)
-            if m["m00"] > 0:
-                centres.append((m["m10"] / m["m00"], m["m01"] / m["m00"]))
-            else:  # a blob one pixel wide: its polygon has no area
-                centres.append(tuple(contour.reshape(-1, 2).mean(axis=0)))
-            depths.append(np.nan)
-        elif d.split_touching:
-            uv = split_two_discs(contour, d)
-            centres.extend(map(tuple, uv))
-            depths.extend([np.nan] * len(uv))
-    return np.array(centres, dtype=float).reshape(-1, 2), np.array(depths, dtype=float)
+            # the depth split needs the blob's pixels, unless the readings of its bounding box already span less than a cut
+            if readable is not None and _valid_depth_range(readable, *cv2.boundingRect(contour), *depth_range) >= d.depth_split_mm:
+                uv, dd = split_by_depth(blob_pixels(contour), depth_mm, d)
+                if len(uv):
+                    centres.extend(map(tuple, uv))
+                    depths.extend(dd)
+                    continue
+            if area <= d.max_area and circularity >= d.min_circularity and convexity >= d.min_convexity:
+                if (threshold, b) not in moments:
+                    moments[threshold, b] = blob_centroid(contour)
+                centres.append(moments[threshold, b])
+                depths.append(np.nan)
+            elif d.split_touching:
+                uv = split_two_discs(contour, d)
+                centres.extend(map(tuple, uv))
+                depths.extend([np.nan] * len(uv))
+        results.append((np.array(centres, dtype=float).reshape(-1, 2), np.array(depths, dtype=float)))
+    return results
+
+
+def blob_centroid(contour: np.ndarray) -> tuple[float, float]:
+    """(u, v) px: the centroid of the area inside a contour (k, 1, 2) from its moments, or the mean of its points
+    for a blob one pixel wide (its polygon has no area)."""
+    m = cv2.moments(contour)
+    if m["m00"] > 0:
+        return m["m10"] / m["m00"], m["m01"] / m["m00"]
+    return tuple(contour.reshape(-1, 2).mean(axis=0))
 
 
 def lookup_depth(depth_mm: np.ndarray, uv: np.ndarray, detection: DetectionParams) -> np.ndarray:
@@ -374,11 +417,20 @@ def detect_markers_unchecked(ir: np.ndarray, depth_mm: np.ndarray, unproject: np
                              T_world_cam: np.ndarray | None = None) -> np.ndarray:
     """:func:`detect_markers` on a frame known to be usable (arrays that :func:`validate_frame` accepts, unproject
     float): the per-frame path of frames the library rendered or validated itself."""
-    uv, d_split = detect_blobs(ir, detection, depth_mm)
-    d_mm = np.where(np.isnan(d_split), lookup_depth(depth_mm, uv, detection), d_split)
-    keep = np.isfinite(d_mm)
-    xy = unit_plane_coordinates(uv[keep], unproject)
-    rays = np.column_stack([xy, np.ones(len(xy))])
-    rays /= np.linalg.norm(rays, axis=1, keepdims=True)
-    points_cam = rays * ((d_mm[keep] + detection.depth_offset_mm) / 1000.0)[:, None]  # depth is along the ray
-    return points_cam if T_world_cam is None else transform_points(T_world_cam, points_cam)
+    return detect_markers_each(ir, depth_mm, unproject, [detection], T_world_cam)[0]
+
+
+def detect_markers_each(ir: np.ndarray, depth_mm: np.ndarray, unproject: np.ndarray, detections: list[DetectionParams],
+                        T_world_cam: np.ndarray | None = None) -> list[np.ndarray]:
+    """:func:`detect_markers_unchecked` of one frame with each of several detectors (sharing what they have in
+    common, :func:`detect_blobs_each`): one (n, 3) array of points per detector, in order."""
+    points = []
+    for detection, (uv, d_split) in zip(detections, detect_blobs_each(ir, detections, depth_mm)):
+        d_mm = np.where(np.isnan(d_split), lookup_depth(depth_mm, uv, detection), d_split)
+        keep = np.isfinite(d_mm)
+        xy = unit_plane_coordinates(uv[keep], unproject)
+        rays = np.column_stack([xy, np.ones(len(xy))])
+        rays /= np.linalg.norm(rays, axis=1, keepdims=True)
+        points_cam = rays * ((d_mm[keep] + detection.depth_offset_mm) / 1000.0)[:, None]  # depth is along the ray
+        points.append(points_cam if T_world_cam is None else transform_points(T_world_cam, points_cam))
+    return points

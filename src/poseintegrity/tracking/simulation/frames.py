@@ -99,15 +99,33 @@ def _draw_sphere(depth, brightness, centre, radius_m, K, u0, v0, noise_mm, bias_
 
 
 @numba.njit(cache=True, nogil=True)
-def _draw_ellipse(depth, brightness, phantom, u0, v0, noise_mm, level, s):
-    """Draw one phantom (u, v, radius_px, elongation, angle, depth_mm) into the patch of pixels
+def _draw_ellipse(depth, brightness, phantom, u0, v0, noise_mm, level, s):  # pragma: no cover - compiled
+    """Draw one phantom (6,) (u, v, radius_px, elongation, angle, depth_mm) into the patch of pixels
     [u0, u0 + w) x [v0, v0 + h) of depth and brightness, in place, as :func:`_draw_sphere` draws a sphere: cover is
-    the share of the s x s rays inside the ellipse, depth its constant depth_mm plus noise_mm (h, w)."""
-    pu, pv, radius, elongation, angle, depth_mm = phantom
+    the share of the s x s rays inside the ellipse, depth its constant depth_mm plus noise_mm (h, w).
+
+    Each pixel row is tested only over the columns where one of its ray rows crosses the ellipse grown by half a
+    pixel (every ray the exact test accepts lies well inside that one): a thin tilted reflection fills a few
+    pixels of each row of its square patch."""
+    pu, pv, radius, elongation, angle, depth_mm = phantom[0], phantom[1], phantom[2], phantom[3], phantom[4], phantom[5]
     cos, sin = np.cos(angle), np.sin(angle)
     h, w = noise_mm.shape
+    # the grown ellipse (P du + Q dv)^2 + (R du + T dv)^2 <= 1, for one ray row a quadratic qa du^2 + qb du + qc <= 0
+    P, Q = cos / (radius * elongation + 0.5), sin / (radius * elongation + 0.5)
+    R, T = -sin / (radius + 0.5), cos / (radius + 0.5)
+    qa = P * P + R * R
+    first_offset, last_offset = 0.5 / s - 0.5, (s - 0.5) / s - 0.5  # of the rays within a pixel
     for i in range(h):
-        for j in range(w):
+        j0, j1 = w, -1
+        for a in range(s):
+            dv = v0 + i + ((a + 0.5) / s - 0.5) - pv
+            qb, qc = 2.0 * (P * Q + R * T) * dv, (Q * Q + T * T) * dv * dv - 1.0
+            disc = qb * qb - 4.0 * qa * qc
+            if disc >= 0.0:
+                root = np.sqrt(disc)
+                j0 = min(j0, int(np.floor((-qb - root) / (2.0 * qa) + pu - u0 - last_offset)))
+                j1 = max(j1, int(np.ceil((-qb + root) / (2.0 * qa) + pu - u0 - first_offset)))
+        for j in range(max(j0, 0), min(j1 + 1, w)):
             hits = 0
             for a in range(s):
                 dv = v0 + i + ((a + 0.5) / s - 0.5) - pv
@@ -135,46 +153,98 @@ def render_frame(
     frames: FrameParams,
     marker_radius_m: float,
     rng: np.random.Generator,
+    background_noise: bool = True,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Render one IR and one depth frame.
 
     markers_cam : (k, 3) centres of the visible markers in the camera frame, metres (z forward).
-    phantoms : reflections to draw.  marker_radius_m : sphere radius, m.
+    phantoms : reflections to draw.  marker_radius_m : sphere radius, m.  background_noise : see :func:`ir_image`
+    (False only where nothing reads the unlit pixels but a threshold above the background's largest value).
     Returns ir : (H, W) uint16 (raw reflectivity, background ~80, markers saturate above 1000) and
     depth_mm : (H, W) uint16, millimetres along the ray (background_depth_mm where nothing is hit).
 
     Depth is kept as whole millimetres throughout: rounding and clipping to uint16 are monotone, so rounding
     each surface before taking the nearest one gives the same image as rounding the nearest float depth.
     Per marker (far to near) the generator draws its depth bias, its patch's depth noise and its IR level; per
-    phantom its depth noise and IR level; then the IR noise (:func:`ir_image`).
+    phantom its depth noise and IR level; then the IR noise (:func:`ir_image`).  The marker and phantom draws
+    are one call of standard normals, scaled as ``rng.normal`` scales them (loc + scale z), so the values and
+    the generator's state are those of one ``rng.normal`` call per draw.
     """
     H, W, s = camera.height, camera.width, frames.supersampling
     K = intrinsics(camera)
     brightness = np.zeros((H, W), dtype=np.float32)
     depth = np.full((H, W), depth_mm_uint16(frames.background_depth_mm), dtype=np.uint16)
     frame_bias = rng.normal(0.0, frames.frame_depth_bias_std_mm)
-    for c in markers_cam[np.argsort(-markers_cam[:, 2])] if len(markers_cam) else []:
-        if c[2] <= marker_radius_m:
+    centres = np.ascontiguousarray(markers_cam[np.argsort(-markers_cam[:, 2])] if len(markers_cam) else np.zeros((0, 3)), dtype=float)
+    shapes = np.array([(p.u, p.v, p.radius_px, p.elongation, p.angle, p.depth_mm) for p in phantoms], dtype=float).reshape(-1, 6)
+    sphere_patches = _sphere_patches(centres, K, float(camera.focal_px), float(marker_radius_m), W, H)
+    ellipse_patches = _ellipse_patches(shapes, W, H)
+    drawn = sphere_patches[:, 0] < sphere_patches[:, 1]
+    areas = np.r_[(sphere_patches[drawn, 1] - sphere_patches[drawn, 0]) * (sphere_patches[drawn, 3] - sphere_patches[drawn, 2]) + 2,
+                  np.maximum(ellipse_patches[:, 1] - ellipse_patches[:, 0], 0) * np.maximum(ellipse_patches[:, 3] - ellipse_patches[:, 2], 0) + 1]
+    z = rng.standard_normal(int(areas.sum()))
+    _draw_scene(depth, brightness, centres, sphere_patches, shapes, ellipse_patches, z, frame_bias, float(frames.depth_bias_std_mm),
+                float(frames.depth_noise_mm), float(frames.marker_ir), float(frames.marker_ir_std), K, float(marker_radius_m), s)
+    patches = np.concatenate([sphere_patches[drawn], ellipse_patches])  # the only pixels a reflection can light
+    return ir_image(brightness, frames, rng, patches, background_noise), depth
+
+
+@numba.njit(cache=True, nogil=True)
+def _sphere_patches(centres, K, focal_px, radius_m, W, H):  # pragma: no cover - compiled
+    """Pixel patches (k, 4) int rows (v0, v1, u0, u1) holding the image of each sphere of centres (k, 3) m: its
+    projected centre +- its image radius + 2 px, within the image; (0, 0, 0, 0) for a sphere not drawn (centre
+    within one radius of the camera, or a patch outside the image)."""
+    patches = np.zeros((len(centres), 4), np.int64)
+    for k in range(len(centres)):
+        x, y, z = centres[k, 0], centres[k, 1], centres[k, 2]
+        if z <= radius_m:
             continue
-        u_c, v_c = K[0, 0] * c[0] / c[2] + K[0, 2], K[1, 1] * c[1] / c[2] + K[1, 2]
-        rho = camera.focal_px * marker_radius_m / np.sqrt(c[2] ** 2 - marker_radius_m**2) + 2.0
-        u0, u1 = max(int(u_c - rho), 0), min(int(u_c + rho) + 2, W)
-        v0, v1 = max(int(v_c - rho), 0), min(int(v_c + rho) + 2, H)
-        if u0 >= u1 or v0 >= v1:
+        u_c, v_c = K[0, 0] * x / z + K[0, 2], K[1, 1] * y / z + K[1, 2]
+        rho = focal_px * radius_m / np.sqrt(z**2 - radius_m**2) + 2.0
+        u0, u1 = max(np.trunc(u_c - rho), 0.0), min(np.trunc(u_c + rho) + 2.0, W)  # int() truncates toward zero
+        v0, v1 = max(np.trunc(v_c - rho), 0.0), min(np.trunc(v_c + rho) + 2.0, H)
+        if u0 < u1 and v0 < v1:
+            patches[k, 0], patches[k, 1], patches[k, 2], patches[k, 3] = int(v0), int(v1), int(u0), int(u1)
+    return patches
+
+
+@numba.njit(cache=True, nogil=True)
+def _ellipse_patches(shapes, W, H):  # pragma: no cover - compiled
+    """Pixel patches (p, 4) int rows (v0, v1, u0, u1) of the phantoms (p, 6) (u, v, radius_px, elongation, angle,
+    depth_mm): their centre +- radius_px elongation + 2 px, within the image (possibly empty: v1 <= v0 or u1 <= u0)."""
+    patches = np.empty((len(shapes), 4), np.int64)
+    for k in range(len(shapes)):
+        extent = shapes[k, 2] * shapes[k, 3] + 2.0
+        patches[k, 2], patches[k, 3] = max(int(np.trunc(shapes[k, 0] - extent)), 0), min(int(np.trunc(shapes[k, 0] + extent)) + 2, W)
+        patches[k, 0], patches[k, 1] = max(int(np.trunc(shapes[k, 1] - extent)), 0), min(int(np.trunc(shapes[k, 1] + extent)) + 2, H)
+    return patches
+
+
+@numba.njit(cache=True, nogil=True)
+def _draw_scene(depth, brightness, centres, sphere_patches, shapes, ellipse_patches, z, frame_bias, depth_bias_std_mm, depth_noise_mm,
+                marker_ir, marker_ir_std, K, radius_m, s):  # pragma: no cover - compiled
+    """Every sphere with a patch (far to near) and then every phantom, in place, taking their normal draws from z
+    in order: per sphere its depth bias, its patch's depth noise (row-major) and its IR level; per phantom its
+    patch's depth noise and its IR level (loc + scale z, as ``rng.normal`` computes them)."""
+    k = 0
+    for m in range(len(centres)):
+        v0, v1, u0, u1 = sphere_patches[m, 0], sphere_patches[m, 1], sphere_patches[m, 2], sphere_patches[m, 3]
+        if v0 >= v1:
             continue
-        bias = frame_bias + rng.normal(0.0, frames.depth_bias_std_mm)
-        noise = rng.normal(0.0, frames.depth_noise_mm, (v1 - v0, u1 - u0))
-        level = frames.marker_ir + rng.normal(0.0, frames.marker_ir_std)
-        _draw_sphere(depth, brightness, np.ascontiguousarray(c, dtype=float), marker_radius_m, K, u0, v0, noise, bias, level, s)
-    for p in phantoms:
-        extent = p.radius_px * p.elongation + 2.0
-        u0, u1 = max(int(p.u - extent), 0), min(int(p.u + extent) + 2, W)
-        v0, v1 = max(int(p.v - extent), 0), min(int(p.v + extent) + 2, H)
-        noise = rng.normal(0.0, frames.depth_noise_mm, (max(v1 - v0, 0), max(u1 - u0, 0)))
-        level = frames.marker_ir + rng.normal(0.0, frames.marker_ir_std)
-        shape = (float(p.u), float(p.v), float(p.radius_px), float(p.elongation), float(p.angle), float(p.depth_mm))
-        _draw_ellipse(depth, brightness, shape, u0, v0, noise, level, s)
-    return ir_image(brightness, frames, rng), depth
+        bias = frame_bias + (0.0 + depth_bias_std_mm * z[k])
+        noise = (0.0 + depth_noise_mm * z[k + 1 : k + 1 + (v1 - v0) * (u1 - u0)]).reshape(v1 - v0, u1 - u0)
+        k += 1 + (v1 - v0) * (u1 - u0)
+        level = marker_ir + marker_ir_std * z[k]
+        k += 1
+        _draw_sphere(depth, brightness, centres[m], radius_m, K, u0, v0, noise, bias, level, s)
+    for m in range(len(shapes)):
+        v0, v1, u0, u1 = ellipse_patches[m, 0], ellipse_patches[m, 1], ellipse_patches[m, 2], ellipse_patches[m, 3]
+        h, w = max(v1 - v0, 0), max(u1 - u0, 0)
+        noise = (0.0 + depth_noise_mm * z[k : k + h * w]).reshape(h, w)
+        k += h * w
+        level = marker_ir + marker_ir_std * z[k]
+        k += 1
+        _draw_ellipse(depth, brightness, shapes[m], u0, v0, noise, level, s)
 
 
 UNIFORM_LEVELS = 65536  # 16-bit uniforms: the background's inverse-CDF table has this many entries
@@ -199,19 +269,61 @@ def _lookup_16bit(words: np.ndarray, table: np.ndarray, out: np.ndarray) -> None
         flat[i] = table[(words[i // 4] >> np.uint64(16 * (i % 4))) & np.uint64(0xFFFF)]
 
 
-def ir_image(brightness: np.ndarray, frames: FrameParams, rng: np.random.Generator) -> np.ndarray:
+@numba.njit(cache=True, nogil=True)
+def _lit_pixels(brightness: np.ndarray, patches: np.ndarray) -> np.ndarray:
+    """``np.flatnonzero(brightness > 0)`` for brightness (H, W) that is 0 outside the patches (k, 4) int rows
+    (v0, v1, u0, u1): each row is scanned only from the leftmost to the rightmost patch column that covers it."""
+    H, W = brightness.shape
+    out = np.empty(min(H * W, int(((patches[:, 1] - patches[:, 0]) * W).sum())), np.int64)  # rows the patches span, whole
+    n = 0
+    for v in range(H):
+        first, last = W, 0
+        for k in range(len(patches)):
+            if patches[k, 0] <= v < patches[k, 1]:
+                first, last = min(first, patches[k, 2]), max(last, patches[k, 3])
+        for u in range(first, last):
+            if brightness[v, u] > 0:
+                out[n] = v * W + u
+                n += 1
+    return out[:n]
+
+
+def skip_raw(rng: np.random.Generator, n_words: int) -> None:
+    """Move rng on as ``rng.bit_generator.random_raw(n_words)`` would, without computing the words.
+
+    PCG64 (numpy's default) jumps ahead in O(log n); ``advance`` clears the buffered half of a 64-bit word that a
+    32-bit draw may have left (random_raw keeps it), so that buffer is put back.  Other bit generators draw the words."""
+    bit_generator = rng.bit_generator
+    if not hasattr(bit_generator, "advance"):
+        bit_generator.random_raw(n_words)
+        return
+    state = bit_generator.state
+    bit_generator.advance(n_words)
+    bit_generator.state = {**bit_generator.state, "has_uint32": state["has_uint32"], "uinteger": state["uinteger"]}
+
+
+def ir_image(brightness: np.ndarray, frames: FrameParams, rng: np.random.Generator, patches: np.ndarray | None = None,
+             background_noise: bool = True) -> np.ndarray:
     """Raw IR (H, W) uint16: rint(ir_background + ir_noise_std z + brightness) clipped to uint16, z ~ N(0, 1)
-    independent per pixel.  brightness : (H, W) float32 >= 0, the reflections (0 where there is none).
+    independent per pixel.  brightness : (H, W) float32 >= 0, the reflections (0 where there is none);
+    patches : (k, 4) int rows (v0, v1, u0, u1) outside which brightness is 0 (None: anywhere).
 
     Unlit pixels (brightness 0, nearly all of them) take the quantized value directly from
     :func:`background_quantiles` with a 16-bit uniform, four per raw 64-bit word of the generator; lit pixels
     draw z as a float32 normal.  This has the distribution of drawing z everywhere (within 1 / 65536 per value on
     the background, which is ~30 noise_std below the detector's threshold either way) at a quarter of the cost.
+    background_noise False: the unlit pixels read the table's median, rint(ir_background), and the generator skips
+    their words (:func:`skip_raw`), so the lit pixels and every later draw are those of the noisy image; only a
+    reader of the unlit pixels can tell the two apart (the detector's mask cannot: see ``record``).
     """
     ir = np.empty(brightness.shape, dtype=np.uint16)
-    words = rng.bit_generator.random_raw(-(-ir.size // 4))
-    _lookup_16bit(words, background_quantiles(frames.ir_background, frames.ir_noise_std), ir)
-    lit = np.flatnonzero(brightness > 0)
+    table = background_quantiles(frames.ir_background, frames.ir_noise_std)
+    if background_noise:
+        _lookup_16bit(rng.bit_generator.random_raw(-(-ir.size // 4)), table, ir)
+    else:
+        skip_raw(rng, -(-ir.size // 4))
+        ir.fill(table[UNIFORM_LEVELS // 2])
+    lit = np.flatnonzero(brightness > 0) if patches is None else _lit_pixels(brightness, patches)
     value = rng.standard_normal(lit.size, dtype=np.float32)  # in place: ir_background + ir_noise_std * z + brightness
     value *= np.float32(frames.ir_noise_std)
     value += np.float32(frames.ir_background)

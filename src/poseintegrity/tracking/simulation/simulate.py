@@ -15,9 +15,9 @@ import pandas as pd
 from tqdm.auto import tqdm
 
 from poseintegrity.tracking.markers.correspondence import match_markers_unchecked
-from poseintegrity.tracking.markers.detection import detect_markers_unchecked
+from poseintegrity.tracking.markers.detection import detect_markers_each, raw_threshold
 from poseintegrity.tracking.simulation.errors import error_columns
-from poseintegrity.tracking.simulation.frames import draw_phantoms, intrinsics, render_frame
+from poseintegrity.tracking.simulation.frames import background_quantiles, draw_phantoms, intrinsics, render_frame
 from poseintegrity.parallel import in_worker_task
 from poseintegrity.poses import NAN_POSE, pose_matrix
 from poseintegrity.tracking.markers.geometry import MARKER_DIAMETER_M, transform_points
@@ -59,6 +59,15 @@ def T_world_cam(params: TrackParams) -> np.ndarray:
     return pose_matrix(np.eye(3), np.array(params.camera.origin_m))
 
 
+def background_seen(params: TrackParams, detections: Sequence[DetectionParams]) -> bool:
+    """Whether any of these detectors can tell the noisy IR background from a flat one: the detector reads IR only
+    through its threshold (:func:`~poseintegrity.tracking.markers.detection.raw_threshold`), so when that lies above
+    the largest background value (:func:`~poseintegrity.tracking.simulation.frames.background_quantiles`) frames
+    rendered with ``background_noise=False`` give the same masks, points and later random draws, for less work."""
+    brightest_unlit = background_quantiles(params.frames.ir_background, params.frames.ir_noise_std).max()
+    return any(brightest_unlit > raw_threshold(d, np.uint16) for d in detections)
+
+
 def record(
     params: TrackParams,
     trajectory: Trajectory,
@@ -74,6 +83,8 @@ def record(
     detections : the detectors' constants; one :class:`Simulation` per detector is returned, all of the same
     rendered frames (detection draws no random number).  sink(t, ir, depth_mm) receives each rendered frame.
     The points of a frame come from detection on the rendered images, so their error is the detector's.
+    Without a sink the frames are rendered without background noise unless a detector could see it
+    (:func:`background_seen`).
     """
     idx = timeline.frame_index
     T_true = pose_matrix(trajectory.rotation(idx), trajectory.position[idx])
@@ -82,14 +93,15 @@ def record(
     K = intrinsics(params.camera)
     t = trajectory.t[idx]
     points: list[list[np.ndarray]] = [[] for _ in detections]
+    background_noise = sink is not None or background_seen(params, detections)
     for f in tqdm(range(len(idx)), desc=label, leave=False, mininterval=5, disable=in_worker_task()):
         markers_cam = transform_points(T_cw, transform_points(T_true[f], markers_body))[~timeline.occluded[f]]
         phantoms = draw_phantoms(int(timeline.n_phantoms[f]), params.camera, params.frames, params.motion.phantom_round_fraction, rng)
-        ir, depth_mm = render_frame(markers_cam, phantoms, params.camera, params.frames, MARKER_DIAMETER_M / 2, rng)
+        ir, depth_mm = render_frame(markers_cam, phantoms, params.camera, params.frames, MARKER_DIAMETER_M / 2, rng, background_noise)
         if sink is not None:
             sink(float(t[f]), ir, depth_mm)
-        for found, detection in zip(points, detections):
-            found.append(detect_markers_unchecked(ir, depth_mm, K, detection, T_world_cam=T_wc))  # rendered here: a usable frame
+        for found, detected in zip(points, detect_markers_each(ir, depth_mm, K, list(detections), T_world_cam=T_wc)):  # rendered here: usable
+            found.append(detected)
     occlusions = [tuple(o) for o in params.motion.occlusions]
     return [Simulation(trajectory, timeline, markers_body, t, T_true, found, inside_occlusions(t, occlusions), occlusions)
             for found in points]
