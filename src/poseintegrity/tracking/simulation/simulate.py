@@ -157,18 +157,18 @@ def run_no_filter(sim: Simulation, params: TrackParams) -> pd.DataFrame:
     correct: at least min_markers markers matched and every matched point within correct_tolerance_m of
     its true marker (correspondence right and pose usable).  Error columns: :func:`~poseintegrity.tracking.simulation.errors.error_columns`.
     """
-    m, rows, poses = params.matching, [], []
+    m, n_frames = params.matching, len(sim.points)
+    true_markers = transform_points(sim.T_true, sim.markers_body)  # (F, m, 3)
+    poses, n_matched, correct = np.empty((n_frames, 4, 4)), np.zeros(n_frames, dtype=np.int64), np.zeros(n_frames, dtype=bool)
     for f, points in enumerate(sim.points):
         assignment = match_markers_unchecked(points, sim.markers_body, None, m)
         matched = assignment >= 0
-        true_markers = transform_points(sim.T_true[f], sim.markers_body)
-        poses.append(pose_from_points_unchecked(points[assignment[matched]], sim.markers_body[matched]) if matched.sum() >= 3 else NAN_POSE)
-        err = np.linalg.norm(points[assignment[matched]] - true_markers[matched], axis=1) if matched.any() else np.zeros(0)
-        correct = matched.sum() >= m.min_markers and bool(np.all(err <= params.evaluation.correct_tolerance_m))
-        visible = int((~sim.timeline.occluded[f]).sum())
-        rows.append({"frame": f, "t": sim.t[f], "n_visible": visible, "n_detected": len(points), "n_matched": int(matched.sum()), "correct": correct})
-    df = pd.DataFrame(rows)
-    poses = np.stack(poses)
+        n_matched[f] = matched.sum()
+        poses[f] = pose_from_points_unchecked(points[assignment[matched]], sim.markers_body[matched]) if n_matched[f] >= 3 else NAN_POSE
+        err = np.linalg.norm(points[assignment[matched]] - true_markers[f][matched], axis=1) if n_matched[f] else np.zeros(0)
+        correct[f] = n_matched[f] >= m.min_markers and bool(np.all(err <= params.evaluation.correct_tolerance_m))
+    df = pd.DataFrame({"frame": np.arange(n_frames), "t": sim.t[:n_frames], "n_visible": (~sim.timeline.occluded[:n_frames]).sum(axis=1),
+                       "n_detected": [len(points) for points in sim.points], "n_matched": n_matched, "correct": correct})
     for name, column in error_columns(poses, sim.T_true).items():
         df[name] = column
     df[["x_mm", "y_mm", "z_mm"]] = poses[:, :3, 3] * 1000.0
