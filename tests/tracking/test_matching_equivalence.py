@@ -1,7 +1,7 @@
 """The compiled matchers give the assignments of the numpy code they replaced (reference_matching.py), element for
 element: random frames of the real marker body (params.yaml) in random poses with 0.5 mm noise, phantoms near and far,
 dropped markers, NaN rows, duplicated points (exact ties), the body's near-symmetric permutation (4, 3, 2, 1) and
-predictions near, far or permuted.  ``python tests/tracking/test_matching_equivalence.py 200000`` runs a larger draw.
+predictions near, far or permuted.  ``PYTHONPATH=src:tests python tests/tracking/test_matching_equivalence.py 200000`` runs a larger draw.
 """
 
 import sys
@@ -129,7 +129,7 @@ def test_the_sum_of_squares_is_numpys_for_long_bodies():
         assert compiled._numpy_sum(a) == a.sum()
 
 
-if __name__ == "__main__":  # a larger draw by hand: python tests/tracking/test_matching_equivalence.py 200000 [seed]
+if __name__ == "__main__":  # a larger draw by hand (PYTHONPATH=src:tests), e.g. 200000 cases [seed]
     n_cases, seed = int(sys.argv[1]), int(sys.argv[2]) if len(sys.argv) > 2 else 12345
     differ = differences(n_cases, seed)
     print(f"{n_cases} cases (seed {seed}): {len(differ)} differ{': ' + str(differ[:20]) if differ else ''}")

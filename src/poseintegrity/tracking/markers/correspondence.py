@@ -306,7 +306,13 @@ def _brute_force(points, geometry, fixed, pool, tolerance_m, min_markers):  # pr
     pool (int, ascending).  Per number of open markers matched, from the most down to min_markers in all, every
     marker subset (combinations) and every map of it to the pool (permutations) is fitted with Kabsch (Alg. 4) in
     the order [known markers, chosen markers]; a map counts if every residual is within tolerance_m, and the first
-    one with the least error e wins."""
+    one with the least error e wins.
+
+    Maps that cannot count are skipped without the fit, with every map sharing their first points: if two matched
+    points are farther apart or closer than their markers by more than 2 tolerance_m (+ ``slack``), no pose puts both
+    within tolerance_m (triangle inequality: |R (y^a - y^b) - (r^a - r^b)| <= res_a + res_b, and R keeps lengths).
+    The slack, 1e-9 of the largest coordinate (+ 1e-9 m), is far above the rounding of the computed residuals and of
+    R's length error (< 1e-12 of it), so a skipped map would have failed the test as computed too."""
     m = geometry.shape[0]
     known, open_markers = np.flatnonzero(fixed >= 0), np.flatnonzero(fixed < 0)
     n_known, n_pool = known.size, pool.size
@@ -315,6 +321,18 @@ def _brute_force(points, geometry, fixed, pool, tolerance_m, min_markers):  # pr
     y_bar, scratch, R, t = np.empty(3), np.empty((4, 4, 4)), np.empty((3, 3)), np.empty(3)
     for j in range(n_known):
         world[j], body[j] = points[fixed[known[j]]], geometry[known[j]]
+    scale = 0.0
+    for j in range(n_known):
+        scale = max(scale, np.abs(world[j]).max())
+    for j in range(n_pool):
+        scale = max(scale, np.abs(points[pool[j]]).max())
+    for i in range(m):
+        scale = max(scale, np.abs(geometry[i]).max())
+    slack = 2.0 * tolerance_m + 1e-9 * (1.0 + scale)  # a pair whose distance misses its markers' by more cannot count
+    for a in range(n_known):
+        for b in range(a):
+            if abs(_reduce_norm(world[a], world[b]) - _reduce_norm(body[a], body[b])) > slack:
+                return np.full(m, -1, dtype=np.int64)  # the known markers are in every map
     for n_open in range(min(open_markers.size, n_pool), -1, -1):
         k = n_known + n_open
         if k < min_markers:
@@ -328,8 +346,10 @@ def _brute_force(points, geometry, fixed, pool, tolerance_m, min_markers):  # pr
             centre_into(body[:k], ell[:k], y_bar)
             more = _first_permutation(perm, taken)  # perm: positions in pool, as itertools.permutations
             while more:
-                for j in range(n_open):
-                    world[n_known + j] = points[pool[perm[j]]]
+                misfit = _first_misfit(world, body, points, pool, perm, n_known, slack)
+                if misfit < n_open:  # every map starting with perm[:misfit + 1] has the misfitting pair
+                    more = _next_permutation(perm, taken, misfit)
+                    continue
                 kabsch_into(world[:k], ell[:k], y_bar, scratch, R, t)
                 residuals_into(world[:k], body[:k], R, t, res[:k])
                 if _all_within(res[:k], tolerance_m):
@@ -343,12 +363,26 @@ def _brute_force(points, geometry, fixed, pool, tolerance_m, min_markers):  # pr
                             best[known[j]] = fixed[known[j]]
                         for j in range(n_open):
                             best[open_markers[chosen[j]]] = pool[perm[j]]
-                more = _next_permutation(perm, taken)
+                more = _next_permutation(perm, taken, n_open - 1)
             if not _next_combination(chosen, open_markers.size):
                 break
         if best_e < np.inf:
             return best
     return np.full(m, -1, dtype=np.int64)
+
+
+@numba.njit(cache=True)
+def _first_misfit(world, body, points, pool, perm, n_known, slack):  # pragma: no cover - compiled
+    """Fill world[n_known:] with the points of the map perm and return the first position j of perm whose point is
+    misplaced against an earlier one (the distance of the pair misses that of its markers by more than slack), or
+    perm.size if none is; world[:n_known] and body hold the known points and the markers in map order."""
+    for j in range(perm.size):
+        a = n_known + j
+        world[a] = points[pool[perm[j]]]
+        for b in range(a):
+            if abs(_reduce_norm(world[a], world[b]) - _reduce_norm(body[a], body[b])) > slack:
+                return j
+    return perm.size
 
 
 @numba.njit(cache=True)
@@ -381,11 +415,14 @@ def _first_permutation(perm, taken):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True)
-def _next_permutation(perm, taken):  # pragma: no cover - compiled
+def _next_permutation(perm, taken, level):  # pragma: no cover - compiled
     """Advance perm (r,) distinct positions of range(n), taken (n,) marking them, to the next r-permutation in
-    itertools order (lexicographic); False after the last."""
+    itertools order (lexicographic) whose first level + 1 positions differ from perm's (level = r - 1: the very next);
+    False after the last."""
     r, n = perm.size, taken.size
-    for i in range(r - 1, -1, -1):
+    for i in range(level + 1, r):
+        taken[perm[i]] = False
+    for i in range(level, -1, -1):
         taken[perm[i]] = False  # the positions after i are free already
         v = perm[i] + 1
         while v < n and taken[v]:
