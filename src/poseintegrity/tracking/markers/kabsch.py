@@ -8,6 +8,9 @@ from __future__ import annotations
 
 import numba
 import numpy as np
+from llvmlite import ir
+from numba.core import cgutils, types
+from numba.extending import intrinsic
 
 from poseintegrity.errors import ArgumentError, check_array
 from poseintegrity.poses import pose_matrix
@@ -72,19 +75,43 @@ def _kabsch_kernel(points_world, points_body):  # pragma: no cover - compiled
     b, n = points_world.shape[0], points_world.shape[1]
     R = np.empty((b, 3, 3))
     t = np.empty((b, 3))
+    ell, y_bar, scratch = np.empty((n, 3)), np.empty(3), np.empty((4, 4, 4))
     for k in range(b):
-        body = points_body[k if points_body.shape[0] > 1 else 0]
-        r_bar = np.zeros(3)
-        y_bar = np.zeros(3)
-        for i in range(n):
-            r_bar += points_world[k, i]
-            y_bar += body[i]
-        r_bar /= n
-        y_bar /= n
-        R[k] = horn_rotation(centred_cross_covariance(points_world[k], body - y_bar))
-        for a in range(3):
-            t[k, a] = r_bar[a] - (R[k, a, 0] * y_bar[0] + R[k, a, 1] * y_bar[1] + R[k, a, 2] * y_bar[2])
+        centre_into(points_body[k if points_body.shape[0] > 1 else 0], ell, y_bar)
+        kabsch_into(points_world[k], ell, y_bar, scratch, R[k], t[k])
     return R, t
+
+
+@numba.njit(cache=True)
+def centre_into(body, ell, y_bar):  # pragma: no cover - compiled
+    """y_bar (3,) = the mean of body (n, 3), summed row by row, and ell (n, 3) = body - y_bar: Alg. 4's centred body."""
+    n = body.shape[0]
+    y_bar[:] = 0.0
+    for i in range(n):
+        y_bar += body[i]
+    y_bar /= n
+    for i in range(n):
+        for a in range(3):
+            ell[i, a] = body[i, a] - y_bar[a]
+
+
+@numba.njit(cache=True)
+def kabsch_into(points_world, ell, y_bar, scratch, R, t):  # pragma: no cover - compiled
+    """Alg. 4 for one problem without allocating: points_world (n, 3), the centred body ell (n, 3) and its mean y_bar
+    (:func:`centre_into`); scratch (4, 4, 4) (H, V, N, M); R (3, 3) and t (3,) = r_bar - R y_bar receive the pose."""
+    n = points_world.shape[0]
+    r_bar = np.zeros(3)
+    for i in range(n):
+        r_bar += points_world[i]
+    r_bar /= n
+    H, V, N, M = scratch[0, :3, :3], scratch[1], scratch[2], scratch[3]
+    centred_cross_covariance_into(points_world, ell, H)
+    V[:] = 0.0
+    for a in range(4):
+        V[a, a] = 1.0
+    horn_rotation_into(H, V, N, M, R)
+    for a in range(3):
+        t[a] = r_bar[a] - (R[a, 0] * y_bar[0] + R[a, 1] * y_bar[1] + R[a, 2] * y_bar[2])
 
 
 def pose_from_points(points_world: np.ndarray, points_body: np.ndarray) -> np.ndarray:
@@ -100,9 +127,50 @@ def pose_from_points_unchecked(points_world: np.ndarray, points_body: np.ndarray
 def kabsch_residuals(points_world: np.ndarray, points_body: np.ndarray) -> np.ndarray:
     """Distances ``|R y^i + t - r^i|`` after the Kabsch fit, (..., n) metres (the error of Alg. 3); unchecked
     (correspondence calls it on its own candidate sets, see :func:`kabsch_unchecked`)."""
-    R, t = kabsch_unchecked(points_world, points_body)
-    fitted = points_body @ np.swapaxes(R, -1, -2) + t[..., None, :]
-    return np.linalg.norm(fitted - points_world, axis=-1)
+    points_world = np.asarray(points_world, dtype=np.float64)
+    points_body = np.asarray(points_body, dtype=np.float64)
+    batch, n = points_world.shape[:-2], points_world.shape[-2]
+    if points_body.ndim > 2:  # one body per problem; else the same (n, 3) body for all
+        points_body = np.broadcast_to(points_body, points_world.shape)
+    res = _residuals_kernel(np.ascontiguousarray(points_world.reshape(-1, n, 3)), np.ascontiguousarray(points_body.reshape(-1, n, 3)))
+    return res.reshape(batch + (n,))
+
+
+@numba.njit(cache=True)
+def _residuals_kernel(points_world, points_body):  # pragma: no cover - compiled
+    """:func:`kabsch_residuals` of b problems: points_world (b, n, 3), points_body (b, n, 3) or (1, n, 3); (b, n)."""
+    b, n = points_world.shape[0], points_world.shape[1]
+    res = np.empty((b, n))
+    ell, y_bar, scratch, R, t = np.empty((n, 3)), np.empty(3), np.empty((4, 4, 4)), np.empty((3, 3)), np.empty(3)
+    for k in range(b):
+        body = points_body[k if points_body.shape[0] > 1 else 0]
+        centre_into(body, ell, y_bar)
+        kabsch_into(points_world[k], ell, y_bar, scratch, R, t)
+        residuals_into(points_world[k], body, R, t, res[k])
+    return res
+
+
+@numba.njit(cache=True)
+def residuals_into(points_world, points_body, R, t, res):  # pragma: no cover - compiled
+    """res (n,) = |R y^i + t - r^i| for the pose (R, t) of :func:`kabsch_into`, rounded as numpy rounds
+    ``norm(points_body @ R.T + t - points_world, axis=-1)``: the product as OpenBLAS's dgemm forms it (a fused
+    multiply-add per term, in order), then the squares summed in order."""
+    for i in range(points_world.shape[0]):
+        y = points_body[i]
+        d0 = fused_multiply_add(y[2], R[0, 2], fused_multiply_add(y[1], R[0, 1], y[0] * R[0, 0])) + t[0] - points_world[i, 0]
+        d1 = fused_multiply_add(y[2], R[1, 2], fused_multiply_add(y[1], R[1, 1], y[0] * R[1, 0])) + t[1] - points_world[i, 1]
+        d2 = fused_multiply_add(y[2], R[2, 2], fused_multiply_add(y[1], R[2, 1], y[0] * R[2, 0])) + t[2] - points_world[i, 2]
+        res[i] = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+
+
+@intrinsic
+def fused_multiply_add(typingctx, a, b, c):  # pragma: no cover - compiled
+    """a * b + c rounded once (LLVM's llvm.fma.f64), in compiled code: the arithmetic of the BLAS kernels numpy calls."""
+    def codegen(context, builder, signature, args):
+        fma = cgutils.get_or_insert_function(builder.module, ir.FunctionType(ir.DoubleType(), [ir.DoubleType()] * 3), "llvm.fma.f64")
+        return builder.call(fma, args)
+
+    return types.float64(types.float64, types.float64, types.float64), codegen
 
 
 @numba.njit(cache=True)
