@@ -328,7 +328,10 @@ from pathlib import Path
 from poseintegrity.config import load_section
 from poseintegrity.parallel import Workers
 from poseintegrity.report.metrics import json_ready
-from poseintegrity.tracking.experiments.study import run_study
+try:
+    from poseintegrity.tracking.experiments.study import run_study
+except ModuleNotFoundError:  # a commit from before the tracking package was split into sub-packages
+    from poseintegrity.tracking.evaluation import run_study
 params_path, frames, out = Path(sys.argv[1]), int(sys.argv[2]), Path(sys.argv[3])
 params = load_section(params_path, "track")
 params = params.model_copy(update={"evaluation": params.evaluation.model_copy(update={"success_frames": frames})})

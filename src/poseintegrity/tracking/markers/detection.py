@@ -428,9 +428,20 @@ def detect_markers_each(ir: np.ndarray, depth_mm: np.ndarray, unproject: np.ndar
     for detection, (uv, d_split) in zip(detections, detect_blobs_each(ir, detections, depth_mm)):
         d_mm = np.where(np.isnan(d_split), lookup_depth(depth_mm, uv, detection), d_split)
         keep = np.isfinite(d_mm)
-        xy = unit_plane_coordinates(uv[keep], unproject)
-        rays = np.column_stack([xy, np.ones(len(xy))])
-        rays /= np.linalg.norm(rays, axis=1, keepdims=True)
-        points_cam = rays * ((d_mm[keep] + detection.depth_offset_mm) / 1000.0)[:, None]  # depth is along the ray
+        points_cam = points_along_rays(unit_plane_coordinates(uv[keep], unproject), d_mm[keep] + detection.depth_offset_mm)
         points.append(points_cam if T_world_cam is None else transform_points(T_world_cam, points_cam))
+    return points
+
+
+@numba.njit(cache=True, nogil=True)
+def points_along_rays(xy, distance_mm):  # pragma: no cover - compiled
+    """Points (k, 3) m at distance_mm (k,) along the rays through xy (k, 2) on the z = 1 plane (AHAT depth is measured
+    along the ray): (x, y, 1) / |(x, y, 1)| * distance_mm / 1000, rounded as numpy rounds it (the norm's squares
+    summed in order, then the division, then the product)."""
+    points = np.empty((len(xy), 3))
+    for k in range(len(xy)):
+        x, y = xy[k, 0], xy[k, 1]
+        norm = np.sqrt((x * x + y * y) + 1.0 * 1.0)
+        scale = distance_mm[k] / 1000.0
+        points[k, 0], points[k, 1], points[k, 2] = (x / norm) * scale, (y / norm) * scale, (1.0 / norm) * scale
     return points

@@ -177,58 +177,53 @@ def render_frame(
     frame_bias = rng.normal(0.0, frames.frame_depth_bias_std_mm)
     centres = np.ascontiguousarray(markers_cam[np.argsort(-markers_cam[:, 2])] if len(markers_cam) else np.zeros((0, 3)), dtype=float)
     shapes = np.array([(p.u, p.v, p.radius_px, p.elongation, p.angle, p.depth_mm) for p in phantoms], dtype=float).reshape(-1, 6)
-    sphere_patches = _sphere_patches(centres, K, float(camera.focal_px), float(marker_radius_m), W, H)
-    ellipse_patches = _ellipse_patches(shapes, W, H)
-    drawn = sphere_patches[:, 0] < sphere_patches[:, 1]
-    areas = np.r_[(sphere_patches[drawn, 1] - sphere_patches[drawn, 0]) * (sphere_patches[drawn, 3] - sphere_patches[drawn, 2]) + 2,
-                  np.maximum(ellipse_patches[:, 1] - ellipse_patches[:, 0], 0) * np.maximum(ellipse_patches[:, 3] - ellipse_patches[:, 2], 0) + 1]
-    z = rng.standard_normal(int(areas.sum()))
-    _draw_scene(depth, brightness, centres, sphere_patches, shapes, ellipse_patches, z, frame_bias, float(frames.depth_bias_std_mm),
-                float(frames.depth_noise_mm), float(frames.marker_ir), float(frames.marker_ir_std), K, float(marker_radius_m), s)
-    patches = np.concatenate([sphere_patches[drawn], ellipse_patches])  # the only pixels a reflection can light
+    patches, n_draws = _patches(centres, shapes, K, float(camera.focal_px), float(marker_radius_m), W, H)  # the only pixels lit
+    z = rng.standard_normal(n_draws)
+    _draw_scene(depth, brightness, centres, shapes, patches, z, frame_bias, float(frames.depth_bias_std_mm), float(frames.depth_noise_mm),
+                float(frames.marker_ir), float(frames.marker_ir_std), K, float(marker_radius_m), s)
     return ir_image(brightness, frames, rng, patches, background_noise), depth
 
 
 @numba.njit(cache=True, nogil=True)
-def _sphere_patches(centres, K, focal_px, radius_m, W, H):  # pragma: no cover - compiled
-    """Pixel patches (k, 4) int rows (v0, v1, u0, u1) holding the image of each sphere of centres (k, 3) m: its
-    projected centre +- its image radius + 2 px, within the image; (0, 0, 0, 0) for a sphere not drawn (centre
-    within one radius of the camera, or a patch outside the image)."""
-    patches = np.zeros((len(centres), 4), np.int64)
+def _patches(centres, shapes, K, focal_px, radius_m, W, H):  # pragma: no cover - compiled
+    """Pixel patches (k + p, 4) int rows (v0, v1, u0, u1) of the spheres (k, 3) m and then the phantoms (p, 6) (u, v,
+    radius_px, elongation, angle, depth_mm), and the number of normal draws :func:`_draw_scene` takes.
+
+    A sphere's patch is its projected centre +- its image radius + 2 px within the image, (0, 0, 0, 0) if it is not
+    drawn (centre within one radius of the camera, or a patch outside the image); it draws 2 + its pixel count.  A
+    phantom's is its centre +- radius_px elongation + 2 px within the image (possibly empty); it draws 1 + its pixel
+    count.  Bounds truncate toward zero, as ``int()`` does."""
+    patches = np.zeros((len(centres) + len(shapes), 4), np.int64)
+    n_draws = 0
     for k in range(len(centres)):
         x, y, z = centres[k, 0], centres[k, 1], centres[k, 2]
         if z <= radius_m:
             continue
         u_c, v_c = K[0, 0] * x / z + K[0, 2], K[1, 1] * y / z + K[1, 2]
         rho = focal_px * radius_m / np.sqrt(z**2 - radius_m**2) + 2.0
-        u0, u1 = max(np.trunc(u_c - rho), 0.0), min(np.trunc(u_c + rho) + 2.0, W)  # int() truncates toward zero
+        u0, u1 = max(np.trunc(u_c - rho), 0.0), min(np.trunc(u_c + rho) + 2.0, W)
         v0, v1 = max(np.trunc(v_c - rho), 0.0), min(np.trunc(v_c + rho) + 2.0, H)
         if u0 < u1 and v0 < v1:
             patches[k, 0], patches[k, 1], patches[k, 2], patches[k, 3] = int(v0), int(v1), int(u0), int(u1)
-    return patches
+            n_draws += 2 + (int(v1) - int(v0)) * (int(u1) - int(u0))
+    for q in range(len(shapes)):
+        extent = shapes[q, 2] * shapes[q, 3] + 2.0
+        row = patches[len(centres) + q]
+        row[2], row[3] = max(int(np.trunc(shapes[q, 0] - extent)), 0), min(int(np.trunc(shapes[q, 0] + extent)) + 2, W)
+        row[0], row[1] = max(int(np.trunc(shapes[q, 1] - extent)), 0), min(int(np.trunc(shapes[q, 1] + extent)) + 2, H)
+        n_draws += 1 + max(row[1] - row[0], 0) * max(row[3] - row[2], 0)
+    return patches, n_draws
 
 
 @numba.njit(cache=True, nogil=True)
-def _ellipse_patches(shapes, W, H):  # pragma: no cover - compiled
-    """Pixel patches (p, 4) int rows (v0, v1, u0, u1) of the phantoms (p, 6) (u, v, radius_px, elongation, angle,
-    depth_mm): their centre +- radius_px elongation + 2 px, within the image (possibly empty: v1 <= v0 or u1 <= u0)."""
-    patches = np.empty((len(shapes), 4), np.int64)
-    for k in range(len(shapes)):
-        extent = shapes[k, 2] * shapes[k, 3] + 2.0
-        patches[k, 2], patches[k, 3] = max(int(np.trunc(shapes[k, 0] - extent)), 0), min(int(np.trunc(shapes[k, 0] + extent)) + 2, W)
-        patches[k, 0], patches[k, 1] = max(int(np.trunc(shapes[k, 1] - extent)), 0), min(int(np.trunc(shapes[k, 1] + extent)) + 2, H)
-    return patches
-
-
-@numba.njit(cache=True, nogil=True)
-def _draw_scene(depth, brightness, centres, sphere_patches, shapes, ellipse_patches, z, frame_bias, depth_bias_std_mm, depth_noise_mm,
-                marker_ir, marker_ir_std, K, radius_m, s):  # pragma: no cover - compiled
-    """Every sphere with a patch (far to near) and then every phantom, in place, taking their normal draws from z
-    in order: per sphere its depth bias, its patch's depth noise (row-major) and its IR level; per phantom its
-    patch's depth noise and its IR level (loc + scale z, as ``rng.normal`` computes them)."""
+def _draw_scene(depth, brightness, centres, shapes, patches, z, frame_bias, depth_bias_std_mm, depth_noise_mm, marker_ir, marker_ir_std, K,
+                radius_m, s):  # pragma: no cover - compiled
+    """Every sphere with a patch (far to near) and then every phantom, in place, in their patches (:func:`_patches`),
+    taking their normal draws from z in order: per sphere its depth bias, its patch's depth noise (row-major) and
+    its IR level; per phantom its patch's depth noise and its IR level (loc + scale z, as ``rng.normal`` computes them)."""
     k = 0
     for m in range(len(centres)):
-        v0, v1, u0, u1 = sphere_patches[m, 0], sphere_patches[m, 1], sphere_patches[m, 2], sphere_patches[m, 3]
+        v0, v1, u0, u1 = patches[m, 0], patches[m, 1], patches[m, 2], patches[m, 3]
         if v0 >= v1:
             continue
         bias = frame_bias + (0.0 + depth_bias_std_mm * z[k])
@@ -238,7 +233,7 @@ def _draw_scene(depth, brightness, centres, sphere_patches, shapes, ellipse_patc
         k += 1
         _draw_sphere(depth, brightness, centres[m], radius_m, K, u0, v0, noise, bias, level, s)
     for m in range(len(shapes)):
-        v0, v1, u0, u1 = ellipse_patches[m, 0], ellipse_patches[m, 1], ellipse_patches[m, 2], ellipse_patches[m, 3]
+        v0, v1, u0, u1 = patches[len(centres) + m, 0], patches[len(centres) + m, 1], patches[len(centres) + m, 2], patches[len(centres) + m, 3]
         h, w = max(v1 - v0, 0), max(u1 - u0, 0)
         noise = (0.0 + depth_noise_mm * z[k : k + h * w]).reshape(h, w)
         k += h * w
@@ -274,7 +269,7 @@ def _lit_pixels(brightness: np.ndarray, patches: np.ndarray) -> np.ndarray:
     """``np.flatnonzero(brightness > 0)`` for brightness (H, W) that is 0 outside the patches (k, 4) int rows
     (v0, v1, u0, u1): each row is scanned only from the leftmost to the rightmost patch column that covers it."""
     H, W = brightness.shape
-    out = np.empty(min(H * W, int(((patches[:, 1] - patches[:, 0]) * W).sum())), np.int64)  # rows the patches span, whole
+    out = np.empty(min(H * W, int((np.maximum(patches[:, 1] - patches[:, 0], 0) * W).sum())), np.int64)  # rows the patches span, whole
     n = 0
     for v in range(H):
         first, last = W, 0
