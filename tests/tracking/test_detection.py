@@ -6,7 +6,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from poseintegrity.tracking.markers.detection import (
-    _valid_depth_range, blob_pixels, detect_markers, detect_markers_each, raw_threshold, split_by_depth, validate_frame,
+    _valid_depth_range, blob_pixels, detect_markers, detect_markers_each, points_along_rays, raw_threshold, split_by_depth, validate_frame,
 )
 from poseintegrity.tracking.simulation.frames import Phantom, intrinsics, render_frame, unit_plane_lut
 from poseintegrity.tracking.markers.geometry import MARKER_DIAMETER_M
@@ -185,3 +185,13 @@ def test_a_blob_whose_box_spans_less_than_a_depth_cut_has_no_depth_split():
             elif len(centres):
                 cases["split"] = cases.get("split", 0) + 1
     assert cases[True] > 50 and cases[False] > 10 and cases.get("split", 0) > 5
+
+
+def test_points_along_rays_round_as_numpy_does():
+    rng = np.random.default_rng(4)
+    xy = rng.uniform(-1.2, 1.2, (500, 2))
+    distance_mm = rng.uniform(100.0, 1000.0, 500)
+    rays = np.column_stack([xy, np.ones(len(xy))])
+    rays /= np.linalg.norm(rays, axis=1, keepdims=True)
+    np.testing.assert_array_equal(points_along_rays(xy, distance_mm), rays * (distance_mm / 1000.0)[:, None])
+    assert points_along_rays(np.zeros((0, 2)), np.zeros(0)).shape == (0, 3)

@@ -7,7 +7,7 @@ from poseintegrity.errors import PoseIntegrityError
 from poseintegrity.tracking.markers.geometry import transform_points
 from poseintegrity.tracking.markers.kabsch import pose_from_points
 from poseintegrity.tracking.params import PAPER_SIGMAS
-from poseintegrity.tracking.filter.tracker import MarkerTracker
+from poseintegrity.tracking.filter.tracker import MarkerTracker, innovation_gate
 
 from tracking.track_section import GEOMETRY, TRACK
 
@@ -102,3 +102,27 @@ def test_published_sigmas_track_a_constant_rate_turn():
     late = np.array(errors[100:])
     assert np.sqrt((late[:, 0] ** 2).mean()) < 0.0015 and np.sqrt((late[:, 1] ** 2).mean()) < 1.5
     np.testing.assert_allclose(tracker.filter.x[12:15], [0.3, -0.2, 0.5], atol=0.05)
+
+
+def test_the_compiled_innovation_gate_decides_as_numpys_solve():
+    """innovation_gate against the quadratic form written with numpy (stacked products and np.linalg.solve), on
+    random factors and innovations around the threshold; cases within 1e-9 of it are left out (rounding)."""
+    rng = np.random.default_rng(8)
+    n, N, chi2, decided = 4, 18, 21.1, 0
+    for _ in range(400):
+        S = np.tril(rng.normal(0.0, 0.002, (N, N)))
+        x = rng.normal(0.0, 0.3, N)
+        observed = rng.random(n) < 0.8
+        points = x[: 3 * n].reshape(n, 3) + rng.normal(0.0, rng.choice([0.001, 0.005, 0.02]), (n, 3))
+        rows = S[: 3 * n].reshape(n, 3, N)
+        cov = rows @ np.swapaxes(rows, 1, 2) + 0.003**2 * np.eye(3)
+        nu = points - x[: 3 * n].reshape(n, 3)
+        d = np.einsum("ki,ki->k", nu, np.linalg.solve(cov, nu[:, :, None])[:, :, 0])
+        clear = np.abs(d - chi2) > 1e-9 * chi2
+        ok = innovation_gate(S, x, points, observed, 0.003**2, chi2)
+        np.testing.assert_array_equal(ok[clear], (observed & (d <= chi2))[clear])
+        decided += int((observed & clear).sum())
+    assert decided > 1000
+    S[0, 0] = np.nan
+    assert not innovation_gate(S, x, points, np.ones(n, dtype=bool), 0.003**2, chi2)[0]  # NaN fails the gate
+    assert not innovation_gate(np.zeros((N, N)), x, points, np.ones(n, dtype=bool), 0.0, chi2).any()  # C = 0: not positive definite

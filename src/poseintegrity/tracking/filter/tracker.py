@@ -31,6 +31,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numba
 import numpy as np
 
 from poseintegrity.defaults import published
@@ -157,13 +158,8 @@ class MarkerTracker:
 
     def innovation_ok(self, points: np.ndarray, observed: np.ndarray) -> np.ndarray:
         """(n,) bool: observed markers whose point (n, 3 rows in geometry order) passes the innovation gate."""
-        i = np.flatnonzero(observed)
-        rows = self.filter.sqrt_covariance()[: 3 * self.filter.n].reshape(self.filter.n, 3, -1)[i]  # (k, 3, N)
-        cov = rows @ np.swapaxes(rows, 1, 2) + self.params.sigma_r**2 * np.eye(3)  # predicted marker + measurement noise (eq. 16)
-        nu = points[i] - self.filter.markers()[i]  # (k, 3)
-        ok = np.zeros(self.filter.n, dtype=bool)
-        ok[i] = np.einsum("ki,ki->k", nu, np.linalg.solve(cov, nu[:, :, None])[:, :, 0]) <= self.params.innovation_gate_chi2
-        return ok
+        return innovation_gate(np.ascontiguousarray(self.filter.sqrt_covariance()), self.filter.x, np.ascontiguousarray(points, dtype=np.float64),
+                               observed, float(self.params.sigma_r) ** 2, float(self.params.innovation_gate_chi2))
 
     def frame(self, t: float, points: np.ndarray) -> FrameResult:
         """A marker frame at t: measured points (n, 3), metres, world frame (may be empty, NaN rows ignored).
@@ -207,3 +203,44 @@ class MarkerTracker:
         self.last_marker_t = self.last_fused_t = t
         self.n_rejected = 0
         return FrameResult(assignment, T_measured, self.pose(), flag)
+
+
+@numba.njit(cache=True)
+def innovation_gate(S, x, points, observed, sigma_r2, chi2):  # pragma: no cover - compiled
+    """(n,) bool: the observed markers whose measured point passes the chi-square gate nu^T C^-1 nu <= chi2.
+
+    S (N, N): the filter's covariance factor (P = S S^T); x (N,): its state, markers first (eq. 3); points (n, 3) m
+    in geometry order; observed (n,) bool.  Marker i's innovation nu = point - x[3i:3i+3] has the covariance
+    C = S_i S_i^T + sigma_r2 I of its predicted position and the measurement noise (eq. 16), S_i the marker's
+    three rows of S; the quadratic form runs through C's Cholesky factor.  A C that is not positive definite, or
+    any NaN, fails the gate."""
+    n, N = observed.shape[0], S.shape[1]
+    ok = np.zeros(n, dtype=np.bool_)
+    C, L, y = np.empty((3, 3)), np.zeros((3, 3)), np.empty(3)
+    for i in range(n):
+        if not observed[i]:
+            continue
+        for a in range(3):
+            for b in range(3):
+                total = 0.0
+                for j in range(N):
+                    total += S[3 * i + a, j] * S[3 * i + b, j]
+                C[a, b] = total + (sigma_r2 if a == b else 0.0)
+        positive = True
+        for a in range(3):  # C = L L^T
+            for b in range(a + 1):
+                total = C[a, b]
+                for k in range(b):
+                    total -= L[a, k] * L[b, k]
+                if a == b:
+                    positive = positive and total > 0.0
+                    L[a, a] = np.sqrt(total) if total > 0.0 else 1.0
+                else:
+                    L[a, b] = total / L[b, b]
+        for a in range(3):  # y = L^-1 nu: nu^T C^-1 nu = y . y
+            total = points[i, a] - x[3 * i + a]
+            for k in range(a):
+                total -= L[a, k] * y[k]
+            y[a] = total / L[a, a]
+        ok[i] = positive and y[0] * y[0] + y[1] * y[1] + y[2] * y[2] <= chi2
+    return ok
