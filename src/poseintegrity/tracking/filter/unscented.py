@@ -100,6 +100,7 @@ class UnscentedMarkerFilter:
         self.failed_downdates = 0
         self.n_divergences = 0
         self.last_reason = ""
+        self._measured: dict[tuple, tuple[np.ndarray, np.ndarray]] = {}  # (rows, noise std) by (observed mask, gyro, sigma_r, sigma_omega)
 
     # -- covariance representation, provided by the subclass -------------------------------------
     def sqrt_covariance(self) -> np.ndarray:
@@ -220,10 +221,13 @@ class UnscentedMarkerFilter:
 
     def _update(self, z: np.ndarray, observed: np.ndarray, gyro: bool) -> bool:
         """:meth:`update` on checked arguments (z float64 of the right length, observed (n,) bool)."""
-        rows = measurement_rows(observed, gyro)
+        key = (observed.tobytes(), gyro, self.settings.sigma_r, self.settings.sigma_omega)
+        if key not in self._measured:  # the rows and noise of each combination of measured markers and gyro, made once
+            self._measured[key] = (measurement_rows(observed, gyro),
+                                   measurement_noise_std(observed, gyro, self.settings.sigma_r, self.settings.sigma_omega))
+        rows, noise_std = self._measured[key]
         if rows.size == 0:
             return True
-        noise_std = measurement_noise_std(observed, gyro, self.settings.sigma_r, self.settings.sigma_omega)
         return self._record_health(self._measurement_update(rows, z, noise_std))
 
     def markers(self) -> np.ndarray:

@@ -120,8 +120,22 @@ def pose_from_points(points_world: np.ndarray, points_body: np.ndarray) -> np.nd
 
 
 def pose_from_points_unchecked(points_world: np.ndarray, points_body: np.ndarray) -> np.ndarray:
-    """:func:`pose_from_points` without the argument checks (see :func:`kabsch_unchecked`)."""
+    """:func:`pose_from_points` without the argument checks (see :func:`kabsch_unchecked`); one (n, 3) problem, the
+    tracker's per-event pose, runs in one compiled call."""
+    if np.ndim(points_world) == 2 and np.ndim(points_body) == 2:
+        return _pose_kernel(np.ascontiguousarray(points_world, dtype=np.float64), np.ascontiguousarray(points_body, dtype=np.float64))
     return pose_matrix(*kabsch_unchecked(points_world, points_body))
+
+
+@numba.njit(cache=True)
+def _pose_kernel(points_world, points_body):  # pragma: no cover - compiled
+    """T_world_body (4, 4) of Alg. 4 for one problem: points_world and points_body (n, 3)."""
+    n = points_body.shape[0]
+    ell, y_bar, scratch, T = np.empty((n, 3)), np.empty(3), np.empty((4, 4, 4)), np.zeros((4, 4))
+    centre_into(points_body, ell, y_bar)
+    kabsch_into(points_world, ell, y_bar, scratch, T[:3, :3], T[:3, 3])
+    T[3, 3] = 1.0
+    return T
 
 
 def kabsch_residuals(points_world: np.ndarray, points_body: np.ndarray) -> np.ndarray:
