@@ -54,16 +54,8 @@ def is_consistent(points: np.ndarray, geometry: np.ndarray, assignment: np.ndarr
     return bool(kabsch_residuals(p, geometry[g]).max() <= tolerance_m)
 
 
-def match_voting(points: np.ndarray, geometry: np.ndarray, *, tolerance_m: float) -> tuple[np.ndarray, np.ndarray]:
-    """Alg. 2: Euclidean-distance voting.  Returns (assignment (m,) int, outlier (n,) bool).
-
-    For every geometry pair (i, j), the measured pair (k, l) whose distance is closest to |y^i - y^j| gets
-    one vote for each of i, j on each of k, l (V[i, k], V[i, l], V[j, k], V[j, l] += 1).  Beyond the paper,
-    a pair only votes if its distance differs by at most tolerance_m (metres; the paper compares squared
-    distances without a gate).  A point with no vote is an outlier.  Point k is assigned to geometry
-    marker i only if V[i, k] is the unique maximum of its column, reaches m - 1 (every pair of i agreed),
-    and no other point claims i; the rest is left for brute force.
-    """
+def match_voting(points, geometry, *, tolerance_m):
+    """Alg. 2 with a (geometry pairs, measured pairs) difference matrix and np.add.at votes."""
     geometry = np.asarray(geometry, dtype=float)
     m = geometry.shape[0]
     rows = _finite_rows(points)
@@ -94,23 +86,8 @@ def match_voting(points: np.ndarray, geometry: np.ndarray, *, tolerance_m: float
     return assignment, outlier
 
 
-def match_brute_force(
-    points: np.ndarray,
-    geometry: np.ndarray,
-    *,
-    fixed: np.ndarray | None = None,
-    candidates: np.ndarray | None = None,
-    tolerance_m: float,
-    min_markers: int,
-) -> np.ndarray:
-    """Alg. 3 generalised: try every injective map of geometry markers to points, Kabsch each, keep the best.
-
-    fixed : (m,) int, matches already known (kept; -1 = open).  candidates : (n,) bool, points that may
-    be used for the open markers (default: every finite point not in fixed).
-    The map with the most matched markers whose every Kabsch residual is within tolerance_m wins, ties
-    broken by the error e = sum |r_bar + R ell^i - r^i|^2 of Alg. 3.  All -1 if fewer than min_markers fit.
-    All maps of one size and marker subset are evaluated as one batch of Kabsch problems.
-    """
+def match_brute_force(points, geometry, *, fixed=None, candidates=None, tolerance_m, min_markers):
+    """Alg. 3 as numpy batches: every map of one size and marker subset fitted as one batch of Kabsch problems."""
     geometry = np.asarray(geometry, dtype=float)
     points = np.asarray(points, dtype=float).reshape(-1, 3)
     m = geometry.shape[0]
