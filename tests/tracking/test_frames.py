@@ -180,6 +180,8 @@ def test_a_flat_background_differs_only_where_nothing_reflects_and_detects_the_s
 
 
 def test_lit_pixels_inside_patches_are_flatnonzero_of_the_image():
+    """_lit_pixels on the box (from origin) around the patches gives the flat indices np.flatnonzero finds in the
+    whole image, and their brightness."""
     rng = np.random.default_rng(2)
     for _ in range(50):
         brightness = np.zeros((64, 80), np.float32)
@@ -189,7 +191,12 @@ def test_lit_pixels_inside_patches_are_flatnonzero_of_the_image():
             v1, u1 = min(v0 + int(rng.integers(0, 20)), 64), min(u0 + int(rng.integers(0, 20)), 80)
             brightness[v0:v1, u0:u1] = np.where(rng.random((v1 - v0, u1 - u0)) < 0.5, rng.uniform(1, 9, (v1 - v0, u1 - u0)), 0.0)
             patches.append((v0, v1, u0, u1))
-        np.testing.assert_array_equal(_lit_pixels(brightness, np.array(patches, dtype=np.int64).reshape(-1, 4)), np.flatnonzero(brightness > 0))
+        patches = np.array(patches, dtype=np.int64).reshape(-1, 4)
+        drawn = patches[(patches[:, 0] < patches[:, 1]) & (patches[:, 2] < patches[:, 3])]
+        v0, v1, u0, u1 = (drawn[:, 0].min(), drawn[:, 1].max(), drawn[:, 2].min(), drawn[:, 3].max()) if len(drawn) else (0, 0, 0, 0)
+        lit, reflected = _lit_pixels(brightness[v0:v1, u0:u1], (int(v0), int(u0)), patches, 80)
+        np.testing.assert_array_equal(lit, np.flatnonzero(brightness > 0))
+        np.testing.assert_array_equal(reflected, brightness.ravel()[lit])
 
 
 def test_the_background_is_seen_only_by_a_detector_whose_threshold_it_can_reach():

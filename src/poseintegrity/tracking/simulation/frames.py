@@ -70,10 +70,11 @@ def draw_phantoms(n: int, camera: CameraParams, frames: FrameParams, round_fract
 
 
 @numba.njit(cache=True, nogil=True)
-def _draw_sphere(depth, brightness, centre, radius_m, K, u0, v0, noise_mm, bias_mm, level, s):
+def _draw_sphere(depth, brightness, origin, centre, radius_m, K, u0, v0, noise_mm, bias_mm, level, s):
     """Ray-cast one sphere into the patch of pixels [u0, u0 + w) x [v0, v0 + h) of depth and brightness, in place.
 
-    depth : (H, W) uint16 mm; brightness : (H, W) float32; centre : (3,) m, camera frame; K : (3, 3) pinhole;
+    depth : (H, W) uint16 mm; brightness : float32, the image's pixels from origin (v, u) on (a box holding every
+    patch); centre : (3,) m, camera frame; K : (3, 3) pinhole;
     noise_mm : (h, w) depth noise, mm; bias_mm : depth bias, mm; level : IR of a fully covered pixel; s : rays
     per pixel side.  A pixel's cover is the share of its s x s rays (row-major grid, offsets (i + 0.5) / s - 0.5
     px) that hit the sphere, its depth the nearest hit along the ray (t = d.c - sqrt(R^2 - |c|^2 + (d.c)^2),
@@ -95,11 +96,11 @@ def _draw_sphere(depth, brightness, centre, radius_m, K, u0, v0, noise_mm, bias_
                         hits += 1
                         near = min(near, (proj - np.sqrt(disc)) * 1000.0)
             if hits:
-                _compose(depth, brightness, v0 + i, u0 + j, near + bias_mm + noise_mm[i, j], level * (hits / (s * s)))
+                _compose(depth, brightness, origin, v0 + i, u0 + j, near + bias_mm + noise_mm[i, j], level * (hits / (s * s)))
 
 
 @numba.njit(cache=True, nogil=True)
-def _draw_ellipse(depth, brightness, phantom, u0, v0, noise_mm, level, s):  # pragma: no cover - compiled
+def _draw_ellipse(depth, brightness, origin, phantom, u0, v0, noise_mm, level, s):  # pragma: no cover - compiled
     """Draw one phantom (6,) (u, v, radius_px, elongation, angle, depth_mm) into the patch of pixels
     [u0, u0 + w) x [v0, v0 + h) of depth and brightness, in place, as :func:`_draw_sphere` draws a sphere: cover is
     the share of the s x s rays inside the ellipse, depth its constant depth_mm plus noise_mm (h, w).
@@ -135,15 +136,15 @@ def _draw_ellipse(depth, brightness, phantom, u0, v0, noise_mm, level, s):  # pr
                     minor = (-du * sin + dv * cos) / radius
                     hits += major * major + minor * minor <= 1.0
             if hits:
-                _compose(depth, brightness, v0 + i, u0 + j, depth_mm + noise_mm[i, j], level * (hits / (s * s)))
+                _compose(depth, brightness, origin, v0 + i, u0 + j, depth_mm + noise_mm[i, j], level * (hits / (s * s)))
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
-def _compose(depth, brightness, v, u, depth_mm, ir):
+def _compose(depth, brightness, origin, v, u, depth_mm, ir):
     """A surface at depth_mm (rounded to whole mm, clipped to uint16) reflecting ir: the pixel (v, u) keeps the
     nearer depth and the brighter reflection."""
     depth[v, u] = min(depth[v, u], min(max(np.rint(depth_mm), 0.0), 65535.0))
-    brightness[v, u] = max(brightness[v, u], np.float32(ir))
+    brightness[v - origin[0], u - origin[1]] = max(brightness[v - origin[0], u - origin[1]], np.float32(ir))
 
 
 def render_frame(
@@ -158,7 +159,7 @@ def render_frame(
     """Render one IR and one depth frame.
 
     markers_cam : (k, 3) centres of the visible markers in the camera frame, metres (z forward).
-    phantoms : reflections to draw.  marker_radius_m : sphere radius, m.  background_noise : see :func:`ir_image`
+    phantoms : reflections to draw.  marker_radius_m : sphere radius, m.  background_noise : see :func:`sensor_ir`
     (False only where nothing reads the unlit pixels but a threshold above the background's largest value).
     Returns ir : (H, W) uint16 (raw reflectivity, background ~80, markers saturate above 1000) and
     depth_mm : (H, W) uint16, millimetres along the ray (background_depth_mm where nothing is hit).
@@ -172,16 +173,18 @@ def render_frame(
     """
     H, W, s = camera.height, camera.width, frames.supersampling
     K = intrinsics(camera)
-    brightness = np.zeros((H, W), dtype=np.float32)
     depth = np.full((H, W), depth_mm_uint16(frames.background_depth_mm), dtype=np.uint16)
     frame_bias = rng.normal(0.0, frames.frame_depth_bias_std_mm)
     centres = np.ascontiguousarray(markers_cam[np.argsort(-markers_cam[:, 2])] if len(markers_cam) else np.zeros((0, 3)), dtype=float)
     shapes = np.array([(p.u, p.v, p.radius_px, p.elongation, p.angle, p.depth_mm) for p in phantoms], dtype=float).reshape(-1, 6)
-    patches, n_draws = _patches(centres, shapes, K, float(camera.focal_px), float(marker_radius_m), W, H)  # the only pixels lit
+    patches, n_draws, box = _patches(centres, shapes, K, float(camera.focal_px), float(marker_radius_m), W, H)  # the only pixels lit
     z = rng.standard_normal(n_draws)
-    _draw_scene(depth, brightness, centres, shapes, patches, z, frame_bias, float(frames.depth_bias_std_mm), float(frames.depth_noise_mm),
+    brightness = np.zeros((box[1] - box[0], box[3] - box[2]), dtype=np.float32)  # the pixels of the box around every patch
+    origin = (int(box[0]), int(box[2]))
+    _draw_scene(depth, brightness, origin, centres, shapes, patches, z, frame_bias, float(frames.depth_bias_std_mm), float(frames.depth_noise_mm),
                 float(frames.marker_ir), float(frames.marker_ir_std), K, float(marker_radius_m), s)
-    return ir_image(brightness, frames, rng, patches, background_noise), depth
+    lit, reflected = _lit_pixels(brightness, origin, patches, W)
+    return sensor_ir((H, W), lit, reflected, frames, rng, background_noise), depth
 
 
 @numba.njit(cache=True, nogil=True)
@@ -192,7 +195,8 @@ def _patches(centres, shapes, K, focal_px, radius_m, W, H):  # pragma: no cover 
     A sphere's patch is its projected centre +- its image radius + 2 px within the image, (0, 0, 0, 0) if it is not
     drawn (centre within one radius of the camera, or a patch outside the image); it draws 2 + its pixel count.  A
     phantom's is its centre +- radius_px elongation + 2 px within the image (possibly empty); it draws 1 + its pixel
-    count.  Bounds truncate toward zero, as ``int()`` does."""
+    count.  Bounds truncate toward zero, as ``int()`` does.  Also returns the box (4,) (v0, v1, u0, u1) around
+    every non-empty patch (all 0 if there is none)."""
     patches = np.zeros((len(centres) + len(shapes), 4), np.int64)
     n_draws = 0
     for k in range(len(centres)):
@@ -212,11 +216,17 @@ def _patches(centres, shapes, K, focal_px, radius_m, W, H):  # pragma: no cover 
         row[2], row[3] = max(int(np.trunc(shapes[q, 0] - extent)), 0), min(int(np.trunc(shapes[q, 0] + extent)) + 2, W)
         row[0], row[1] = max(int(np.trunc(shapes[q, 1] - extent)), 0), min(int(np.trunc(shapes[q, 1] + extent)) + 2, H)
         n_draws += 1 + max(row[1] - row[0], 0) * max(row[3] - row[2], 0)
-    return patches, n_draws
+    box = np.array([H, 0, W, 0], np.int64)  # (v0, v1, u0, u1) around every non-empty patch; empty if there is none
+    for row in patches:
+        if row[0] < row[1] and row[2] < row[3]:
+            box[0], box[1], box[2], box[3] = min(box[0], row[0]), max(box[1], row[1]), min(box[2], row[2]), max(box[3], row[3])
+    if box[0] >= box[1]:
+        box[:] = 0
+    return patches, n_draws, box
 
 
 @numba.njit(cache=True, nogil=True)
-def _draw_scene(depth, brightness, centres, shapes, patches, z, frame_bias, depth_bias_std_mm, depth_noise_mm, marker_ir, marker_ir_std, K,
+def _draw_scene(depth, brightness, origin, centres, shapes, patches, z, frame_bias, depth_bias_std_mm, depth_noise_mm, marker_ir, marker_ir_std, K,
                 radius_m, s):  # pragma: no cover - compiled
     """Every sphere with a patch (far to near) and then every phantom, in place, in their patches (:func:`_patches`),
     taking their normal draws from z in order: per sphere its depth bias, its patch's depth noise (row-major) and
@@ -231,7 +241,7 @@ def _draw_scene(depth, brightness, centres, shapes, patches, z, frame_bias, dept
         k += 1 + (v1 - v0) * (u1 - u0)
         level = marker_ir + marker_ir_std * z[k]
         k += 1
-        _draw_sphere(depth, brightness, centres[m], radius_m, K, u0, v0, noise, bias, level, s)
+        _draw_sphere(depth, brightness, origin, centres[m], radius_m, K, u0, v0, noise, bias, level, s)
     for m in range(len(shapes)):
         v0, v1, u0, u1 = patches[len(centres) + m, 0], patches[len(centres) + m, 1], patches[len(centres) + m, 2], patches[len(centres) + m, 3]
         h, w = max(v1 - v0, 0), max(u1 - u0, 0)
@@ -239,7 +249,7 @@ def _draw_scene(depth, brightness, centres, shapes, patches, z, frame_bias, dept
         k += h * w
         level = marker_ir + marker_ir_std * z[k]
         k += 1
-        _draw_ellipse(depth, brightness, shapes[m], u0, v0, noise, level, s)
+        _draw_ellipse(depth, brightness, origin, shapes[m], u0, v0, noise, level, s)
 
 
 UNIFORM_LEVELS = 65536  # 16-bit uniforms: the background's inverse-CDF table has this many entries
@@ -265,22 +275,27 @@ def _lookup_16bit(words: np.ndarray, table: np.ndarray, out: np.ndarray) -> None
 
 
 @numba.njit(cache=True, nogil=True)
-def _lit_pixels(brightness: np.ndarray, patches: np.ndarray) -> np.ndarray:
-    """``np.flatnonzero(brightness > 0)`` for brightness (H, W) that is 0 outside the patches (k, 4) int rows
-    (v0, v1, u0, u1): each row is scanned only from the leftmost to the rightmost patch column that covers it."""
-    H, W = brightness.shape
-    out = np.empty(min(H * W, int((np.maximum(patches[:, 1] - patches[:, 0], 0) * W).sum())), np.int64)  # rows the patches span, whole
+def _lit_pixels(brightness, origin, patches, W):  # pragma: no cover - compiled
+    """The lit pixels of an image W wide, in raster order: their flat indices and their brightness (float32).
+    brightness : the pixels from origin (v, u) on, 0 outside the patches (k, 4) int rows (v0, v1, u0, u1); each row
+    is scanned only from the leftmost to the rightmost patch column that covers it."""
+    h = brightness.shape[0]
+    size = 0
+    for k in range(len(patches)):
+        size += max(patches[k, 1] - patches[k, 0], 0) * max(patches[k, 3] - patches[k, 2], 0)
+    lit, reflected = np.empty(size, np.int64), np.empty(size, np.float32)  # patches may overlap: at most their total area
     n = 0
-    for v in range(H):
+    for r in range(h):
+        v = origin[0] + r
         first, last = W, 0
         for k in range(len(patches)):
-            if patches[k, 0] <= v < patches[k, 1]:
+            if patches[k, 0] <= v < patches[k, 1] and patches[k, 2] < patches[k, 3]:  # an empty patch lights nothing
                 first, last = min(first, patches[k, 2]), max(last, patches[k, 3])
         for u in range(first, last):
-            if brightness[v, u] > 0:
-                out[n] = v * W + u
+            if brightness[r, u - origin[1]] > 0:
+                lit[n], reflected[n] = v * W + u, brightness[r, u - origin[1]]
                 n += 1
-    return out[:n]
+    return lit[:n], reflected[:n]
 
 
 def skip_raw(rng: np.random.Generator, n_words: int) -> None:
@@ -297,32 +312,38 @@ def skip_raw(rng: np.random.Generator, n_words: int) -> None:
     bit_generator.state = {**bit_generator.state, "has_uint32": state["has_uint32"], "uinteger": state["uinteger"]}
 
 
-def ir_image(brightness: np.ndarray, frames: FrameParams, rng: np.random.Generator, patches: np.ndarray | None = None,
-             background_noise: bool = True) -> np.ndarray:
+def ir_image(brightness: np.ndarray, frames: FrameParams, rng: np.random.Generator, background_noise: bool = True) -> np.ndarray:
     """Raw IR (H, W) uint16: rint(ir_background + ir_noise_std z + brightness) clipped to uint16, z ~ N(0, 1)
-    independent per pixel.  brightness : (H, W) float32 >= 0, the reflections (0 where there is none);
-    patches : (k, 4) int rows (v0, v1, u0, u1) outside which brightness is 0 (None: anywhere).
+    independent per pixel.  brightness : (H, W) float32 >= 0, the reflections (0 where there is none).
+    See :func:`sensor_ir` (which :func:`render_frame` calls with the lit pixels it knows)."""
+    lit = np.flatnonzero(brightness > 0)
+    return sensor_ir(brightness.shape, lit, brightness.ravel()[lit], frames, rng, background_noise)
 
-    Unlit pixels (brightness 0, nearly all of them) take the quantized value directly from
-    :func:`background_quantiles` with a 16-bit uniform, four per raw 64-bit word of the generator; lit pixels
-    draw z as a float32 normal.  This has the distribution of drawing z everywhere (within 1 / 65536 per value on
-    the background, which is ~30 noise_std below the detector's threshold either way) at a quarter of the cost.
+
+def sensor_ir(shape: tuple[int, int], lit: np.ndarray, reflected: np.ndarray, frames: FrameParams, rng: np.random.Generator,
+              background_noise: bool = True) -> np.ndarray:
+    """Raw IR (H, W) = shape, uint16, of an image lit at the flat indices lit (k,) (ascending) with brightness
+    reflected (k,) float32 > 0 and dark elsewhere: rint(ir_background + ir_noise_std z + brightness), clipped to uint16.
+
+    Unlit pixels (nearly all of them) take the quantized value directly from :func:`background_quantiles` with a
+    16-bit uniform, four per raw 64-bit word of the generator; lit pixels draw z as a float32 normal.  This has the
+    distribution of drawing z everywhere (within 1 / 65536 per value on the background, which is ~30 noise_std
+    below the detector's threshold either way) at a quarter of the cost.
     background_noise False: the unlit pixels read the table's median, rint(ir_background), and the generator skips
     their words (:func:`skip_raw`), so the lit pixels and every later draw are those of the noisy image; only a
     reader of the unlit pixels can tell the two apart (the detector's mask cannot: see ``record``).
     """
-    ir = np.empty(brightness.shape, dtype=np.uint16)
+    ir = np.empty(shape, dtype=np.uint16)
     table = background_quantiles(frames.ir_background, frames.ir_noise_std)
     if background_noise:
         _lookup_16bit(rng.bit_generator.random_raw(-(-ir.size // 4)), table, ir)
     else:
         skip_raw(rng, -(-ir.size // 4))
         ir.fill(table[UNIFORM_LEVELS // 2])
-    lit = np.flatnonzero(brightness > 0) if patches is None else _lit_pixels(brightness, patches)
     value = rng.standard_normal(lit.size, dtype=np.float32)  # in place: ir_background + ir_noise_std * z + brightness
     value *= np.float32(frames.ir_noise_std)
     value += np.float32(frames.ir_background)
-    value += brightness.ravel()[lit]
+    value += reflected
     ir.ravel()[lit] = np.clip(np.rint(value, out=value), 0, 65535, out=value)
     return ir
 
