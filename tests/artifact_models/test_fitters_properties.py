@@ -24,7 +24,7 @@ def samples(draw) -> tuple[np.ndarray, np.ndarray]:
     """(theta, n_inliers): k stops x m images of a random decay, flat level or single theta, then corrupted."""
     k = draw(st.integers(1, 8))
     m = draw(st.integers(1, 6))
-    step = draw(st.floats(0.5, 10.0))
+    step = draw(st.floats(0.5, END / k))  # every stop within the range end (a sample beyond it is refused, naming theta_end)
     theta = np.repeat(step * np.arange(1, k + 1), m)
     kind = draw(st.sampled_from(["decay", "flat", "zeros"]))
     rng = np.random.default_rng(draw(st.integers(0, 2**32 - 1)))
