@@ -5,7 +5,7 @@ from scipy.spatial.transform import Rotation
 
 from poseintegrity.tracking.markers.detection import detect_markers, raw_threshold
 from poseintegrity.tracking.simulation.simulate import background_seen
-from poseintegrity.tracking.simulation.frames import _lit_pixels, background_quantiles, draw_phantoms, intrinsics, ir_image, render_frame, skip_raw
+from poseintegrity.tracking.simulation.frames import _lit_pixels, background_quantiles, draw_phantoms, intrinsics, render_frame, sensor_ir, skip_raw
 from poseintegrity.tracking.markers.geometry import MARKER_DIAMETER_M
 
 from tracking.track_section import GEOMETRY, TRACK
@@ -47,7 +47,8 @@ def test_ir_noise_is_the_quantized_normal_on_the_background_and_on_the_reflectio
     rng = np.random.default_rng(3)
     brightness = np.zeros((CAMERA.height, CAMERA.width), np.float32)
     brightness[:128] = 790.0
-    ir = np.concatenate([ir_image(brightness, FRAMES, rng) for _ in range(4)])
+    lit = np.flatnonzero(brightness > 0)
+    ir = np.concatenate([sensor_ir(brightness.shape, lit, brightness.ravel()[lit], FRAMES, rng) for _ in range(4)])
     background = ir[np.tile(brightness == 0, (4, 1))].astype(float)
     lit = ir[np.tile(brightness > 0, (4, 1))].astype(float)
     assert chi_square_pvalue(background, BACKGROUND, NOISE) > 1e-3

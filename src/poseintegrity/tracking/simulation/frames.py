@@ -4,7 +4,7 @@ A pinhole camera stands in for the HoloLens 2 AHAT camera (512 x 512, docs/refer
 rendered by ray casting with ``supersampling**2`` rays per pixel: IR is proportional to the covered
 fraction of the pixel, depth is the distance in millimetres *along the ray* to the first hit (as AHAT
 reports it), so the detector's depth lookup lands on the sphere surface, not its centre.
-IR is ``rint(ir_background + ir_noise_std z + reflection)``, z ~ N(0, 1) per pixel (:func:`ir_image`).
+IR is ``rint(ir_background + ir_noise_std z + reflection)``, z ~ N(0, 1) per pixel (:func:`sensor_ir`).
 """
 
 from __future__ import annotations
@@ -167,7 +167,7 @@ def render_frame(
     Depth is kept as whole millimetres throughout: rounding and clipping to uint16 are monotone, so rounding
     each surface before taking the nearest one gives the same image as rounding the nearest float depth.
     Per marker (far to near) the generator draws its depth bias, its patch's depth noise and its IR level; per
-    phantom its depth noise and IR level; then the IR noise (:func:`ir_image`).  The marker and phantom draws
+    phantom its depth noise and IR level; then the IR noise (:func:`sensor_ir`).  The marker and phantom draws
     are one call of standard normals, scaled as ``rng.normal`` scales them (loc + scale z), so the values and
     the generator's state are those of one ``rng.normal`` call per draw.
     """
@@ -310,14 +310,6 @@ def skip_raw(rng: np.random.Generator, n_words: int) -> None:
     state = bit_generator.state
     bit_generator.advance(n_words)
     bit_generator.state = {**bit_generator.state, "has_uint32": state["has_uint32"], "uinteger": state["uinteger"]}
-
-
-def ir_image(brightness: np.ndarray, frames: FrameParams, rng: np.random.Generator, background_noise: bool = True) -> np.ndarray:
-    """Raw IR (H, W) uint16: rint(ir_background + ir_noise_std z + brightness) clipped to uint16, z ~ N(0, 1)
-    independent per pixel.  brightness : (H, W) float32 >= 0, the reflections (0 where there is none).
-    See :func:`sensor_ir` (which :func:`render_frame` calls with the lit pixels it knows)."""
-    lit = np.flatnonzero(brightness > 0)
-    return sensor_ir(brightness.shape, lit, brightness.ravel()[lit], frames, rng, background_noise)
 
 
 def sensor_ir(shape: tuple[int, int], lit: np.ndarray, reflected: np.ndarray, frames: FrameParams, rng: np.random.Generator,
