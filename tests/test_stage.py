@@ -3,6 +3,7 @@ reaches the terminal while the notebook runs, no kernel warning, HTML and a timi
 leaves nothing that looks complete."""
 
 import json
+import os
 import subprocess
 import sys
 import time
@@ -11,6 +12,7 @@ from pathlib import Path
 import nbformat
 import pytest
 
+from poseintegrity.dispatch import cpu_flags, pinned_environment
 from poseintegrity.timing import StageTiming, summary
 
 PARAMETERS = 'params_path = "params.yaml"\ndata_dir = "data"\nreports_dir = "reports"'
@@ -135,3 +137,28 @@ def test_summary_lists_stages_in_name_order_with_their_total(tmp_path):
     assert "dask at tcp://10.0.0.5:8786, n_jobs 4" in lines[1] and "finished 2025-11-23 14:02" in lines[1]
     assert lines[2].split()[1] == "42"
     assert summary(tmp_path / "missing") == []
+
+
+PINNED = """\
+import os
+import cv2
+from poseintegrity.dispatch import dispatch_above_ceiling
+with Workers(load_section(params_path, "parallel")) as workers:
+    in_workers = workers.map(os.getenv, ["OPENCV_CPU_DISABLE", "NUMBA_CPU_NAME"])
+(Path(data_dir) / "pinned.txt").write_text(repr([os.getenv("OPENCV_CPU_DISABLE"), cv2.getCPUFeaturesLine(),
+                                                 dispatch_above_ceiling(), in_workers]))"""
+
+
+@pytest.mark.notebook
+def test_the_kernel_and_its_workers_run_pinned_whatever_the_callers_environment(tmp_path):
+    """dispatch.py: the runner imports poseintegrity, which pins the environment its kernel and workers inherit;
+    a caller's OPENCV_CPU_DISABLE=AVX2 (a lower level) does not reach them."""
+    notebook = make_notebook(tmp_path / "pinned.ipynb", {"work": WORK, "pinned": PINNED})
+    command = runner(notebook, tmp_path, "{backend: local, n_jobs: 2}")
+    env = {k: v for k, v in os.environ.items() if k != "POSEINTEGRITY_CPU_DISPATCH"} | {"OPENCV_CPU_DISABLE": "AVX2"}
+    subprocess.run(command, env=env, check=True, capture_output=True)
+    disabled, features, above, in_workers = eval((tmp_path / "data" / "pinned.txt").read_text())
+    expected = pinned_environment(cpu_flags())["OPENCV_CPU_DISABLE"]
+    assert disabled == expected and in_workers == [expected, "haswell"] and above == []
+    if "avx2" in cpu_flags():
+        assert "*AVX2 " in features  # enabled: a disabled one reads "*AVX2?"

@@ -6,7 +6,12 @@ Augmented Reality Guidance and Teleoperation" (IEEE Transactions on Instrumentat
 DOI 10.1109/TIM.2024.3398108), as a DVC pipeline of papermill notebooks (docs/references.md).
 """
 
-from poseintegrity.errors import ArgumentError, PoseIntegrityError
+from poseintegrity.dispatch import check_dispatch, pin_dispatch
+
+pin_dispatch()  # before numpy, OpenCV, torch or numba load: they read it once (dispatch.py)
+check_dispatch()
+
+from poseintegrity.errors import ArgumentError, PoseIntegrityError  # noqa: E402
 
 __all__ = ["ArgumentError", "PoseIntegrityError"]
 __version__ = "0.1.0"
