@@ -21,7 +21,8 @@ from poseintegrity.lens import Camera  # noqa: E402
 from poseintegrity.localization import envelope as envelope_module  # noqa: E402
 from poseintegrity.localization.dataset import BoardMeta  # noqa: E402
 from poseintegrity.localization.features import ImageReadError, as_gray8, read_gray  # noqa: E402
-from poseintegrity.localization.ground_truth import board_pose, make_board  # noqa: E402
+from poseintegrity.boards import board_from_dict  # noqa: E402
+from poseintegrity.localization.ground_truth import board_pose  # noqa: E402
 from poseintegrity.localization.pnp import solve_pnp_ransac  # noqa: E402
 from poseintegrity.tables import check_artifacts, check_envelopes, read_envelopes  # noqa: E402
 from poseintegrity.localization.target_model import triangulate  # noqa: E402
@@ -60,7 +61,7 @@ def test_bad_distortion_and_size_are_refused():
 
 
 def test_valid_board_pose_is_unchanged(image):
-    pose = board_pose(image, make_board(synthetic.BOARD), synthetic.CAMERA)
+    pose = board_pose(image, synthetic.BOARD, synthetic.CAMERA)
     assert pose.status == "ok"
     E_t, E_r = pose_errors(pose.T_cam_board, synthetic.arc_pose(0.0, 0.0))
     assert E_t < 1.0 and E_r < 0.5
@@ -68,7 +69,7 @@ def test_valid_board_pose_is_unchanged(image):
 
 # --- images -------------------------------------------------------------------------------------------------------
 def test_colour_and_16_bit_images_are_converted_as_documented(image):
-    board = make_board(synthetic.BOARD)
+    board = synthetic.BOARD
     assert as_gray8("image", image) is image  # the pipeline's own images: untouched
     colour = np.dstack([image] * 3)
     np.testing.assert_array_equal(as_gray8("image", colour), image)
@@ -85,7 +86,7 @@ def test_unusable_images_are_refused_naming_argument_shape_dtype(bad, words, ima
     with pytest.raises(PoseIntegrityError, match=rf"^image: .*{words}"):
         as_gray8("image", bad)
     with pytest.raises(PoseIntegrityError, match=rf"^image: .*{words}"):
-        board_pose(bad, make_board(synthetic.BOARD), synthetic.CAMERA)
+        board_pose(bad, synthetic.BOARD, synthetic.CAMERA)
 
 
 @pytest.mark.parametrize("damage", ["empty", "truncated", "junk", "missing"])
@@ -104,7 +105,7 @@ def test_unknown_aruco_dictionary_is_refused_on_read():
     with pytest.raises(Exception, match="unknown ArUco dictionary 'DICT_9X9_1'"):
         BoardMeta.model_validate(dict(synthetic.BOARD, dictionary="DICT_9X9_1"))
     with pytest.raises(PoseIntegrityError, match="board.dictionary"):
-        make_board(dict(synthetic.BOARD, dictionary="DICT_9X9_1"))
+        board_from_dict(dict(synthetic.BOARD, dictionary="DICT_9X9_1"))
     with pytest.raises(Exception, match="do not fit DICT_4X4_50"):
         BoardMeta.model_validate(dict(synthetic.BOARD, first_id=48))
 

@@ -25,8 +25,9 @@ from pydantic import ValidationError
 from poseintegrity.errors import PoseIntegrityError, read_text_file
 from poseintegrity.grayscale import as_gray8
 from poseintegrity.lens import Camera, read_camera_yaml
+from poseintegrity.boards import board_description
 from poseintegrity.localization.dataset import BoardMeta, pose_problem
-from poseintegrity.localization.ground_truth import board_pose, make_board
+from poseintegrity.localization.ground_truth import board_pose
 from poseintegrity.recorded.geometry import camera_centre, distance_mm, relative_pose, viewing_angle_deg
 
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".tif", ".tiff")
@@ -171,7 +172,7 @@ def _board(path: Path, problems: _Problems) -> dict[str, Any] | None:
     if content is None:
         return None
     try:
-        return BoardMeta.model_validate(content).model_dump()
+        return BoardMeta.model_validate(content).model_dump(exclude_none=True)
     except ValidationError as error:
         for item in error.errors():
             field = ".".join(map(str, item["loc"])) or "board"
@@ -310,11 +311,10 @@ def read_recorded(folder: str | Path) -> Recorded:
             found.add(f"{path}: extra image, listed in neither stops.csv nor model.csv")
 
     if board is not None and camera is not None and board_image is not None:  # IV-C: the board anchors M_t
-        status = board_pose(read_image(folder / board_image)[0], make_board(board), camera).status
-        if status != "ok":
-            found.add(f"{folder / 'board.yaml'}: the board ({board['dictionary']}, {board['markers_x']} x "
-                      f"{board['markers_y']} markers from id {board['first_id']}) is not found in model image "
-                      f"{board_image} ({status})")
+        anchor = board_pose(read_image(folder / board_image)[0], board, camera)
+        if anchor.status not in ("ok", "bad_ground_truth"):  # a pose that fails its checks still places M_t
+            found.add(f"{folder / 'board.yaml'}: the board ({board_description(board)}) is not found in model image "
+                      f"{board_image} ({anchor.status}: {anchor.reason})")
 
     required = ground_truth == "poses"
     model_poses = _poses(model_rows, model_path, required, found) if model_rows else None
