@@ -2,7 +2,10 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from poseintegrity.localization.envelope import actual_envelope, envelopes, headline, stop_criteria
+from poseintegrity.localization.envelope import (
+    CRITERIA, actual_envelope, envelope_crossing, envelopes, headline, stop_criteria,
+)
+from poseintegrity.localization.envelope_causes import envelope_causes
 from poseintegrity.protocol import FAILED_FRAME_RULES, EnvelopeParams
 
 THETA = np.array([0.0, 2.25, 4.5, 6.75])  # IV-D: the first stop is the model view
@@ -101,3 +104,51 @@ def test_table_envelopes_use_theta_for_arcs_and_x_for_lines_under_every_rule():
     assert snapped.loc["2mm_3deg", "theta_a"] == pytest.approx(20.0)  # the previous stop
     assert list(ours.reset_index().columns) == ["dataset", "tolerance", "world", "trajectory", "method", "theta_a",
                                                 "censored"]
+
+
+def test_the_crossing_names_the_criterion_that_ends_the_envelope():
+    errors = np.array([[0.5, 1.0], [1.0, 2.0], [2.5, 7.0], [5.0, 9.0]])  # E_r crosses first (2.7 before 3.75)
+    assert envelope_crossing(THETA, errors, TOLERANCE) == (pytest.approx(2.7), False, 1)
+    assert envelope_crossing(THETA, np.full((4, 2), 0.5), TOLERANCE) == (6.75, True, -1)
+    criteria, bounds = stop_criteria(FAILING, (2.0, 3.0), "fail_fraction", RULES)
+    assert envelope_crossing(THETA, criteria, bounds)[2] == 2  # the share without a pose
+    assert CRITERIA[2] == "no_pose"
+
+
+def _causes_table(truth_errors, exact_errors, posed=None, board_status="ok"):
+    """One arc, 4 stops of 2 frames: E_t against the ground truth and against the exact pose per stop."""
+    rows = []
+    for s, (truth, exact) in enumerate(zip(truth_errors, exact_errors)):
+        for image in range(2):
+            ok = True if posed is None else posed[s]
+            rows.append(dict(world="main", dataset="d", trajectory="arc", stop=s, image=image, theta_deg=2.25 * s,
+                             x_mm=0.0, method="usac_magsac", status="ok" if ok else "no_consensus",
+                             E_t_mm=truth if ok else np.nan, E_r_deg=0.1 if ok else np.nan,
+                             E_t_exact_mm=exact if ok else np.nan,
+                             E_r_exact_deg=0.1 if ok and np.isfinite(exact) else np.nan,
+                             n_inliers=100 - 20 * s, board_status=board_status, board_n_dropped=0,
+                             board_sigma_t_mm=0.1))
+    return pd.DataFrame(rows)
+
+
+@pytest.mark.parametrize("truth, exact, posed, cause, limit", [
+    ([0.5, 1.0, 3.0, 4.0], [0.5, 1.0, 3.0, 4.0], None, "estimate", "translation"),
+    ([0.5, 1.0, 3.0, 4.0], [0.4, 0.5, 0.6, 0.7], None, "ground_truth", "translation"),
+    ([0.5, 0.5, 0.5, 0.5], [0.5, 0.5, 0.5, 0.5], [True, True, False, False], "no_pose", "no_pose"),
+    ([0.5, 0.5, 0.5, 0.5], [0.5, 0.5, 0.5, 0.5], None, "censored", "censored"),
+])
+def test_each_envelope_end_gets_its_limit_and_cause(truth, exact, posed, cause, limit):
+    causes = envelope_causes(_causes_table(truth, exact, posed), [(2.0, 3.0)], RULES, "usac_magsac")
+    row = causes.iloc[0]
+    assert (row["limit"], row["cause"]) == (limit, cause)
+    if cause == "ground_truth":  # against the exact pose the envelope lasts to the arc's end
+        assert row["theta_a"] == pytest.approx(2.25 + 2.25 / 2) and row["theta_a_exact"] == pytest.approx(6.75)
+        assert row["n_inliers_at_theta_a"] == pytest.approx(70.0)
+
+
+def test_without_exact_poses_the_boards_own_checks_stand_in():
+    table = _causes_table([0.5, 1.0, 3.0, 4.0], [np.nan] * 4)
+    assert envelope_causes(table, [(2.0, 3.0)], RULES, "usac_magsac").iloc[0]["cause"] == "estimate"
+    table.loc[table.stop == 2, "board_n_dropped"] = 1
+    row = envelope_causes(table, [(2.0, 3.0)], RULES, "usac_magsac").iloc[0]
+    assert row["cause"] == "ground_truth" and row["board_dropped_share"] == 1.0 and np.isnan(row["theta_a_exact"])

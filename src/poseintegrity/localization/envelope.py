@@ -44,15 +44,21 @@ COLUMNS = ["world", "dataset", "trajectory", "tolerance", "method", "rule", "the
 
 
 def actual_envelope(theta: np.ndarray, criteria: np.ndarray, bounds: np.ndarray) -> tuple[float, bool]:
-    """theta_a and whether it is censored (IV-E).
+    """theta_a and whether it is censored (IV-E): :func:`envelope_crossing` without the criterion."""
+    theta_a, censored, _ = envelope_crossing(theta, criteria, bounds)
+    return theta_a, censored
+
+
+def envelope_crossing(theta: np.ndarray, criteria: np.ndarray, bounds: np.ndarray) -> tuple[float, bool, int]:
+    """theta_a, whether it is censored (IV-E), and the index of the criterion that ends it (-1 when none does).
 
     theta : (m,) increasing stop positions (deg or mm), the first one the trajectory start
     criteria : (m, b) per stop, each criterion (mean E_t, mean E_r, share of frames without a pose, ...); inf fails
                the stop and crosses at the previous one; NaN (nothing to average) never fails a stop
     bounds : (b,) the bound of each criterion
-    Returns (NaN, False) when a criterion is NaN at every stop and the first stop does not fail (nothing measured:
-    no envelope can be read). Refused (:class:`~poseintegrity.errors.ArgumentError` naming the argument): theta
-    empty, not finite or not increasing; criteria not (m, b) of theta's length; bounds not b finite numbers.
+    Returns (NaN, False, -1) when a criterion is NaN at every stop and the first stop does not fail (nothing
+    measured: no envelope can be read). Refused (:class:`~poseintegrity.errors.ArgumentError` naming the argument):
+    theta empty, not finite or not increasing; criteria not (m, b) of theta's length; bounds not b finite numbers.
     """
     theta = check_increasing("theta", theta)
     values = check_array("criteria", criteria, shape=(None, None), finite=False)
@@ -63,29 +69,36 @@ def actual_envelope(theta: np.ndarray, criteria: np.ndarray, bounds: np.ndarray)
     if values.shape[1] != len(bounds):
         raise ArgumentError(f"criteria, bounds: {values.shape[1]} criteria per stop but {len(bounds)} bounds")
     with np.errstate(invalid="ignore"):
-        exceeded = np.any(values > bounds, axis=1)
-    if np.isnan(values).all(axis=0).any() and not exceeded[0]:
-        return float("nan"), False
-    if not exceeded.any():
-        return float(theta[-1]), True
-    k = int(np.argmax(exceeded))  # first failing stop
+        exceeded = values > bounds
+    failing = np.any(exceeded, axis=1)
+    if np.isnan(values).all(axis=0).any() and not failing[0]:
+        return float("nan"), False, -1
+    if not failing.any():
+        return float(theta[-1]), True, -1
+    k = int(np.argmax(failing))  # first failing stop
     if k == 0:
-        return float(theta[0]), False
-    crossings = []
-    for before, after, bound in zip(values[k - 1], values[k], bounds):
+        return float(theta[0]), False, int(np.argmax(exceeded[0]))
+    crossings = {}
+    for c, (before, after, bound) in enumerate(zip(values[k - 1], values[k], bounds)):
         if after > bound:
             interpolable = np.isfinite(before) and np.isfinite(after)
             fraction = (bound - before) / (after - before) if interpolable else 0.0
-            crossings.append(theta[k - 1] + fraction * (theta[k] - theta[k - 1]))
-    return float(min(crossings)), False
+            crossings[c] = theta[k - 1] + fraction * (theta[k] - theta[k - 1])
+    criterion = min(crossings, key=crossings.get)
+    return float(crossings[criterion]), False, criterion
+
+
+GROUND_TRUTH_ERRORS = ("E_t_mm", "E_r_deg")  # against the ground truth (IV-C): the paper's metric
+EXACT_ERRORS = ("E_t_exact_mm", "E_r_exact_deg")  # against the renderer's exact pose: a diagnostic, not the paper's
+CRITERIA = ("translation", "rotation", "no_pose")  # what each column of stop_criteria bounds
 
 
 def stop_criteria(frames: pd.DataFrame, tolerance: tuple[float, float], rule: str,
-                  envelope: EnvelopeParams) -> tuple[np.ndarray, np.ndarray]:
+                  envelope: EnvelopeParams, errors: tuple[str, str] = GROUND_TRUTH_ERRORS) -> tuple[np.ndarray, np.ndarray]:
     """Per stop of one dataset and PnP method: the criteria of ``rule`` and their bounds.
 
-    frames : usable artifact rows (``status`` "ok" = a pose; ``E_t_mm``, ``E_r_deg`` against the ground truth,
-             NaN where the board was not detected or there is no pose), with ``stop``
+    frames : usable artifact rows (``status`` "ok" = a pose; the ``errors`` columns, E_t and E_r against the
+             ground truth by default, NaN where the board gave no trusted pose or there is no pose), with ``stop``
     Returns criteria (m, b) in stop order and bounds (b,): mean E_t, mean E_r, and for ``fail_fraction`` the share
     of frames without a pose.
     """
@@ -93,7 +106,7 @@ def stop_criteria(frames: pd.DataFrame, tolerance: tuple[float, float], rule: st
         raise ArgumentError(f"rule: unknown failed-frame rule {rule!r}; expected one of {FAILED_FRAME_RULES}")
     tol = np.asarray(tolerance, dtype=float)
     posed = (frames["status"] == "ok").to_numpy()
-    errors = frames[["E_t_mm", "E_r_deg"]].to_numpy(dtype=float, copy=True)
+    errors = frames[list(errors)].to_numpy(dtype=float, copy=True)
     if rule == "infinite":
         errors[~posed] = np.inf
     elif rule == "capped":
@@ -109,9 +122,11 @@ def stop_criteria(frames: pd.DataFrame, tolerance: tuple[float, float], rule: st
     return per_stop[["E_t", "E_r"]].to_numpy(), tol
 
 
-def envelopes(table: pd.DataFrame, tolerances: list[tuple[float, float]], envelope: EnvelopeParams) -> pd.DataFrame:
+def envelopes(table: pd.DataFrame, tolerances: list[tuple[float, float]], envelope: EnvelopeParams,
+              errors: tuple[str, str] = GROUND_TRUTH_ERRORS) -> pd.DataFrame:
     """theta_a per dataset, tolerance, PnP method and failed-frame rule from an artifacts table (columns
-    :data:`COLUMNS`; theta_a in deg for arcs (``theta_deg``), mm for lines (``x_mm``)).
+    :data:`COLUMNS`; theta_a in deg for arcs (``theta_deg``), mm for lines (``x_mm``)), the errors of the ``errors``
+    columns (:data:`GROUND_TRUTH_ERRORS`, the paper's; :data:`EXACT_ERRORS`, against the exact pose: a diagnostic).
 
     table : usable artifact rows (:func:`~poseintegrity.localization.extract.usable`), checked
         (:func:`~poseintegrity.tables.check_artifacts`: columns, one row per frame and method, ...)
@@ -119,7 +134,7 @@ def envelopes(table: pd.DataFrame, tolerances: list[tuple[float, float]], envelo
     """
     from poseintegrity.tables import check_artifacts  # noqa: PLC0415 (tables imports this module)
 
-    check_artifacts(table, "the artifacts table given to envelopes", columns=ENVELOPE_INPUT)
+    check_artifacts(table, "the artifacts table given to envelopes", columns=tuple(dict.fromkeys((*ENVELOPE_INPUT, *errors))))
     rows = []
     for (world, dataset, trajectory, method), frames in table.groupby(["world", "dataset", "trajectory", "method"],
                                                                       sort=True):
@@ -127,7 +142,7 @@ def envelopes(table: pd.DataFrame, tolerances: list[tuple[float, float]], envelo
         theta = frames.groupby("stop", sort=True)[position].mean().to_numpy()
         for tolerance in tolerances:
             for rule in FAILED_FRAME_RULES:
-                criteria, bounds = stop_criteria(frames, tolerance, rule, envelope)
+                criteria, bounds = stop_criteria(frames, tolerance, rule, envelope, errors)
                 theta_a, censored = actual_envelope(theta, criteria, bounds)
                 rows.append(dict(world=world, dataset=dataset, trajectory=trajectory, tolerance=tolerance_name(tolerance),
                                  method=method, rule=rule, theta_a=theta_a, censored=censored))

@@ -67,7 +67,7 @@ def render_summary(metrics: dict[str, dict], timings: list[StageTiming]) -> str:
              "found no such value (e.g. no threshold n_t <= 100 reaches zero incursions); \"not run\": no metrics yet.", ""]
     for stage, title in SECTIONS.items():
         lines += [f"## {title}", "", "| figure | ours | paper | target |", "| --- | --- | --- | --- |"]
-        for h in (h for h in HEADLINES if h.stage == stage):
+        for h in (h for h in HEADLINES if h.shown_in == stage):
             lines.append(f"| {h.label} | {_fmt(lookup(metrics, stage, h.key), h.fmt)} | {h.paper} | {h.target} |")
         described = lookup(metrics, stage, "realism.description_only")  # recorded data: no bar is judged
         lines += ["", f"Realism bars: {described}."] if isinstance(described, str) else []
