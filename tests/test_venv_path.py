@@ -1,0 +1,45 @@
+"""The `python` of every dvc.yaml cmd is the interpreter of the venv that runs dvc, whatever PATH holds
+(venv-on-path.pth, installed by `make install`), and the stage runner's kernel is this venv's even when the user has
+a `python3` kernel of their own. tests/recorded/test_dvc_repro.py runs `dvc repro` itself with a foreign PATH."""
+
+import json
+import os
+import subprocess
+import sys
+import sysconfig
+from pathlib import Path
+
+from repository import ROOT
+
+FOREIGN = {**{k: v for k, v in os.environ.items() if k not in ("JUPYTER_PATH", "VIRTUAL_ENV")}, "PATH": "/usr/bin:/bin"}
+
+
+def test_the_venv_holds_the_repositorys_path_hook():
+    installed = Path(sysconfig.get_path("purelib")) / "venv-on-path.pth"
+    assert installed.read_text() == (ROOT / "venv-on-path.pth").read_text(), "run make install"
+
+
+def test_a_child_of_the_venvs_interpreter_finds_the_venvs_python_first():
+    """What DVC does: a shell started from the interpreter with its environment resolves `python`."""
+    script = "import subprocess; subprocess.run(['sh', '-c', 'command -v python'])"
+    done = subprocess.run([sys.executable, "-c", script], env=FOREIGN, capture_output=True, text=True, check=True)
+    assert done.stdout.strip() == str(Path(sys.executable).parent / "python")
+    plain = subprocess.run(["sh", "-c", "command -v python || true"], env=FOREIGN, capture_output=True, text=True)
+    assert plain.stdout.strip() != done.stdout.strip()  # the foreign PATH alone finds another python, or none
+
+
+def test_the_stage_runner_prefers_the_venvs_kernel_to_the_users(tmp_path):
+    """jupyter_core (>= 5) searches the venv's share/jupyter before the user's data folder, but JUPYTER_PATH before
+    both: a user's JUPYTER_PATH holding a `python3` kernel (another environment's) would run the notebooks."""
+    user_kernel = tmp_path / "data" / "kernels" / "python3"
+    user_kernel.mkdir(parents=True)
+    (user_kernel / "kernel.json").write_text(json.dumps({"argv": ["/usr/bin/python3", "-m", "ipykernel_launcher", "-f",
+                                                                  "{connection_file}"], "display_name": "mine",
+                                                         "language": "python"}))
+    script = ("from jupyter_client.kernelspec import KernelSpecManager as M; from poseintegrity.stage import "
+              "kernel_search_path; print(M().get_kernel_spec('python3').argv[0]); kernel_search_path(); "
+              "print(M().get_kernel_spec('python3').argv[0])")
+    done = subprocess.run([sys.executable, "-c", script], env={**FOREIGN, "JUPYTER_PATH": str(tmp_path / "data")},
+                          capture_output=True, text=True, check=True)
+    before, after = done.stdout.split()
+    assert before == "/usr/bin/python3" and after == sys.executable
