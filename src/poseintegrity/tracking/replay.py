@@ -43,7 +43,7 @@ from poseintegrity.errors import PoseIntegrityError
 from poseintegrity.staging import check_new_file
 from poseintegrity.timing import usage_error
 from poseintegrity.tracking.io.hl2_recordings import HL2SS_MAGIC, STREAM_RECORDER_SENSOR, convert_hl2ss, convert_stream_recorder
-from poseintegrity.tracking.io.recording import read_recording, track_recording
+from poseintegrity.tracking.io.recording import RecordingError, read_recording, track_recording
 from poseintegrity.tracking.io.tool_files import read_tools
 
 FORMATS = ("folder", "stream-recorder", "hl2ss")
@@ -71,17 +71,17 @@ def detect_format(recording: Path) -> str | None:
 
 
 def choose_format(recording: Path, given: str) -> str:
-    """The format to read ``recording`` with: ``given``, or the detected one for ``auto``; :class:`PoseIntegrityError`
+    """The format to read ``recording`` with: ``given``, or the detected one for ``auto``; :class:`RecordingError`
     when nothing fits ``auto`` or ``given`` is not the layout that is there (naming the ``--format`` that fits)."""
     if not recording.exists():
-        raise PoseIntegrityError(f"{recording}: no such recording (file or folder)")
+        raise RecordingError(f"{recording}: no such recording (file or folder)")
     detected = detect_format(recording)
     if given == "auto" and detected is None:
-        raise PoseIntegrityError(f"{recording}: not a recording this command reads: neither "
-                                 f"{', nor '.join(LAYOUTS.values())}")
+        raise RecordingError(f"{recording}: not a recording this command reads: neither "
+                             f"{', nor '.join(LAYOUTS.values())}")
     if given not in ("auto", detected) and detected is not None:
-        raise PoseIntegrityError(f"{recording}: is {LAYOUTS[detected]}, not {LAYOUTS[given]}: use --format {detected} "
-                                 f"(or leave --format out)")
+        raise RecordingError(f"{recording}: is {LAYOUTS[detected]}, not {LAYOUTS[given]}: use --format {detected} "
+                             f"(or leave --format out)")
     return detected if given == "auto" else given
 
 
