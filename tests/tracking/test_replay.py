@@ -101,7 +101,7 @@ def test_the_command_replays_a_stream_recorder_capture_as_the_same_frames_in_our
 def test_an_hl2ss_recording_replays_with_its_calibration(recorded, tools, tmp_path):
     lut, frames = recorded
     path = write_hl2ss(tmp_path / "rm_depth_ahat.bin", tmp_path / "calibration", lut, frames)
-    status, stdout, stderr = _run([path, "--tools", tools, "--format", "hl2ss", "--calibration", tmp_path / "calibration",
+    status, stdout, stderr = _run([path, "--calibration", tmp_path / "calibration", "--tools", tools,  # format found
                                    "--out", tmp_path / "poses.csv", "--params", TINY_PARAMS])
     assert status == 0, stderr
     assert (pd.read_csv(tmp_path / "poses.csv").flag == "ok").sum() >= 4
