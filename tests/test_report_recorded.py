@@ -32,6 +32,7 @@ def test_the_summary_of_recorded_data_says_what_was_measured_on_each_dataset():
     assert "The predictors on world `lab_a`" in section
     assert "| static baseline | 20.5; size 21 |" in section and "| long range (eq. 1) | 25; n_t 23 |" in section
     assert "Held-out world `lab_b`" in section and "| long range (eq. 1) | 0; 12.5 |" in section
+    assert "No lines in `lab_a`: no line operating point to apply." in section
     assert "## Stage 01 · rendered robot datasets" not in text  # replaced by the section above
     assert "| weakest decay over arcs: min of -Spearman(theta, mean n_i) | 0.9 | n_i 'decays' with viewing angle | - |" \
         in text  # its rendered-world target (>= 0.8) is not shown

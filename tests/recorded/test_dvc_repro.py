@@ -43,7 +43,12 @@ RUNS = {
 
 @pytest.fixture(scope="session")
 def cache_dir(tmp_path_factory):
-    return tmp_path_factory.mktemp("dvc_cache")
+    """One DVC cache for the session's runs, shared by pytest-xdist's workers (their base folders are siblings):
+    the second run restores stage 06 from the run cache when the first has finished it."""
+    base = tmp_path_factory.getbasetemp()
+    cache = (base.parent if base.name.startswith("popen-gw") else base) / "dvc_cache"
+    cache.mkdir(exist_ok=True)
+    return cache
 
 
 def declared_outputs() -> list[str]:
@@ -89,7 +94,8 @@ def check_summary(name, copy):
     for folder in RUNS[name][0]:
         assert f"| {folder.world or 'recorded'} | {folder.name} | {folder.trajectory} |" in section
     assert "Stage 01 · rendered robot datasets" not in summary and "realism bars passed" not in summary
-    rows = [line.split("|") for line in summary.splitlines() if line.startswith("| ") and line.count("|") == 5]
+    headlines = summary.split("## Stage wall times")[0]  # the tables "figure | ours | paper | target"
+    rows = [line.split("|") for line in headlines.splitlines() if line.startswith("| ") and line.count("|") == 5]
     assert rows and all(cells[4].strip() in ("-", "---", "target") for cells in rows)  # no rendered-world target
     artifacts = json.loads((copy / "reports/metrics/artifacts.json").read_text())
     validation = json.loads((copy / "reports/metrics/validation.json").read_text())
@@ -104,3 +110,4 @@ def check_summary(name, copy):
         assert {row["dataset"] for row in artifacts["worlds"]["lab_b"]["datasets"]} == {"arc_b", "line_b"}
         assert validation["world"] == "lab_b" and validation["chosen_on"] == "lab_a"
         assert "No arcs in this world" in section and "Held-out world `lab_b`" in section
+        assert "No arcs in `lab_a`: no arc operating point to apply." in section and "| lines: predictor |" in section

@@ -76,20 +76,30 @@ def _predictor_lines(predictors: dict, tolerances: list[str], n_arcs: int, n_lin
     return lines
 
 
-def _transfer_lines(validation: dict, tolerances: list[str]) -> list[str]:
-    """The first world's operating points on the held-out world (validation.json), or its note."""
+def _transfer_lines(validation: dict, tolerances: list[str], kinds: list[str]) -> list[str]:
+    """The first world's operating points on the held-out world (validation.json: arcs, and straight lines with the
+    static baseline and the long range predictor), or its note. ``kinds``: the trajectories of the first world's
+    datasets (an operating point exists only for those)."""
     if validation.get("world") is None:
         return [f"Held-out world: {validation.get('note', 'none')}."]
     lines = [f"Held-out world `{validation['world']}`: the operating points chosen on `{validation.get('chosen_on')}` "
-             "applied unchanged (arcs; R_i: incursion rate, eq. 4; mean SPL, eq. 3):", "",
-             "| predictor | " + " | ".join(f"{t}: R_i; mean SPL (deg)" for t in tolerances) + " |",
-             "| --- |" + " --- |" * len(tolerances)]
-    for predictor, name in PREDICTORS.items():
-        entry = validation.get("transfer", {}).get(predictor, {})
-        cells = [f"{_number(entry.get(t, {}).get('incursion_rate'))}; {_number(entry.get(t, {}).get('mean_spl'))}"
-                 for t in tolerances]
-        lines.append(f"| {name} | " + " | ".join(cells) + " |")
-    return lines
+             "applied unchanged (R_i: incursion rate, eq. 4; mean SPL, eq. 3, in deg on arcs and mm on lines):", ""]
+    parts = (("arc", "transfer", PREDICTORS), ("line", "transfer_straight_line",
+                                               {key: PREDICTORS[key] for key in ("static", "long_range")}))
+    for trajectory, key, predictors in parts:
+        if trajectory not in kinds:
+            lines += [f"No {trajectory}s in `{validation.get('chosen_on')}`: no {trajectory} operating point to apply.",
+                      ""]
+            continue
+        lines += [f"| {trajectory}s: predictor | " + " | ".join(f"{t}: R_i; mean SPL" for t in tolerances) + " |",
+                  "| --- |" + " --- |" * len(tolerances)]
+        for predictor, name in predictors.items():
+            entry = validation.get(key, {}).get(predictor, {})
+            cells = [f"{_number(entry.get(t, {}).get('incursion_rate'))}; {_number(entry.get(t, {}).get('mean_spl'))}"
+                     for t in tolerances]
+            lines.append(f"| {name} | " + " | ".join(cells) + " |")
+        lines.append("")
+    return lines[:-1]
 
 
 def recorded_section(metrics: dict[str, dict]) -> list[str]:
@@ -125,11 +135,11 @@ def recorded_section(metrics: dict[str, dict]) -> list[str]:
         lines.append("")
     else:
         lines += ["Stage 02 has not run yet: no per-dataset measurement.", ""]
+    chosen = metrics.get("validation", {}).get("chosen_on", next(iter(worlds), "-"))
+    kinds = [row["trajectory"] for row in rows if row["world"] == chosen]
     if "predictors" in metrics:
-        chosen = metrics.get("validation", {}).get("chosen_on", next(iter(worlds), "-"))
-        kinds = [row["trajectory"] for row in rows if row["world"] == chosen]
         lines += [f"The predictors on world `{chosen}`, where their operating points are chosen:", "",
                   *_predictor_lines(metrics["predictors"], tolerances, kinds.count("arc"), kinds.count("line")), ""]
     if "validation" in metrics:
-        lines += [*_transfer_lines(metrics["validation"], tolerances), ""]
+        lines += [*_transfer_lines(metrics["validation"], tolerances, kinds), ""]
     return lines
