@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import os
+import resource
 import shutil
 import subprocess
 import sys
@@ -36,14 +37,16 @@ def project_copy(folder: Path, overlay: dict, cache_dir: Path) -> Path:
     return folder
 
 
-def run(argv: list[str], cwd: Path) -> tuple[str, float]:
-    """(output, wall time s) of ``argv`` run in ``cwd`` with the foreign PATH and none of the Makefile's settings;
-    AssertionError with the output when it fails."""
+def run(argv: list[str], cwd: Path) -> tuple[str, float, float]:
+    """(output, wall time s, CPU time s of the command and every process it waited for) of ``argv`` run in ``cwd``
+    with the foreign PATH and none of the Makefile's settings; AssertionError with the output when it fails."""
     env = {key: value for key, value in os.environ.items()
            if key not in ("JUPYTER_PATH", "VIRTUAL_ENV") and not key.startswith(("MALLOC_", "PYTEST", "COV_"))}
     env["PATH"] = FOREIGN_PATH
-    start = time.perf_counter()
+    start, before = time.perf_counter(), resource.getrusage(resource.RUSAGE_CHILDREN)
     done = subprocess.run(argv, cwd=cwd, env=env, capture_output=True, text=True)
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
     output = done.stdout + done.stderr
     assert done.returncode == 0, f"{' '.join(argv)} failed ({done.returncode}):\n{output[-6000:]}"
-    return output, time.perf_counter() - start
+    cpu = after.ru_utime + after.ru_stime - before.ru_utime - before.ru_stime
+    return output, time.perf_counter() - start, cpu

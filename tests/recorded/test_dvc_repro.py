@@ -64,8 +64,8 @@ def test_dvc_repro_runs_recorded_data_end_to_end(name, tmp_path, cache_dir):
     for folder in folders:
         write_folder(tmp_path / "recordings", folder)
     project_copy(tmp_path, {"generate": {"source": "recordings"}, **overlay}, cache_dir)
-    output, seconds = run([str(DVC), "repro"], tmp_path)
-    print(f"dvc repro of {name}: {seconds:.0f} s")
+    output, seconds, cpu = run([str(DVC), "repro"], tmp_path)
+    print(f"dvc repro of {name}: {seconds:.0f} s wall, {cpu:.0f} s CPU")
     missing = [out for out in declared_outputs() if not (tmp_path / out).exists()]
     assert not missing, f"declared outputs not written: {missing}\n{output[-3000:]}"
     check_stage_01(name, tmp_path)
