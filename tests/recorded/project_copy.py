@@ -22,8 +22,7 @@ DVC = Path(sys.executable).parent / "dvc"  # the venv's dvc, as `.venv/bin/dvc r
 
 def project_copy(folder: Path, overlay: dict, cache_dir: Path) -> Path:
     """``folder`` made a DVC project: the repository's dvc.yaml, .dvcignore, notebooks and src, and a params.yaml of
-    tests/params_tiny.yaml merged with ``overlay``; its DVC cache is ``cache_dir`` (shared: stage 06's run is
-    restored from the run cache when its deps and params are the same)."""
+    tests/params_tiny.yaml merged with ``overlay``; its DVC cache is ``cache_dir``."""
     folder.mkdir(parents=True, exist_ok=True)
     for name in ("dvc.yaml", ".dvcignore"):
         shutil.copy(ROOT / name, folder / name)
