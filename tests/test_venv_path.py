@@ -28,21 +28,22 @@ def test_a_child_of_the_venvs_interpreter_finds_the_venvs_python_first():
     assert plain.stdout.strip() != done.stdout.strip()  # the foreign PATH alone finds another python, or none
 
 
-def test_the_stage_runner_prefers_the_venvs_kernel_to_the_users(tmp_path):
+def test_the_stage_runner_prefers_the_venvs_kernel_to_the_users(tmp_path, monkeypatch):
     """jupyter_core (>= 5) searches the venv's share/jupyter before the user's data folder, but JUPYTER_PATH before
     both: a user's JUPYTER_PATH holding a `python3` kernel (another environment's) would run the notebooks."""
-    user_kernel = tmp_path / "data" / "kernels" / "python3"
+    from jupyter_client.kernelspec import KernelSpecManager
+
+    from poseintegrity.stage import kernel_search_path
+
+    user_kernel = tmp_path / "kernels" / "python3"
     user_kernel.mkdir(parents=True)
     (user_kernel / "kernel.json").write_text(json.dumps({"argv": ["/usr/bin/python3", "-m", "ipykernel_launcher", "-f",
                                                                   "{connection_file}"], "display_name": "mine",
                                                          "language": "python"}))
-    script = ("from jupyter_client.kernelspec import KernelSpecManager as M; from poseintegrity.stage import "
-              "kernel_search_path; print(M().get_kernel_spec('python3').argv[0]); kernel_search_path(); "
-              "print(M().get_kernel_spec('python3').argv[0])")
-    done = subprocess.run([sys.executable, "-c", script], env={**FOREIGN, "JUPYTER_PATH": str(tmp_path / "data")},
-                          capture_output=True, text=True, check=True)
-    before, after = done.stdout.split()
-    assert before == "/usr/bin/python3" and after == sys.executable
+    monkeypatch.setenv("JUPYTER_PATH", str(tmp_path))  # restored after the test, whatever kernel_search_path sets
+    assert KernelSpecManager().get_kernel_spec("python3").argv[0] == "/usr/bin/python3"
+    kernel_search_path()
+    assert KernelSpecManager().get_kernel_spec("python3").argv[0] == sys.executable
 
 
 def test_dvc_exp_run_gives_its_stage_the_venvs_python(tmp_path):
