@@ -389,10 +389,11 @@ def _entries() -> list[EntryPoint]:
         EntryPoint("tables.read_artifacts", lambda a: tables.read_artifacts(a["path"]),
                    lambda tmp: {"path": _parquet(tmp, "artifacts.parquet", _artifacts_table())}, {"path": "file"}),
         # ---- command lines: one line naming the file, exit status 2, no traceback
-        EntryPoint("python -m poseintegrity.tracking.replay",
-                   lambda a: _cli(replay.main, [str(a["tools"].parent / "recording"), "--tools", str(a["tools"]), "--out",
-                                                str(a["tools"].parent / "poses.csv"), "--params", str(TINY_PARAMS)], a["tools"]),
-                   lambda tmp: {"tools": _recording_dir(tmp).parent / _tools_json(tmp).name}, {"tools": "file"},
+        EntryPoint("python -m poseintegrity.tracking.replay",  # the recording stays where it is (checked first)
+                   lambda a: _cli(replay.main, [str(a["recording"]), "--tools", str(a["tools"]), "--out",
+                                                str(a["recording"].parent / "poses.csv"), "--params", str(TINY_PARAMS)],
+                                  a["tools"]),
+                   lambda tmp: {"recording": _recording_dir(tmp), "tools": _tools_json(tmp)}, {"tools": "file"},
                    flagged=_cli_refused),
         EntryPoint("python -m poseintegrity.timing", lambda a: _cli(timing.main, [str(a["path"].parent)], a["path"]),
                    lambda tmp: {"path": _timing_file(tmp)}, {"path": "file"}, flagged=_cli_refused,

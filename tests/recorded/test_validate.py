@@ -32,7 +32,8 @@ def test_a_good_folder_passes_with_one_summary_line(exported):
     status, out, err = run(["validate", str(exported / "arc_r"), str(exported / "line_r")])
     assert status == 0 and err == ""
     lines = out.strip().splitlines()
-    assert len(lines) == 2 and "6 images at 3 stops" in lines[0] and "2 images at 2 stops" in lines[1]
+    assert len(lines) == 3 and "6 images at 3 stops" in lines[0] and "2 images at 2 stops" in lines[1]
+    assert lines[2].startswith("range ends, tolerances and extract settings of ")  # ./params.yaml, or the published
 
 
 def rewrite_csv(path: Path, transform) -> None:

@@ -28,9 +28,12 @@ from poseintegrity.lens import Camera, read_camera_yaml
 from poseintegrity.boards import board_description
 from poseintegrity.localization.dataset import BoardMeta, pose_problem
 from poseintegrity.localization.ground_truth import board_pose
+from poseintegrity.protocol import ProtocolParams
 from poseintegrity.recorded.geometry import camera_centre, distance_mm, relative_pose, viewing_angle_deg
 
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".tif", ".tiff")
+RANGE_KEYS = {"arc": ("theta_deg", "protocol.arc_span_deg", "deg"),
+              "line": ("x_mm", "protocol.line_length_mm", "mm")}  # position column, range-end key, unit
 TRAJECTORIES = ("arc", "line")
 GROUND_TRUTHS = ("board", "poses")
 DEFAULT_WORLD = "recorded"
@@ -254,6 +257,25 @@ def _number(cell: str, where: str, problems: _Problems, integer: bool = False) -
         problems.add(f"{where}: expected {'an integer >= 0' if integer else 'a finite number'}, got {cell!r:.40}")
         return None
     return value
+
+
+def range_problems(recorded: Recorded, protocol: ProtocolParams, params_name: str = "params.yaml") -> list[str]:
+    """The stops of ``recorded`` outside [0, the protocol's range end] of its trajectory type (``protocol.arc_span_deg``
+    or ``protocol.line_length_mm``, where every stage fits the artifact models and searches for theta_p, III-D),
+    one line naming the key and the value that would hold them; [] when they all lie inside."""
+    column, key, unit = RANGE_KEYS[recorded.trajectory]
+    end = protocol.range_end(recorded.trajectory)
+    values = np.array([getattr(frame, column) for frame in recorded.frames])
+    where = f"{recorded.folder / 'stops.csv'}: field {column}"
+    lines = []
+    if values.max() > end:
+        lines.append(f"{where}: the stops reach {values.max():.6g} {unit}, beyond {key} = {end:g} {unit} "
+                     f"({params_name}; the range end of every {recorded.trajectory}): set {key} to at least "
+                     f"{values.max():.6g} in the params file of your run")
+    if values.min() < 0:
+        lines.append(f"{where}: a stop at {values.min():.6g} {unit}: positions start at 0 (the model view for arcs, the "
+                     f"line's first position for lines), so {key}'s range 0 .. {end:g} {unit} cannot hold it")
+    return lines
 
 
 def problems(folder: str | Path) -> list[str]:

@@ -36,6 +36,15 @@ SECTIONS = {
     "tracking": "Stage 06 · marker tracking (Black & Salcudean, IEEE TIM 2024, DOI 10.1109/TIM.2024.3398108, section III)",
 }
 
+RECORDED_TITLES = {  # the sections' titles on recorded data (generate.source a folder): no rendered world
+    "artifacts": "Stage 02 · artifact extraction on your datasets (Windsor et al. III-B, IV-C); the realism values "
+                 "describe them, none is judged",
+    "validation": "Stage 04 · the held-out world (your second world): the first world's operating points applied "
+                  "unchanged, and its own sweep",
+    "tracking": "Stage 06 · marker tracking on its own simulation, not on your datasets (Black & Salcudean, IEEE TIM "
+                "2024, DOI 10.1109/TIM.2024.3398108, section III)",
+}
+
 FIT_STATUS_LABELS = {"ok": "ok", "at_bound": "at a bound", "non_physical": "non-physical",
                      "fallback": "fallen back to a line"}  # the statuses of artifact_models/fitted.py
 MODEL_LABELS = {"emg": "EMG (eq. 1)", "exponential": "exponential", "gaussian": "Gaussian", "logistic": "logistic",
