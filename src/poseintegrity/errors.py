@@ -102,7 +102,7 @@ def check_intrinsics(name: str, K: object) -> np.ndarray:
     """A (3, 3) pinhole camera matrix [[fx, s, cx], [0, fy, cy], [0, 0, 1]] with positive focal lengths (pixels)."""
     K = check_array(name, K, shape=(3, 3))
     if K[0, 0] <= 0 or K[1, 1] <= 0:
-        raise ArgumentError(f"{name}: focal lengths must be positive, got fx {K[0, 0]!r}, fy {K[1, 1]!r}")
+        raise ArgumentError(f"{name}: focal lengths must be positive, got fx {float(K[0, 0])!r}, fy {float(K[1, 1])!r}")
     if not np.allclose(K[2], [0.0, 0.0, 1.0]) or K[1, 0] != 0:
         raise ArgumentError(f"{name}: expected [[fx, s, cx], [0, fy, cy], [0, 0, 1]], got {K.tolist()}")
     return K
