@@ -1,7 +1,9 @@
 import cv2
 import numpy as np
+import pytest
 
 import loc_synthetic as synthetic
+from poseintegrity.errors import ArgumentError
 from poseintegrity.lens import Camera
 from poseintegrity.poses import pose_errors
 from poseintegrity.localization.ground_truth import board_pose, make_board
@@ -44,3 +46,17 @@ def test_no_board_gives_nan_pose_and_a_flag():
     result = board_pose(np.full((400, 640), 128, np.uint8), make_board(synthetic.BOARD), synthetic.CAMERA)
     assert result.status == "board_not_detected" and result.n_markers == 0
     assert np.all(np.isnan(result.T_cam_board))
+
+
+@pytest.mark.parametrize(("change", "words"), [
+    (lambda b: b.pop("first_id"), "board: first_id: Field required"),  # was a bare KeyError: 'first_id'
+    (lambda b: b.pop("dictionary"), "board: dictionary: Field required"),
+    (lambda b: b.__setitem__("markers_x", "three"), "board: markers_x: Input should be a valid integer"),
+    (lambda b: b.__setitem__("marker_length_mm", float("nan")), "board: marker_length_mm: Input should be a finite number"),
+    (lambda b: b.__setitem__("first_id", 48), "board: .*markers 48 .. 53 do not fit DICT_4X4_50"),
+])
+def test_a_board_spec_missing_or_spoiling_a_key_is_refused_naming_it(change, words):
+    board = dict(synthetic.BOARD)
+    change(board)
+    with pytest.raises(ArgumentError, match=words):
+        make_board(board)

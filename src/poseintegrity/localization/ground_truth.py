@@ -11,11 +11,12 @@ from typing import Any
 
 import cv2
 import numpy as np
+from pydantic import ValidationError
 
 from poseintegrity.errors import ArgumentError
 from poseintegrity.grayscale import as_gray8
 from poseintegrity.lens import Camera
-from poseintegrity.localization.dataset import aruco_dictionary
+from poseintegrity.localization.dataset import BoardMeta, aruco_dictionary
 from poseintegrity.poses import NAN_POSE, pose_from_rvec_tvec
 
 
@@ -30,9 +31,16 @@ class BoardPose:
 
 
 def make_board(board: dict[str, Any]) -> cv2.aruco.GridBoard:
-    """The GridBoard described by a dataset's ``meta.json["board"]`` (lengths in mm; checked when the dataset is
-    read, :class:`~poseintegrity.localization.dataset.BoardMeta`). An unknown dictionary name raises
-    :class:`~poseintegrity.errors.ArgumentError` naming it."""
+    """The GridBoard described by a dataset's ``meta.json["board"]`` or a board.yaml (lengths in mm), checked as a
+    dataset's board is (:class:`~poseintegrity.localization.dataset.BoardMeta`): a missing key, a value of the wrong
+    type or range, an unknown dictionary or marker ids outside it raise :class:`~poseintegrity.errors.ArgumentError`
+    naming ``board`` and each key."""
+    try:
+        board = BoardMeta.model_validate(board).model_dump()
+    except ValidationError as error:
+        problems = "; ".join(f"{'.'.join(map(str, item['loc'])) or 'the board'}: {item['msg']}"
+                             for item in error.errors())
+        raise ArgumentError(f"board: {problems} (expected the keys {', '.join(BoardMeta.model_fields)})") from None
     dictionary = cv2.aruco.getPredefinedDictionary(aruco_dictionary(board["dictionary"]))
     n_markers = board["markers_x"] * board["markers_y"]
     ids = np.arange(board["first_id"], board["first_id"] + n_markers)
