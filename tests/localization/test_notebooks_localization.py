@@ -41,7 +41,8 @@ def test_stage_02_writes_tables_metrics_and_figures(executed):
     table = pd.read_parquet(data_dir / "artifacts" / "artifacts.parquet")
     assert set(table["method"]) == {"usac_magsac"} and table["dataset"].nunique() == 3
     env = pd.read_parquet(data_dir / "artifacts" / "envelopes.parquet")
-    assert list(env.columns) == ["world", "dataset", "trajectory", "tolerance", "method", "rule", "theta_a", "censored"]
+    assert list(env.columns) == ["world", "dataset", "trajectory", "tolerance", "method", "rule", "theta_a", "censored",
+                                 "status", "reason"]
     assert set(table.loc[table.status.isin(["bad_image", "bad_pose"]), "image"]) == {3, 4}  # of dataset "bad"
     metrics = json.loads((reports_dir / "metrics" / "artifacts.json").read_text())
     assert metrics["flagged_frames"] == {"bad_image": 1, "bad_pose": 1}
