@@ -1,6 +1,7 @@
 """Shared fixtures: the repository root, the tiny parameters every notebook test runs with, and work done once per
 test session whichever xdist worker asks for it first; the order in which the workers take the test modules."""
 
+import copy
 import fcntl
 import os
 import shutil
@@ -62,10 +63,16 @@ def run_once(tmp_path_factory) -> Callable[[str, Callable[[Path], object]], Path
     return run
 
 
-@pytest.fixture
-def tiny_raw() -> dict:
-    """tests/params_tiny.yaml merged onto params.yaml, as a plain dict to be altered by a test."""
+@pytest.fixture(scope="session")
+def _tiny_raw_once() -> dict:
     return read_raw(TINY_PARAMS)[0]
+
+
+@pytest.fixture
+def tiny_raw(_tiny_raw_once) -> dict:
+    """tests/params_tiny.yaml merged onto params.yaml, as a plain dict to be altered by a test (a copy of the one
+    read per session: reading and merging the YAML took a third of every bad-value case)."""
+    return copy.deepcopy(_tiny_raw_once)
 
 
 @pytest.fixture
