@@ -100,8 +100,8 @@ _FIELDS = {"aruco_grid": ("dictionary", "markers_x", "markers_y", "marker_length
 def board_from_dict(spec: dict[str, Any], where: str = "board") -> Board:
     """The board a dataset describes (meta.json's ``board``, a board.yaml): ``type`` ``aruco_grid`` (the default,
     the paper's board) or ``charuco``, the fields of that type, and optionally ``scale`` [x, y] (measured printed size
-    over drawn size). Values are checked by the readers' schemas (:class:`~poseintegrity.localization.dataset.
-    BoardMeta`); here a missing field or an unknown type raises :class:`ArgumentError` naming ``where`` and the key."""
+    over drawn size). A missing field, an unknown type or dictionary, or a value that is not a positive number (an
+    integer for counts) raises :class:`ArgumentError` naming ``where`` and the key."""
     if not isinstance(spec, dict):
         raise ArgumentError(f"{where}: expected a mapping of the board's fields, got {type(spec).__name__}")
     kind = spec.get("type", "aruco_grid")
@@ -111,11 +111,36 @@ def board_from_dict(spec: dict[str, Any], where: str = "board") -> Board:
     if missing:
         raise ArgumentError(f"{where}: a {kind} board needs {', '.join(missing)} (missing)")
     aruco_dictionary(spec["dictionary"], f"{where}.dictionary")
-    scale = tuple(float(s) for s in spec.get("scale", (1.0, 1.0)))
-    values = {key: spec[key] for key in _FIELDS[kind]}
+    values = {key: _checked(spec[key], f"{where}.{key}", integer=key.endswith(("_x", "_y")))
+              for key in _FIELDS[kind][1:]}
+    values["dictionary"] = spec["dictionary"]
+    scale = spec.get("scale", (1.0, 1.0))
+    if not isinstance(scale, (list, tuple)) or len(scale) != 2:
+        raise ArgumentError(f"{where}.scale: expected [x, y], the printed over the drawn size, got {scale!r}")
+    scale = tuple(_checked(s, f"{where}.scale", integer=False) for s in scale)
+    if kind == "aruco_grid":
+        values["first_id"] = _checked(spec.get("first_id", 0), f"{where}.first_id", integer=True, allow_zero=True)
+        first, n_markers = values["first_id"], values["markers_x"] * values["markers_y"]
+    else:
+        first, n_markers = 0, values["squares_x"] * values["squares_y"] // 2
+    size = cv2.aruco.getPredefinedDictionary(aruco_dictionary(spec["dictionary"])).bytesList.shape[0]
+    if first + n_markers > size:
+        raise ArgumentError(f"{where}: markers {first} .. {first + n_markers - 1} do not fit {spec['dictionary']} "
+                            f"({size} markers)")
     if kind == "charuco":
         return Charuco(**values, scale=scale)
-    return ArucoGrid(**values, first_id=int(spec.get("first_id", 0)), scale=scale)
+    return ArucoGrid(**values, scale=scale)
+
+
+def _checked(value: object, key: str, integer: bool, allow_zero: bool = False) -> int | float:
+    """A board field as a number: a positive (or, with ``allow_zero``, non-negative) integer or finite float;
+    :class:`ArgumentError` naming ``key`` otherwise (text, NaN, a bool, a fraction where a count is wanted)."""
+    number = isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, bool)
+    if number and np.isfinite(value) and (value > 0 or (allow_zero and value == 0)) and (
+            not integer or float(value).is_integer()):
+        return int(value) if integer else float(value)
+    wanted = "a non-negative integer" if allow_zero else "a positive integer" if integer else "a positive number"
+    raise ArgumentError(f"{key}: expected {wanted}, got {value!r}")
 
 
 def scaled(points: np.ndarray, board: Board) -> np.ndarray:

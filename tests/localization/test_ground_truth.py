@@ -17,8 +17,7 @@ from poseintegrity.localization.params import GroundTruthParams
 from poseintegrity.poses import pose_errors, pose_from_rvec_tvec, pose_matrix
 from scipy.spatial.transform import Rotation
 
-CHECKS = GroundTruthParams(consistency_factor=4.0, noise_floor_px=0.05, min_markers=3, min_corners=6,
-                           max_sigma_t_mm=0.5, max_sigma_r_deg=0.5)
+CHECKS = synthetic.CHECKS
 
 
 def test_board_pose_of_a_warped_board_image_is_the_known_pose():
@@ -164,3 +163,19 @@ def test_truth_error_is_zero_for_the_same_board_frame_error_and_the_offset_other
     E_t, E_r = truth_error(shifted, exact_f, exact_0 @ delta, exact_0)
     assert E_t == pytest.approx(0.4, abs=1e-9) and E_r == pytest.approx(0.0, abs=1e-6)
     assert np.isnan(truth_error(exact_f, exact_f, np.full((4, 4), np.nan), exact_0)[0])
+
+
+@pytest.mark.parametrize(("change", "words"), [
+    (lambda b: b.pop("separation_mm"), "board: a aruco_grid board needs separation_mm"),  # was a bare KeyError
+    (lambda b: b.pop("dictionary"), "board: a aruco_grid board needs dictionary"),
+    (lambda b: b.__setitem__("markers_x", "three"), "board.markers_x: expected a positive integer, got 'three'"),
+    (lambda b: b.__setitem__("markers_x", 2.5), "board.markers_x: expected a positive integer"),
+    (lambda b: b.__setitem__("marker_length_mm", float("nan")), "board.marker_length_mm: expected a positive number"),
+    (lambda b: b.__setitem__("first_id", 48), "board: markers 48 .. 53 do not fit DICT_4X4_50 .50 markers."),
+    (lambda b: b.__setitem__("scale", [1.0]), r"board.scale: expected \[x, y\]"),
+])
+def test_a_board_spec_missing_or_spoiling_a_key_is_refused_naming_it(change, words):
+    board = dict(synthetic.BOARD)
+    change(board)
+    with pytest.raises(ArgumentError, match=words):
+        board_from_dict(board)

@@ -48,6 +48,8 @@ BAD_VALUES = [
     ("calibration.distance_mm", [450.0, 250.0], "calibration.distance_mm"),
     ("calibration.distance_mm", [50.0, 300.0], "calibration.distance_mm"),  # nearer than the lens focuses
     ("calibration.max_tilt_deg", 85.0, "calibration.max_tilt_deg"),  # the board seen edge-on
+    ("calibration.max_tilt_deg", 0.0, "calibration.max_tilt_deg"),  # every view fronto-parallel: f undetermined
+    ("calibration.max_tilt_deg", 19.0, "calibration.max_tilt_deg"),  # too little tilt for an accurate focal length
     ("calibration.max_rms_px", 0.0, "calibration.max_rms_px"),  # no calibration passes
     ("camera.distortion", [-3.0, 0.0, 0.0, 0.0, 0.0], "camera.distortion.0"),  # a fisheye: plumb_bob cannot model it
     ("printed_boards.scale_std", 0.05, "printed_boards.scale_std"),  # 5 %: seen with a ruler

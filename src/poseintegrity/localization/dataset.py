@@ -39,7 +39,7 @@ import pyarrow
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
 from poseintegrity.boards import aruco_dictionary
-from poseintegrity.errors import ArgumentError, PoseIntegrityError
+from poseintegrity.errors import ArgumentError, PoseIntegrityError, not_numbers
 from poseintegrity.lens import Camera, CameraFileError, read_camera_yaml
 
 INDEX_COLUMNS = ("dataset", "path")
@@ -285,6 +285,12 @@ def _check_frames(frames: pd.DataFrame, path: Path, name: str) -> None:
         raise DatasetError(f"dataset {name}: {path} lacks the column(s) {missing}")
     if frames.empty:
         raise DatasetError(f"dataset {name}: {path} has no rows (a dataset without frames would give an empty stage)")
+    for column in ("stop", "image", "theta_deg", "x_mm"):
+        if (text := not_numbers(frames[column])).any():
+            row = int(np.argmax(text))
+            value, stop, image = (frames[key].tolist()[row] for key in (column, "stop", "image"))
+            raise DatasetError(f"dataset {name}: {path}: column {column} must hold numbers, got {value!r} in row {row} "
+                               f"(stop {stop!r}, image {image!r})")
     if frames[["dataset", "stop", "image", "file"]].isna().any().any():
         raise DatasetError(f"dataset {name}: {path} has empty dataset, stop, image or file entries")
     if others := sorted(set(frames["dataset"].astype(str)) - {name}):

@@ -21,7 +21,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from poseintegrity.localization.envelope import CRITERIA, EXACT_ERRORS, envelope_crossing, stop_criteria
+from poseintegrity.localization.envelope import CRITERIA, EXACT_ERRORS, actual_envelope, stop_criteria
 from poseintegrity.protocol import EnvelopeParams, tolerance_name
 
 COLUMNS = ["world", "dataset", "trajectory", "tolerance", "theta_a", "censored", "theta_a_exact", "limit", "cause",
@@ -43,7 +43,7 @@ def envelope_causes(table: pd.DataFrame, tolerances: list[tuple[float, float]], 
         has_exact = bool(frames[list(EXACT_ERRORS)].notna().any().any())
         for tolerance in tolerances:
             criteria, bounds = stop_criteria(frames, tolerance, envelope.failed_frames, envelope)
-            theta_a, censored, criterion = envelope_crossing(theta, criteria, bounds)
+            theta_a, censored, _, criterion = actual_envelope(theta, criteria, bounds)
             exact = (stop_criteria(frames, tolerance, envelope.failed_frames, envelope, EXACT_ERRORS)
                      if has_exact else None)
             with np.errstate(invalid="ignore"):
@@ -52,7 +52,7 @@ def envelope_causes(table: pd.DataFrame, tolerances: list[tuple[float, float]], 
             at_stop = frames[frames["stop"] == stops[failing]]
             row = dict(world=world, dataset=dataset, trajectory=trajectory, tolerance=tolerance_name(tolerance),
                        theta_a=theta_a, censored=censored,
-                       theta_a_exact=envelope_crossing(theta, *exact)[0] if exact is not None else float("nan"),
+                       theta_a_exact=actual_envelope(theta, *exact).theta_a if exact is not None else float("nan"),
                        n_inliers_at_theta_a=float(np.interp(theta_a, theta, n_inliers)) if np.isfinite(theta_a)
                        else float("nan"),
                        board_untrusted_share=float((at_stop["board_status"] != "ok").mean()),

@@ -15,6 +15,13 @@ from poseintegrity.lens import LensError, check_folding
 from poseintegrity.schema import FromList, KeyRule, Section, ordered_range
 
 MIN_IMAGE_PX = 64  # the rendered image's shorter side: below it no target keeps enough pixels to be localized
+# Zhang's method takes the focal length from how the board's plane turns between views (views of parallel planes add
+# no constraint, Zhang 2000, section 3.3): with views tilted by at most max_tilt_deg the calibration of params.yaml's
+# session still converges with an RMS of 0.07-0.09 px at any tilt, but its focal length is off by up to 3590 % at
+# 0 deg, 39 % at 2, 10 % at 5, 3.9 % at 10, 2.4 % at 15, 1.6 % at 20 and 1.1 % at params.yaml's 40 deg (worst of 3
+# sessions, benchmarks/bench_calibration_tilt.py): below 20 deg the error grows as the tilt shrinks, past 1.5 times
+# what more tilt reaches
+MIN_CALIBRATION_TILT_DEG = 20.0
 MAX_SENSOR_PX = 4096  # a side of the sensor: larger frames take GBs of z-buffer per worker
 
 
@@ -194,9 +201,19 @@ class CalibrationParams(Section):
     distance_mm: ordered_range(ge=100, le=2000) = Field(
         description="camera to board centre, drawn per view: within [100, 2000] mm, where the lens focuses and the "
                     "board covers more than a few pixels")
-    max_tilt_deg: float = Field(ge=0, le=70, description="board tilt from facing the camera, drawn per view")
+    max_tilt_deg: float = Field(ge=0, le=70, description="board tilt from facing the camera, drawn per view (at "
+                                                         "least MIN_CALIBRATION_TILT_DEG, checked below)")
     max_rms_px: float = Field(gt=0, le=5, description="a calibration whose reprojection RMS exceeds this stops "
                                                       "stage 01: its camera would not be worth using")
+
+    @field_validator("max_tilt_deg")
+    @classmethod
+    def _tilted_enough(cls, tilt: float) -> float:
+        if tilt < MIN_CALIBRATION_TILT_DEG:
+            raise ValueError(f"views tilted by at most {tilt:g} deg are nearly parallel to the image, and Zhang's "
+                             f"calibration cannot tell the focal length from the distance (off by 10 % at 5 deg, 3.9 % "
+                             f"at 10 deg): must be >= {MIN_CALIBRATION_TILT_DEG:g}")
+        return tilt
 
 
 class CaptureParams(Section):
