@@ -52,8 +52,14 @@ def world(counts_by_dataset, trajectory="arc"):
                                  theta_deg=theta if trajectory == "arc" else 0.0,
                                  x_mm=10.0 * stop if trajectory == "line" else 0.0, method="usac_magsac",
                                  n_inliers=n_i, status="ok" if n_i else "no_consensus",
-                                 E_t_mm=50.0 / n_i if n_i else np.nan, E_r_deg=0.0))
+                                 E_t_mm=50.0 / n_i if n_i else np.nan, E_r_deg=0.0, **BOARD))
     return pd.DataFrame(rows)
+
+
+# every frame's board trusted, adding 0.1 mm / 0.05 deg to E_t / E_r (R11 passes), the model placed 0.3 mm off
+BOARD = dict(board_status="ok", board_n_points=24, board_n_dropped=0, board_rms_px=0.05, board_sigma_t_mm=0.05,
+             board_sigma_r_deg=0.02, E_t_truth_mm=0.1, E_r_truth_deg=0.05, E_t_placement_mm=0.3,
+             E_r_placement_deg=0.1)
 
 
 def linear(decay):
@@ -82,6 +88,8 @@ def test_realism_metrics_of_a_world_with_known_answers():
     assert metrics["theta_a_gap"] == {"b": pytest.approx(metrics["theta_a_4mm10deg"]["b"] - metrics["min_theta_a_2mm3deg"])}
     assert metrics["decay_ratio_arc"] == pytest.approx({"a": 0.89, "b": 0.85, "c": 0.94})
     assert not metrics["passed"]["r5_early_decay"]  # linear decays keep most inliers over the sampled stops
+    assert metrics["truth_accuracy"]["p99_E_t_truth_mm"] == pytest.approx(0.1)  # R11: the board's 0.1 mm / 0.05 deg
+    assert metrics["passed"]["r11_truth_accuracy"] and metrics["truth_accuracy"]["trusted_share"] == 1.0
     # R6-R10: the hardest arc (b) far past 9 deg; mean / min of the three envelopes; no lines; E_t at the sampled
     # stops (50 / n_i, frames with a pose); b's theta_a between stops
     theta_a = metrics["theta_a_2mm3deg"]

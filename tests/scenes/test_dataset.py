@@ -48,7 +48,8 @@ def test_layout_and_index(tiny_root):
     assert set(index["trajectory"]) == {"arc", "line"} and set(index["world"]) == {"main", "validation"}
     for world in ("main", "validation"):
         calibration = root.parent / "calibration" / world
-        assert (calibration / "camera.yaml").is_file() and len(list((calibration / "views").glob("*.png"))) == 25
+        views = params.worlds()[world].calibration.n_views
+        assert (calibration / "camera.yaml").is_file() and len(list((calibration / "views").glob("*.png"))) == views
     for row in index.itertuples():
         frames = pd.read_parquet(root / row.dataset / "frames.parquet")
         meta = json.loads((root / row.dataset / "meta.json").read_text())
@@ -142,7 +143,8 @@ def test_interrupted_run_leaves_nothing_that_looks_complete(tiny_root, tmp_path,
 
     def failing_expose(*args, **kwargs):
         calls["n"] += 1
-        if calls["n"] > 60:  # past both worlds' calibration sessions (25 views each), into the datasets
+        calibration_views = sum(w.calibration.n_views for w in params.worlds().values())  # both worlds' sessions
+        if calls["n"] > calibration_views + 10:  # into the datasets
             raise KeyboardInterrupt("simulated interruption")
         return real_expose(*args, **kwargs)
 

@@ -45,6 +45,8 @@ def write_dataset(recorded: Recorded, root: Path) -> dict:
                  "masks": [f"model/mask_{k}.png" for k in range(2)], "T_cam1_cam0": recorded.T_cam1_cam0.tolist()}
         if recorded.ground_truth == "poses":
             model["T_cam0_ref"] = recorded.T_cam0_ref.tolist()
+        elif recorded.T_cam0_ref is not None:  # a board, and model image 0's recorded pose in its frame: the
+            model["exact_T_cam_board"] = [recorded.T_cam0_ref.tolist()]  # reference of the board's own accuracy (R11)
         for k, (image, mask) in enumerate(zip(recorded.model_images, recorded.model_masks)):
             _write_image(recorded.folder / image, tmp / model["images"][k])
             if mask is None:  # no mask: the whole image is target

@@ -187,7 +187,8 @@ def place_board(size_mm: tuple[float, float], margin_mm: float, targets: list[np
     if not keep.any():
         raise PlacementError(f"{where}: no place beside the target keeps a {w:g} x {h:g} mm board (with its margin) "
                              f"{MIN_IN_VIEW:.0%} in view and clear of the targets along every trajectory; a smaller "
-                             f"generate.board, a larger distance_mm or fewer targets would leave room")
+                             f"generate.board, a larger distance_mm, fewer or smaller targets (generate.scapula.length_mm) would "
+                             f"leave room")
     origins = centres - (size_mm[0] / 2) * x_b - (size_mm[1] / 2) * y_b
     lever = np.linalg.norm(origins - target_centre, axis=1)
     best = min(np.flatnonzero(keep), key=lambda i: (-round(worst[i], 2), lever[i], i))
