@@ -1,7 +1,7 @@
 """The PnP results of one frame for every method, computed once and cached beside its evidence.
 
 Stages 02 and 05 solve each frame's correspondences with their PnP methods (:mod:`pnp`). The results are kept in
-one small ``.npz`` per frame (``<features_dir>/<dataset>/images/<image>.pnp.npz``), an entry per method, like the
+one small ``.npz`` per frame (``<features_dir>/<dataset>/images/<image>.pnp.npz``), a row per method, like the
 SIFT features and the evidence, so that a re-run recomputes only what its changes reach (an edit of the package, of
 ``protocol`` or of ``parallel`` re-runs the stage, not its PnP). An entry's key hashes everything its result
 depends on: the correspondences themselves (object and image points, which stand for the image, its features, M_t,
@@ -28,7 +28,8 @@ from poseintegrity.localization.params import ExtractParams
 from poseintegrity.localization.pnp import PnPResult, solve_methods
 
 PNP_CACHE_VERSION = 1  # bump when the cached content, its layout or what computes it changes
-FIELDS = ("key", "T_cam_model", "inliers", "n_inliers_reported", "status", "reason")
+# one array per field, a row per method (the inliers of all methods concatenated): an .npz array costs ~30 us to read
+FIELDS = ("methods", "keys", "T_cam_model", "n_inliers_reported", "status", "reason", "inlier_counts", "inliers")
 
 
 def pnp_key(
@@ -48,24 +49,34 @@ def pnp_key(
     return hashlib.sha1(json.dumps(settings).encode() + points).hexdigest()
 
 
-def _stored(path: Path) -> dict[str, np.ndarray]:
-    """Every array of a cache file; {} when it is missing, truncated or not an .npz."""
+def _stored(path: Path) -> dict[str, tuple[str, PnPResult]]:
+    """The entries of a cache file: method -> (its key, its result); {} when the file is missing, truncated, not an
+    .npz or of another layout."""
     try:
         with np.load(path) as stored:
-            return {name: stored[name] for name in stored.files}
+            methods, keys, T, n_reported, status, reason, counts, inliers = (stored[name] for name in FIELDS)
     except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile):
         return {}
+    m = len(methods)
+    if (methods.ndim != 1 or T.shape != (m, 4, 4) or any(len(a) != m for a in (keys, n_reported, status, reason, counts))
+            or inliers.ndim != 1 or counts.sum() != len(inliers)):
+        return {}  # a foreign layout: recomputed
+    bounds = np.cumsum(counts)
+    return {method: (str(keys[i]), PnPResult(T[i].astype(np.float64),
+                                             inliers[bounds[i] - counts[i]:bounds[i]].astype(np.intp),
+                                             int(n_reported[i]), str(status[i]), str(reason[i])))
+            for i, method in enumerate(methods.tolist())}
 
 
-def _entry(stored: Mapping[str, np.ndarray], method: str, key: str) -> PnPResult | None:
-    """The result of ``method`` in a cache file when stored under ``key``, else None."""
-    names = [f"{method}.{field}" for field in FIELDS]
-    if not all(name in stored for name in names) or str(stored[names[0]]) != key:
-        return None
-    T_cam_model, inliers, n_reported, status, reason = (stored[name] for name in names[1:])
-    if T_cam_model.shape != (4, 4) or inliers.ndim != 1:
-        return None  # a foreign layout: recomputed
-    return PnPResult(T_cam_model.astype(np.float64), inliers.astype(np.intp), int(n_reported), str(status), str(reason))
+def _write(path: Path, entries: Mapping[str, tuple[str, PnPResult]]) -> None:
+    """Store the entries (:func:`_stored`'s layout) by write-then-rename."""
+    results = [result for _, result in entries.values()]
+    write_npz(path, methods=np.array(list(entries), dtype=str), keys=np.array([key for key, _ in entries.values()], dtype=str),
+              T_cam_model=np.array([r.T_cam_model for r in results], dtype=np.float64).reshape(-1, 4, 4),
+              n_inliers_reported=np.array([r.n_inliers_reported for r in results], dtype=np.int64),
+              status=np.array([r.status for r in results], dtype=str), reason=np.array([r.reason for r in results], dtype=str),
+              inlier_counts=np.array([r.n_inliers for r in results], dtype=np.int64),
+              inliers=np.concatenate([np.empty(0, np.intp)] + [r.inliers for r in results]).astype(np.int64))
 
 
 def frame_pnp(
@@ -81,17 +92,10 @@ def frame_pnp(
     keys = {method: pnp_key(method, object_points, image_points, K, digest, params, max_iterations[method], seed)
             for method in methods}
     stored = _stored(path) if path.exists() else {}
-    results = {method: _entry(stored, method, keys[method]) for method in methods}
-    missing = [method for method, result in results.items() if result is None]
-    if not missing:
-        return results
-    results |= solve_methods(object_points, image_points, K, missing, params.reprojection_threshold_px,
-                             params.ransac_confidence, max_iterations, seed, params.usac_refine_lm)
-    kept = {name: array for name, array in stored.items() if name.split(".")[0] not in missing}
-    for method in missing:
-        result = results[method]
-        kept |= {f"{method}.key": np.str_(keys[method]), f"{method}.T_cam_model": result.T_cam_model,
-                 f"{method}.inliers": result.inliers, f"{method}.n_inliers_reported": result.n_inliers_reported,
-                 f"{method}.status": np.str_(result.status), f"{method}.reason": np.str_(result.reason)}
-    write_npz(path, **kept)
-    return results
+    missing = [method for method in methods if stored.get(method, ("",))[0] != keys[method]]
+    if missing:
+        computed = solve_methods(object_points, image_points, K, missing, params.reprojection_threshold_px,
+                                 params.ransac_confidence, max_iterations, seed, params.usac_refine_lm)
+        stored |= {method: (keys[method], result) for method, result in computed.items()}  # the others stay
+        _write(path, stored)
+    return {method: stored[method][1] for method in methods}
