@@ -230,7 +230,8 @@ def test_the_methods_of_the_epnp_kernel_run_one_ransac(methods, outlier_fraction
     X, x, _, _ = scene(seed=8, n=120, outlier_fraction=outlier_fraction, noise_px=0.5)
     calls = []
     ransac = cv2.solvePnPRansac
-    monkeypatch.setattr(cv2, "solvePnPRansac", lambda *args, **kwargs: calls.append(kwargs["flags"]) or ransac(*args, **kwargs))
+    monkeypatch.setattr(cv2, "solvePnPRansac",
+                        lambda *args, **kwargs: calls.append(kwargs["flags"]) or ransac(*args, **kwargs))
     caps = dict.fromkeys(methods, 300)
     shared = solve_methods(X, x, K, methods, 1.0, 0.999, caps, 3, refine_lm=True)
     leader = next(method for method in EPNP_KERNEL if method in methods)

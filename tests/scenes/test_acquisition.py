@@ -46,7 +46,8 @@ def test_the_compiled_rotation_maps_are_numpys_to_the_bit(dtype):
     rng = np.random.default_rng(3)
     x, y = np.meshgrid(np.arange(320.0), np.arange(240.0))
     r2 = ((x - 160) ** 2 + (y - 120) ** 2) / 500.0**2
-    map_x, map_y = (x + (x - 160) * 0.06 * r2 + rng.normal(0, 1e-3, x.shape)).astype(dtype), (y + (y - 120) * 0.06 * r2).astype(dtype)
+    map_x = (x + (x - 160) * 0.06 * r2 + rng.normal(0, 1e-3, x.shape)).astype(dtype)
+    map_y = (y + (y - 120) * 0.06 * r2).astype(dtype)
     for scale in (1e-4, 1e-3, 1e-2, 0.3):
         rotation = rng.normal(0.0, scale, 3)
         ours, reference = rotation_maps(K, rotation, map_x, map_y), numpy_rotation_maps(K, rotation, map_x, map_y)

@@ -8,8 +8,9 @@ depends on: the correspondences themselves (object and image points, which stand
 the ratio and the lens), M_t's digest, K, the method, the threshold, the confidence, the method's iteration cap,
 the frame's seed, USAC's ``refine_lm`` (for USAC only), and what computes it: OpenCV's version and the CPU features
 its kernels dispatch to, numpy's version (its Generator orders the matches). An entry is used only when recomputing
-it would give the same result; the methods without one are computed (:func:`~poseintegrity.localization.pnp.solve_methods`,
-the classic RANSAC shared) and the file is rewritten by write-then-rename with them added.
+it would give the same result; the methods without one are computed
+(:func:`~poseintegrity.localization.pnp.solve_methods`, the classic RANSAC shared) and the file is rewritten by
+write-then-rename with them added.
 """
 
 from __future__ import annotations
@@ -58,8 +59,8 @@ def _stored(path: Path) -> dict[str, tuple[str, PnPResult]]:
     except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile):
         return {}
     m = len(methods)
-    if (methods.ndim != 1 or T.shape != (m, 4, 4) or any(len(a) != m for a in (keys, n_reported, status, reason, counts))
-            or inliers.ndim != 1 or counts.sum() != len(inliers)):
+    if (methods.ndim != 1 or T.shape != (m, 4, 4) or inliers.ndim != 1 or counts.sum() != len(inliers)
+            or any(len(a) != m for a in (keys, n_reported, status, reason, counts))):
         return {}  # a foreign layout: recomputed
     bounds = np.cumsum(counts)
     return {method: (str(keys[i]), PnPResult(T[i].astype(np.float64),
@@ -71,10 +72,12 @@ def _stored(path: Path) -> dict[str, tuple[str, PnPResult]]:
 def _write(path: Path, entries: Mapping[str, tuple[str, PnPResult]]) -> None:
     """Store the entries (:func:`_stored`'s layout) by write-then-rename."""
     results = [result for _, result in entries.values()]
-    write_npz(path, methods=np.array(list(entries), dtype=str), keys=np.array([key for key, _ in entries.values()], dtype=str),
+    write_npz(path, methods=np.array(list(entries), dtype=str),
+              keys=np.array([key for key, _ in entries.values()], dtype=str),
               T_cam_model=np.array([r.T_cam_model for r in results], dtype=np.float64).reshape(-1, 4, 4),
               n_inliers_reported=np.array([r.n_inliers_reported for r in results], dtype=np.int64),
-              status=np.array([r.status for r in results], dtype=str), reason=np.array([r.reason for r in results], dtype=str),
+              status=np.array([r.status for r in results], dtype=str),
+              reason=np.array([r.reason for r in results], dtype=str),
               inlier_counts=np.array([r.n_inliers for r in results], dtype=np.int64),
               inliers=np.concatenate([np.empty(0, np.intp)] + [r.inliers for r in results]).astype(np.int64))
 

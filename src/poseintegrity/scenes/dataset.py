@@ -183,7 +183,8 @@ def drive_scene(params: GenerateParams, mine: list[tuple[DatasetPlan, Trip]], sc
         stops = visits(placed, trip_path(trip), params, plan.dataset)[len(trip.model_views):]
         routes[plan.dataset] = Route(model[plan.trajectory], stops)
     return routes, accuracy(placed, [t for p, t in mine if p.trajectory == "arc"],
-                            [t for p, t in mine if p.trajectory == "line"], keyed_rng(params.seed, "accuracy", scene_index))
+                            [t for p, t in mine if p.trajectory == "line"],
+                            keyed_rng(params.seed, "accuracy", scene_index))
 
 
 @dataclass(frozen=True)
