@@ -3,6 +3,8 @@
 PYTHON ?= python3.11
 VENV := .venv
 BIN := $(CURDIR)/$(VENV)/bin
+# venv-on-path.pth: this venv's bin first on PATH in every process of its Python, so that dvc.yaml's `python` is it
+PATH_HOOK := $(VENV)/lib/python3.11/site-packages/venv-on-path.pth
 export PATH := $(BIN):$(PATH)
 # Papermill's `-k python3` must resolve to this venv's kernel, never to one of the user's.
 export JUPYTER_PATH := $(CURDIR)/$(VENV)/share/jupyter
@@ -33,11 +35,14 @@ $(VENV)/.installed: requirements.lock pyproject.toml
 	$(BIN)/python -m ipykernel install --sys-prefix --name python3 > /dev/null
 	touch $@
 
-install: $(VENV)/.installed ## create .venv and install the pinned dependencies
+$(PATH_HOOK): venv-on-path.pth $(VENV)/.installed
+	cp venv-on-path.pth $@
 
-repro: $(VENV)/.installed ## run the paper-scale pipeline (dvc repro), then print each stage's wall time
+install: $(VENV)/.installed $(PATH_HOOK) ## create .venv and install the pinned dependencies
+
+repro: $(VENV)/.installed $(PATH_HOOK) ## run the paper-scale pipeline (dvc repro), then print each stage's wall time
 	$(BIN)/dvc repro
 	@$(BIN)/python -m poseintegrity.timing reports/metrics/timing
 
-test: $(VENV)/.installed ## run the pytest suite (notebooks executed with tiny parameters)
+test: $(VENV)/.installed $(PATH_HOOK) ## run the pytest suite (notebooks executed with tiny parameters)
 	$(BIN)/python -m pytest -n 2

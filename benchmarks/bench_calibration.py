@@ -94,7 +94,7 @@ def main() -> None:
     render_s = time.perf_counter() - start
     print(f"  render {render_s:.2f} s ({render_s / len(images) * 1000:.0f} ms per view)")
     start = time.perf_counter()
-    found = [detect_corners(image, spec.board()) for image in images]
+    found = [detect_corners(image, spec) for image in images]
     detect_s = time.perf_counter() - start
     covered = np.concatenate([img for _, img in found])
     print(f"  detection {detect_s:.2f} s; corners per view {[len(o) for o, _ in found]}; corners reach "

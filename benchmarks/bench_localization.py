@@ -36,7 +36,8 @@ from poseintegrity.localization.dataset import DatasetError, load_dataset, load_
 from poseintegrity.localization.evidence import correspondences, frame_evidence, model_digest
 from poseintegrity.localization.extract import dataset_model, frame_seed, iteration_cap, localize
 from poseintegrity.localization.features import detect_features, read_gray
-from poseintegrity.localization.ground_truth import board_pose, make_board
+from poseintegrity.boards import board_from_dict
+from poseintegrity.localization.ground_truth import board_pose
 from poseintegrity.localization.pnp import CLASSIC_FLAGS, solve_pnp_ransac
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -74,7 +75,7 @@ def arc_dataset(data_dir: Path):
 def pipeline_ratios(dataset, model, params, cache: Path, repeats: int) -> float:
     """The per-frame table of five stops; returns the mean SIFT time (s) of those frames."""
     digest = model_digest(model)
-    board = make_board(dataset.meta["board"])
+    board = board_from_dict(dataset.meta["board"])
     sift = cv2.SIFT_create()
     stops = sorted(dataset.frames["stop"].unique())
     header = f"{'stop':>4} {'theta':>6} {'kp':>5} {'match':>5} {'n_i':>4} {'SIFT ms':>8} {'pipeline/SIFT':>13} " + " ".join(

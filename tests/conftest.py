@@ -1,8 +1,12 @@
-"""Shared fixtures: the repository root and the tiny parameters every notebook test runs with."""
+"""Shared fixtures: the repository root, the tiny parameters every notebook test runs with, and work done once per
+test session whichever xdist worker asks for it first; the order in which the workers take the test modules."""
 
-from pathlib import Path
-
+import copy
+import fcntl
 import os
+import shutil
+from collections.abc import Callable
+from pathlib import Path
 
 import pytest
 from hypothesis import settings
@@ -15,14 +19,60 @@ settings.register_profile("ci", derandomize=True)
 if os.environ.get("CI"):
     settings.load_profile("ci")
 
+# The notebooks the tests execute save every figure as the pipeline does, without also rendering each one into the
+# notebook (the inline backend's second drawing of every figure: a fifth of stage 04's time on the tiny parameters).
+os.environ.setdefault("MPLBACKEND", "Agg")
+
 ROOT = Path(__file__).resolve().parents[1]
 TINY_PARAMS = ROOT / "tests" / "params_tiny.yaml"
 
+# The longest modules first, each given whole to one worker (pyproject.toml: --dist loadscope, in this order): the
+# pipeline chain on one worker and stage 06's notebook, which the chain's report reuses (run_once), on the other.
+LONGEST_FIRST = ("tests/test_notebooks.py", "tests/tracking/test_notebook_06.py", "tests/recorded/test_stage01.py",
+                 "tests/test_stage.py")
+
+
+def pytest_collection_modifyitems(config, items):
+    rank = {name: i for i, name in enumerate(LONGEST_FIRST)}
+    items.sort(key=lambda item: rank.get(Path(item.path).relative_to(ROOT).as_posix(), len(rank)))  # stable
+
+
+@pytest.fixture(scope="session")
+def run_once(tmp_path_factory) -> Callable[[str, Callable[[Path], object]], Path]:
+    """``run_once(name, produce)``: a folder filled by ``produce(folder)`` once per test session, whichever worker
+    asks first; a worker asking meanwhile waits for it (a file lock in the session's folder, which the xdist workers
+    share) and then reads the same folder. A ``produce`` that fails leaves no folder, so the next one tries again."""
+    base = tmp_path_factory.getbasetemp()
+    root = base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base
+
+    def run(name: str, produce: Callable[[Path], object]) -> Path:
+        folder = root / f"once-{name}"
+        with open(root / f"once-{name}.lock", "w") as lock:
+            fcntl.flock(lock, fcntl.LOCK_EX)  # released when the file closes
+            if not (folder / ".done").is_file():
+                shutil.rmtree(folder, ignore_errors=True)
+                folder.mkdir()
+                try:
+                    produce(folder)
+                except BaseException:
+                    shutil.rmtree(folder, ignore_errors=True)
+                    raise
+                (folder / ".done").touch()
+        return folder
+
+    return run
+
+
+@pytest.fixture(scope="session")
+def _tiny_raw_once() -> dict:
+    return read_raw(TINY_PARAMS)[0]
+
 
 @pytest.fixture
-def tiny_raw() -> dict:
-    """tests/params_tiny.yaml merged onto params.yaml, as a plain dict to be altered by a test."""
-    return read_raw(TINY_PARAMS)[0]
+def tiny_raw(_tiny_raw_once) -> dict:
+    """tests/params_tiny.yaml merged onto params.yaml, as a plain dict to be altered by a test (a copy of the one
+    read per session: reading and merging the YAML took a third of every bad-value case)."""
+    return copy.deepcopy(_tiny_raw_once)
 
 
 @pytest.fixture

@@ -21,7 +21,8 @@ from poseintegrity.lens import Camera  # noqa: E402
 from poseintegrity.localization import envelope as envelope_module  # noqa: E402
 from poseintegrity.localization.dataset import BoardMeta  # noqa: E402
 from poseintegrity.localization.features import ImageReadError, as_gray8, read_gray  # noqa: E402
-from poseintegrity.localization.ground_truth import board_pose, make_board  # noqa: E402
+from poseintegrity.boards import board_from_dict  # noqa: E402
+from poseintegrity.localization.ground_truth import board_pose  # noqa: E402
 from poseintegrity.localization.pnp import solve_pnp_ransac  # noqa: E402
 from poseintegrity.tables import check_artifacts, check_envelopes, read_envelopes  # noqa: E402
 from poseintegrity.localization.target_model import triangulate  # noqa: E402
@@ -60,7 +61,7 @@ def test_bad_distortion_and_size_are_refused():
 
 
 def test_valid_board_pose_is_unchanged(image):
-    pose = board_pose(image, make_board(synthetic.BOARD), synthetic.CAMERA)
+    pose = board_pose(image, synthetic.BOARD, synthetic.CAMERA, synthetic.CHECKS)
     assert pose.status == "ok"
     E_t, E_r = pose_errors(pose.T_cam_board, synthetic.arc_pose(0.0, 0.0))
     assert E_t < 1.0 and E_r < 0.5
@@ -68,12 +69,12 @@ def test_valid_board_pose_is_unchanged(image):
 
 # --- images -------------------------------------------------------------------------------------------------------
 def test_colour_and_16_bit_images_are_converted_as_documented(image):
-    board = make_board(synthetic.BOARD)
+    board = synthetic.BOARD
     assert as_gray8("image", image) is image  # the pipeline's own images: untouched
     colour = np.dstack([image] * 3)
     np.testing.assert_array_equal(as_gray8("image", colour), image)
     np.testing.assert_array_equal(as_gray8("image", image.astype(np.uint16) * 257), image)
-    assert board_pose(image.astype(np.uint16) * 257, board, synthetic.CAMERA).status == "ok"
+    assert board_pose(image.astype(np.uint16) * 257, board, synthetic.CAMERA, synthetic.CHECKS).status == "ok"
 
 
 @pytest.mark.parametrize(("bad", "words"), [
@@ -85,7 +86,7 @@ def test_unusable_images_are_refused_naming_argument_shape_dtype(bad, words, ima
     with pytest.raises(PoseIntegrityError, match=rf"^image: .*{words}"):
         as_gray8("image", bad)
     with pytest.raises(PoseIntegrityError, match=rf"^image: .*{words}"):
-        board_pose(bad, make_board(synthetic.BOARD), synthetic.CAMERA)
+        board_pose(bad, synthetic.BOARD, synthetic.CAMERA)
 
 
 @pytest.mark.parametrize("damage", ["empty", "truncated", "junk", "missing"])
@@ -104,7 +105,7 @@ def test_unknown_aruco_dictionary_is_refused_on_read():
     with pytest.raises(Exception, match="unknown ArUco dictionary 'DICT_9X9_1'"):
         BoardMeta.model_validate(dict(synthetic.BOARD, dictionary="DICT_9X9_1"))
     with pytest.raises(PoseIntegrityError, match="board.dictionary"):
-        make_board(dict(synthetic.BOARD, dictionary="DICT_9X9_1"))
+        board_from_dict(dict(synthetic.BOARD, dictionary="DICT_9X9_1"))
     with pytest.raises(Exception, match="do not fit DICT_4X4_50"):
         BoardMeta.model_validate(dict(synthetic.BOARD, first_id=48))
 
@@ -154,6 +155,8 @@ def _envelopes() -> pd.DataFrame:
     (lambda t: t.drop(columns="E_t_mm"), r"lacks columns \['E_t_mm'\]"),
     (lambda t: t.assign(stop=t.stop.astype(float)), "column stop must hold integers"),
     (lambda t: t.assign(E_t_mm=-t.E_t_mm), "below 0 E_t_mm"),
+    (lambda t: t.assign(x_mm=t.x_mm.astype(object).where(t.index != 3, "20.0 mm")),
+     r"column x_mm must hold numbers, got dtype object: '20.0 mm' in dataset arc_00 \(stop 1, image 1"),
 ])
 def test_spoiled_artifacts_tables_are_refused_naming_table_and_row(spoil, words):
     assert check_artifacts(_artifacts()) is not None  # the valid table passes
@@ -182,7 +185,7 @@ BOUNDS = np.array([2.0, 3.0])
 
 
 def test_valid_envelope_is_unchanged():
-    assert envelope_module.actual_envelope(THETA, CRITERIA, BOUNDS) == (7.5, False)
+    assert envelope_module.actual_envelope(THETA, CRITERIA, BOUNDS)[:3] == (7.5, False, ())
 
 
 @pytest.mark.parametrize(("theta", "criteria", "words"), [
@@ -198,16 +201,16 @@ def test_bad_stops_are_refused_naming_the_argument(theta, criteria, words):
 
 def test_unmeasured_errors_are_flagged_not_read_as_within_tolerance():
     nothing = np.full((4, 2), np.nan)
-    theta_a, censored = envelope_module.actual_envelope(THETA, nothing, BOUNDS)
-    assert np.isnan(theta_a) and not censored
+    theta_a, censored, unmeasured, _ = envelope_module.actual_envelope(THETA, nothing, BOUNDS)
+    assert np.isnan(theta_a) and not censored and unmeasured == tuple(THETA)
     failed_at_once = np.column_stack([nothing, np.ones(4)])  # no pose anywhere: fails at the first stop, known
-    assert envelope_module.actual_envelope(THETA, failed_at_once, np.append(BOUNDS, 0.5)) == (0.0, False)
+    assert envelope_module.actual_envelope(THETA, failed_at_once, np.append(BOUNDS, 0.5))[:3] == (0.0, False, ())
     frames = _artifacts().assign(E_t_mm=np.nan, E_r_deg=np.nan)
     from poseintegrity.protocol import EnvelopeParams
     params = EnvelopeParams.model_validate(dict(failed_frames="fail_fraction", cap_factor=2.0, max_failed_fraction=0.5))
     with pytest.warns(UserWarning, match=r"arc_00.*NaN: no pose error was measured"):
         table = envelope_module.envelopes(frames, [(2.0, 3.0)], params)
-    assert table.theta_a.isna().all() and not table.censored.any()
+    assert table.theta_a.isna().all() and not table.censored.any() and set(table.status) == {"not_measured"}
 
 
 # --- fits ---------------------------------------------------------------------------------------------------------

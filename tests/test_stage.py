@@ -117,6 +117,15 @@ def test_bad_parallel_value_stops_before_any_work_naming_the_key(tmp_path):
     assert not (tmp_path / "reports").exists()  # no kernel started, no folder made
 
 
+def test_a_file_where_the_reports_or_data_folder_goes_is_refused_before_any_work(tmp_path):
+    notebook = make_notebook(tmp_path / "demo.ipynb", {"work": WORK})
+    argv = runner(notebook, tmp_path, "{backend: local, n_jobs: 1}")
+    (tmp_path / "reports").write_text("mine")
+    result = subprocess.run(argv, capture_output=True, text=True, timeout=120)
+    assert result.returncode == 2 and f"--reports {tmp_path / 'reports'}: exists and is not a folder" in result.stderr
+    assert (tmp_path / "reports").read_text() == "mine" and "Traceback" not in result.stderr
+
+
 def test_process_start_is_when_the_process_started_not_a_whole_second_before():
     """psutil's create_time rests on the boot time of /proc/stat, whole seconds: up to 1 s early, which once made
     a stage's wall time exceed the time the test measured around it."""

@@ -10,11 +10,11 @@ term is then not fitted to noise). The result is what every later stage uses as 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
 
 import cv2
 import numpy as np
 
+from poseintegrity.boards import Charuco, scaled
 from poseintegrity.errors import PoseIntegrityError
 from poseintegrity.lens import Camera
 
@@ -24,31 +24,6 @@ MIN_VIEWS = 5  # views a calibration needs: the intrinsics and distortion are 8 
 
 class CalibrationError(PoseIntegrityError):
     """A calibration session that cannot give an estimate, or gives one worse than the bound asked for."""
-
-
-@dataclass(frozen=True)
-class CharucoSpec:
-    """A ChArUco board (cv2.aruco.CharucoBoard): squares_x x squares_y chessboard squares of ``square_mm``, ArUco
-    markers of ``marker_mm`` in the white ones; board frame: origin at the board's top-left corner, x right, y down,
-    z into the board (``getChessboardCorners``), mm."""
-
-    squares_x: int
-    squares_y: int
-    square_mm: float
-    marker_mm: float
-    dictionary: str
-
-    def board(self) -> "cv2.aruco.CharucoBoard":
-        dictionary = cv2.aruco.getPredefinedDictionary(getattr(cv2.aruco, self.dictionary))
-        return cv2.aruco.CharucoBoard((self.squares_x, self.squares_y), self.square_mm, self.marker_mm, dictionary)
-
-    @property
-    def size_mm(self) -> tuple[float, float]:
-        return self.squares_x * self.square_mm, self.squares_y * self.square_mm
-
-    def as_dict(self) -> dict[str, Any]:
-        return {"squares_x": self.squares_x, "squares_y": self.squares_y, "square_mm": self.square_mm,
-                "marker_mm": self.marker_mm, "dictionary": self.dictionary}
 
 
 @dataclass(frozen=True)
@@ -63,21 +38,21 @@ class Calibration:
     n_corners: tuple[int, ...]
 
 
-def detect_corners(image: np.ndarray, board: "cv2.aruco.CharucoBoard") -> tuple[np.ndarray, np.ndarray]:
-    """ChArUco corners of an 8-bit gray image (h, w): board points (k, 3) mm and image points (k, 2) px; (0, 3),
-    (0, 2) when none are found."""
-    corners, ids, _, _ = cv2.aruco.CharucoDetector(board).detectBoard(image)
+def detect_corners(image: np.ndarray, board: Charuco) -> tuple[np.ndarray, np.ndarray]:
+    """ChArUco corners of an 8-bit gray image (h, w): printed board points (k, 3) mm (the drawing's, scaled by the
+    board's measured ``scale``) and image points (k, 2) px; (0, 3), (0, 2) when none are found."""
+    cv_board = board.cv_board()
+    corners, ids, _, _ = cv2.aruco.CharucoDetector(cv_board).detectBoard(image)
     if ids is None or len(ids) == 0:
         return np.empty((0, 3)), np.empty((0, 2))
-    object_points, image_points = board.matchImagePoints(corners, ids)
-    return object_points.reshape(-1, 3).astype(np.float64), image_points.reshape(-1, 2).astype(np.float64)
+    object_points, image_points = cv_board.matchImagePoints(corners, ids)
+    return scaled(object_points.reshape(-1, 3), board), image_points.reshape(-1, 2).astype(np.float64)
 
 
-def calibrate(images: list[np.ndarray], spec: CharucoSpec, max_rms_px: float, key: str) -> Calibration:
+def calibrate(images: list[np.ndarray], board: Charuco, max_rms_px: float, key: str) -> Calibration:
     """Estimate the camera from calibration images (each (h, w) uint8, one size); ``key``: the params section of the
     ``max_rms_px`` came from, named by :class:`CalibrationError` (too few usable views, no convergence, an RMS above
     the bound)."""
-    board = spec.board()
     height, width = images[0].shape
     found = [(i, *detect_corners(image, board)) for i, image in enumerate(images)]
     used = [(i, obj, img) for i, obj, img in found if len(obj) >= MIN_CORNERS]

@@ -10,8 +10,9 @@ call once on what they are given (never inside a per-frame loop), in the spirit 
 
 from __future__ import annotations
 
+import codecs
 import math
-from collections.abc import Sequence, Sized
+from collections.abc import Iterable, Sequence, Sized
 from numbers import Real
 from pathlib import Path
 
@@ -102,7 +103,7 @@ def check_intrinsics(name: str, K: object) -> np.ndarray:
     """A (3, 3) pinhole camera matrix [[fx, s, cx], [0, fy, cy], [0, 0, 1]] with positive focal lengths (pixels)."""
     K = check_array(name, K, shape=(3, 3))
     if K[0, 0] <= 0 or K[1, 1] <= 0:
-        raise ArgumentError(f"{name}: focal lengths must be positive, got fx {K[0, 0]!r}, fy {K[1, 1]!r}")
+        raise ArgumentError(f"{name}: focal lengths must be positive, got fx {float(K[0, 0])!r}, fy {float(K[1, 1])!r}")
     if not np.allclose(K[2], [0.0, 0.0, 1.0]) or K[1, 0] != 0:
         raise ArgumentError(f"{name}: expected [[fx, s, cx], [0, fy, cy], [0, 0, 1]], got {K.tolist()}")
     return K
@@ -134,14 +135,24 @@ def check_increasing(name: str, values: object, *, strict: bool = True) -> np.nd
     return values
 
 
+def not_numbers(values: Iterable[object]) -> np.ndarray:
+    """(n,) bool: the entries of a table column (a pandas Series, any sequence) that are neither a real number nor
+    missing (None): text such as ``'20.0 mm'``, a bool, a list. Numeric columns have none."""
+    if getattr(values, "dtype", np.dtype(object)).kind in "iuf":
+        return np.zeros(len(values), dtype=bool)  # type: ignore[arg-type]
+    return np.array([not (v is None or (isinstance(v, Real) and not isinstance(v, (bool, np.bool_)))) for v in values],
+                    dtype=bool)
+
+
 def read_text_file(path: Path, error: type[PoseIntegrityError], what: str = "file") -> str:
-    """The UTF-8 text of a small input file (a table, a tool list); ``error`` naming the file when it cannot be read,
-    is empty, is not UTF-8 or holds NUL bytes (a binary file given by mistake)."""
+    """The UTF-8 text of a small input file (a table, a tool list) without the byte-order mark a spreadsheet may
+    write first (Excel's "CSV UTF-8"; it would otherwise stick to the first column's name); ``error`` naming the file
+    when it cannot be read, is empty, is not UTF-8 or holds NUL bytes (a binary file given by mistake)."""
     try:
         data = Path(path).read_bytes()
     except OSError as problem:
         raise error(f"{path}: cannot read the {what} ({problem.strerror or problem})") from None
-    if not data.strip():
+    if not data.removeprefix(codecs.BOM_UTF8).strip():
         raise error(f"{path}: the {what} is empty")
     try:
         text = data.decode("utf-8")
@@ -149,7 +160,7 @@ def read_text_file(path: Path, error: type[PoseIntegrityError], what: str = "fil
         raise error(f"{path}: not UTF-8 text (byte {problem.start}); is it a binary file?") from None
     if "\x00" in text:
         raise error(f"{path}: contains NUL bytes; is it a binary file?")
-    return text
+    return text.removeprefix("\ufeff")
 
 
 def check_same_length(**arrays: Sized) -> int:

@@ -214,17 +214,21 @@ def read_camera_yaml(path: str | Path) -> Camera:
     return Camera(K, dist, *size)
 
 
-def write_camera_yaml(path: str | Path, camera: Camera, name: str) -> None:
-    """``camera.yaml`` of ``camera`` in the ROS camera_info layout (monocular: identity rectification, projection
-    matrix [K | 0])."""
+def write_camera_yaml(path: str | Path, camera: Camera, name: str, projection: np.ndarray | None = None,
+                      rectification: np.ndarray | None = None) -> None:
+    """``camera.yaml`` of ``camera`` in the ROS camera_info layout. ``projection`` (3, 4) and ``rectification``
+    (3, 3) are written as given (a ROS camera_info's P and R, e.g. of a stereo pair); by default those of a
+    monocular camera, [K | 0] and the identity (the pipeline reads neither)."""
     K = np.asarray(camera.K, dtype=float)
+    P = np.hstack([K, np.zeros((3, 1))]) if projection is None else np.asarray(projection, dtype=float).reshape(3, 4)
+    R = np.eye(3) if rectification is None else np.asarray(rectification, dtype=float).reshape(3, 3)
     info = {
         "image_width": int(camera.width), "image_height": int(camera.height), "camera_name": name,
         "camera_matrix": {"rows": 3, "cols": 3, "data": K.ravel().tolist()},
         "distortion_model": next(name for name, n in DISTORTION_MODELS.items() if n == len(camera.dist)),
         "distortion_coefficients": {"rows": 1, "cols": len(camera.dist),
                                     "data": np.asarray(camera.dist, dtype=float).tolist()},
-        "rectification_matrix": {"rows": 3, "cols": 3, "data": np.eye(3).ravel().tolist()},
-        "projection_matrix": {"rows": 3, "cols": 4, "data": np.hstack([K, np.zeros((3, 1))]).ravel().tolist()},
+        "rectification_matrix": {"rows": 3, "cols": 3, "data": R.ravel().tolist()},
+        "projection_matrix": {"rows": 3, "cols": 4, "data": P.ravel().tolist()},
     }
     Path(path).write_text(yaml.safe_dump(info, sort_keys=False))

@@ -48,7 +48,8 @@ class EnvelopeParams(Section):
 class ProtocolParams(Section):
     """Windsor et al. IV: trajectories, PnP method, tolerances, sampled stops. Lengths in mm, angles in deg."""
 
-    arc_span_deg: float = Field(gt=0, le=90, description="arcs: theta = 0 .. span, the model view at 0 (IV-D: 45)")
+    arc_span_deg: float = Field(gt=0, le=180, description="arcs: theta = 0 .. span, the model view at 0 (IV-D: 45); "
+                                                          "a viewing angle is at most 180 deg")
     line_length_mm: float = Field(gt=0, le=1000, description="lines: x = 0 .. length from their start (IV-D: 150)")
     pnp_method: PnPMethod = Field(description="the PnP-RANSAC of the paper's tables (OpenCV USAC, MAGSAC)")
     tolerances: list[Annotated[tuple[Annotated[float, Field(gt=0, le=1000)], Annotated[float, Field(gt=0, le=180)]],

@@ -40,7 +40,18 @@ from poseintegrity.config import ParamsError, load_section  # noqa: E402
 from poseintegrity.parallel import worker_count  # noqa: E402
 from poseintegrity.timing import StageTiming, usage_error  # noqa: E402
 
-KERNEL = "python3"  # the kernelspec `make install` writes into .venv (the Makefile points JUPYTER_PATH there)
+KERNEL = "python3"  # the kernelspec `make install` writes into .venv's share/jupyter (kernel_search_path)
+
+
+def kernel_search_path() -> None:
+    """Put this interpreter's ``share/jupyter`` first on JUPYTER_PATH, where `make install` wrote the kernelspec
+    ``python3`` (``ipykernel install --sys-prefix``): a ``python3`` kernel on the user's own JUPYTER_PATH (searched
+    first) would otherwise run the notebooks with another Python (docs/references.md, "DVC and papermill"). So
+    ``.venv/bin/dvc repro`` needs no environment of the Makefile's; the kernel inherits the setting."""
+    ours = str(Path(sys.prefix) / "share" / "jupyter")
+    paths = os.environ.get("JUPYTER_PATH", "")
+    if paths.split(os.pathsep)[0] != ours:
+        os.environ["JUPYTER_PATH"] = os.pathsep.join(filter(None, (ours, paths)))
 
 
 def kernel_config() -> Config:
@@ -87,6 +98,7 @@ def run_stage(notebook: Path, params_path: Path, data_dir: Path, reports_dir: Pa
     papermill.PapermillExecutionError when a cell fails."""
     start = time.time() if started is None else started
     name = notebook.stem
+    kernel_search_path()
     parallel = load_section(params_path, "parallel")
     n_jobs = worker_count(parallel)
     outputs = StageOutputs(reports_dir, name)
@@ -142,6 +154,9 @@ def main(argv: list[str] | None = None) -> None:
     name = args.notebook.stem
     if not args.notebook.is_file():  # bad input: one line, exit status 2, no traceback
         sys.exit(usage_error(f"{args.notebook}: no such notebook"))
+    for option, folder in (("--data", args.data), ("--reports", args.reports)):
+        if folder.exists() and not folder.is_dir():  # the stage writes under it: a file there is not replaced
+            sys.exit(usage_error(f"{option} {folder}: exists and is not a folder"))
     partial = StageOutputs(args.reports, name).partial_notebook
     try:
         record = run_stage(args.notebook, args.params, args.data, args.reports,

@@ -23,7 +23,7 @@ import numpy as np
 import pandas as pd
 import pyarrow
 
-from poseintegrity.errors import PoseIntegrityError
+from poseintegrity.errors import PoseIntegrityError, not_numbers
 
 TRAJECTORIES = ("arc", "line")
 ARTIFACT_KEYS = ("dataset", "stop", "image", "method")
@@ -67,8 +67,10 @@ def _numeric(table: pd.DataFrame, name: str, column: str, keys: Iterable[str], *
         return
     kind = table[column].dtype.kind
     if kind not in ("iu" if integer else "iuf"):
+        text = not_numbers(table[column])
+        example = f": {table[column][text].iloc[0]!r} in {_row(table, text, keys)}" if text.any() else ""
         raise TableError(f"{name}: column {column} must hold {'integers' if integer else 'numbers'}, "
-                         f"got dtype {table[column].dtype}")
+                         f"got dtype {table[column].dtype}{example}")
     values = table[column].to_numpy(dtype=np.float64)
     bad = np.isinf(values) | (values < low) | (np.zeros_like(values, dtype=bool) if nan else np.isnan(values))
     if bad.any():

@@ -28,6 +28,10 @@ def _first(array: np.ndarray) -> tuple:
     return (0,) * np.ndim(array)
 
 
+def _first_number(mapping: dict) -> str:
+    return next(key for key, value in mapping.items() if not isinstance(value, str))
+
+
 COMMON: dict[str, BadValue] = {
     "None": lambda v, _: None,
     "text": lambda v, _: "text",
@@ -58,7 +62,15 @@ MATRIX: dict[str, BadValue] = {  # fixed-shape matrices: K, poses
     "inf": lambda v, _: _set(v, _first(v), np.inf),
     "huge": lambda v, _: _set(v, _first(v), 1e300),
     "zeros": lambda v, _: np.zeros(np.shape(v)),
+    "one_size_smaller": lambda v, _: np.asarray(v)[:-1, :-1],  # a 3 x 3 rotation where a 4 x 4 pose is wanted
     "text_entries": lambda v, _: np.full(np.shape(v), "x"),
+}
+MAPPING: dict[str, BadValue] = {  # a dict of named values (a board spec)
+    **COMMON,
+    "empty": lambda v, _: {},
+    "missing_key": lambda v, _: dict(list(v.items())[1:]),  # the first: a required key
+    "text_value": lambda v, _: {**v, _first_number(v): "x"},
+    "nan_value": lambda v, _: {**v, _first_number(v): float("nan")},
 }
 IMAGE: dict[str, BadValue] = {
     **COMMON,
@@ -131,6 +143,21 @@ FILE: dict[str, BadValue] = {  # a file argument: the valid file's name, bad con
 }
 
 
+def _with_bom(value: Any, folder: Path) -> Path:
+    data = Path(value).read_bytes()
+    path = _bad_copy(value, folder)
+    path.unlink(missing_ok=True)
+    path.write_bytes(b"\xef\xbb\xbf" + data)
+    return path
+
+
+TEXT_FILE: dict[str, BadValue] = {  # a text file a person may have written (a CSV table, YAML, JSON)
+    **FILE,
+    "bom_only": _file(b"\xef\xbb\xbf"),  # empty, whatever the mark says
+    "utf8_bom": _with_bom,  # Excel's "CSV UTF-8" starts with a byte-order mark: the same text (VALID)
+}
+
+
 def _retyped(table: pd.DataFrame) -> pd.DataFrame:
     bad = table.copy()
     column = next(c for c in bad.columns if pd.api.types.is_numeric_dtype(bad[c]) and not pd.api.types.is_bool_dtype(bad[c]))
@@ -147,6 +174,23 @@ TABLE: dict[str, BadValue] = {  # a table passed between stages
     "duplicated_row": lambda v, _: pd.concat([v, v.iloc[:1]], ignore_index=True),
 }
 
+
+def stored(spoil: BadValue) -> BadValue:
+    """A parquet file's bad version: its table spoiled by a TABLE value, written where :func:`_bad_copy` puts it."""
+    def write(value: Any, folder: Path) -> Path:
+        table = spoil(pd.read_parquet(value), folder)
+        path = _bad_copy(value, folder)
+        path.unlink(missing_ok=True)
+        table.to_parquet(path)
+        return path
+    return write
+
+
+PARQUET: dict[str, BadValue] = {**FILE, **{label: stored(spoil) for label, spoil in TABLE.items()}}  # a table file
+
 KINDS = {"array": ARRAY, "points": POINTS, "matrix": MATRIX, "image": IMAGE, "scalar": SCALAR,
-         "timestamp": TIMESTAMP, "file": FILE, "table": TABLE}
+         "timestamp": TIMESTAMP, "file": FILE, "text_file": TEXT_FILE, "parquet": PARQUET, "table": TABLE,
+         "mapping": MAPPING}
+FILE_KINDS = {"file", "text_file", "parquet"}  # arguments that are a file, named in errors by the file's name
 BENIGN = {"int32"}  # a lossless conversion any numeric entry point may perform
+VALID = {"utf8_bom"}  # the valid input in another spelling: must give the valid result (neither refused nor flagged)

@@ -18,7 +18,10 @@ from typing import Any
 
 import numpy as np
 import pandas as pd
+import yaml
 from scipy.spatial.transform import Rotation
+
+from bad_values import stored
 
 ROOT = Path(__file__).resolve().parents[2]
 TINY_PARAMS = ROOT / "tests" / "params_tiny.yaml"
@@ -33,6 +36,7 @@ class EntryPoint:
     flagged: Callable[[Any], bool] = lambda result: False
     accepts: dict[str, set[str]] = field(default_factory=dict)  # argument -> labels whose result is correct
     names: dict[str, str] = field(default_factory=dict)  # argument -> the word its error message must contain
+    cases: dict[str, dict[str, Callable]] = field(default_factory=dict)  # argument -> bad values of its own beyond its kind's
 
 
 # ----------------------------------------------------------------------------------------------- valid inputs
@@ -55,7 +59,7 @@ def localization_scene() -> dict[str, Any]:
     world = rng.uniform([85, -20, 0], [165, 65, 0], (60, 3))
     uv, _ = __import__("cv2").projectPoints(world, __import__("cv2").Rodrigues(T[:3, :3])[0], T[:3, 3], synthetic.K, None)
     return dict(image=image, T=T, object_points=world, image_points=uv.reshape(-1, 2), K=synthetic.K,
-                camera=synthetic.CAMERA, board=synthetic.make_board())
+                camera=synthetic.CAMERA, board=synthetic.BOARD, checks=synthetic.CHECKS)
 
 
 @cache
@@ -155,7 +159,7 @@ TRACKER_ACCEPTS = {"points": {"one_element", "one_fewer", "nan", "inf", "huge"}}
 
 
 def _entries() -> list[EntryPoint]:
-    from poseintegrity import config, lens, poses, tables, timing
+    from poseintegrity import boards, config, lens, poses, tables, timing
     from poseintegrity.artifact_models.models import fit_model
     from poseintegrity.localization import dataset, envelope, features, ground_truth, matching, pnp, target_model
     from poseintegrity.prediction import metrics, predictors
@@ -173,6 +177,12 @@ def _entries() -> list[EntryPoint]:
         # ---- params
         EntryPoint("config.load_params", lambda a: config.load_params(a["path"]),
                    lambda tmp: {"path": TINY_PARAMS}, {"path": "file"}),
+        EntryPoint("config.load_params[generate.calibration.max_tilt_deg]",
+                   lambda a: config.load_params(_overlay(a["folder"], {"generate": {"calibration": {"max_tilt_deg": a["value"]}}})),
+                   lambda tmp: {"value": 40.0, "folder": tmp}, {"value": "scalar"},
+                   names={"value": "generate.calibration.max_tilt_deg"},
+                   # every view (nearly) facing the camera: Zhang's method cannot separate the focal length from distance
+                   cases={"value": {"fronto_parallel": lambda v, _: 0.0, "nearly_fronto_parallel": lambda v, _: 1.0}}),
         # ---- lens
         EntryPoint("lens.read_camera_yaml", lambda a: lens.read_camera_yaml(a["path"]),
                    lambda tmp: {"path": _camera_yaml(tmp)}, {"path": "file"}),
@@ -195,7 +205,8 @@ def _entries() -> list[EntryPoint]:
                                                   0.999, 1000, 0, True),
                    lambda tmp: {k: loc()[k] for k in ("object_points", "image_points", "K")},
                    {"object_points": "points", "image_points": "points", "K": "matrix"}, flagged=_status_not_ok),
-        EntryPoint("localization.board_pose", lambda a: ground_truth.board_pose(a["image"], loc()["board"], a["camera"]),
+        EntryPoint("localization.board_pose", lambda a: ground_truth.board_pose(a["image"], loc()["board"], a["camera"],
+                                                                              loc()["checks"]),
                    lambda tmp: {"image": loc()["image"], "camera": loc()["camera"]}, {"image": "image"},
                    flagged=_status_not_ok, accepts=GRAY8_CONVERSIONS),
         EntryPoint("localization.triangulate",
@@ -206,14 +217,22 @@ def _entries() -> list[EntryPoint]:
                    lambda tmp: {"theta": np.arange(0.0, 40, 2.5), "criteria": np.c_[np.linspace(0.1, 3, 16),
                                 np.linspace(0.1, 4, 16)], "bounds": np.array([2.0, 3.0])},
                    {"theta": "array", "criteria": "points", "bounds": "array"},
-                   # NaN: nothing to average at a stop; inf and 1e300: an error that fails the stop (documented)
-                   accepts={"criteria": {"nan", "inf", "huge"}}),
+                   # NaN: an unmeasured stop, skipped and named; inf and 1e300: an error that fails the stop (documented)
+                   flagged=lambda result: bool(result.unmeasured) or bool(np.isnan(result.theta_a)),
+                   accepts={"criteria": {"inf", "huge"}},
+                   cases={"criteria": {"unmeasured_stop": lambda v, _: np.where(np.arange(len(v))[:, None] == 3, np.nan, v)}}),
+        EntryPoint("boards.board_from_dict", lambda a: boards.board_from_dict(a["board"]),
+                   lambda tmp: {"board": dict(__import__("loc_synthetic").BOARD)}, {"board": "mapping"}),
         EntryPoint("localization.load_index", lambda a: dataset.load_index(a["index"].parents[1]),
                    lambda tmp: {"index": _dataset_dir(tmp)}, {"index": "file"}, names={"index": "index.parquet"}),
         EntryPoint("localization.load_dataset",
                    lambda a: dataset.load_dataset(a["meta"].parents[2], a["meta"].parent.relative_to(a["meta"].parents[2])),
                    lambda tmp: {"meta": _dataset_dir(tmp).parent / "ds_arc" / "meta.json"}, {"meta": "file"},
                    names={"meta": "meta.json"}),
+        EntryPoint("localization.load_dataset[frames.parquet]",
+                   lambda a: dataset.load_dataset(a["frames"].parents[2], a["frames"].parent.relative_to(a["frames"].parents[2])),
+                   lambda tmp: {"frames": _dataset_dir(tmp).parent / "ds_arc" / "frames.parquet"}, {"frames": "parquet"},
+                   names={"frames": "frames.parquet"}, cases={"frames": {"text_in_x_mm": stored(_text_in_x_mm)}}),
         EntryPoint("poses.pose_errors", lambda a: poses.pose_errors(a["T_est"], a["T_true"]),
                    lambda tmp: {"T_est": loc()["T"], "T_true": loc()["T"]}, {"T_est": "matrix", "T_true": "matrix"},
                    accepts={"T_est": {"nan", "inf"}, "T_true": {"nan", "inf"}}),  # an unknown pose: NaN errors
@@ -274,6 +293,11 @@ def _entries() -> list[EntryPoint]:
                    # uint8/uint16/float IR and depth are documented inputs; a NaN pixel is an invalid pixel
                    accepts={"ir": {"uint16", "float32", "int32", "float_nan"},
                             "depth_mm": {"uint16", "float32", "int32", "float_nan"}}),
+        EntryPoint("tracking.detect_markers[K, T_world_cam]",
+                   lambda a: _warned(detection.detect_markers, tracking_frame()["ir"], tracking_frame()["depth"], a["K"],
+                                     P().track.detection, a["T_world_cam"]),
+                   lambda tmp: {"K": tracking_frame()["K"], "T_world_cam": np.eye(4)}, {"K": "matrix", "T_world_cam": "matrix"},
+                   flagged=_warning_flag, accepts={"T_world_cam": {"None"}}),  # None: the camera's frame (documented)
         EntryPoint("tracking.kabsch", lambda a: kabsch_fit(a["points_world"], a["points_body"]),
                    lambda tmp: {"points_world": tracking_frame()["markers"], "points_body": tracking_frame()["geometry"]},
                    {"points_world": "points", "points_body": "points"},
@@ -302,7 +326,7 @@ def _entries() -> list[EntryPoint]:
                    {"z": "array", "observed": "array"}, flagged=lambda ok: ok is False,
                    accepts={"observed": {"bool"}}),  # all True: every marker observed, a valid mask
         EntryPoint("tracking.read_tools", lambda a: tool_files.read_tools(a["path"], P().track.matching.distinct_m),
-                   lambda tmp: {"path": _tools_json(tmp)}, {"path": "file"}),
+                   lambda tmp: {"path": _tools_json(tmp)}, {"path": "text_file"}),
         EntryPoint("tracking.MultiToolTracker",
                    lambda a: multi_tool.MultiToolTracker(a["tools"], P().track.filter, P().track.matching).frame(
                        0.0, a["points"]),
@@ -329,7 +353,7 @@ def _entries() -> list[EntryPoint]:
         *[EntryPoint(f"tracking.convert_stream_recorder[{Path(name).name}]",
                      lambda a: hl2_recordings.convert_stream_recorder(_capture_of(a["file"]), _capture_of(a["file"]).parent / "converted",
                                                                       overwrite=True),
-                     lambda tmp, name=name: {"file": _stream_recorder_capture(tmp) / name}, {"file": "file"},
+                     lambda tmp, name=name: {"file": _stream_recorder_capture(tmp) / name}, {"file": _file_kind(name)},
                      names={"file": Path(name).name}, flagged=_pose_missing)
           for name in ("Depth AHaT/1000.pgm", "Depth AHaT/1000_ab.pgm", "Depth AHaT_lut.bin", "Depth AHaT_extrinsics.txt",
                        "Depth AHaT_rig2world.txt")],
@@ -344,7 +368,7 @@ def _entries() -> list[EntryPoint]:
         # ---- recorded datasets: every file of the folder (an image lies one folder down)
         *[EntryPoint(f"recorded.read_recorded[{Path(name).name}]",
                      lambda a, name=name: reader.read_recorded(a["file"].parents[name.count("/")]),
-                     lambda tmp, name=name: {"file": _recorded_dir(tmp) / name}, {"file": "file"})
+                     lambda tmp, name=name: {"file": _recorded_dir(tmp) / name}, {"file": _file_kind(name)})
           for name in RECORDED_FILES],
         EntryPoint("recorded.read_image", lambda a: reader.read_image(a["path"]), lambda tmp: {"path": _png(tmp)},
                    {"path": "file"}),
@@ -363,10 +387,10 @@ def _entries() -> list[EntryPoint]:
                          "/camera/camera_info", a["file"] if name == "stops" else a["file"].parent / "stops.csv",
                          a["file"].parent / "imported", trajectory="arc"),
                      lambda tmp, name=name: {"file": _bag_dir(tmp) / ("run.bag" if name == "bag" else "stops.csv")},
-                     {"file": "file"})
+                     {"file": "file" if name == "bag" else "text_file"})
           for name in ("bag", "stops")],
         EntryPoint("recorded.materialize", lambda a: materialize.materialize([a["file"].parent], a["file"].parents[2]),
-                   lambda tmp: {"file": _recorded_dir(tmp) / "stops.csv"}, {"file": "file"}),
+                   lambda tmp: {"file": _recorded_dir(tmp) / "stops.csv"}, {"file": "text_file"}),
         EntryPoint("recorded.export_dataset",
                    lambda a: export.export_dataset(a["meta"].parents[2], f"datasets/{a['meta'].parent.name}",
                                                    a["meta"].parents[2] / "exported"),
@@ -374,7 +398,7 @@ def _entries() -> list[EntryPoint]:
         *[EntryPoint(f"python -m poseintegrity.recorded validate [{Path(name).name}]",
                      lambda a, name=name: _cli(recorded_cli.main,
                                                ["validate", str(a["file"].parents[name.count("/")])], a["file"]),
-                     lambda tmp, name=name: {"file": _recorded_dir(tmp) / name}, {"file": "file"},
+                     lambda tmp, name=name: {"file": _recorded_dir(tmp) / name}, {"file": _file_kind(name)},
                      flagged=_cli_listed)
           for name in RECORDED_FILES],
         # ---- stage tables and the files they are written to
@@ -389,10 +413,11 @@ def _entries() -> list[EntryPoint]:
         EntryPoint("tables.read_artifacts", lambda a: tables.read_artifacts(a["path"]),
                    lambda tmp: {"path": _parquet(tmp, "artifacts.parquet", _artifacts_table())}, {"path": "file"}),
         # ---- command lines: one line naming the file, exit status 2, no traceback
-        EntryPoint("python -m poseintegrity.tracking.replay",
-                   lambda a: _cli(replay.main, [str(a["tools"].parent / "recording"), "--tools", str(a["tools"]), "--out",
-                                                str(a["tools"].parent / "poses.csv"), "--params", str(TINY_PARAMS)], a["tools"]),
-                   lambda tmp: {"tools": _recording_dir(tmp).parent / _tools_json(tmp).name}, {"tools": "file"},
+        EntryPoint("python -m poseintegrity.tracking.replay",  # the recording stays where it is (checked first)
+                   lambda a: _cli(replay.main, [str(a["recording"]), "--tools", str(a["tools"]), "--out",
+                                                str(a["recording"].parent / "poses.csv"), "--params", str(TINY_PARAMS)],
+                                  a["tools"]),
+                   lambda tmp: {"recording": _recording_dir(tmp), "tools": _tools_json(tmp)}, {"tools": "text_file"},
                    flagged=_cli_refused),
         EntryPoint("python -m poseintegrity.timing", lambda a: _cli(timing.main, [str(a["path"].parent)], a["path"]),
                    lambda tmp: {"path": _timing_file(tmp)}, {"path": "file"}, flagged=_cli_refused,
@@ -411,6 +436,26 @@ def entry_points() -> dict[str, EntryPoint]:
 
 
 # ------------------------------------------------------------------------------------------------ helpers
+def _file_kind(name: str) -> str:
+    """A text file a person may write or edit (tables, YAML, JSON, text) is a "text_file"; images and binaries "file"."""
+    return "text_file" if name.endswith((".csv", ".yaml", ".json", ".txt")) else "file"
+
+
+def _overlay(folder: Path, values: dict[str, Any]) -> Path:
+    """A params overlay on the tiny parameters setting ``values`` (arrays written as lists)."""
+    def plain(value):
+        return {k: plain(v) for k, v in value.items()} if isinstance(value, dict) else (
+            value.tolist() if isinstance(value, np.ndarray) else value)
+    return _write(folder, "overlay.yaml", yaml.safe_dump({"extends": str(TINY_PARAMS), **plain(values)}))
+
+
+def _text_in_x_mm(table: pd.DataFrame, _) -> pd.DataFrame:
+    """A frames table whose x_mm holds text in its first row, as a hand-edited table may ('20.0 mm')."""
+    bad = table.astype({"x_mm": object})
+    bad.loc[bad.index[0], "x_mm"] = "20.0 mm"
+    return bad
+
+
 def _warned(function, *args):
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")

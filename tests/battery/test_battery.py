@@ -18,21 +18,23 @@ import pytest
 
 from poseintegrity import PoseIntegrityError
 
-from bad_values import BENIGN, KINDS
+from bad_values import BENIGN, FILE_KINDS, KINDS, VALID
 from registry import entry_points
 
 CASES = [(name, argument, label) for name, entry in entry_points().items()
-         for argument, kind in entry.arguments.items() for label in KINDS[kind]]
+         for argument, kind in entry.arguments.items() for label in [*KINDS[kind], *entry.cases.get(argument, {})]]
 
 
 def outcome(name: str, argument: str, label: str, tmp_path: Path) -> str:
     """``"refused"``, ``"flagged"``, ``"accepted"`` (correct by declaration or conversion) or a failure:
-    ``"raw <ExceptionType>"``, ``"unnamed"`` (a family error that does not name the argument) or ``"silent"``."""
+    ``"raw <ExceptionType>"``, ``"unnamed"`` (a family error that does not name the argument) or ``"silent"``;
+    for a VALID label (the valid input spelled otherwise) anything but ``"accepted"`` is ``"not accepted: ..."``."""
     entry = entry_points()[name]
     arguments = dict(entry.valid(tmp_path))
-    arguments[argument] = KINDS[entry.arguments[argument]][label](arguments[argument], tmp_path)
+    bad_value = {**KINDS[entry.arguments[argument]], **entry.cases.get(argument, {})}[label]
+    arguments[argument] = bad_value(arguments[argument], tmp_path)
     word = entry.names.get(argument, argument)
-    if entry.arguments[argument] == "file":  # a file is named by its name (its folder for a recording)
+    if entry.arguments[argument] in FILE_KINDS:  # a file is named by its name (its folder for a recording)
         word = entry.names.get(argument, Path(arguments[argument]).name)
     try:
         with warnings.catch_warnings():
@@ -40,12 +42,12 @@ def outcome(name: str, argument: str, label: str, tmp_path: Path) -> str:
             with np.errstate(all="ignore"):
                 result = entry.call(arguments)
     except PoseIntegrityError as error:
-        return "refused" if word.lower() in str(error).lower() else "unnamed"
+        return f"not accepted: {error}" if label in VALID else "refused" if word.lower() in str(error).lower() else "unnamed"
     except Exception as error:  # noqa: BLE001 - the battery classifies every other exception as a failure
         return f"raw {type(error).__name__}"
     if entry.flagged(result):
-        return "flagged"
-    if label in BENIGN or label in entry.accepts.get(argument, set()):
+        return "not accepted: flagged" if label in VALID else "flagged"
+    if label in BENIGN or label in VALID or label in entry.accepts.get(argument, set()):
         return "accepted"
     return "silent"
 

@@ -159,6 +159,11 @@ STOPS = {
                              ["dataset line_a", "2 rows with the same stop and image", "s00_i01.png"]),
     "NaN stop position": (lambda d: edit_frames(d, lambda f: f.assign(x_mm=f.x_mm.where(f.index != 0))),
                           ["dataset line_a", "x_mm"]),
+    "text in a stop position": (lambda d: edit_frames(d, lambda f: f.assign(x_mm=[f"{x:.1f} mm" for x in f.x_mm])),
+                                ["dataset line_a", "frames.parquet", "column x_mm must hold numbers",
+                                 "'20.0 mm' in row 0 (stop 0, image 0)"]),  # as a table edited by hand
+    "text in a stop number": (lambda d: edit_frames(d, lambda f: f.assign(stop=[f"stop {s}" for s in f.stop])),
+                              ["dataset line_a", "frames.parquet", "column stop must hold numbers", "'stop 0' in row 0"]),
     "missing index.parquet": (lambda d: (d / "datasets" / "index.parquet").unlink(),
                               ["index.parquet is missing", "run stage 01"]),
     "unreadable index.parquet": (lambda d: (d / "datasets" / "index.parquet").write_bytes(b"garbage"),

@@ -2,7 +2,10 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from poseintegrity.localization.envelope import actual_envelope, envelopes, headline, stop_criteria
+from poseintegrity.localization.envelope import (
+    CRITERIA, actual_envelope, envelopes, headline, stop_criteria,
+)
+from poseintegrity.localization.envelope_causes import envelope_causes
 from poseintegrity.protocol import FAILED_FRAME_RULES, EnvelopeParams
 
 THETA = np.array([0.0, 2.25, 4.5, 6.75])  # IV-D: the first stop is the model view
@@ -12,7 +15,7 @@ RULES = EnvelopeParams(failed_frames="fail_fraction", max_failed_fraction=0.5, c
 
 def test_linear_interpolation_between_the_last_passing_and_first_failing_stop():
     errors = np.array([[0.5, 0.1], [1.0, 0.2], [3.0, 0.3], [5.0, 9.0]])  # E_t crosses 2 mm halfway 2.25 -> 4.5
-    assert actual_envelope(THETA, errors, TOLERANCE) == (pytest.approx(3.375), False)
+    assert actual_envelope(THETA, errors, TOLERANCE)[:3] == (pytest.approx(3.375), False, ())
 
 
 def test_either_bound_fails_and_the_earlier_crossing_wins():
@@ -23,19 +26,40 @@ def test_either_bound_fails_and_the_earlier_crossing_wins():
 
 def test_failing_model_view_leaves_no_envelope():
     errors = np.array([[4.0, 0.0], [9.0, 9.0], [9.0, 9.0], [9.0, 9.0]])
-    assert actual_envelope(THETA, errors, TOLERANCE) == (0.0, False)
+    assert actual_envelope(THETA, errors, TOLERANCE)[:3] == (0.0, False, ())
 
 
 def test_never_failing_dataset_is_censored_at_the_end():
     errors = np.full((4, 2), 0.5)
-    assert actual_envelope(THETA, errors, TOLERANCE) == (6.75, True)
+    assert actual_envelope(THETA, errors, TOLERANCE)[:3] == (6.75, True, ())
 
 
 def test_an_infinite_criterion_crosses_at_the_previous_stop_and_nan_never_fails():
     errors = np.array([[0.5, 0.1], [0.5, 0.1], [np.inf, np.inf], [0.5, 0.1]])
-    assert actual_envelope(THETA, errors, TOLERANCE) == (2.25, False)
+    assert actual_envelope(THETA, errors, TOLERANCE)[:3] == (2.25, False, ())
     unscored = np.array([[0.5, 0.1], [np.nan, np.nan], [0.5, 0.1], [0.5, 0.1]])
-    assert actual_envelope(THETA, unscored, TOLERANCE) == (6.75, True)
+    assert actual_envelope(THETA, unscored, TOLERANCE)[:3] == (6.75, True, (2.25,))  # skipped, and said
+
+
+def test_an_unmeasured_stop_is_skipped_interpolating_from_the_last_measured_one():
+    # E_t 0.5 mm at 0 deg, unmeasured at 2.25 and 4.5 (no board in any posed frame), 5 mm at 6.75: the 2 mm bound is
+    # crossed at 0 + (2 - 0.5) / (5 - 0.5) * 6.75 = 2.25 deg by IV-E's interpolation between sampled points, not at
+    # the unmeasured 4.5 deg (where the envelope would be read as 100 % longer than the measurements say)
+    errors = np.array([[0.5, 0.1], [np.nan, np.nan], [np.nan, np.nan], [5.0, 0.1]])
+    assert actual_envelope(THETA, errors, TOLERANCE)[:3] == (pytest.approx(2.25), False, (2.25, 4.5))
+    infinite = errors.copy()
+    infinite[3] = np.inf  # a frame without a pose at the failing stop: the crossing is the last measured stop
+    assert actual_envelope(THETA, infinite, TOLERANCE)[:3] == (0.0, False, (2.25, 4.5))
+    # an unmeasured last stop: censored where every criterion was last measured, not at the unmeasured end
+    assert actual_envelope(THETA, errors[[0, 3, 1, 2]] * [0.1, 1], TOLERANCE)[:3] == (2.25, True, (4.5, 6.75))
+    # measured stops only: the paper's definition, unchanged (the interpolation of the first test)
+    assert actual_envelope(THETA[[0, 3]], errors[[0, 3]], TOLERANCE)[:2] == (pytest.approx(2.25), False)
+
+
+def test_a_criterion_measured_only_where_it_fails_gives_no_envelope():
+    errors = np.array([[np.nan, 0.1], [np.nan, 0.2], [5.0, 0.3], [5.0, 0.4]])
+    theta_a, censored, unmeasured, _ = actual_envelope(THETA, errors, TOLERANCE)
+    assert np.isnan(theta_a) and not censored and unmeasured == (0.0, 2.25)
 
 
 def stop(errors_mm: list[float], failed: int) -> list[tuple[str, float]]:
@@ -58,7 +82,7 @@ def test_fail_fraction_rule_interpolates_the_share_of_frames_without_a_pose():
     np.testing.assert_allclose(bounds, [2.0, 3.0, 0.5])
     assert np.isnan(criteria[3, 0])  # nothing to average where no frame has a pose
     # the share crosses 0.5 at 2.25 + (0.5 - 0.1) / (0.6 - 0.1) * 2.25 = 4.05, between the stops
-    assert actual_envelope(THETA, criteria, bounds) == (pytest.approx(4.05), False)
+    assert actual_envelope(THETA, criteria, bounds)[:3] == (pytest.approx(4.05), False, ())
 
 
 def test_capped_rule_counts_a_missing_pose_as_cap_factor_times_the_tolerance():
@@ -70,7 +94,7 @@ def test_capped_rule_counts_a_missing_pose_as_cap_factor_times_the_tolerance():
 
 def test_infinite_rule_snaps_to_the_stop_before_any_frame_without_a_pose():
     criteria, bounds = stop_criteria(FAILING, (2.0, 3.0), "infinite", RULES)
-    assert actual_envelope(THETA, criteria, bounds) == (0.0, False)
+    assert actual_envelope(THETA, criteria, bounds)[:3] == (0.0, False, ())
 
 
 def test_a_frame_without_ground_truth_is_left_out_of_the_mean():
@@ -100,4 +124,65 @@ def test_table_envelopes_use_theta_for_arcs_and_x_for_lines_under_every_rule():
     snapped = table[(table.rule == "infinite") & (table.dataset == "line")].set_index("tolerance")
     assert snapped.loc["2mm_3deg", "theta_a"] == pytest.approx(20.0)  # the previous stop
     assert list(ours.reset_index().columns) == ["dataset", "tolerance", "world", "trajectory", "method", "theta_a",
-                                                "censored"]
+                                                "censored", "status", "reason"]
+    assert set(table["status"]) == {"ok"} and set(table["reason"]) == {""}
+
+
+def test_table_envelopes_flag_a_stop_whose_frames_all_lack_errors():
+    rows = [dict(world="main", dataset="arc", trajectory="arc", stop=s, image=i, status="ok", theta_deg=10.0 * s,
+                 x_mm=0.0, method="usac_magsac", E_t_mm=E_t, E_r_deg=0.0 if np.isfinite(E_t) else np.nan)
+            for s, E_t in enumerate([0.5, np.nan, 5.0]) for i in range(2)]  # stop 1: posed, board never detected
+    table = envelopes(pd.DataFrame(rows), [(2.0, 3.0)], RULES).set_index("rule")
+    for rule in FAILED_FRAME_RULES:  # every frame has a pose: every rule reads the same stops
+        # 0 + (2 - 0.5) / (5 - 0.5) * 20 deg, not the unmeasured stop at 10 deg
+        assert table.loc[rule, "theta_a"] == pytest.approx(20.0 / 3)
+        assert table.loc[rule, "status"] == "unmeasured_stops"
+        assert "stop(s) at 10 deg" in table.loc[rule, "reason"]
+
+
+def test_the_crossing_names_the_criterion_that_ends_the_envelope():
+    errors = np.array([[0.5, 1.0], [1.0, 2.0], [2.5, 7.0], [5.0, 9.0]])  # E_r crosses first (2.7 before 3.75)
+    assert actual_envelope(THETA, errors, TOLERANCE) == (pytest.approx(2.7), False, (), 1)
+    assert actual_envelope(THETA, np.full((4, 2), 0.5), TOLERANCE) == (6.75, True, (), -1)
+    criteria, bounds = stop_criteria(FAILING, (2.0, 3.0), "fail_fraction", RULES)
+    assert actual_envelope(THETA, criteria, bounds).criterion == 2  # the share without a pose
+    assert CRITERIA[2] == "no_pose"
+
+
+def _causes_table(truth_errors, exact_errors, posed=None, board_status="ok"):
+    """One arc, 4 stops of 2 frames: E_t against the ground truth and against the exact pose per stop."""
+    rows = []
+    for s, (truth, exact) in enumerate(zip(truth_errors, exact_errors)):
+        for image in range(2):
+            ok = True if posed is None else posed[s]
+            rows.append(dict(world="main", dataset="d", trajectory="arc", stop=s, image=image, theta_deg=2.25 * s,
+                             x_mm=0.0, method="usac_magsac", status="ok" if ok else "no_consensus",
+                             E_t_mm=truth if ok else np.nan, E_r_deg=0.1 if ok else np.nan,
+                             E_t_exact_mm=exact if ok else np.nan,
+                             E_r_exact_deg=0.1 if ok and np.isfinite(exact) else np.nan,
+                             n_inliers=100 - 20 * s, board_status=board_status, board_n_dropped=0,
+                             board_sigma_t_mm=0.1))
+    return pd.DataFrame(rows)
+
+
+@pytest.mark.parametrize("truth, exact, posed, cause, limit", [
+    ([0.5, 1.0, 3.0, 4.0], [0.5, 1.0, 3.0, 4.0], None, "estimate", "translation"),
+    ([0.5, 1.0, 3.0, 4.0], [0.4, 0.5, 0.6, 0.7], None, "ground_truth", "translation"),
+    ([0.5, 0.5, 0.5, 0.5], [0.5, 0.5, 0.5, 0.5], [True, True, False, False], "no_pose", "no_pose"),
+    ([0.5, 0.5, 0.5, 0.5], [0.5, 0.5, 0.5, 0.5], None, "censored", "censored"),
+])
+def test_each_envelope_end_gets_its_limit_and_cause(truth, exact, posed, cause, limit):
+    causes = envelope_causes(_causes_table(truth, exact, posed), [(2.0, 3.0)], RULES, "usac_magsac")
+    row = causes.iloc[0]
+    assert (row["limit"], row["cause"]) == (limit, cause)
+    if cause == "ground_truth":  # against the exact pose the envelope lasts to the arc's end
+        assert row["theta_a"] == pytest.approx(2.25 + 2.25 / 2) and row["theta_a_exact"] == pytest.approx(6.75)
+        assert row["n_inliers_at_theta_a"] == pytest.approx(70.0)
+
+
+def test_without_exact_poses_the_boards_own_checks_stand_in():
+    table = _causes_table([0.5, 1.0, 3.0, 4.0], [np.nan] * 4)
+    assert envelope_causes(table, [(2.0, 3.0)], RULES, "usac_magsac").iloc[0]["cause"] == "estimate"
+    table.loc[table.stop == 2, "board_n_dropped"] = 1
+    row = envelope_causes(table, [(2.0, 3.0)], RULES, "usac_magsac").iloc[0]
+    assert row["cause"] == "ground_truth" and row["board_dropped_share"] == 1.0 and np.isnan(row["theta_a_exact"])

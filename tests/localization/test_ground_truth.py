@@ -1,22 +1,54 @@
+"""The board's ground truth (localization/ground_truth.py): exact poses of warped board images, the lens, the
+consistency check against known corrupted corners, the predicted uncertainty against a Monte Carlo, the trust
+statuses, and what a ground-truth error adds to E_t (truth_error) on known answers."""
+
 import cv2
 import numpy as np
+import pytest
 
 import loc_synthetic as synthetic
+from poseintegrity.boards import ArucoGrid, Charuco, board_from_dict
+from poseintegrity.errors import ArgumentError
 from poseintegrity.lens import Camera
-from poseintegrity.poses import pose_errors
-from poseintegrity.localization.ground_truth import board_pose, make_board
+from poseintegrity.localization.ground_truth import (
+    board_pose, consistent_fit, predicted_uncertainty, truth_error,
+)
+from poseintegrity.localization.params import GroundTruthParams
+from poseintegrity.poses import pose_errors, pose_from_rvec_tvec, pose_matrix
+from scipy.spatial.transform import Rotation
+
+CHECKS = synthetic.CHECKS
 
 
 def test_board_pose_of_a_warped_board_image_is_the_known_pose():
     """GridBoard.generateImage placed on the plane and warped by the exact homography K [r1 r2 t] A."""
     plane, _ = synthetic.canvas(np.random.default_rng(0))
-    board = make_board(synthetic.BOARD)
     for theta in (0.0, 20.0, 40.0):
         T = synthetic.arc_pose(theta, azimuth_deg=90.0)
-        result = board_pose(synthetic.render(plane, T), board, synthetic.CAMERA)
+        result = board_pose(synthetic.render(plane, T), synthetic.BOARD, synthetic.CAMERA, CHECKS)
         E_t_mm, E_r_deg = pose_errors(result.T_cam_board, T)
-        assert result.status == "ok" and result.n_markers == 6
+        assert result.status == "ok" and result.n_points == 24 and result.n_dropped == 0
         assert E_t_mm < 1.0 and E_r_deg < 0.5
+
+
+def test_a_charuco_board_image_gives_the_known_pose_from_its_corners():
+    board = Charuco("DICT_4X4_50", 7, 5, 15.0, 11.0)
+    px_per_mm, margin = 6, 30
+    image = board.cv_board().generateImage((105 * px_per_mm + 2 * margin, 75 * px_per_mm + 2 * margin),
+                                           marginSize=margin)
+    A = np.array([[1 / px_per_mm, 0, 0.5 / px_per_mm - margin / px_per_mm],
+                  [0, 1 / px_per_mm, 0.5 / px_per_mm - margin / px_per_mm], [0, 0, 1]])  # texel -> board mm
+    T = pose_matrix(Rotation.from_euler("xy", [20, -15], degrees=True).as_matrix(), [-50.0, -35.0, 300.0])
+    # rendered at 4 x and averaged down (INTER_AREA): an anti-aliased image, as a lens and a sensor make one
+    up = np.diag([4.0, 4.0, 1.0]) @ np.array([[1, 0, 0.375], [0, 1, 0.375], [0, 0, 1]])  # pixel centres at 4 x
+    H = up @ synthetic.K @ np.column_stack([T[:3, 0], T[:3, 1], T[:3, 3]]) @ A
+    large = cv2.warpPerspective(image, H, (4 * synthetic.IMAGE_SIZE[0], 4 * synthetic.IMAGE_SIZE[1]),
+                                flags=cv2.INTER_LINEAR, borderValue=128)
+    frame = cv2.resize(large, synthetic.IMAGE_SIZE, interpolation=cv2.INTER_AREA)
+    result = board_pose(frame, board.as_dict(), synthetic.CAMERA, CHECKS)
+    assert result.status == "ok" and result.n_points == 24
+    E_t_mm, E_r_deg = pose_errors(result.T_cam_board, T)
+    assert E_t_mm < 0.3 and E_r_deg < 0.2
 
 
 def test_board_corners_are_undistorted_by_the_camera_before_the_pose():
@@ -25,22 +57,125 @@ def test_board_corners_are_undistorted_by_the_camera_before_the_pose():
     lens = Camera(synthetic.K, np.array([-0.25, 0.08, 0.001, -0.0005, 0.0]), *synthetic.IMAGE_SIZE)
     K_canvas, width, height = lens.canvas
     plane, _ = synthetic.canvas(np.random.default_rng(0))
-    board = make_board(synthetic.BOARD)
     T = synthetic.arc_pose(25.0, azimuth_deg=0.0)
     image = cv2.remap(synthetic.render(plane, T, K=K_canvas, size=(width, height)), *lens.sensor_maps, cv2.INTER_LINEAR)
-    with_lens = pose_errors(board_pose(image, board, lens).T_cam_board, T)
-    pinhole = pose_errors(board_pose(image, board, synthetic.CAMERA).T_cam_board, T)
+    loose = GroundTruthParams(**{**CHECKS.model_dump(), "max_sigma_t_mm": 100.0, "max_sigma_r_deg": 90.0})
+    with_lens = pose_errors(board_pose(image, synthetic.BOARD, lens, loose).T_cam_board, T)
+    pinhole = pose_errors(board_pose(image, synthetic.BOARD, synthetic.CAMERA, loose).T_cam_board, T)
     assert with_lens[0] < 1.0 and with_lens[1] < 0.5
     assert pinhole[0] > 3 * with_lens[0] + 1.0
 
 
 def test_board_built_from_meta_matches_the_reference_board():
-    ours, reference = make_board(synthetic.BOARD), synthetic.make_board()
+    ours, reference = board_from_dict(synthetic.BOARD).cv_board(), synthetic.make_board()
     np.testing.assert_array_equal(np.array(ours.getObjPoints()), np.array(reference.getObjPoints()))
     np.testing.assert_array_equal(ours.getIds(), reference.getIds())
 
 
+@pytest.mark.parametrize("spec, named", [
+    ({k: v for k, v in synthetic.BOARD.items() if k != "separation_mm"}, "separation_mm"),
+    ({"type": "charuco", "dictionary": "DICT_4X4_50", "squares_x": 7, "squares_y": 5, "square_mm": 15.0}, "marker_mm"),
+    ({**synthetic.BOARD, "type": "chessboard"}, "board.type"),
+])
+def test_a_board_spec_missing_a_key_or_of_an_unknown_type_is_refused_by_name(spec, named):
+    with pytest.raises(ArgumentError, match=named):
+        board_from_dict(spec)
+
+
 def test_no_board_gives_nan_pose_and_a_flag():
-    result = board_pose(np.full((400, 640), 128, np.uint8), make_board(synthetic.BOARD), synthetic.CAMERA)
-    assert result.status == "board_not_detected" and result.n_markers == 0
+    result = board_pose(np.full((400, 640), 128, np.uint8), synthetic.BOARD, synthetic.CAMERA, CHECKS)
+    assert result.status == "board_not_detected" and result.n_points == 0
     assert np.all(np.isnan(result.T_cam_board))
+
+
+def test_two_markers_in_view_are_too_few_to_check_and_no_ground_truth():
+    plane, _ = synthetic.canvas(np.random.default_rng(0))
+    T = synthetic.arc_pose(0.0, azimuth_deg=0.0)
+    image = synthetic.render(plane, T)
+    corners, ids, _ = cv2.aruco.ArucoDetector(synthetic.make_board().getDictionary()).detectMarkers(image)
+    for marker, marker_id in zip(corners, ids.ravel()):
+        if marker_id not in (0, 1):  # paint over every marker but two
+            cv2.fillConvexPoly(image, np.round(marker.reshape(4, 2)).astype(np.int32), 200)
+    result = board_pose(image, synthetic.BOARD, synthetic.CAMERA, CHECKS)
+    assert result.status == "bad_ground_truth" and "fewer than 3" in result.reason
+    assert np.all(np.isfinite(result.T_cam_board))  # the refused fit is kept, for diagnosis
+
+
+def _projected_board(T: np.ndarray, noise_px: float, rng: np.random.Generator):
+    board = ArucoGrid("DICT_4X4_50", 3, 2, 24.0, 6.0)
+    objects = np.array(board.cv_board().getObjPoints(), np.float64).reshape(-1, 3)
+    rvec = cv2.Rodrigues(T[:3, :3])[0]
+    image, _ = cv2.projectPoints(objects, rvec, T[:3, 3], synthetic.K, None)
+    return objects, image.reshape(-1, 2) + noise_px * rng.standard_normal((len(objects), 2)), np.repeat(np.arange(6), 4)
+
+
+def test_the_consistency_check_drops_the_marker_with_a_corner_off_and_recovers_the_pose():
+    """A marker whose corner the target pulls 5 px off (a partly hidden marker, still decoded): the fit through it is
+    off by millimetres; the check drops exactly that marker and the pose comes back within the noise."""
+    rng = np.random.default_rng(3)
+    T = pose_matrix(Rotation.from_euler("xy", [25, 10], degrees=True).as_matrix(), [-40.0, -25.0, 350.0])
+    objects, image, groups = _projected_board(T, 0.05, rng)
+    image[9] += [4.0, 3.0]  # marker 2's second corner
+    pose, keep = consistent_fit(objects, image, groups, synthetic.K, CHECKS)
+    assert set(groups[~keep]) == {2}
+    assert pose_errors(pose_from_rvec_tvec(*pose), T)[0] < 0.3
+    all_in = cv2.solvePnP(objects, image, synthetic.K, None, flags=cv2.SOLVEPNP_IPPE)
+    assert pose_errors(pose_from_rvec_tvec(all_in[1], all_in[2]), T)[0] > 1.0
+
+
+def test_the_consistency_check_keeps_every_marker_of_noise_alone():
+    rng = np.random.default_rng(4)
+    T = pose_matrix(Rotation.from_euler("xy", [30, -20], degrees=True).as_matrix(), [-40.0, -25.0, 350.0])
+    dropped = 0
+    for _ in range(50):
+        objects, image, groups = _projected_board(T, 0.1, rng)
+        dropped += (~consistent_fit(objects, image, groups, synthetic.K, CHECKS)[1]).sum()
+    assert dropped == 0
+
+
+def test_the_predicted_uncertainty_matches_a_monte_carlo_of_the_fit():
+    """sigma_t, sigma_r of s^2 (J^T J)^-1 against the RMS error of 400 fits to points with 0.2 px noise."""
+    rng = np.random.default_rng(5)
+    T = pose_matrix(Rotation.from_euler("xy", [20, 15], degrees=True).as_matrix(), [-40.0, -25.0, 350.0])
+    errors, predicted = [], []
+    for _ in range(400):
+        objects, image, _ = _projected_board(T, 0.2, rng)
+        ok, rvec, tvec = cv2.solvePnP(objects, image, synthetic.K, None, flags=cv2.SOLVEPNP_IPPE)
+        rvec, tvec = cv2.solvePnPRefineLM(objects, image, synthetic.K, None, rvec, tvec)
+        errors.append(pose_errors(pose_from_rvec_tvec(rvec, tvec), T))
+        predicted.append(predicted_uncertainty(objects, image, synthetic.K, (rvec.ravel(), tvec.ravel()), 0.0)[1:])
+    errors, predicted = np.array(errors), np.array(predicted)
+    rms_t, rms_r = np.sqrt(np.mean(errors**2, axis=0))
+    assert np.median(predicted[:, 0]) == pytest.approx(rms_t, rel=0.2)
+    assert np.median(predicted[:, 1]) == pytest.approx(rms_r, rel=0.2)
+
+
+def test_truth_error_is_zero_for_the_same_board_frame_error_and_the_offset_otherwise():
+    """A board pose off by the same board-frame error in the frame and in model image 0 adds nothing to E_t (M_t was
+    placed by the same error); a frame off by another 0.4 mm along board x adds exactly that."""
+    rng = np.random.default_rng(6)
+    exact_0 = pose_matrix(Rotation.random(random_state=rng).as_matrix(), [10.0, -5.0, 320.0])
+    exact_f = pose_matrix(Rotation.random(random_state=rng).as_matrix(), [-30.0, 12.0, 350.0])
+    delta = pose_matrix(Rotation.from_rotvec([0.002, -0.001, 0.003]).as_matrix(), [0.3, -0.2, 0.5])
+    E_t, E_r = truth_error(exact_f @ delta, exact_f, exact_0 @ delta, exact_0)
+    assert E_t == pytest.approx(0.0, abs=1e-9) and E_r == pytest.approx(0.0, abs=1e-6)
+    shifted = exact_f @ pose_matrix(np.eye(3), [0.4, 0.0, 0.0]) @ delta
+    E_t, E_r = truth_error(shifted, exact_f, exact_0 @ delta, exact_0)
+    assert E_t == pytest.approx(0.4, abs=1e-9) and E_r == pytest.approx(0.0, abs=1e-6)
+    assert np.isnan(truth_error(exact_f, exact_f, np.full((4, 4), np.nan), exact_0)[0])
+
+
+@pytest.mark.parametrize(("change", "words"), [
+    (lambda b: b.pop("separation_mm"), "board: a aruco_grid board needs separation_mm"),  # was a bare KeyError
+    (lambda b: b.pop("dictionary"), "board: a aruco_grid board needs dictionary"),
+    (lambda b: b.__setitem__("markers_x", "three"), "board.markers_x: expected a positive integer, got 'three'"),
+    (lambda b: b.__setitem__("markers_x", 2.5), "board.markers_x: expected a positive integer"),
+    (lambda b: b.__setitem__("marker_length_mm", float("nan")), "board.marker_length_mm: expected a positive number"),
+    (lambda b: b.__setitem__("first_id", 48), "board: markers 48 .. 53 do not fit DICT_4X4_50 .50 markers."),
+    (lambda b: b.__setitem__("scale", [1.0]), r"board.scale: expected \[x, y\]"),
+])
+def test_a_board_spec_missing_or_spoiling_a_key_is_refused_naming_it(change, words):
+    board = dict(synthetic.BOARD)
+    change(board)
+    with pytest.raises(ArgumentError, match=words):
+        board_from_dict(board)

@@ -7,7 +7,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from poseintegrity.prediction import attach_envelopes, sweep
+from poseintegrity.prediction import attach_envelopes
 from poseintegrity.prediction.model_choice import (
     CHOICE_COLUMNS,
     candidate_sweep,
@@ -22,11 +22,8 @@ def candidates(tables, tiny_predict, tiny_fit, protocol, workers):
     return candidate_sweep(artifacts, tiny_predict, tiny_fit, protocol, workers, progress=False)
 
 
-def test_the_paper_model_candidate_is_the_sweeps_long_range_predictor(candidates, tables, tiny_predict, tiny_fit,
-                                                                     protocol, workers):
+def test_the_paper_model_candidate_is_the_sweeps_long_range_predictor(candidates, theta_p, tiny_predict, protocol):
     """Same fit, same generator: the rows of predict.models.long_range equal the sweep's long range rows."""
-    artifacts, _ = tables
-    theta_p = sweep(artifacts, tiny_predict, tiny_fit, protocol, workers, progress=False)
     ours = candidates[candidates.model == tiny_predict.models.long_range].reset_index(drop=True)
     theirs = theta_p[(theta_p.predictor == "long_range") & (theta_p.method == protocol.pnp_method)]
     pd.testing.assert_frame_equal(ours, theirs.reset_index(drop=True))

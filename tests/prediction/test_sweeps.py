@@ -33,10 +33,8 @@ from poseintegrity.report.metrics import json_ready
 
 
 @pytest.fixture(scope="module")
-def swept(tables, tiny_predict, tiny_fit, protocol, workers):
-    artifacts, envelopes = tables
-    theta_p = sweep(artifacts, tiny_predict, tiny_fit, protocol, workers, progress=False)
-    table = attach_envelopes(theta_p, envelopes, protocol)
+def swept(tables, theta_p, protocol):
+    table = attach_envelopes(theta_p, tables[1], protocol)
     return theta_p, table, operating_curves(table)
 
 

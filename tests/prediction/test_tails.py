@@ -127,4 +127,4 @@ def test_the_tail_figure_shows_both_fits_and_every_theta_a(tiny_predict, tiny_fi
     assert {"eq. 1 (EMG, sigma = 1)", "free-width EMG (ours)"} <= {label.split(" (at")[0] for label in labels}
     assert [line.get_xdata()[0] for line in ax.get_lines() if line.get_linestyle() == ":"] == [15.0, 17.0]
     (note,) = tail_figure([], 30).axes
-    assert "no arc overshoots" in note.texts[0].get_text()
+    assert "no arc overshoots" in note.get_title()

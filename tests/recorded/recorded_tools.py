@@ -1,16 +1,16 @@
-"""Helpers of the recorded-format tests and benchmark: run the command line in-process, and write ROS 1 / ROS 2
-bags with rosbags' own writers from image arrays or encoded files."""
+"""Helpers of the recorded-format tests and benchmark: run the command line in-process, a bag-stops table of a
+folder's images, and write ROS 1 / ROS 2 bags with rosbags' own writers from image arrays or encoded files."""
 
 from __future__ import annotations
 
 import contextlib
+import csv
 import io
 from pathlib import Path
 
 import numpy as np
 
 from poseintegrity.lens import Camera
-
 
 
 def run(argv: list[str]) -> tuple[int, str, str]:
@@ -27,11 +27,31 @@ def run(argv: list[str]) -> tuple[int, str, str]:
     return status, out.getvalue(), err.getvalue()
 
 
+def bag_inputs(folder: Path, tmp_path: Path) -> tuple[list[Path], Path]:
+    """The exported dataset's image files in bag order (model pair first) and the bag-stops table naming them."""
+    with open(folder / "model.csv") as table:
+        model = list(csv.DictReader(table))
+    with open(folder / "stops.csv") as table:
+        stops = list(csv.DictReader(table))
+    files = [folder / row["file"] for row in model] + [folder / row["file"] for row in stops]
+    path = tmp_path / "bag_stops.csv"
+    with open(path, "w", newline="") as table:
+        writer = csv.writer(table)
+        writer.writerow(["index", "stop", "theta_deg", "x_mm", "T_cam_ref"])
+        for k, row in enumerate(model):
+            writer.writerow([k, f"model{k}", "", "", row["T_cam_ref"]])
+        for k, row in enumerate(stops, start=len(model)):
+            writer.writerow([k, row["stop"], row["theta_deg"], row["x_mm"], row["T_cam_ref"]])
+    return files, path
+
+
 def write_bag(path: Path, ros: int, images: list, camera: Camera, *, image_topic: str = "/camera/image",
-              info_topic: str = "/camera/camera_info", encodings: list[str] | None = None) -> Path:
-    """A bag at ``path`` (ROS ``ros`` 1 or 2) with one CameraInfo of ``camera`` and one message per image at 10 Hz:
-    ``images`` are encoded files (bytes: CompressedImage, format after their signature) or arrays (Image, encoded
-    as ``encodings[k]``: mono8, mono16, bgr8 or rgb8, the array already in that layout)."""
+              info_topic: str = "/camera/camera_info", encodings: list[str] | None = None,
+              projection: np.ndarray | None = None, with_info: bool = True) -> Path:
+    """A bag at ``path`` (ROS ``ros`` 1 or 2) with one CameraInfo of ``camera`` (P: ``projection``, default [K|0];
+    none with ``with_info`` False, the topic then holds no message) and one message per image at 10 Hz: ``images``
+    are encoded files (bytes: CompressedImage, format after their signature) or arrays (Image, encoded as
+    ``encodings[k]``: mono8, mono16, bgr8 or rgb8, the array already in that layout)."""
     from rosbags.typesys import Stores, get_typestore
 
     store = get_typestore(Stores.ROS1_NOETIC if ros == 1 else Stores.ROS2_HUMBLE)
@@ -41,7 +61,7 @@ def write_bag(path: Path, ros: int, images: list, camera: Camera, *, image_topic
     roi = T["sensor_msgs/msg/RegionOfInterest"](x_offset=0, y_offset=0, height=0, width=0, do_rectify=False)
     K = np.asarray(camera.K, np.float64).ravel()
     matrices = dict(D=np.asarray(camera.dist, np.float64), K=K, R=np.eye(3).ravel(),
-                    P=np.hstack([camera.K, np.zeros((3, 1))]).ravel())
+                    P=(np.hstack([camera.K, np.zeros((3, 1))]) if projection is None else projection).ravel())
     info = T["sensor_msgs/msg/CameraInfo"](
         header=header(0), height=camera.height, width=camera.width,
         distortion_model="plumb_bob" if len(camera.dist) == 5 else "rational_polynomial",
@@ -61,7 +81,8 @@ def write_bag(path: Path, ros: int, images: list, camera: Camera, *, image_topic
         image_type = "sensor_msgs/msg/CompressedImage" if compressed else "sensor_msgs/msg/Image"
         info_connection = writer.add_connection(info_topic, "sensor_msgs/msg/CameraInfo", typestore=store)
         image_connection = writer.add_connection(image_topic, image_type, typestore=store)
-        writer.write(info_connection, 1, serialize(info, "sensor_msgs/msg/CameraInfo"))
+        if with_info:
+            writer.write(info_connection, 1, serialize(info, "sensor_msgs/msg/CameraInfo"))
         for k, image in enumerate(images):
             ns = 100_000_000 * (k + 1)
             if compressed:

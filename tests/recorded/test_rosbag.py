@@ -4,9 +4,6 @@ CameraInfo's camera, the folder passes validate; a bag without the named topic i
 
 from __future__ import annotations
 
-import csv
-from pathlib import Path
-
 import cv2
 import numpy as np
 import pytest
@@ -14,25 +11,7 @@ import pytest
 from poseintegrity.lens import read_camera_yaml
 from poseintegrity.recorded.reader import RecordedFormatError, read_image, read_recorded
 from poseintegrity.recorded.rosbag import import_rosbag
-from recorded_tools import run, write_bag
-
-
-def bag_inputs(folder: Path, tmp_path: Path) -> tuple[list[Path], Path]:
-    """The exported dataset's image files in bag order (model pair first) and the bag-stops table naming them."""
-    with open(folder / "model.csv") as table:
-        model = list(csv.DictReader(table))
-    with open(folder / "stops.csv") as table:
-        stops = list(csv.DictReader(table))
-    files = [folder / row["file"] for row in model] + [folder / row["file"] for row in stops]
-    path = tmp_path / "bag_stops.csv"
-    with open(path, "w", newline="") as table:
-        writer = csv.writer(table)
-        writer.writerow(["index", "stop", "theta_deg", "x_mm", "T_cam_ref"])
-        for k, row in enumerate(model):
-            writer.writerow([k, f"model{k}", "", "", row["T_cam_ref"]])
-        for k, row in enumerate(stops, start=len(model)):
-            writer.writerow([k, row["stop"], row["theta_deg"], row["x_mm"], row["T_cam_ref"]])
-    return files, path
+from recorded_tools import bag_inputs, run, write_bag
 
 
 @pytest.mark.parametrize("ros", [1, 2])

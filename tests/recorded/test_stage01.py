@@ -8,6 +8,7 @@ import json
 import shutil
 from pathlib import Path
 
+import pandas as pd
 import papermill
 import pytest
 
@@ -30,14 +31,13 @@ def test_a_source_that_is_not_a_folder_is_refused_naming_the_key(tmp_path):
 
 
 @pytest.mark.notebook
-@pytest.mark.parametrize("ground_truth", ["board", "poses"])
-def test_stage_01_materializes_a_recorded_source_that_stage_02_reads(exported, rendered_dir, tmp_path, ground_truth):
+def test_stage_01_materializes_a_recorded_source_that_stage_02_reads(exported, rendered_dir, tmp_path):
+    """One source holding both kinds of ground truth: arc_r with its board, line_r with its exported exact poses as
+    the truth (its board.yaml removed); stages 01 and 02 once for both."""
     source = Path(shutil.copytree(exported, tmp_path / "recorded"))
-    if ground_truth == "poses":  # the exported exact poses become the ground truth, the boards go
-        for folder in source.iterdir():
-            (folder / "board.yaml").unlink()
-            settings = folder / "dataset.yaml"
-            settings.write_text(settings.read_text().replace("ground_truth: board", "ground_truth: poses"))
+    (source / "line_r" / "board.yaml").unlink()
+    settings = source / "line_r" / "dataset.yaml"
+    settings.write_text(settings.read_text().replace("ground_truth: board", "ground_truth: poses"))
     parameters = {"params_path": overlay(tmp_path, source), "data_dir": str(tmp_path / "data"),
                   "reports_dir": str(tmp_path / "reports")}
     for notebook in ("01_generate_datasets", "02_extract_artifacts"):
@@ -48,8 +48,14 @@ def test_stage_01_materializes_a_recorded_source_that_stage_02_reads(exported, r
     assert list(index["dataset"]) == ["arc_r", "line_r"] and list(index["world"]) == ["main", "main"]
     columns = ["stop", "image", "theta_deg", "x_mm"]
     for name in index["dataset"]:
-        again = load_dataset(tmp_path / "data", f"datasets/{name}").frames[columns]
-        assert again.equals(load_dataset(rendered_dir, f"datasets/{name}").frames[columns])
+        again = load_dataset(tmp_path / "data", f"datasets/{name}")
+        assert again.frames[columns].equals(load_dataset(rendered_dir, f"datasets/{name}").frames[columns])
+        assert again.meta["ground_truth"] == ("board" if name == "arc_r" else "poses")
+    rows = pd.read_parquet(tmp_path / "data" / "artifacts" / "artifacts.parquet")
+    assert set(rows.loc[rows.dataset == "line_r", "board_status"]) == {"no_board"}  # the recorded poses instead
+    assert (rows.loc[rows.dataset == "arc_r", "board_status"] == "ok").any()
+    posed = rows[(rows.dataset == "line_r") & (rows.status == "ok")]
+    assert len(posed) and posed.E_t_mm.notna().all()  # measured against the recorded poses
     metrics = json.loads((tmp_path / "reports" / "metrics" / "generate.json").read_text())
     assert metrics["source"] == str(source) and metrics["n_datasets"] == 2 and metrics["n_images"] == 6 + 2 + 2 * 2
     assert not (tmp_path / "data" / "calibration" / "main").exists()  # nothing rendered or calibrated

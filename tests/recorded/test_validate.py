@@ -32,7 +32,23 @@ def test_a_good_folder_passes_with_one_summary_line(exported):
     status, out, err = run(["validate", str(exported / "arc_r"), str(exported / "line_r")])
     assert status == 0 and err == ""
     lines = out.strip().splitlines()
-    assert len(lines) == 2 and "6 images at 3 stops" in lines[0] and "2 images at 2 stops" in lines[1]
+    assert len(lines) == 3 and "6 images at 3 stops" in lines[0] and "2 images at 2 stops" in lines[1]
+    assert lines[2].startswith("range ends, tolerances and extract settings of ")  # ./params.yaml, or the published
+
+
+def test_tables_saved_with_a_byte_order_mark_read_as_without(folder):
+    """Excel's "CSV UTF-8" (and Notepad's UTF-8) start the file with a byte-order mark: it stuck to the first column's
+    name and the table was refused for a "missing column" it has."""
+    plain = read_recorded(folder)
+    for name in ("stops.csv", "model.csv", "dataset.yaml", "board.yaml"):
+        path = folder / name
+        path.write_bytes(b"\xef\xbb\xbf" + path.read_bytes())
+    marked = read_recorded(folder)
+    rows = lambda recorded: [(f.file, f.stop, f.image, f.theta_deg, f.x_mm) for f in recorded.frames]  # noqa: E731
+    assert rows(marked) == rows(plain) and marked.board == plain.board and marked.model_images == plain.model_images
+    (folder / "stops.csv").write_bytes(b"\xef\xbb\xbf")
+    with pytest.raises(RecordedFormatError, match="stops.csv: the table is empty"):
+        read_recorded(folder)
 
 
 def rewrite_csv(path: Path, transform) -> None:

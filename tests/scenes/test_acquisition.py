@@ -11,7 +11,7 @@ from scipy.spatial.transform import Rotation
 
 from poseintegrity.config import load_params
 from poseintegrity.scenes.acquisition import (
-    Visit, _homography_maps, exposure_times, image_motion, image_pose, rotation_maps,
+    Visit, _homography_maps, exposure_times, image_motion, image_pose, model_motion, rotation_maps,
 )
 from poseintegrity.scenes.ringdown import RingDown
 from repository import ROOT
@@ -86,3 +86,20 @@ def test_the_burst_and_its_sub_exposures():
     motion = image_motion(shaking, CAPTURE, 0, 1000.0)
     steps = np.linalg.norm(np.diff(motion.path, axis=0), axis=1) * 1000.0  # px moved between sub-exposures
     assert len(motion.path) > 2 and steps.max() <= CAPTURE.blur_step_px + 1e-9
+
+
+def test_the_model_pair_is_exposed_once_the_arm_has_settled():
+    """III-B: the model is built from two images of a static scene. A model image is exposed model_settle_ms after
+    the reported stop, where the ring-down's envelope A exp(-zeta omega_n t) has decayed below 0.2 % of A (4e-5 deg
+    for A = 0.02 deg: 600 x below the 0.024 deg the pair turned by when taken during the ring-down; the stops' first
+    images, delay_ms after the stop, still turn by most of A), and it is a single sharp sub-exposure."""
+    amplitude = np.radians(0.02)
+    omega = 2 * np.pi * 10.0
+    first_mid = (CAPTURE.delay_ms + CAPTURE.exposure_ms / 2) / 1000.0  # the burst's first image at a crest
+    visit = Visit(np.eye(4), RingDown(np.array([0.0, 1.0, 0.0]), amplitude, -omega * np.sqrt(1 - 0.05**2) * first_mid,
+                                      omega, 0.05))
+    settled, burst = model_motion(visit, CAPTURE, 1024.0), image_motion(visit, CAPTURE, 0, 1024.0)
+    envelope = np.exp(-0.05 * omega * CAPTURE.model_settle_ms / 1000.0)
+    assert envelope < 2e-3 and np.linalg.norm(settled.mid) <= amplitude * envelope
+    assert len(settled.path) == 1
+    assert np.linalg.norm(burst.mid) > 100 * np.linalg.norm(settled.mid)

@@ -36,7 +36,7 @@ def test_the_board_renders_where_the_true_camera_projects_it(tilt_deg):
     R = cv2.Rodrigues(np.array([np.radians(tilt_deg), 0.2, 0.05]))[0]
     width_mm, height_mm = spec.size_mm
     T_cam_board = pose_matrix(R, np.array([0.0, 0.0, 300.0]) - R @ np.array([width_mm / 2, height_mm / 2, 0.0]))
-    board_points, pixels = detect_corners(views.render_view(quiet, T_cam_board, np.random.default_rng(0)), spec.board())
+    board_points, pixels = detect_corners(views.render_view(quiet, T_cam_board, np.random.default_rng(0)), spec)
     assert len(board_points) == (spec.squares_x - 1) * (spec.squares_y - 1)  # every corner found
     errors = projected_corners(T_cam_board, board_points) - pixels
     assert np.sqrt(np.mean(np.sum(errors**2, axis=1))) < 0.12
@@ -46,7 +46,7 @@ def test_the_views_cover_the_image_corners_included():
     """The board's corners over the session's poses (inside the image) fall in every cell of an 8 x 8 grid of the
     image, and come within 10 % of the diagonal of each image corner (measured 2-8 %)."""
     camera, spec, session = true_camera(GENERATE.camera), views.charuco_spec(GENERATE), GENERATE.calibration
-    board_points = spec.board().getChessboardCorners()
+    board_points = spec.cv_board().getChessboardCorners()
     seen = []
     for i in range(session.n_views):
         T = views.view_pose(camera, spec, session.distance_mm, session.max_tilt_deg,

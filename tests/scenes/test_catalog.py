@@ -13,8 +13,18 @@ ROOT = Path(__file__).resolve().parents[2]
 
 
 @pytest.fixture(scope="module")
-def generate():
-    return load_params(ROOT / "params.yaml").generate
+def params():
+    return load_params(ROOT / "params.yaml")
+
+
+@pytest.fixture(scope="module")
+def generate(params):
+    return params.generate
+
+
+@pytest.fixture(scope="module")
+def protocol(params):
+    return params.protocol
 
 
 def spec(targets, **extra):
@@ -24,20 +34,47 @@ def spec(targets, **extra):
 
 
 @pytest.mark.parametrize("targets", [["scapula"], ["block_print"], ["scapula", "block_mosaic"]])
-def test_board_origin_is_on_the_board_edge_nearest_the_target(generate, targets):
-    """E_t is measured at the board origin (the model origin): it is a corner of the edge facing the target."""
-    scene = catalog.build_scene(spec(targets), 3, generate)
+def test_the_board_faces_the_model_camera_its_origin_the_corner_nearest_the_target(generate, protocol, targets):
+    """E_t is measured at the board origin (the model origin, IV-C): the board is turned so that its origin is nearer
+    the target than the corner a half turn would put there (and than its centre); its printed side faces the model
+    camera (board z = the camera's forward axis) and it stands on its post."""
+    scene = catalog.build_scene(spec(targets), 3, generate, protocol)
     bw, bh = scene.board.size_mm
     corners = np.array([[x, y, 0.0, 1.0] for x in (0, bw) for y in (0, bh)]) @ scene.T_world_board.T
-    distances = np.linalg.norm(corners[:, :2] - scene.T_world_target[:2, 3], axis=1)
-    assert 0 in np.argsort(distances)[:2] and distances[0] < 90.0
-    # beside a held phantom the board stands on a pedestal, never far below the aim point
-    assert scene.aim[2] - corners[0, 2] <= catalog.BOARD_BELOW_AIM_MM + 1.0
+    distances = np.linalg.norm(corners[:, :3] - dict(scene.placed)[targets[0]].vertices.mean(axis=0), axis=1)
+    centre = scene.T_world_board @ [bw / 2, bh / 2, 0.0, 1.0]
+    assert distances[0] <= distances[3] and distances[0] < np.linalg.norm(
+        centre[:3] - dict(scene.placed)[targets[0]].vertices.mean(axis=0))
+    np.testing.assert_allclose(scene.T_world_board[:3, 2], -scene.view_dir, atol=1e-9)
+    post = dict(scene.placed)["board_post"].vertices
+    assert post[:, 2].min() == pytest.approx(0.0) and post[:, 2].max() >= corners[:, 2].min()
 
 
-def test_boxes_show_two_printed_sides_to_the_model_camera(generate):
+def test_the_flat_placement_lays_the_board_beside_the_target_on_its_pedestal(generate, protocol):
+    flat = generate.model_copy(update={"board": generate.board.model_copy(update={"placement": "flat"})})
+    scene = catalog.build_scene(spec(["scapula"]), 3, flat, protocol)
+    np.testing.assert_allclose(scene.T_world_board[:3, 2], [0.0, 0.0, -1.0])  # printed side up
+    assert "board_pedestal" in dict(scene.placed)
+
+
+def test_the_lab_measures_the_printed_board_with_calipers(generate, protocol):
+    """meta.json's board is the drawing scaled by what the lab measured: within a caliper error of the printed
+    scale; without calipers (null) the drawing itself."""
+    scene = catalog.build_scene(spec(["block_print"]), 0, generate, protocol)
+    printed, _ = catalog.print_errors(generate, "aruco", generate.printed_boards.board_sag_std_mm)
+    width, height = generate.board.drawing().size_mm
+    caliper = generate.printed_boards.caliper_std_mm
+    assert abs(scene.board.scale[0] - printed[0]) * width < 5 * caliper
+    assert abs(scene.board.scale[1] - printed[1]) * height < 5 * caliper
+    assert scene.board.scale != (1.0, 1.0)
+    unmeasured = generate.model_copy(update={"printed_boards": generate.printed_boards.model_copy(
+        update={"caliper_std_mm": None})})
+    assert catalog.measured_board(unmeasured).scale == (1.0, 1.0)
+
+
+def test_boxes_show_two_printed_sides_to_the_model_camera(generate, protocol):
     """Corner-on: the model view sees two side faces at 45 +- 15 deg each (a 3D point set, not one plane)."""
-    scene = catalog.build_scene(spec(["block_mosaic"]), 0, generate)
+    scene = catalog.build_scene(spec(["block_mosaic"]), 0, generate, protocol)
     view = scene.view_dir[:2] / np.linalg.norm(scene.view_dir[:2])
     R = scene.T_world_target[:3, :3]
     angles = np.degrees(np.arccos(np.clip([abs(view @ R[:2, 0]), abs(view @ R[:2, 1])], -1, 1)))
@@ -45,8 +82,8 @@ def test_boxes_show_two_printed_sides_to_the_model_camera(generate):
 
 
 @pytest.mark.parametrize("tilt", [(0.0, 0.0), (-15.0, 20.0)])
-def test_the_glenoid_faces_the_model_camera_turned_by_the_scene_tilt(generate, tilt):
-    scene = catalog.build_scene(spec(["scapula_drilled"], glenoid_tilt_deg=tilt), 1, generate)
+def test_the_glenoid_faces_the_model_camera_turned_by_the_scene_tilt(generate, protocol, tilt):
+    scene = catalog.build_scene(spec(["scapula_drilled"], glenoid_tilt_deg=tilt), 1, generate, protocol)
     normal = scene.T_world_target[:3, 2]
     angle = np.degrees(np.arccos(normal @ scene.view_dir))
     assert angle == pytest.approx(np.degrees(np.arccos(np.cos(np.radians(tilt[0])) * np.cos(np.radians(tilt[1])))),
@@ -57,18 +94,19 @@ def test_the_glenoid_faces_the_model_camera_turned_by_the_scene_tilt(generate, t
     assert phantom.texture is None and phantom.material.foam_albedo == generate.bone_foam.albedo
 
 
-def test_clutter_holds_bone_foam_and_printed_look_alikes(generate):
+def test_clutter_holds_bone_foam_and_printed_look_alikes(generate, protocol):
     materials = [(m.texture, m.material.foam_albedo) for name, m in catalog.build_scene(
-        spec(["scapula"]).model_copy(update={"n_clutter": 12}), 2, generate).placed if name.startswith("clutter")]
+        spec(["scapula"]).model_copy(update={"n_clutter": 12}), 2, generate, protocol).placed if name.startswith("clutter")]
     assert len(materials) == 12
     assert any(albedo is not None for _, albedo in materials)  # foam offcuts
     assert any(texture in catalog.PRINTED_CLUTTER for texture, _ in materials)
 
 
-def test_the_layout_follows_generate_seed(generate):
-    first = catalog.build_scene(spec(["block_print"]), 0, generate)
-    again = catalog.build_scene(spec(["block_print"]), 0, generate)
-    other = catalog.build_scene(spec(["block_print"]), 0, generate.model_copy(update={"seed": generate.seed + 1}))
+def test_the_layout_follows_generate_seed(generate, protocol):
+    first = catalog.build_scene(spec(["block_print"]), 0, generate, protocol)
+    again = catalog.build_scene(spec(["block_print"]), 0, generate, protocol)
+    other = catalog.build_scene(spec(["block_print"]), 0, generate.model_copy(update={"seed": generate.seed + 1}),
+                                protocol)
     np.testing.assert_array_equal(first.view_dir, again.view_dir)
     assert not np.allclose(first.view_dir, other.view_dir)
 

@@ -38,9 +38,18 @@ BAD_VALUES = [
     ("calibration.board.dictionary", "DICT_4X4_NOPE", "calibration.board.dictionary"),
     ("calibration.board.squares_x", 40, "calibration.board.dictionary"),  # 120 markers, DICT_5X5_100 has 100
     ("calibration.n_views", 2, "calibration.n_views"),  # fewer than a calibration can use
+    ("board.marker_mm", 30.0, "board.marker_mm"),  # a ChArUco marker larger than its square
+    ("board.markers_x", 3, "board.markers_x"),  # an ArUco grid's key on a ChArUco board
+    ("board.squares_x", None, "board.squares_x"),  # a ChArUco board without its size
+    ("board.squares_x", 30, "board.dictionary"),  # 60 markers on 30 x 4 squares, DICT_4X4_50 has 50
+    ("board.placement", "hanging", "board.placement"),
+    ("printed_boards.caliper_std_mm", -0.1, "printed_boards.caliper_std_mm"),
+    ("capture.model_settle_ms", -5.0, "capture.model_settle_ms"),
     ("calibration.distance_mm", [450.0, 250.0], "calibration.distance_mm"),
     ("calibration.distance_mm", [50.0, 300.0], "calibration.distance_mm"),  # nearer than the lens focuses
     ("calibration.max_tilt_deg", 85.0, "calibration.max_tilt_deg"),  # the board seen edge-on
+    ("calibration.max_tilt_deg", 0.0, "calibration.max_tilt_deg"),  # every view fronto-parallel: f undetermined
+    ("calibration.max_tilt_deg", 19.0, "calibration.max_tilt_deg"),  # too little tilt for an accurate focal length
     ("calibration.max_rms_px", 0.0, "calibration.max_rms_px"),  # no calibration passes
     ("camera.distortion", [-3.0, 0.0, 0.0, 0.0, 0.0], "camera.distortion.0"),  # a fisheye: plumb_bob cannot model it
     ("printed_boards.scale_std", 0.05, "printed_boards.scale_std"),  # 5 %: seen with a ruler
@@ -74,12 +83,16 @@ def test_bad_value_names_its_key(tiny_raw, key, value, expected):
 
 
 def test_every_key_is_set_by_params_yaml():
-    """No field has a default that could disagree with params.yaml: leaving any key out is refused (the one
-    optional key, glenoid_tilt_deg, is required exactly where it means something)."""
+    """No field has a default that could disagree with params.yaml: leaving any key out is refused (the optional
+    keys are required exactly where they mean something: glenoid_tilt_deg with a scapula, a board's sizes with its
+    type, and refused elsewhere)."""
+    optional = {("SceneSpec", "glenoid_tilt_deg")} | {
+        ("GroundTruthBoardParams", key) for key in ("markers_x", "markers_y", "marker_length_mm", "separation_mm",
+                                                    "squares_x", "squares_y", "square_mm", "marker_mm")}
+
     def defaults(model):
         for name, field in model.model_fields.items():
-            assert field.is_required() or (model.__name__, name) == ("SceneSpec", "glenoid_tilt_deg"), \
-                f"{model.__name__}.{name} has a default"
+            assert field.is_required() or (model.__name__, name) in optional, f"{model.__name__}.{name} has a default"
             for sub in getattr(field.annotation, "__args__", (field.annotation,)):
                 if isinstance(sub, type) and hasattr(sub, "model_fields"):
                     defaults(sub)

@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
+from poseintegrity.errors import ArgumentError
 from poseintegrity.tracking.markers.detection import (
     _valid_depth_range, blob_pixels, detect_markers, detect_markers_each, points_along_rays, raw_threshold, split_by_depth, validate_frame,
 )
@@ -89,6 +90,29 @@ def test_bad_units_lut_and_dtype_are_named_not_turned_into_points():
     for words, (a, b, c) in cases.items():
         with pytest.warns(RuntimeWarning, match=words):
             assert detect_markers(a, b, c, DETECTION).shape == (0, 3)
+
+
+@pytest.mark.parametrize(("K_bad", "words"), [
+    (np.zeros((3, 3)), r"unproject \(a 3x3 K\): focal lengths must be positive, got fx 0.0"),
+    (np.where(np.eye(3, dtype=bool), np.nan, K), "entries must be finite"),
+    (K * [[1e-9], [1e-9], [1.0]], "put the image corners beyond 20 on the unit plane"),
+])
+def test_a_k_that_cannot_unproject_is_named_not_turned_into_nan_points(K_bad, words):
+    """A K of zeros gave inf/NaN points (a division by fx = 0), a NaN K NaN points, without a word."""
+    _, ir, depth = _frame(6)
+    with pytest.warns(RuntimeWarning, match=words):
+        assert detect_markers(ir, depth, K_bad, DETECTION).shape == (0, 3)
+
+
+@pytest.mark.parametrize(("T", "words"), [
+    (np.eye(3), r"T_world_cam: expected shape \(4, 4\), got \(3, 3\)"),  # was an IndexError
+    (np.full((4, 4), np.nan), "T_world_cam: entries must be finite"),  # was NaN points
+    (np.diag([2.0, 2.0, 2.0, 1.0]), r"T_world_cam\[:3, :3\]: expected a rotation matrix"),
+])
+def test_extrinsics_that_are_not_a_rigid_pose_are_refused_naming_them(T, words):
+    _, ir, depth = _frame(6)
+    with pytest.raises(ArgumentError, match=words):
+        detect_markers(ir, depth, K, DETECTION, T_world_cam=T)
 
 
 def _small_marker_frame(distance_m, seed):

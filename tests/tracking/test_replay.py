@@ -101,7 +101,7 @@ def test_the_command_replays_a_stream_recorder_capture_as_the_same_frames_in_our
 def test_an_hl2ss_recording_replays_with_its_calibration(recorded, tools, tmp_path):
     lut, frames = recorded
     path = write_hl2ss(tmp_path / "rm_depth_ahat.bin", tmp_path / "calibration", lut, frames)
-    status, stdout, stderr = _run([path, "--tools", tools, "--format", "hl2ss", "--calibration", tmp_path / "calibration",
+    status, stdout, stderr = _run([path, "--calibration", tmp_path / "calibration", "--tools", tools,  # format found
                                    "--out", tmp_path / "poses.csv", "--params", TINY_PARAMS])
     assert status == 0, stderr
     assert (pd.read_csv(tmp_path / "poses.csv").flag == "ok").sum() >= 4
@@ -151,3 +151,34 @@ def test_a_gyro_tool_without_gyro_samples_is_said_and_tracks_without_gyro(record
     assert status == 0 and "no gyro.csv, so --gyro-tool probe fused nothing" in stderr
     expected = track_recording(read_recording(folder), {"probe": GEOMETRY}, PARAMS)
     assert list(pd.read_csv(tmp_path / "poses.csv").flag) == list(expected.flag)
+
+
+def test_the_layout_is_found_without_format_and_a_wrong_format_names_the_right_one(recorded, tools, tmp_path):
+    lut, frames = recorded
+    capture = write_stream_recorder(tmp_path / "capture", lut, frames)
+    status, stdout, stderr = _run([capture, "--tools", tools, "--out", tmp_path / "poses.csv", "--params", TINY_PARAMS])
+    assert status == 0, stderr
+    expected = track_recording(read_recording(_own_layout(tmp_path / "rec", recorded)), {"probe": GEOMETRY}, PARAMS)
+    assert list(pd.read_csv(tmp_path / "poses.csv").flag) == list(expected.flag)
+    for given, fits, folder in (("folder", "stream-recorder", capture), ("stream-recorder", "folder", tmp_path / "rec")):
+        status, _, stderr = _run([folder, "--tools", tools, "--format", given, "--out", tmp_path / "again.csv"])
+        assert status == 2 and f"use --format {fits}" in stderr and not (tmp_path / "again.csv").exists()
+    (tmp_path / "empty").mkdir()
+    status, _, stderr = _run([tmp_path / "empty", "--tools", tools, "--out", tmp_path / "again.csv"])
+    assert status == 2 and "not a recording this command reads" in stderr and "frames.csv" in stderr
+
+
+def test_the_output_is_checked_before_any_work(recorded, tools, tmp_path, monkeypatch):
+    folder = _own_layout(tmp_path / "rec", recorded)
+    monkeypatch.setattr("poseintegrity.tracking.replay._replay", lambda *a: pytest.fail("replayed before the check"))
+    (tmp_path / "poses.csv").write_text("the user's table")
+    (tmp_path / "folder.csv").mkdir()
+    for out, words in ((tmp_path / "folder.csv", "is a folder"), (tmp_path / "poses.csv", "the file exists"),
+                       (tmp_path / "no" / "poses.csv", "does not exist")):
+        status, _, stderr = _run([folder, "--tools", tools, "--out", out])
+        assert status == 2 and f"--out {out}: " in stderr and words in stderr
+    assert (tmp_path / "poses.csv").read_text() == "the user's table"
+    monkeypatch.undo()
+    status, _, _ = _run([folder, "--tools", tools, "--out", tmp_path / "poses.csv", "--overwrite",
+                         "--params", TINY_PARAMS])
+    assert status == 0 and pd.read_csv(tmp_path / "poses.csv").frame.nunique() == 6

@@ -106,6 +106,8 @@ def _check(series: Series) -> None:
     if np.any(np.diff(per_stop) <= 0):
         raise ArgumentError(f"{where}: {variable} does not increase with the stop: {np.round(per_stop, 3).tolist()}")
     if series.theta.min() < 0 or series.theta.max() > series.theta_end:
+        key = {"arc": "protocol.arc_span_deg", "line": "protocol.line_length_mm"}[series.trajectory]
         raise ArgumentError(f"{where}: spans {series.theta.min():g} .. {series.theta.max():g}, outside [0, "
-                         f"{series.theta_end:g}] (the protocol's range end): was stage 02's table made with another "
-                         f"protocol?")
+                            f"{series.theta_end:g}], the range end {key}: set {key} to cover every stop (stage 01 "
+                            f"checks recorded stops against it), or re-run stage 02 if its table was made with other "
+                            f"params")

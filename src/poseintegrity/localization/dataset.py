@@ -30,7 +30,7 @@ from __future__ import annotations
 import json
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Literal
+from typing import Annotated, Any, Literal
 
 import cv2
 import numpy as np
@@ -38,7 +38,8 @@ import pandas as pd
 import pyarrow
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
-from poseintegrity.errors import ArgumentError, PoseIntegrityError
+from poseintegrity.boards import aruco_dictionary
+from poseintegrity.errors import ArgumentError, PoseIntegrityError, not_numbers
 from poseintegrity.lens import Camera, CameraFileError, read_camera_yaml
 
 INDEX_COLUMNS = ("dataset", "path")
@@ -66,16 +67,6 @@ def pose_problem(values: Any) -> str | None:
     return None
 
 
-def aruco_dictionary(name: object) -> int:
-    """OpenCV's id of the predefined ArUco dictionary ``name`` ("DICT_4X4_50", ...);
-    :class:`~poseintegrity.errors.ArgumentError` naming it and the known names otherwise."""
-    value = getattr(cv2.aruco, name, None) if isinstance(name, str) and name.startswith("DICT_") else None
-    if isinstance(value, bool) or not isinstance(value, int):
-        known = sorted(key for key in dir(cv2.aruco) if key.startswith("DICT_"))
-        raise ArgumentError(f"board.dictionary: unknown ArUco dictionary {name!r}; OpenCV knows {', '.join(known)}")
-    return value
-
-
 def _pose(values: Any, which: str) -> list[list[float]]:
     problem = pose_problem(values)
     if problem:
@@ -90,14 +81,23 @@ class _Read(BaseModel):
 
 
 class BoardMeta(_Read):
-    """The ArUco GridBoard of the scene (IV-C), lengths in mm."""
+    """The ground-truth board (IV-C; :mod:`poseintegrity.boards`), lengths in mm: ``type`` ``aruco_grid`` (the
+    default, the paper's "ArUco marker board": markers_x, markers_y, marker_length_mm, separation_mm, first_id) or
+    ``charuco`` (squares_x, squares_y, square_mm, marker_mm); ``scale`` [x, y]: the printed size over the drawn size,
+    as measured with calipers (default [1, 1]: the drawing)."""
 
+    type: Literal["aruco_grid", "charuco"] = "aruco_grid"
     dictionary: str = Field(pattern=r"^DICT_\w+$")
-    markers_x: int = Field(ge=1)
-    markers_y: int = Field(ge=1)
-    marker_length_mm: float = Field(gt=0)
-    separation_mm: float = Field(ge=0)
-    first_id: int = Field(ge=0)
+    markers_x: int | None = Field(None, ge=1)
+    markers_y: int | None = Field(None, ge=1)
+    marker_length_mm: float | None = Field(None, gt=0)
+    separation_mm: float | None = Field(None, ge=0)
+    first_id: int = Field(0, ge=0)
+    squares_x: int | None = Field(None, ge=3)
+    squares_y: int | None = Field(None, ge=3)
+    square_mm: float | None = Field(None, gt=0)
+    marker_mm: float | None = Field(None, gt=0)
+    scale: tuple[Annotated[float, Field(ge=0.9, le=1.1)], Annotated[float, Field(ge=0.9, le=1.1)]] = (1.0, 1.0)
 
     @field_validator("dictionary")
     @classmethod
@@ -106,11 +106,21 @@ class BoardMeta(_Read):
         return name
 
     @model_validator(mode="after")
-    def _ids_in_dictionary(self) -> "BoardMeta":
+    def _fields_of_its_type(self) -> "BoardMeta":
+        needed = {"aruco_grid": ("markers_x", "markers_y", "marker_length_mm", "separation_mm"),
+                  "charuco": ("squares_x", "squares_y", "square_mm", "marker_mm")}[self.type]
+        missing = [key for key in needed if getattr(self, key) is None]
+        if missing:
+            raise ValueError(f"a {self.type} board needs {', '.join(missing)}")
+        if self.type == "charuco":
+            if self.marker_mm >= self.square_mm:
+                raise ValueError(f"marker_mm ({self.marker_mm:g}) must be below square_mm ({self.square_mm:g})")
+            first, last = 0, self.squares_x * self.squares_y // 2
+        else:
+            first, last = self.first_id, self.first_id + self.markers_x * self.markers_y
         size = cv2.aruco.getPredefinedDictionary(aruco_dictionary(self.dictionary)).bytesList.shape[0]
-        last = self.first_id + self.markers_x * self.markers_y
         if last > size:
-            raise ValueError(f"board: markers {self.first_id} .. {last - 1} do not fit {self.dictionary}, which has "
+            raise ValueError(f"board: markers {first} .. {last - 1} do not fit {self.dictionary}, which has "
                              f"{size} markers")
         return self
 
@@ -124,6 +134,9 @@ class ModelMeta(_Read):
     T_cam1_cam0: list[list[float]]
     T_cam0_ref: list[list[float]] | None = Field(
         default=None, description="model image 0's pose in the reference frame (ground_truth poses: places M_t)")
+    exact_T_cam_board: list[list[list[float]]] | None = Field(
+        default=None, description="the model images' exact board poses (rendered data: a diagnostic, the reference "
+                                  "of the ground truth's own accuracy, R11)")
 
     @field_validator("T_cam1_cam0", mode="before")
     @classmethod
@@ -134,6 +147,12 @@ class ModelMeta(_Read):
     @classmethod
     def _rigid_anchor(cls, pose: Any) -> Any:
         return None if pose is None else _pose(pose, "model image 0's pose T_cam0_ref")
+
+    @field_validator("exact_T_cam_board", mode="before")
+    @classmethod
+    def _rigid_exact(cls, poses: Any) -> Any:
+        return None if poses is None else [_pose(pose, f"model image {k}'s exact board pose")
+                                           for k, pose in enumerate(poses)]
 
 
 class Meta(_Read):
@@ -266,6 +285,12 @@ def _check_frames(frames: pd.DataFrame, path: Path, name: str) -> None:
         raise DatasetError(f"dataset {name}: {path} lacks the column(s) {missing}")
     if frames.empty:
         raise DatasetError(f"dataset {name}: {path} has no rows (a dataset without frames would give an empty stage)")
+    for column in ("stop", "image", "theta_deg", "x_mm"):
+        if (text := not_numbers(frames[column])).any():
+            row = int(np.argmax(text))
+            value, stop, image = (frames[key].tolist()[row] for key in (column, "stop", "image"))
+            raise DatasetError(f"dataset {name}: {path}: column {column} must hold numbers, got {value!r} in row {row} "
+                               f"(stop {stop!r}, image {image!r})")
     if frames[["dataset", "stop", "image", "file"]].isna().any().any():
         raise DatasetError(f"dataset {name}: {path} has empty dataset, stop, image or file entries")
     if others := sorted(set(frames["dataset"].astype(str)) - {name}):

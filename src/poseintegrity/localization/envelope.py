@@ -19,18 +19,26 @@ stage 04 reports Tables I-III under each, so that the choice is seen:
   previous stop, never a point between stops (the rule of our first reproduction; it snaps theta_a to the stops).
 
 Rules common to all: a tolerance is a pair (E_t mm, E_r deg) and a stop fails when any criterion exceeds its bound;
-theta_a is the earliest crossing, each criterion linearly interpolated between the last passing stop and the first
-failing one (a criterion that is infinite at the failing stop crosses at the previous stop); a dataset whose first
-stop (the model view, IV-D; x = 0 on lines) already fails has theta_a = that stop; one that never fails is censored
-at its last stop (``censored`` True). A criterion never measured at any stop (every frame's E_t NaN: the board was
-never detected) is no evidence of staying within tolerance: theta_a is then NaN (``censored`` False), flagged with a
-warning naming the dataset, unless the first stop already fails; the envelopes table's NaN is refused by the
-prediction stage (prediction.sweeps.attach_envelopes) naming the dataset.
+theta_a is the earliest crossing, each criterion linearly interpolated between the last stop where it was measured
+and passed and the first stop where it fails (a criterion that is infinite at the failing stop crosses at that last
+passing stop); a dataset whose first stop (the model view, IV-D; x = 0 on lines) already fails has theta_a = that
+stop; one that never fails is censored (``censored`` True) at the last stop where every criterion was measured.
+
+A criterion is *unmeasured* at a stop when it is NaN there: every frame of the stop lacks the error (no trusted
+board pose in its posed frames). An unmeasured stop is no sampled point of that criterion (IV-E interpolates "between
+discrete sampled points"): it is skipped, never read as within tolerance, and the row is flagged (``status``
+``unmeasured_stops``, ``reason`` naming the stops) when such a stop lies before the first failing stop. Placing theta_a
+at the unmeasured stop (our first reading) made the envelope end where nothing was measured, later than the
+measured stops say: an optimistic envelope. A criterion not measured before the stop where it fails, or at no stop at
+all, leaves no envelope to read: theta_a is then NaN (``censored`` False, ``status`` ``not_measured``), warned about
+naming the dataset, unless the first stop already fails; the envelopes table's NaN is refused by the prediction stage
+(prediction.sweeps.attach_envelopes) naming the dataset.
 """
 
 from __future__ import annotations
 
 import warnings
+from typing import NamedTuple
 
 import numpy as np
 import pandas as pd
@@ -40,19 +48,34 @@ from poseintegrity.protocol import FAILED_FRAME_RULES, EnvelopeParams, tolerance
 
 ENVELOPE_INPUT = ("world", "dataset", "trajectory", "stop", "image", "theta_deg", "x_mm", "method", "status",
                   "E_t_mm", "E_r_deg")  # what envelopes reads of an artifacts table
-COLUMNS = ["world", "dataset", "trajectory", "tolerance", "method", "rule", "theta_a", "censored"]
+COLUMNS = ["world", "dataset", "trajectory", "tolerance", "method", "rule", "theta_a", "censored", "status", "reason"]
 
 
-def actual_envelope(theta: np.ndarray, criteria: np.ndarray, bounds: np.ndarray) -> tuple[float, bool]:
-    """theta_a and whether it is censored (IV-E).
+class Envelope(NamedTuple):
+    """theta_a (deg or mm; NaN: none can be read), whether it is censored, and the positions of the stops before
+    the first failing one (every stop when none fails) at which a criterion was unmeasured (NaN) and skipped, and
+    the index of the criterion that ends it (-1 when none does: censored, or nothing measured)."""
+
+    theta_a: float
+    censored: bool
+    unmeasured: tuple[float, ...]
+    criterion: int = -1
+
+
+def actual_envelope(theta: np.ndarray, criteria: np.ndarray, bounds: np.ndarray) -> Envelope:
+    """theta_a, whether it is censored, and the unmeasured stops skipped (IV-E; module docstring).
 
     theta : (m,) increasing stop positions (deg or mm), the first one the trajectory start
     criteria : (m, b) per stop, each criterion (mean E_t, mean E_r, share of frames without a pose, ...); inf fails
-               the stop and crosses at the previous one; NaN (nothing to average) never fails a stop
+               the stop and crosses at the last stop before it where the criterion was measured; NaN (nothing to
+               average: unmeasured) never fails a stop and is no sampled point of its criterion
     bounds : (b,) the bound of each criterion
-    Returns (NaN, False) when a criterion is NaN at every stop and the first stop does not fail (nothing measured:
-    no envelope can be read). Refused (:class:`~poseintegrity.errors.ArgumentError` naming the argument): theta
-    empty, not finite or not increasing; criteria not (m, b) of theta's length; bounds not b finite numbers.
+    theta_a is the earliest of the criteria's crossings, each interpolated between the criterion's last measured
+    stop before its first failing stop and that stop; censored at the last stop where every criterion was measured
+    when none fails. (NaN, False) when a criterion is measured at no stop before the one where it fails (or at no
+    stop) and the first stop does not fail: nothing measured, no envelope can be read. Refused
+    (:class:`~poseintegrity.errors.ArgumentError` naming the argument): theta empty, not finite or not increasing;
+    criteria not (m, b) of theta's length; bounds not b finite numbers.
     """
     theta = check_increasing("theta", theta)
     values = check_array("criteria", criteria, shape=(None, None), finite=False)
@@ -63,29 +86,44 @@ def actual_envelope(theta: np.ndarray, criteria: np.ndarray, bounds: np.ndarray)
     if values.shape[1] != len(bounds):
         raise ArgumentError(f"criteria, bounds: {values.shape[1]} criteria per stop but {len(bounds)} bounds")
     with np.errstate(invalid="ignore"):
-        exceeded = np.any(values > bounds, axis=1)
-    if np.isnan(values).all(axis=0).any() and not exceeded[0]:
-        return float("nan"), False
-    if not exceeded.any():
-        return float(theta[-1]), True
-    k = int(np.argmax(exceeded))  # first failing stop
+        exceeded = values > bounds  # (m, b); NaN never exceeds
+    measured = ~np.isnan(values)
+    failing = exceeded.any(axis=1)
+    k = int(np.argmax(failing)) if failing.any() else len(theta)  # first failing stop (m: none)
+    unmeasured = tuple(float(t) for t in theta[:k][~measured[:k].all(axis=1)])
     if k == 0:
-        return float(theta[0]), False
-    crossings = []
-    for before, after, bound in zip(values[k - 1], values[k], bounds):
-        if after > bound:
-            interpolable = np.isfinite(before) and np.isfinite(after)
-            fraction = (bound - before) / (after - before) if interpolable else 0.0
-            crossings.append(theta[k - 1] + fraction * (theta[k] - theta[k - 1]))
-    return float(min(crossings)), False
+        return Envelope(float(theta[0]), False, (), int(np.argmax(exceeded[0])))
+    ends = []  # (position, censored, criterion) per criterion: its crossing, or how far it was measured to pass
+    for c, bound in enumerate(bounds):
+        fails, seen = np.flatnonzero(exceeded[:, c]), np.flatnonzero(measured[:, c])
+        passed = seen[seen < fails[0]] if len(fails) else seen
+        if not len(passed):
+            return Envelope(float("nan"), False, unmeasured)
+        j = int(passed[-1])  # the criterion's last measured stop before it fails
+        if not len(fails):
+            # A criterion that never fails ends the envelope (censored) only when none fails: when another crosses
+            # between stops k - 1 and k, what this one is after stop k - 1 is not read (no pose there, say).
+            if k == len(theta):
+                ends.append((float(theta[j]), True, -1))
+            continue
+        after = int(fails[0])
+        fraction = (bound - values[j, c]) / (values[after, c] - values[j, c]) if np.isfinite(values[after, c]) else 0.0
+        ends.append((float(theta[j] + fraction * (theta[after] - theta[j])), False, c))
+    theta_a, censored, criterion = min(ends, key=lambda end: end[:2])  # the earliest; a crossing before a censored
+    return Envelope(theta_a, censored, unmeasured, criterion)  # end at the same position
+
+
+GROUND_TRUTH_ERRORS = ("E_t_mm", "E_r_deg")  # against the ground truth (IV-C): the paper's metric
+EXACT_ERRORS = ("E_t_exact_mm", "E_r_exact_deg")  # against the renderer's exact pose: a diagnostic, not the paper's
+CRITERIA = ("translation", "rotation", "no_pose")  # what each column of stop_criteria bounds
 
 
 def stop_criteria(frames: pd.DataFrame, tolerance: tuple[float, float], rule: str,
-                  envelope: EnvelopeParams) -> tuple[np.ndarray, np.ndarray]:
+                  envelope: EnvelopeParams, errors: tuple[str, str] = GROUND_TRUTH_ERRORS) -> tuple[np.ndarray, np.ndarray]:
     """Per stop of one dataset and PnP method: the criteria of ``rule`` and their bounds.
 
-    frames : usable artifact rows (``status`` "ok" = a pose; ``E_t_mm``, ``E_r_deg`` against the ground truth,
-             NaN where the board was not detected or there is no pose), with ``stop``
+    frames : usable artifact rows (``status`` "ok" = a pose; the ``errors`` columns, E_t and E_r against the
+             ground truth by default, NaN where the board gave no trusted pose or there is no pose), with ``stop``
     Returns criteria (m, b) in stop order and bounds (b,): mean E_t, mean E_r, and for ``fail_fraction`` the share
     of frames without a pose.
     """
@@ -93,7 +131,7 @@ def stop_criteria(frames: pd.DataFrame, tolerance: tuple[float, float], rule: st
         raise ArgumentError(f"rule: unknown failed-frame rule {rule!r}; expected one of {FAILED_FRAME_RULES}")
     tol = np.asarray(tolerance, dtype=float)
     posed = (frames["status"] == "ok").to_numpy()
-    errors = frames[["E_t_mm", "E_r_deg"]].to_numpy(dtype=float, copy=True)
+    errors = frames[list(errors)].to_numpy(dtype=float, copy=True)
     if rule == "infinite":
         errors[~posed] = np.inf
     elif rule == "capped":
@@ -109,9 +147,11 @@ def stop_criteria(frames: pd.DataFrame, tolerance: tuple[float, float], rule: st
     return per_stop[["E_t", "E_r"]].to_numpy(), tol
 
 
-def envelopes(table: pd.DataFrame, tolerances: list[tuple[float, float]], envelope: EnvelopeParams) -> pd.DataFrame:
+def envelopes(table: pd.DataFrame, tolerances: list[tuple[float, float]], envelope: EnvelopeParams,
+              errors: tuple[str, str] = GROUND_TRUTH_ERRORS) -> pd.DataFrame:
     """theta_a per dataset, tolerance, PnP method and failed-frame rule from an artifacts table (columns
-    :data:`COLUMNS`; theta_a in deg for arcs (``theta_deg``), mm for lines (``x_mm``)).
+    :data:`COLUMNS`; theta_a in deg for arcs (``theta_deg``), mm for lines (``x_mm``)), the errors of the ``errors``
+    columns (:data:`GROUND_TRUTH_ERRORS`, the paper's; :data:`EXACT_ERRORS`, against the exact pose: a diagnostic).
 
     table : usable artifact rows (:func:`~poseintegrity.localization.extract.usable`), checked
         (:func:`~poseintegrity.tables.check_artifacts`: columns, one row per frame and method, ...)
@@ -119,7 +159,7 @@ def envelopes(table: pd.DataFrame, tolerances: list[tuple[float, float]], envelo
     """
     from poseintegrity.tables import check_artifacts  # noqa: PLC0415 (tables imports this module)
 
-    check_artifacts(table, "the artifacts table given to envelopes", columns=ENVELOPE_INPUT)
+    check_artifacts(table, "the artifacts table given to envelopes", columns=tuple(dict.fromkeys((*ENVELOPE_INPUT, *errors))))
     rows = []
     for (world, dataset, trajectory, method), frames in table.groupby(["world", "dataset", "trajectory", "method"],
                                                                       sort=True):
@@ -127,17 +167,32 @@ def envelopes(table: pd.DataFrame, tolerances: list[tuple[float, float]], envelo
         theta = frames.groupby("stop", sort=True)[position].mean().to_numpy()
         for tolerance in tolerances:
             for rule in FAILED_FRAME_RULES:
-                criteria, bounds = stop_criteria(frames, tolerance, rule, envelope)
-                theta_a, censored = actual_envelope(theta, criteria, bounds)
+                criteria, bounds = stop_criteria(frames, tolerance, rule, envelope, errors)
+                theta_a, censored, unmeasured, _ = actual_envelope(theta, criteria, bounds)
                 rows.append(dict(world=world, dataset=dataset, trajectory=trajectory, tolerance=tolerance_name(tolerance),
-                                 method=method, rule=rule, theta_a=theta_a, censored=censored))
+                                 method=method, rule=rule, theta_a=theta_a, censored=censored,
+                                 **flag(theta_a, unmeasured, "mm" if trajectory == "line" else "deg")))
     result = pd.DataFrame(rows, columns=COLUMNS)
     unknown = result[result["theta_a"].isna()]
     if len(unknown):
         names = sorted(set(unknown["dataset"]))
         warnings.warn(f"envelopes: {len(unknown)} theta_a of dataset(s) {names[:5]}{' ...' if len(names) > 5 else ''} "
-                      f"are NaN: no pose error was measured at any stop (ArUco board never detected?)", stacklevel=2)
+                      f"are NaN: no pose error was measured at any stop (board never detected or trusted?)", stacklevel=2)
     return result
+
+
+def flag(theta_a: float, unmeasured: tuple[float, ...], unit: str) -> dict[str, str]:
+    """``status`` and ``reason`` of an envelope row: ``ok``; ``unmeasured_stops`` when stops without a measured
+    error were skipped (named, in ``unit``); ``not_measured`` when theta_a could not be read (NaN)."""
+    stops = ", ".join(f"{t:g}" for t in unmeasured)
+    if np.isnan(theta_a):
+        return dict(status="not_measured", reason="no pose error measured before the first failing stop (board never "
+                                                  "detected or trusted?)" + (f"; unmeasured stops at {stops} {unit}" if stops else ""))
+    if unmeasured:
+        return dict(status="unmeasured_stops", reason=f"no pose error measured at the stop(s) at {stops} {unit} (no "
+                                                      f"trusted board pose in their posed frames): skipped, theta_a read "
+                                                      f"from the measured stops")
+    return dict(status="ok", reason="")
 
 
 def headline(envelope_table: pd.DataFrame, envelope: EnvelopeParams) -> pd.DataFrame:

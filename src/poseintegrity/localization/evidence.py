@@ -2,8 +2,9 @@
 
 Per frame, stages 02 and 05 need the same method-independent evidence: the image checked against its dataset's
 camera (8-bit gray, camera.yaml's size), its CLAHE + SIFT features (IV-C), the ratio-test 2D-3D correspondences
-to M_t (III-B), their image points undistorted by the calibrated lens, and the ArUco board pose (the ground truth of
-IV-C; none for a recorded dataset without a board, status ``no_board``). Stage 02 computes them and stores them in one
+to M_t (III-B), their image points undistorted by the calibrated lens, and the board's checked pose (the ground truth
+of IV-C, :mod:`~poseintegrity.localization.ground_truth`; none for a recorded dataset without a board, status
+``no_board``). Stage 02 computes them and stores them in one
 small ``.npz`` per frame (``<features_dir>/<dataset>/images/<image>.evidence.npz``); stage 05, which runs the other
 PnP methods on the same frames, reads them back instead of decoding the image, loading its descriptors,
 matching them and detecting the board again. The entry's key hashes everything the evidence depends on (image
@@ -26,13 +27,12 @@ from poseintegrity.lens import Camera
 from poseintegrity.localization.features import (
     ImageReadError, cached_features, decode_gray, features_key, read_image_bytes, write_npz,
 )
-from poseintegrity.localization.ground_truth import BoardPose, board_pose, make_board
+from poseintegrity.localization.ground_truth import BoardPose, board_from_dict, board_pose, no_pose
 from poseintegrity.localization.matching import match_ratio_test
 from poseintegrity.localization.params import ExtractParams
-from poseintegrity.poses import NAN_POSE
 from poseintegrity.localization.target_model import TargetModel
 
-EVIDENCE_VERSION = 2  # bump when the cached content or its layout changes
+EVIDENCE_VERSION = 3  # bump when the cached content or its layout changes (3: the checked board pose, issue 30)
 
 
 @dataclass(frozen=True)
@@ -43,7 +43,7 @@ class FrameEvidence:
     object_points : (k, 3) float64, M_t points of the k ratio-test matches, board frame, mm
     image_points : (k, 2) float64, the frame's keypoints of those matches, undistorted (ideal pinhole px of K)
     n_keypoints : SIFT keypoints in the frame
-    board : the ArUco board pose (ground truth)
+    board : the board's checked pose (the ground truth, :mod:`~poseintegrity.localization.ground_truth`)
     """
 
     image_problem: str
@@ -55,7 +55,7 @@ class FrameEvidence:
 
 def bad_image(problem: str) -> FrameEvidence:
     """The evidence of a frame whose image failed its check: no correspondences, no board."""
-    return FrameEvidence(problem, np.empty((0, 3)), np.empty((0, 2)), 0, BoardPose(NAN_POSE.copy(), 0, "bad_image"))
+    return FrameEvidence(problem, np.empty((0, 3)), np.empty((0, 2)), 0, no_pose("bad_image", problem))
 
 
 def model_digest(model: TargetModel) -> str:
@@ -64,8 +64,10 @@ def model_digest(model: TargetModel) -> str:
 
 
 def evidence_key(features_key_: str, digest: str, params: ExtractParams, board: dict[str, Any], camera: Camera) -> str:
-    """Hash of what a frame's evidence depends on beyond its features: M_t, the ratio, the board, the camera."""
+    """Hash of what a frame's evidence depends on beyond its features: M_t, the ratio, the board and its checks, the
+    camera."""
     settings = json.dumps([EVIDENCE_VERSION, features_key_, digest, params.ratio_test, board,
+                           params.ground_truth.model_dump(),
                            np.asarray(camera.K, np.float64).tolist(), np.asarray(camera.dist, np.float64).tolist(),
                            [camera.width, camera.height]], sort_keys=True)
     return hashlib.sha1(settings.encode()).hexdigest()
@@ -86,7 +88,9 @@ def _load(path: Path, key: str) -> FrameEvidence | None:
         with np.load(path) as stored:
             if str(stored["key"]) != key:
                 return None
-            board = BoardPose(stored["board_T_cam_board"], int(stored["board_n_markers"]), str(stored["board_status"]))
+            board = BoardPose(stored["board_T_cam_board"], str(stored["board_status"]), str(stored["board_reason"]),
+                              *(int(stored[k]) for k in ("board_n_points", "board_n_dropped")),
+                              *(float(stored[k]) for k in ("board_rms_px", "board_sigma_t_mm", "board_sigma_r_deg")))
             return FrameEvidence("", stored["object_points"], stored["image_points"], int(stored["n_keypoints"]), board)
     except (OSError, ValueError, KeyError):
         return None  # missing, truncated or foreign: recomputed
@@ -111,9 +115,10 @@ def frame_evidence(
         return bad_image(str(error))
     features = cached_features(image_path, features_path, params.clahe, params.sift, data=data, image=image)
     object_points, image_points = correspondences(features, model, params.ratio_test, camera)
-    aruco = (board_pose(image, make_board(board), camera) if board is not None  # no board: recorded poses instead
-             else BoardPose(NAN_POSE.copy(), 0, "no_board"))
+    truth = (board_pose(image, board_from_dict(board), camera, params.ground_truth) if board is not None
+             else no_pose("no_board", "recorded poses are the ground truth"))  # no board: recorded poses instead
     write_npz(evidence_path, key=key, object_points=object_points, image_points=image_points,
-              n_keypoints=features.n_keypoints, board_T_cam_board=aruco.T_cam_board,
-              board_n_markers=aruco.n_markers, board_status=aruco.status)
-    return FrameEvidence("", object_points, image_points, features.n_keypoints, aruco)
+              n_keypoints=features.n_keypoints, board_T_cam_board=truth.T_cam_board, board_status=truth.status,
+              board_reason=truth.reason, board_n_points=truth.n_points, board_n_dropped=truth.n_dropped,
+              board_rms_px=truth.rms_px, board_sigma_t_mm=truth.sigma_t_mm, board_sigma_r_deg=truth.sigma_r_deg)
+    return FrameEvidence("", object_points, image_points, features.n_keypoints, truth)

@@ -8,11 +8,16 @@ workers of the ``parallel`` section (:class:`~poseintegrity.parallel.Workers`):
    camera.yaml's image size stops the stage naming it. M_t is stored beside the SIFT cache, and every frame task
    loads it from there once per worker process (a task carries its path, not its 1-2 MB of descriptors);
 2. per frame (one task, results in frame order): its evidence (:mod:`evidence`: image check, CLAHE + SIFT, ratio-test
-   matches to M_t, ArUco board pose; cached, so stage 05 reuses stage 02's), then PnP-RANSAC per method
+   matches to M_t, the board's checked pose; cached, so stage 05 reuses stage 02's), then PnP-RANSAC per method
    (:mod:`frame_pnp`: cached per frame, the classic RANSAC shared by EPnP, SQPnP and iterative) ->
-   artifacts (III-C) and E_t/E_r against the ground truth, the ArUco board pose of the frame (IV-C): ``E_t_mm``,
-   ``E_r_deg`` (NaN without a pose or without a detected board); against the exact renderer pose as a diagnostic:
-   ``E_t_exact_mm``, ``E_r_exact_deg``. A recorded dataset whose meta.json says ``ground_truth: poses``
+   artifacts (III-C) and E_t/E_r against the ground truth, the board pose of the frame (IV-C): ``E_t_mm``,
+   ``E_r_deg`` (NaN without a pose, and without a trusted board pose: ``board_status`` other than "ok", e.g.
+   ``bad_ground_truth`` with its ``board_reason``; such a frame keeps its localization status and n_i, it is only
+   not judged); against the exact renderer pose as a diagnostic: ``E_t_exact_mm``, ``E_r_exact_deg``. The board
+   pose's own errors: ``E_*_board_exact`` (against the exact pose, absolute) and ``E_*_truth`` (what it adds to E_t
+   and E_r: relative to model image 0's, :func:`~poseintegrity.localization.ground_truth.truth_error`; R11); the
+   model placement's (``E_*_placement``: model image 0's board pose against its exact pose, ``anchor_status`` its
+   check). A recorded dataset whose meta.json says ``ground_truth: poses``
    (:mod:`poseintegrity.recorded`) has no board: M_t is placed by model image 0's pose ``model.T_cam0_ref``, the
    frames' poses of frames.parquet are the ground truth of E_t/E_r (as well as of the ``_exact`` columns), and the
    board columns say ``no_board``.
@@ -42,7 +47,7 @@ from poseintegrity.localization.evidence import FrameEvidence, frame_evidence, m
 from poseintegrity.localization.features import cached_features, read_gray, write_npz
 from poseintegrity.localization.frame_artifacts import frame_artifacts
 from poseintegrity.localization.frame_pnp import frame_pnp
-from poseintegrity.localization.ground_truth import board_pose, make_board
+from poseintegrity.localization.ground_truth import BoardPose, board_from_dict, board_pose, no_pose, truth_error
 from poseintegrity.localization.params import ExtractParams
 from poseintegrity.localization.pnp import PnPResult, failed, solve_checked
 from poseintegrity.localization.ransac import minimal_sample_size, ransac_iterations
@@ -117,12 +122,13 @@ class ModelTask:
 
 @dataclass(frozen=True)
 class StoredModel:
-    """Where a dataset's M_t is stored, its digest (part of every evidence key) and size."""
+    """Where a dataset's M_t is stored, its digest (part of every evidence key) and size; ``anchor``: the board's
+    checked pose in model image 0 that placed M_t in the board frame (status ``no_board`` with recorded poses)."""
 
     path: Path
     digest: str
     size: int
-
+    anchor: BoardPose
 
 @dataclass(frozen=True)
 class FrameTask:
@@ -138,6 +144,7 @@ class FrameTask:
     methods: tuple[str, ...]
     params: ExtractParams
     ground_truth: str = "board"  # meta.json's ground_truth: "board" (IV-C) or "poses" (frames.parquet's)
+    T_cam0_board_exact: np.ndarray | None = None  # model image 0's exact board pose (rendered data: R11)
 
     @property
     def pnp_path(self) -> Path:
@@ -145,10 +152,12 @@ class FrameTask:
         return self.evidence_path.with_name(self.evidence_path.name.removesuffix(".evidence.npz") + ".pnp.npz")
 
 
-def dataset_model(dataset: Dataset, params: ExtractParams, cache_dir: Path) -> TargetModel:
-    """M_t of a dataset from its two model images (features cached like frames). Each image and mask must be the
-    8-bit gray image of camera.yaml's size: :class:`~poseintegrity.localization.features.ImageReadError`
-    naming the dataset and the file otherwise."""
+def dataset_model(dataset: Dataset, params: ExtractParams, cache_dir: Path) -> tuple[TargetModel, BoardPose]:
+    """M_t of a dataset from its two model images (features cached like frames), and the board pose in model image
+    0 that placed it. Each image and mask must be the 8-bit gray image of camera.yaml's size:
+    :class:`~poseintegrity.localization.features.ImageReadError` naming the dataset and the file otherwise. A board
+    that gives no pose in model image 0 stops the stage naming the dataset; one whose pose fails its checks
+    (``bad_ground_truth``) still places M_t, and the anchor's status says so (artifacts.json)."""
     model = dataset.meta["model"]
     try:
         images = [read_gray(dataset.path(image), dataset.image_size) for image in model["images"]]
@@ -162,19 +171,20 @@ def dataset_model(dataset: Dataset, params: ExtractParams, cache_dir: Path) -> T
     if dataset.meta.get("ground_truth", "board") == "poses":  # recorded: M_t in the external system's frame
         T_cam0_ref = np.asarray(dataset.meta["model"]["T_cam0_ref"], dtype=np.float64)
         return build_target_model(features, masks, dataset.model_baseline(), T_cam0_ref, dataset.camera,
-                                  params.ratio_test, params.model_max_reprojection_px)
-    anchor = board_pose(images[0], make_board(dataset.meta["board"]), dataset.camera)  # IV-C: M_t in the board frame
-    if anchor.status != "ok":
+                                  params.ratio_test, params.model_max_reprojection_px), no_pose("no_board", "")
+    anchor = board_pose(images[0], board_from_dict(dataset.meta["board"], f"dataset {dataset.name}: meta.json board"),
+                        dataset.camera, params.ground_truth)  # IV-C: M_t in the board frame
+    if anchor.status not in ("ok", "bad_ground_truth"):
         raise DatasetError(f"dataset {dataset.name}: the ArUco board is not found in model image "
-                           f"{model['images'][0]} ({anchor.status}), so the target model cannot be placed in the "
-                           f"board frame (IV-C)")
+                           f"{model['images'][0]} ({anchor.status}: {anchor.reason}), so the target model cannot be "
+                           f"placed in the board frame (IV-C)")
     return build_target_model(features, masks, dataset.model_baseline(), anchor.T_cam_board, dataset.camera,
-                              params.ratio_test, params.model_max_reprojection_px)
+                              params.ratio_test, params.model_max_reprojection_px), anchor
 
 
 def store_model(task: ModelTask) -> StoredModel:
     """Build M_t of a dataset (a worker task) and store it for the frame tasks (unless stored already)."""
-    model = dataset_model(task.dataset, task.params, task.cache_dir)
+    model, anchor = dataset_model(task.dataset, task.params, task.cache_dir)
     digest = model_digest(model)
     try:
         with np.load(task.path) as stored:
@@ -183,7 +193,7 @@ def store_model(task: ModelTask) -> StoredModel:
         current = False
     if not current:
         write_npz(task.path, digest=digest, points=model.points, descriptors=model.descriptors)
-    return StoredModel(task.path, digest, model.size)
+    return StoredModel(task.path, digest, model.size, anchor)
 
 
 @lru_cache(maxsize=4)
@@ -206,15 +216,18 @@ def frame_rows(task: FrameTask) -> list[dict[str, Any]]:
     truth_problem = pose_problem(frame["T_cam_board"]) if known else None
     T_cam_board = NAN_POSE if truth_problem or not known else np.asarray(frame["T_cam_board"],
                                                                           dtype=np.float64).reshape(4, 4)
-    truth = T_cam_board if task.ground_truth == "poses" else evidence.board.T_cam_board
+    board = evidence.board  # the checked board pose: ground truth only when trusted (ground_truth.py)
+    truth = T_cam_board if task.ground_truth == "poses" else (board.T_cam_board if board.trusted else NAN_POSE)
     if evidence.image_problem:
         status, reason = "bad_image", evidence.image_problem
     elif truth_problem:
         status, reason = "bad_pose", f"ground truth T_cam_board of frames.parquet {truth_problem}"
     else:
         status, reason = None, ""
-    aruco = evidence.board
-    E_t_board_exact_mm, E_r_board_exact_deg = map(float, pose_errors(aruco.T_cam_board, T_cam_board))
+    E_t_board_exact_mm, E_r_board_exact_deg = map(float, pose_errors(board.T_cam_board, T_cam_board))
+    exact_0 = NAN_POSE if task.T_cam0_board_exact is None else task.T_cam0_board_exact
+    E_t_truth_mm, E_r_truth_deg = truth_error(board.T_cam_board, T_cam_board, model.anchor.T_cam_board, exact_0)
+    E_t_placement_mm, E_r_placement_deg = map(float, pose_errors(model.anchor.T_cam_board, exact_0))
     seed = frame_seed(task.params.seed, frame["dataset"], int(frame["stop"]), int(frame["image"]))
     caps = {method: iteration_cap(method, task.params) for method in task.methods}
     results = {} if evidence.image_problem else frame_pnp(  # cached per frame; the classic RANSAC shared
@@ -241,8 +254,12 @@ def frame_rows(task: FrameTask) -> list[dict[str, Any]]:
             | artifacts
             | dict(
                 E_t_mm=E_t_mm, E_r_deg=E_r_deg, E_t_exact_mm=E_t_exact_mm, E_r_exact_deg=E_r_exact_deg,
-                board_status=aruco.status, board_n_markers=aruco.n_markers,
+                board_status=board.status, board_reason=board.reason, board_n_points=board.n_points,
+                board_n_dropped=board.n_dropped, board_rms_px=board.rms_px, board_sigma_t_mm=board.sigma_t_mm,
+                board_sigma_r_deg=board.sigma_r_deg,
                 E_t_board_exact_mm=E_t_board_exact_mm, E_r_board_exact_deg=E_r_board_exact_deg,
+                E_t_truth_mm=E_t_truth_mm, E_r_truth_deg=E_r_truth_deg, anchor_status=model.anchor.status,
+                E_t_placement_mm=E_t_placement_mm, E_r_placement_deg=E_r_placement_deg,
                 T_cam_board_est=T_est.ravel().tolist(),
             )
         )
@@ -261,7 +278,7 @@ def extract_datasets(
         FrameTask(
             frame, dataset.path(frame["file"]), cache_dir / Path(frame["file"]).with_suffix(".npz"),
             cache_dir / Path(frame["file"]).with_suffix(".evidence.npz"), model, dataset.meta.get("board"),
-            dataset.camera, tuple(methods), params, dataset.meta.get("ground_truth", "board"),
+            dataset.camera, tuple(methods), params, dataset.meta.get("ground_truth", "board"), exact_model_pose(dataset),
         )
         for dataset, cache_dir, model in zip(datasets, cache_dirs, models)
         for frame in dataset.frames.assign(world=dataset.meta["world"], trajectory=dataset.meta["trajectory"])
@@ -269,6 +286,12 @@ def extract_datasets(
     ]
     results = workers.map(frame_rows, tasks, desc=f"frames of {len(datasets)} dataset(s)", progress=progress)
     return pd.DataFrame([row for rows in results for row in rows])
+
+
+def exact_model_pose(dataset: Dataset) -> np.ndarray | None:
+    """Model image 0's exact board pose (4, 4, mm) when the dataset has one (rendered data), else None."""
+    exact = dataset.meta["model"].get("exact_T_cam_board")
+    return None if exact is None else np.asarray(exact[0], dtype=np.float64).reshape(4, 4)
 
 
 def _cache_root(data_dir: Path, params: ExtractParams) -> Path:

@@ -1,75 +1,246 @@
-"""Board-based ground truth (IV-C): ArUco GridBoard detection -> board.matchImagePoints -> cv2.solvePnP.
+"""Board-based ground truth (Windsor et al. IV-C), checked before it judges anything.
 
-OpenCV 5 API (docs/references.md, "OpenCV 5"): ``cv2.aruco.ArucoDetector(...).detectMarkers`` replaces the removed free functions.
-The estimated pose maps board coordinates (the frame of ``board.getObjPoints()``, mm) into the camera frame.
+The board's points are found (an ArUco GridBoard: ``ArucoDetector`` with sub-pixel corners, four per marker; a
+ChArUco board: ``CharucoDetector.detectBoard``, whose chessboard corners are refined by ``cornerSubPix``; OpenCV 5
+API, docs/references.md "OpenCV 5"), undistorted by the calibrated lens and matched to the printed board's points
+(:mod:`poseintegrity.boards`). Then, before a pose is trusted:
+
+1. **Consistency of each group** (a marker's four corners; a ChArUco corner on its own). A marker partly hidden by the
+   target is still decoded by OpenCV, with a corner several pixels off, and a fit through it is millimetres off. Each
+   group is predicted by the pose fitted to all the *other* groups (leave one out, Levenberg-Marquardt from the full
+   fit), and its RMS distance from that prediction is compared with the residual scale of that fit (what the rest of
+   the board says its points agree to, floored at ``noise_floor_px``). The group whose ratio exceeds
+   ``consistency_factor`` most is dropped, and the check repeats on the rest (:func:`consistent_fit`). Nothing here
+   reads an exact pose.
+2. **Enough groups to check**: at least ``min_markers`` markers or ``min_corners`` ChArUco corners must remain.
+3. **Predicted uncertainty**: the covariance of the fitted pose, s^2 (J^T J)^-1, J the Jacobian of the projections
+   with respect to (rvec, tvec) at the solution and s^2 = SSR / (2n - 6) the residual variance per coordinate
+   (floored at ``noise_floor_px``^2); sigma_t (mm) is the RMS error it predicts for the board origin, where E_t is
+   measured, sigma_r (deg) for the rotation. Above ``max_sigma_t_mm`` or ``max_sigma_r_deg`` the pose is too weak
+   to judge a localization error of the tolerances' size.
+
+A pose that passes has status ``ok``; one that fails 2 or 3 has status ``bad_ground_truth`` and a reason, and is no
+ground truth (its frame's errors are NaN, the frame is listed, not counted as a localization error). ``board_not_
+detected`` / ``board_pnp_failed``: nothing to check.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
 
 import cv2
 import numpy as np
 
+from poseintegrity.boards import Board, Charuco, board_from_dict, scaled
+from poseintegrity.defaults import published
 from poseintegrity.errors import ArgumentError
 from poseintegrity.grayscale import as_gray8
 from poseintegrity.lens import Camera
-from poseintegrity.localization.dataset import aruco_dictionary
-from poseintegrity.poses import NAN_POSE, pose_from_rvec_tvec
+from poseintegrity.localization.params import GroundTruthParams
+from poseintegrity.poses import NAN_POSE, inverse, pose_errors, pose_from_rvec_tvec
+
+__all__ = ["BoardPose", "board_from_dict", "board_pose", "detect_board_points", "consistent_fit", "truth_error"]
+
+LM_CRITERIA = (cv2.TERM_CRITERIA_EPS | cv2.TERM_CRITERIA_COUNT, 50, 1e-12)
 
 
 @dataclass(frozen=True)
 class BoardPose:
-    """T_cam_board : (4, 4) float, mm (NaN unless status == "ok"); n_markers : detected board markers;
-    status : "ok", "board_not_detected" or "board_pnp_failed"."""
+    """The board's pose in one image and how far it can be trusted.
+
+    T_cam_board : (4, 4) float, mm: NaN unless ``status`` is "ok" or "bad_ground_truth" (then the fit it refused)
+    status : "ok", "bad_ground_truth", "board_not_detected", "board_pnp_failed" (or, set by callers, "no_board",
+        "bad_image"); reason : why it is not "ok" ("" when it is)
+    n_points : board points of the final fit; n_dropped : groups dropped by the consistency check
+    rms_px : RMS reprojection residual of the final fit; sigma_t_mm, sigma_r_deg : its predicted uncertainty at the
+        board origin (NaN without a fit)
+    """
 
     T_cam_board: np.ndarray
-    n_markers: int
     status: str
+    reason: str = ""
+    n_points: int = 0
+    n_dropped: int = 0
+    rms_px: float = float("nan")
+    sigma_t_mm: float = float("nan")
+    sigma_r_deg: float = float("nan")
+
+    @property
+    def trusted(self) -> bool:
+        return self.status == "ok"
 
 
-def make_board(board: dict[str, Any]) -> cv2.aruco.GridBoard:
-    """The GridBoard described by a dataset's ``meta.json["board"]`` (lengths in mm; checked when the dataset is
-    read, :class:`~poseintegrity.localization.dataset.BoardMeta`). An unknown dictionary name raises
-    :class:`~poseintegrity.errors.ArgumentError` naming it."""
-    dictionary = cv2.aruco.getPredefinedDictionary(aruco_dictionary(board["dictionary"]))
-    n_markers = board["markers_x"] * board["markers_y"]
-    ids = np.arange(board["first_id"], board["first_id"] + n_markers)
-    return cv2.aruco.GridBoard(
-        (board["markers_x"], board["markers_y"]), board["marker_length_mm"], board["separation_mm"], dictionary, ids
-    )
+def no_pose(status: str, reason: str, n_points: int = 0) -> BoardPose:
+    return BoardPose(NAN_POSE.copy(), status, reason, n_points)
 
 
-def board_pose(image: np.ndarray, board: cv2.aruco.GridBoard, camera: Camera) -> BoardPose:
-    """Pose of the board in an 8-bit grayscale image (h, w) of ``camera`` (its corners undistorted by the calibrated
-    lens, then solvePnP with its K).
+def detect_board_points(image: np.ndarray, board: Board) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The board points found in an 8-bit gray image (h, w): printed board points (n, 3) mm, their image points
+    (n, 2) sensor px, and each point's group (n,) int (a marker's four corners share one; ChArUco corners are one
+    each). Empty arrays when nothing is found."""
+    cv_board = board.cv_board()
+    if isinstance(board, Charuco):
+        charuco = cv2.aruco.CharucoParameters()
+        charuco.tryRefineMarkers = True  # markers the layout predicts are searched again (defocused, far views)
+        corners, ids, _, _ = cv2.aruco.CharucoDetector(cv_board, charuco, detector_parameters()).detectBoard(image)
+        if ids is None or len(ids) == 0:
+            return np.empty((0, 3)), np.empty((0, 2)), np.empty(0, int)
+        object_points = cv_board.getChessboardCorners()[ids.ravel()]
+        image_points, groups = corners.reshape(-1, 2), np.arange(len(ids))
+    else:
+        parameters = detector_parameters()
+        parameters.cornerRefinementMethod = cv2.aruco.CORNER_REFINE_SUBPIX  # sub-pixel corners for pose
+        detector = cv2.aruco.ArucoDetector(cv_board.getDictionary(), parameters)
+        corners, ids, rejected = detector.detectMarkers(image)
+        if ids is not None and len(ids):  # markers the layout predicts are searched again among the rejected
+            corners, ids, _, _ = detector.refineDetectedMarkers(image, cv_board, corners, ids, rejected)
+        if ids is None or len(ids) == 0:
+            return np.empty((0, 3)), np.empty((0, 2)), np.empty(0, int)
+        object_points, image_points = cv_board.matchImagePoints(corners, ids)
+        if object_points is None or len(object_points) == 0:
+            return np.empty((0, 3)), np.empty((0, 2)), np.empty(0, int)
+        object_points, image_points = object_points.reshape(-1, 3), image_points.reshape(-1, 2)
+        groups = np.repeat(np.arange(len(object_points) // 4), 4)
+    return scaled(object_points, board), np.asarray(image_points, np.float64), groups
 
-    Needs at least one board marker (4 coplanar corners); otherwise a NaN pose with a status, never an error.
-    image : (h, w) uint8; colour or 16-bit images are converted, anything else refused
-    (:func:`~poseintegrity.grayscale.as_gray8`). ``camera`` is a checked
-    :class:`~poseintegrity.lens.Camera` (finite K, positive focal lengths, finite distortion).
+
+def detector_parameters() -> "cv2.aruco.DetectorParameters":
+    """OpenCV's marker detection with thresholding windows up to 53 px and 8 px per bit when a marker is read: a
+    marker blurred by defocus (the lines' far stops are 150 mm beyond the focus) is then still found and decoded;
+    the defaults (23 px, 4 px per bit) lost most markers there (docs/references.md, "Ground-truth boards")."""
+    parameters = cv2.aruco.DetectorParameters()
+    parameters.adaptiveThreshWinSizeMax = 53
+    parameters.perspectiveRemovePixelPerCell = 8
+    return parameters
+
+
+def _fit(object_points: np.ndarray, image_points: np.ndarray, K: np.ndarray,
+         start: tuple[np.ndarray, np.ndarray] | None = None) -> tuple[np.ndarray, np.ndarray] | None:
+    """(rvec, tvec) of the least-squares pose of ideal-pinhole image points: IPPE (planar points) then LM, or LM from
+    ``start``; None when OpenCV finds none."""
+    obj, img = object_points.astype(np.float64), image_points.astype(np.float64)
+    try:
+        if start is None:
+            found, rvec, tvec = cv2.solvePnP(obj, img, K, None, flags=cv2.SOLVEPNP_IPPE)
+            if not found:
+                return None
+        else:  # (3, 1): OpenCV refines a (3,) vector in a copy and hands the start back unchanged
+            rvec, tvec = start[0].reshape(3, 1).copy(), start[1].reshape(3, 1).copy()
+        rvec, tvec = cv2.solvePnPRefineLM(obj, img, K, None, rvec, tvec, criteria=LM_CRITERIA)
+    except cv2.error:
+        return None
+    if not (np.all(np.isfinite(rvec)) and np.all(np.isfinite(tvec))):
+        return None
+    return rvec.reshape(3), tvec.reshape(3)
+
+
+def _residuals(object_points: np.ndarray, image_points: np.ndarray, K: np.ndarray, pose) -> np.ndarray:
+    projected, _ = cv2.projectPoints(object_points, pose[0], pose[1], K, None)
+    return np.linalg.norm(projected.reshape(-1, 2) - image_points, axis=1)
+
+
+def consistent_fit(object_points: np.ndarray, image_points: np.ndarray, groups: np.ndarray, K: np.ndarray,
+                   params: GroundTruthParams) -> tuple[tuple[np.ndarray, np.ndarray] | None, np.ndarray]:
+    """Step 1 of the module docstring: the pose (rvec, tvec) fitted to the groups that agree with the others, and
+    the mask (n,) of the points kept. object_points (n, 3) mm; image_points (n, 2) ideal-pinhole px of K.
+
+    Each group g is predicted by the pose fitted to the others; its score is its RMS distance from that prediction
+    over the residual scale of that fit, sqrt(SSR / (2 n - 6)) of the other points (a deleted residual in units of
+    the fit's own noise; the scale floored at ``noise_floor_px``). A group that disagrees with a board its removal
+    leaves consistent scores far above 1; one that fits scores about 1. The highest score above
+    ``consistency_factor`` is dropped, and the check repeats on the rest while 3 groups remain."""
+    keep = np.ones(len(groups), bool)
+    pose = _fit(object_points, image_points, K)
+    while pose is not None and len(np.unique(groups[keep])) >= 3:
+        scores = {}
+        for g in np.unique(groups[keep]):
+            others, mine = keep & (groups != g), keep & (groups == g)
+            fitted = _fit(object_points[others], image_points[others], K, start=pose)
+            if fitted is None:
+                scores[g] = np.inf
+                continue
+            spread = _residuals(object_points[others], image_points[others], K, fitted)
+            scale = max(float(np.sqrt(np.sum(spread**2) / max(2 * others.sum() - 6, 1))), params.noise_floor_px)
+            scores[g] = float(np.sqrt(np.mean(_residuals(object_points[mine], image_points[mine], K, fitted) ** 2)
+                                      )) / scale
+        worst = max(scores, key=scores.get)
+        if scores[worst] <= params.consistency_factor:
+            break
+        keep &= groups != worst
+        pose = _fit(object_points[keep], image_points[keep], K, start=pose)
+    return pose, keep
+
+
+def predicted_uncertainty(object_points: np.ndarray, image_points: np.ndarray, K: np.ndarray, pose,
+                          noise_floor_px: float) -> tuple[float, float, float]:
+    """Step 3: (rms_px, sigma_t_mm, sigma_r_deg) of a fitted pose, from s^2 (J^T J)^-1 (module docstring)."""
+    projected, jacobian = cv2.projectPoints(object_points, pose[0], pose[1], K, None)
+    residual = projected.reshape(-1, 2) - image_points
+    n = len(object_points)
+    rms = float(np.sqrt(np.mean(np.sum(residual**2, axis=1))))
+    s2 = max(float(np.sum(residual**2)) / max(2 * n - 6, 1), noise_floor_px**2)
+    J = jacobian[:, :6]  # d(u, v) / d(rvec, tvec)
+    try:
+        covariance = s2 * np.linalg.inv(J.T @ J)
+    except np.linalg.LinAlgError:
+        return rms, float("inf"), float("inf")
+    sigma_r = float(np.degrees(np.sqrt(max(np.trace(covariance[:3, :3]), 0.0))))
+    sigma_t = float(np.sqrt(max(np.trace(covariance[3:, 3:]), 0.0)))
+    return rms, sigma_t, sigma_r
+
+
+def board_pose(image: np.ndarray, board: Board | dict, camera: Camera, params: GroundTruthParams | None = None
+               ) -> BoardPose:
+    """The checked pose of ``board`` in an 8-bit gray image (h, w) of ``camera`` (module docstring).
+
+    image : (h, w) uint8 (colour or 16-bit images are converted, anything else refused,
+    :func:`~poseintegrity.grayscale.as_gray8`); board : a :mod:`poseintegrity.boards` board or its dict; camera : a
+    checked :class:`~poseintegrity.lens.Camera`; params : ``extract.ground_truth`` (params.yaml's by default).
+    Never raises on what an image shows: a board not found, too few consistent points or too uncertain a pose are
+    statuses.
     """
     if not isinstance(camera, Camera):
         raise ArgumentError(f"camera: expected a poseintegrity.lens.Camera, got {type(camera).__name__}")
-    if not isinstance(board, cv2.aruco.Board):
-        raise ArgumentError(f"board: expected a cv2.aruco board (make_board), got {type(board).__name__}")
+    board = board_from_dict(board) if isinstance(board, dict) else board
+    if not hasattr(board, "cv_board"):
+        raise ArgumentError(f"board: expected a poseintegrity.boards board or its dict, got {type(board).__name__}")
+    params = published("extract.ground_truth") if params is None else params
     image = as_gray8("image", image)
-    detector_params = cv2.aruco.DetectorParameters()
-    detector_params.cornerRefinementMethod = cv2.aruco.CORNER_REFINE_SUBPIX  # sub-pixel corners for pose
-    detector = cv2.aruco.ArucoDetector(board.getDictionary(), detector_params)
-    corners, ids, _ = detector.detectMarkers(image)
-    if ids is None or len(ids) == 0:
-        return BoardPose(NAN_POSE.copy(), 0, "board_not_detected")
-    object_points, image_points = board.matchImagePoints(corners, ids)
-    if object_points is None or len(object_points) < 4:
-        return BoardPose(NAN_POSE.copy(), 0, "board_not_detected")
-    n_markers = len(object_points) // 4
-    try:
-        ideal = camera.undistort(image_points.reshape(-1, 2))
-        found, rvec, tvec = cv2.solvePnP(object_points, ideal, np.asarray(camera.K, np.float64), None)
-    except cv2.error:
-        found = False
-    if not found or not (np.all(np.isfinite(rvec)) and np.all(np.isfinite(tvec))):
-        return BoardPose(NAN_POSE.copy(), n_markers, "board_pnp_failed")
-    return BoardPose(pose_from_rvec_tvec(rvec, tvec), n_markers, "ok")
+    object_points, sensor_points, groups = detect_board_points(image, board)
+    if len(object_points) < 4:
+        return no_pose("board_not_detected", f"{len(object_points)} board points found (a pose needs 4)",
+                       len(object_points))
+    K = np.asarray(camera.K, np.float64)
+    image_points = camera.undistort(sensor_points)
+    pose, keep = consistent_fit(object_points, image_points, groups, K, params)
+    if pose is None:
+        return no_pose("board_pnp_failed", "OpenCV found no pose for the board's points", len(object_points))
+    n_groups, n_dropped = len(np.unique(groups[keep])), len(np.unique(groups)) - len(np.unique(groups[keep]))
+    rms, sigma_t, sigma_r = predicted_uncertainty(object_points[keep], image_points[keep], K, pose,
+                                                  params.noise_floor_px)
+    T = pose_from_rvec_tvec(*pose)
+    checked = dict(T_cam_board=T, n_points=int(keep.sum()), n_dropped=n_dropped, rms_px=rms, sigma_t_mm=sigma_t,
+                   sigma_r_deg=sigma_r)
+    unit, needed = ("corners", params.min_corners) if isinstance(board, Charuco) else ("markers", params.min_markers)
+    if n_groups < needed:
+        return BoardPose(status="bad_ground_truth", reason=f"{n_groups} consistent board {unit} ({n_dropped} "
+                         f"dropped): fewer than {needed} to check each against the others", **checked)
+    if sigma_t > params.max_sigma_t_mm or sigma_r > params.max_sigma_r_deg:
+        return BoardPose(status="bad_ground_truth", reason=f"predicted uncertainty {sigma_t:.3f} mm / "
+                         f"{sigma_r:.3f} deg at the board origin exceeds {params.max_sigma_t_mm:g} mm / "
+                         f"{params.max_sigma_r_deg:g} deg ({n_groups} {unit}, RMS {rms:.2f} px)", **checked)
+    return BoardPose(status="ok", **checked)
+
+
+def truth_error(T_cam_board: np.ndarray, T_cam_board_exact: np.ndarray, T_cam0_board: np.ndarray,
+                T_cam0_board_exact: np.ndarray) -> tuple[float, float]:
+    """(E_t mm, E_r deg) that the board's ground truth adds to a frame's E_t and E_r (R11, issue 30).
+
+    M_t is placed by the board's pose in model image 0 (T_cam0_board), so a perfect localization of a frame returns
+    T_cam_cam0 T_cam0_board, T_cam_cam0 the frame camera's true motion since model image 0 (T_cam_board_exact
+    T_cam0_board_exact^-1). E_t and E_r compare it with the frame's board pose T_cam_board: their difference, which
+    this returns (IV-C's E_t and E_r, :func:`~poseintegrity.poses.pose_errors`), is the ground truth's error as E_t
+    sees it, the board pose relative to model image 0's against the same relative exact pose. All (4, 4), mm; NaN
+    when any pose is unknown."""
+    perfect = T_cam_board_exact @ inverse(T_cam0_board_exact) @ T_cam0_board
+    return tuple(float(e) for e in pose_errors(T_cam_board, perfect))

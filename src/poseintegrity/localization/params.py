@@ -44,6 +44,24 @@ class RealismParams(Section):
     max_nfev: int = Field(ge=10, le=100_000, description="curve_fit evaluation budget of each R1 fit")
 
 
+class GroundTruthParams(Section):
+    """When a board pose may serve as ground truth (:mod:`poseintegrity.localization.ground_truth`): its groups must
+    agree with each other, enough of them must remain, and its predicted uncertainty must be small beside the
+    tolerances it judges."""
+
+    consistency_factor: float = Field(
+        ge=2, le=100, description="a group (a marker's 4 corners, a ChArUco corner) is dropped when its distance from "
+        "the pose fitted to the others exceeds this times that fit's residual scale")
+    noise_floor_px: float = Field(
+        gt=0, le=5, description="floor of the residual scale: the check never calls a point off by less than "
+        "consistency_factor times this, and the predicted uncertainty never assumes less noise")
+    min_markers: int = Field(ge=2, le=1000, description="ArUco GridBoard: consistent markers a trusted pose needs")
+    min_corners: int = Field(ge=4, le=1000, description="ChArUco board: consistent corners a trusted pose needs")
+    max_sigma_t_mm: float = Field(gt=0, le=100, description="predicted RMS error of the board origin above which the "
+                                                            "pose is no ground truth")
+    max_sigma_r_deg: float = Field(gt=0, le=90, description="the same for the rotation")
+
+
 class ExtractParams(Section):
     """Target localization pipeline, artifact extraction and actual envelopes (stages 02 and 05)."""
 
@@ -72,6 +90,7 @@ class ExtractParams(Section):
     datasets: distinct(str) | None = Field(
         min_length=1, description="dataset ids to process (names of index.parquet); null: every dataset")
     realism: RealismParams
+    ground_truth: GroundTruthParams
 
     @model_validator(mode="after")
     def _check(self, info: ValidationInfo) -> ExtractParams:

@@ -16,6 +16,7 @@ from scipy.stats import spearmanr
 from poseintegrity.artifact_models.base_functions import BASE_FUNCTIONS
 from poseintegrity.localization.envelope import headline
 from poseintegrity.localization.params import RealismParams
+from poseintegrity.localization.truth_accuracy import truth_accuracy
 from poseintegrity.protocol import ProtocolParams, tolerance_name
 
 
@@ -70,6 +71,9 @@ def realism_metrics(
       in [0.3, 1.5] mm
     - R10 (IV-E: theta_a is interpolated between stops) ``share_theta_a_on_stop_2mm3deg``: the share of uncensored
       arcs whose theta_a lies within 0.01 deg of a stop, <= 0.5
+    - R11 (a measurement finer than what it judges) ``truth_accuracy``
+      (:func:`~poseintegrity.localization.truth_accuracy.truth_accuracy`): what the board's ground truth adds to E_t
+      and E_r, 99th percentile <= 0.5 mm and 0.5 deg over the frames whose board pose is trusted
     ``n_bars_passed`` / ``n_bars`` count the bars of ``passed``.
 
     recorded : the rows are recorded data (:mod:`poseintegrity.recorded`), not a rendered world: the same values
@@ -78,6 +82,7 @@ def realism_metrics(
     method, sampled = protocol.pnp_method, protocol.sampled_stops.arc
     envelope_table = headline(envelope_table, protocol.envelope)
     rows = table[table["method"] == method]
+    truth = truth_accuracy(rows)
     arcs = rows[rows["trajectory"] == "arc"]
     per_stop = arcs.groupby(["dataset", "stop"]).agg(theta=("theta_deg", "mean"), n_i=("n_inliers", "mean"))
     spearman = {
@@ -159,6 +164,7 @@ def realism_metrics(
         line_x_a_mean_over_min_2mm3deg=_mean_over_min(lines["theta_a"]),
         median_E_t_mm_first_stops=float(first_stops["E_t_mm"].median()),
         share_theta_a_on_stop_2mm3deg=float(np.mean(on_stop)) if on_stop else float("nan"),
+        truth_accuracy=truth,
     )
     median_at_failure = (metrics["median_inliers_at_theta_a_2mm3deg"], metrics["median_inliers_at_theta_a_4mm10deg"])
     p90_at_failure = (metrics["p90_inliers_at_theta_a_2mm3deg"], metrics["p90_inliers_at_theta_a_4mm10deg"])
@@ -182,6 +188,7 @@ def realism_metrics(
         r8_line_spread=bool(metrics["line_x_a_mean_over_min_2mm3deg"] >= 1.4),
         r9_pipeline_accuracy=bool(0.3 <= metrics["median_E_t_mm_first_stops"] <= 1.5),
         r10_interpolated=bool(metrics["share_theta_a_on_stop_2mm3deg"] <= 0.5),
+        r11_truth_accuracy=bool(truth["r11_passed"]),
     )
     metrics["n_bars"] = len(metrics["passed"])
     metrics["n_bars_passed"] = int(sum(metrics["passed"].values()))

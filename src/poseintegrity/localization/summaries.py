@@ -55,6 +55,27 @@ def envelope_rule_summary(envelope_table: pd.DataFrame, table: pd.DataFrame, met
     return pd.DataFrame(out)
 
 
+def dataset_summary(table: pd.DataFrame, envelope_table: pd.DataFrame, method: str) -> pd.DataFrame:
+    """What was measured on each dataset, for ``method`` (the paper's PnP path): world, trajectory, frames, stops,
+    the last stop's position (deg for arcs, mm for lines), the share of frames localized (status ok), the mean n_i
+    at the first stop, and per tolerance theta_a (deg or mm) and whether it is censored (the envelope reaches the
+    end of the range, IV-E). ``table``: usable rows (the data flags left out); ``envelope_table``: one rule's rows
+    (:func:`poseintegrity.localization.envelope.headline`). One row per dataset, by world and name."""
+    rows = table[table["method"] == method]
+    rows = rows.assign(position=rows["theta_deg"].where(rows["trajectory"] == "arc", rows["x_mm"]))
+    first = rows[rows["stop"] == rows.groupby("dataset")["stop"].transform("min")]
+    summary = rows.groupby(["world", "trajectory", "dataset"]).agg(
+        n_frames=("status", "size"), n_stops=("stop", "nunique"), last_stop=("position", "max"),
+        localized_share=("status", lambda status: float((status == "ok").mean())))
+    summary["first_stop_mean_n_inliers"] = first.groupby(["world", "trajectory", "dataset"])["n_inliers"].mean()
+    envelopes = envelope_table[envelope_table["method"] == method]
+    for column in ("theta_a", "censored"):
+        wide = envelopes.pivot_table(index=["world", "trajectory", "dataset"], columns="tolerance", values=column,
+                                     aggfunc="first")
+        summary = summary.join(wide.rename(columns=lambda tolerance: f"{column}_{tolerance}"))
+    return summary.reset_index().sort_values(["world", "dataset"], ignore_index=True)
+
+
 def failure_shares(table: pd.DataFrame) -> pd.DataFrame:
     """Per PnP method (rows) the share of its frames per status that is not "ok" (columns: every status of
     :data:`FAILURE_STATUSES`, 0 where none, then any other failed status found). Every failed row carries its reason
@@ -62,16 +83,3 @@ def failure_shares(table: pd.DataFrame) -> pd.DataFrame:
     shares = pd.crosstab(table["method"], table["status"], normalize="index")
     others = [status for status in shares.columns if status != "ok" and status not in FAILURE_STATUSES]
     return shares.reindex(columns=[*FAILURE_STATUSES, *others], fill_value=0.0)
-
-
-def board_summary(table: pd.DataFrame) -> dict[str, float]:
-    """How far the ArUco ground truth is from the exact renderer pose (one row per frame is enough)."""
-    frames = table.drop_duplicates(["dataset", "stop", "image"])
-    detected = frames[frames["board_status"] == "ok"]
-    return dict(
-        detection_rate=float(len(detected) / len(frames)) if len(frames) else float("nan"),
-        median_E_t_mm=float(detected["E_t_board_exact_mm"].median()),
-        p95_E_t_mm=float(detected["E_t_board_exact_mm"].quantile(0.95)),
-        median_E_r_deg=float(detected["E_r_board_exact_deg"].median()),
-        p95_E_r_deg=float(detected["E_r_board_exact_deg"].quantile(0.95)),
-    )

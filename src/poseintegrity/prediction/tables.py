@@ -176,7 +176,8 @@ def rule_metrics(theta_p: pd.DataFrame, envelopes: pd.DataFrame, protocol: Proto
                  predictors: tuple[str, ...] = PAPER_PREDICTORS) -> dict:
     """Tables I-III under every failed-frame rule of theta_a (:mod:`poseintegrity.localization.envelope`):
     <rule>.<predictor>.<tolerance>.{max_mean_spl_zero_incursion, best_operating_point} on the arcs of the paper's PnP
-    path, and <rule>.<predictor>.relative_improvement over static (mean of the tolerances).
+    path, and <rule>.<predictor>.relative_improvement over static (mean of the tolerances). Every tolerance of
+    ``protocol`` has its entry, NaN where nothing was measured (a world without arcs).
 
     theta_p : :func:`~.sweeps.sweep` rows (those of datasets without an envelope, e.g. of another world, are left
     out); envelopes : one world's stage-02 envelopes, every rule
@@ -189,7 +190,7 @@ def rule_metrics(theta_p: pd.DataFrame, envelopes: pd.DataFrame, protocol: Proto
         best = best[(best["trajectory"] == "arc") & (best["method"] == protocol.pnp_method)]
         entry: dict = {}
         for predictor in predictors:
-            rows = best[best["predictor"] == predictor].set_index("tolerance")
+            rows = best[best["predictor"] == predictor].set_index("tolerance").reindex(protocol.tolerance_names)
             entry[predictor] = {tol: {"max_mean_spl_zero_incursion": float(row.max_mean_spl),
                                       "best_operating_point": float(row.best_operating_point)}
                                 for tol, row in rows.iterrows()}

@@ -18,7 +18,7 @@ import yaml
 
 from poseintegrity.localization.dataset import load_dataset, load_index
 from poseintegrity.recorded.reader import write_table
-from poseintegrity.staging import staged
+from poseintegrity.staging import check_new_folder, staged
 
 
 def _pose_text(values) -> str:
@@ -51,5 +51,12 @@ def export_dataset(data_dir: str | Path, folder: str | Path, out: str | Path) ->
 
 
 def export_all(data_dir: str | Path, out: str | Path) -> list[Path]:
-    """Every dataset of ``data_dir/datasets/index.parquet`` exported into ``out`` (:func:`export_dataset`)."""
-    return [export_dataset(data_dir, row.path, out) for row in load_index(data_dir).itertuples()]
+    """Every dataset of ``data_dir/datasets/index.parquet`` exported into ``out`` (:func:`export_dataset`), all or
+    nothing: ``out`` must be a new or empty folder (:func:`~poseintegrity.staging.check_new_folder`, checked before
+    any work), the datasets are written into its staging folder, which becomes ``out`` when every one is written and
+    is removed on any error (a broken dataset leaves no export at all). Returns the datasets' folders."""
+    out = check_new_folder(out)
+    index = load_index(data_dir)
+    with staged(out) as tmp:
+        names = [export_dataset(data_dir, row.path, tmp).name for row in index.itertuples()]
+    return [out / name for name in names]

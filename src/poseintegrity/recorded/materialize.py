@@ -22,7 +22,8 @@ import numpy as np
 import pandas as pd
 
 from poseintegrity.lens import write_camera_yaml
-from poseintegrity.recorded.reader import Recorded, RecordedFormatError, read_image, read_recorded
+from poseintegrity.protocol import ProtocolParams
+from poseintegrity.recorded.reader import Recorded, RecordedFormatError, range_problems, read_image, read_recorded
 from poseintegrity.staging import staged
 
 
@@ -69,19 +70,28 @@ def write_dataset(recorded: Recorded, root: Path) -> dict:
             "trajectory": recorded.trajectory, "n_frames": len(recorded.frames), "path": f"datasets/{recorded.name}"}
 
 
-def materialize(folders: list[str | Path], data_dir: str | Path) -> pd.DataFrame:
+def materialize(folders: list[str | Path], data_dir: str | Path, protocol: ProtocolParams | None = None,
+                params_name: str = "params.yaml") -> pd.DataFrame:
     """Write the recorded dataset ``folders`` into ``data_dir/datasets/`` and its ``index.parquet`` (returned).
 
-    Every folder is checked first (:func:`~poseintegrity.recorded.reader.read_recorded`):
+    Every folder is checked first (:func:`~poseintegrity.recorded.reader.read_recorded`), and its stops against the
+    range ends of ``protocol`` (default: the published params.yaml's; ``params_name`` names its file in the
+    messages, :func:`~poseintegrity.recorded.reader.range_problems`):
     :class:`~poseintegrity.recorded.reader.RecordedFormatError` listing the problems of all of them, nothing written.
     Two folders of the same name (the dataset's name) are refused likewise.
     """
+    if protocol is None:
+        from poseintegrity.defaults import published
+
+        protocol = published("protocol")
     datasets, problems = [], []
     for folder in folders:
         try:
             datasets.append(read_recorded(folder))
         except RecordedFormatError as error:
             problems += error.problems
+            continue
+        problems += range_problems(datasets[-1], protocol, params_name)
     names = [dataset.name for dataset in datasets]
     problems += [f"{dataset.folder}: a second dataset named {dataset.name}" for dataset in datasets
                  if names.count(dataset.name) > 1]
@@ -103,11 +113,12 @@ def recorded_folders(source: str | Path) -> list[Path]:
     return sorted(path for path in Path(source).iterdir() if path.is_dir() and not path.name.startswith("."))
 
 
-def materialize_source(source: str | Path, data_dir: str | Path) -> pd.DataFrame:
+def materialize_source(source: str | Path, data_dir: str | Path, protocol: ProtocolParams | None = None,
+                       params_name: str = "params.yaml") -> pd.DataFrame:
     """Stage 01 with a recorded source: every dataset folder of ``source`` materialized into ``data_dir/datasets``
-    (:func:`materialize`); returns the index."""
+    (:func:`materialize`, stops checked against ``protocol``'s range ends); returns the index."""
     source = Path(source)
     if not source.is_dir():
         raise RecordedFormatError(f"{source}: not a folder (generate.source names a folder of recorded dataset "
                                   f"folders)")
-    return materialize(recorded_folders(source), data_dir)
+    return materialize(recorded_folders(source), data_dir, protocol, params_name)

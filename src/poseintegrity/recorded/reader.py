@@ -25,11 +25,15 @@ from pydantic import ValidationError
 from poseintegrity.errors import PoseIntegrityError, read_text_file
 from poseintegrity.grayscale import as_gray8
 from poseintegrity.lens import Camera, read_camera_yaml
+from poseintegrity.boards import board_description
 from poseintegrity.localization.dataset import BoardMeta, pose_problem
-from poseintegrity.localization.ground_truth import board_pose, make_board
+from poseintegrity.localization.ground_truth import board_pose
+from poseintegrity.protocol import ProtocolParams
 from poseintegrity.recorded.geometry import camera_centre, distance_mm, relative_pose, viewing_angle_deg
 
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".tif", ".tiff")
+RANGE_KEYS = {"arc": ("theta_deg", "protocol.arc_span_deg", "deg"),
+              "line": ("x_mm", "protocol.line_length_mm", "mm")}  # position column, range-end key, unit
 TRAJECTORIES = ("arc", "line")
 GROUND_TRUTHS = ("board", "poses")
 DEFAULT_WORLD = "recorded"
@@ -171,7 +175,7 @@ def _board(path: Path, problems: _Problems) -> dict[str, Any] | None:
     if content is None:
         return None
     try:
-        return BoardMeta.model_validate(content).model_dump()
+        return BoardMeta.model_validate(content).model_dump(exclude_none=True)
     except ValidationError as error:
         for item in error.errors():
             field = ".".join(map(str, item["loc"])) or "board"
@@ -255,6 +259,25 @@ def _number(cell: str, where: str, problems: _Problems, integer: bool = False) -
     return value
 
 
+def range_problems(recorded: Recorded, protocol: ProtocolParams, params_name: str = "params.yaml") -> list[str]:
+    """The stops of ``recorded`` outside [0, the protocol's range end] of its trajectory type (``protocol.arc_span_deg``
+    or ``protocol.line_length_mm``, where every stage fits the artifact models and searches for theta_p, III-D),
+    one line naming the key and the value that would hold them; [] when they all lie inside."""
+    column, key, unit = RANGE_KEYS[recorded.trajectory]
+    end = protocol.range_end(recorded.trajectory)
+    values = np.array([getattr(frame, column) for frame in recorded.frames])
+    where = f"{recorded.folder / 'stops.csv'}: field {column}"
+    lines = []
+    if values.max() > end:
+        lines.append(f"{where}: the stops reach {values.max():.6g} {unit}, beyond {key} = {end:g} {unit} "
+                     f"({params_name}; the range end of every {recorded.trajectory}): set {key} to at least "
+                     f"{values.max():.6g} in the params file of your run")
+    if values.min() < 0:
+        lines.append(f"{where}: a stop at {values.min():.6g} {unit}: positions start at 0 (the model view for arcs, the "
+                     f"line's first position for lines), so {key}'s range 0 .. {end:g} {unit} cannot hold it")
+    return lines
+
+
 def problems(folder: str | Path) -> list[str]:
     """Every problem of the recorded dataset folder, one line each naming the file and field; [] when fine."""
     try:
@@ -310,11 +333,10 @@ def read_recorded(folder: str | Path) -> Recorded:
             found.add(f"{path}: extra image, listed in neither stops.csv nor model.csv")
 
     if board is not None and camera is not None and board_image is not None:  # IV-C: the board anchors M_t
-        status = board_pose(read_image(folder / board_image)[0], make_board(board), camera).status
-        if status != "ok":
-            found.add(f"{folder / 'board.yaml'}: the board ({board['dictionary']}, {board['markers_x']} x "
-                      f"{board['markers_y']} markers from id {board['first_id']}) is not found in model image "
-                      f"{board_image} ({status})")
+        anchor = board_pose(read_image(folder / board_image)[0], board, camera)
+        if anchor.status not in ("ok", "bad_ground_truth"):  # a pose that fails its checks still places M_t
+            found.add(f"{folder / 'board.yaml'}: the board ({board_description(board)}) is not found in model image "
+                      f"{board_image} ({anchor.status}: {anchor.reason})")
 
     required = ground_truth == "poses"
     model_poses = _poses(model_rows, model_path, required, found) if model_rows else None

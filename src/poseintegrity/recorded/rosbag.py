@@ -3,7 +3,7 @@
 
 Read from the bag: the image topic (sensor_msgs/Image with encoding mono8, mono16, bgr8 or rgb8, or
 sensor_msgs/CompressedImage) and the first message of the camera-info topic (sensor_msgs/CameraInfo -> camera.yaml:
-K, distortion_model plumb_bob or rational_polynomial with its D, width, height). Given by the user: a bag-stops
+K, distortion_model plumb_bob or rational_polynomial with its D, width, height, and its P and R as they are). Given by the user: a bag-stops
 table, CSV with columns ``index`` (the image's message index on the image topic, 0-based in the bag's time order),
 ``stop`` (an integer >= 0, or ``model0`` / ``model1`` for the model pair) and optionally ``theta_deg``, ``x_mm`` and
 ``T_cam_ref`` (copied into stops.csv / model.csv as they are); the trajectory; and the board (its board.yaml: board
@@ -12,7 +12,8 @@ not imported.
 
 Images are written as they were recorded: Image messages as PNG (mono8 and bgr8 unchanged, mono16 as 16-bit PNG,
 rgb8 reordered to BGR), CompressedImage messages byte for byte (``.png`` or ``.jpg`` after their format). The folder
-is written atomically and is not checked here: ``python -m poseintegrity.recorded validate`` checks it.
+``out`` must be new or empty (checked before the bag is opened); it is written atomically (a staging folder beside
+it, removed on any error) and is not checked here: ``python -m poseintegrity.recorded validate`` checks it.
 """
 
 from __future__ import annotations
@@ -26,7 +27,7 @@ import yaml
 from poseintegrity.errors import PoseIntegrityError, read_text_file
 from poseintegrity.lens import DISTORTION_MODELS, Camera, write_camera_yaml
 from poseintegrity.recorded.reader import TRAJECTORIES, RecordedFormatError, read_table, write_table
-from poseintegrity.staging import staged
+from poseintegrity.staging import check_new_folder, staged
 
 IMAGE_TYPES = ("sensor_msgs/msg/Image", "sensor_msgs/msg/CompressedImage")
 INFO_TYPE = "sensor_msgs/msg/CameraInfo"
@@ -63,6 +64,19 @@ def image_from_message(message, where: str) -> tuple[bytes, str]:
     image = np.frombuffer(rows.tobytes(), stored).astype(dtype).reshape(message.height, message.width, channels)
     image = image[:, :, 0] if channels == 1 else image[:, :, ::-1] if message.encoding == "rgb8" else image
     return cv2.imencode(".png", np.ascontiguousarray(image))[1].tobytes(), ".png"
+
+
+def info_matrices(message, where: str) -> tuple[np.ndarray, np.ndarray]:
+    """(P (3, 4), R (3, 3)) of a CameraInfo message, kept in camera.yaml as the bag has them (the projection of a
+    rectified or stereo camera is not [K | 0])."""
+    matrices = []
+    for names, shape in ((("p", "P"), (3, 4)), (("r", "R"), (3, 3))):
+        values = np.asarray(_field(message, *names), dtype=np.float64)
+        if values.size != shape[0] * shape[1] or not np.all(np.isfinite(values)):
+            raise RecordedFormatError(f"{where}: field {names[1]} must be {shape[0] * shape[1]} finite numbers, got "
+                                      f"{values.tolist()}")
+        matrices.append(values.reshape(shape))
+    return matrices[0], matrices[1]
 
 
 def camera_from_info(message, where: str) -> Camera:
@@ -120,7 +134,7 @@ def import_rosbag(bag: str | Path, image_topic: str, info_topic: str, stops: str
     from rosbags.serde import SerdeError
     from rosbags.typesys import TypesysError
 
-    bag, stops, out = Path(bag), Path(stops), Path(out)
+    bag, stops, out = Path(bag), Path(stops), check_new_folder(out)  # before any work: nothing of the user's replaced
     if trajectory not in TRAJECTORIES:
         raise RecordedFormatError(f"trajectory: expected one of {', '.join(TRAJECTORIES)}, got {trajectory!r}")
     rows = _bag_stops(stops)
@@ -136,8 +150,13 @@ def import_rosbag(bag: str | Path, image_topic: str, info_topic: str, stops: str
                 if topics[topic] not in types:
                     raise RecordedFormatError(f"{bag}: topic {topic!r} carries {topics[topic]}, expected "
                                               f"{' or '.join(types)}")
-            info = next(reader.messages([c for c in reader.connections if c.topic == info_topic]))
-            camera = camera_from_info(reader.deserialize(info[2], info[0].msgtype), f"{bag}, topic {info_topic}")
+            info = next(reader.messages([c for c in reader.connections if c.topic == info_topic]), None)
+            if info is None:
+                raise RecordedFormatError(f"{bag}: topic {info_topic!r} holds no message (a CameraInfo is needed for "
+                                          f"camera.yaml)")
+            message = reader.deserialize(info[2], info[0].msgtype)
+            camera = camera_from_info(message, f"{bag}, topic {info_topic}")
+            projection, rectification = info_matrices(message, f"{bag}, topic {info_topic}")
             images, count = {}, 0
             for count, (connection, _, raw) in enumerate(
                     reader.messages([c for c in reader.connections if c.topic == image_topic]), start=1):
@@ -167,7 +186,7 @@ def import_rosbag(bag: str | Path, image_topic: str, info_topic: str, stops: str
                 stop_rows.append([file, row["stop"], *cells])
         write_table(tmp / "model.csv", ["file", "mask", "T_cam_ref"], [model_rows[stop] for stop in MODEL_STOPS])
         write_table(tmp / "stops.csv", ["file", "stop", "theta_deg", "x_mm", "T_cam_ref"], stop_rows)
-        write_camera_yaml(tmp / "camera.yaml", camera, out.name)
+        write_camera_yaml(tmp / "camera.yaml", camera, out.name, projection, rectification)
         settings = {"trajectory": trajectory, "ground_truth": "board" if board else "poses", "world": world}
         (tmp / "dataset.yaml").write_text(yaml.safe_dump(settings, sort_keys=False))
         if board_text is not None:

@@ -19,6 +19,15 @@ def _read(path: Path):
     return cv2.imread(str(path), cv2.IMREAD_GRAYSCALE)
 
 
+def nothing_to_draw(title: str) -> plt.Figure:
+    """A small figure whose title says why it is empty (e.g. recorded data without straight lines): a declared
+    output that exists and says so, never a stale figure of another run."""
+    fig, ax = plt.subplots(figsize=(6, 1.2))
+    ax.axis("off")
+    ax.set_title(title, fontsize=10)
+    return fig
+
+
 def scene_gallery(root: Path, index: pd.DataFrame, n_cols: int = 4) -> plt.Figure:
     """Like Fig. 4 of Windsor et al.: the first model image of every scene."""
     scenes = index.drop_duplicates("scene")
@@ -69,12 +78,9 @@ TAIL_STYLES = {"long_range": ("eq. 1 (EMG, sigma = 1)", "C0", "-"),
 def tail_figure(tails: list[TailFit], n_t_max: int, n_cols: int = 3) -> plt.Figure:
     """The artifact model's tail (prediction/tails.py): per arc, every image's n_i (grey), the first k stops fitted
     (black), the long range predictor's fitted curves (eq. 1 and the free-width EMG) over the whole arc, theta_a per
-    tolerance (vertical lines). ``n_t_max`` : the diagnosis' largest n_t (titles). One note panel without arcs."""
+    tolerance (vertical lines). ``n_t_max`` : the diagnosis' largest n_t (titles). Without arcs, a titled empty figure."""
     if not tails:
-        fig, ax = plt.subplots(figsize=(6, 1.2))
-        ax.axis("off")
-        ax.text(0.5, 0.5, f"no arc overshoots its theta_a at every n_t <= {n_t_max}", ha="center", va="center")
-        return fig
+        return nothing_to_draw(f"no arc overshoots its theta_a at every n_t <= {n_t_max}")
     n_rows = -(-len(tails) // n_cols)
     fig, axes = plt.subplots(n_rows, min(n_cols, len(tails)), figsize=(4.6 * min(n_cols, len(tails)), 3.4 * n_rows),
                              squeeze=False)  # fmt: skip

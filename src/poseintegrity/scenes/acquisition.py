@@ -46,19 +46,28 @@ def visits(placed: PlacedRobot, path: list[np.ndarray], params: GenerateParams, 
                  for k, T in enumerate(actual))
 
 
-def exposure_times(capture: CaptureParams, image: int) -> tuple[float, float]:
-    """(start, end) of image ``image``'s exposure, s after the robot reported its stop."""
-    start = (capture.delay_ms + image * capture.interval_ms) / 1000.0
+def exposure_times(capture: CaptureParams, image: int, delay_ms: float | None = None) -> tuple[float, float]:
+    """(start, end) of image ``image``'s exposure, s after the robot reported its stop, the first ``delay_ms``
+    (default ``capture.delay_ms``) after it."""
+    start = ((capture.delay_ms if delay_ms is None else delay_ms) + image * capture.interval_ms) / 1000.0
     return start, start + capture.exposure_ms / 1000.0
 
 
-def image_motion(visit: Visit, capture: CaptureParams, image: int, f_px: float) -> Exposure:
-    """The ring-down during image ``image``'s exposure: its rotation at mid-exposure and a path sampled evenly in time
+def model_motion(visit: Visit, capture: CaptureParams, f_px: float) -> Exposure:
+    """The ring-down during a model image's exposure: taken ``capture.model_settle_ms`` after the robot reported the
+    model pose, once the arm has settled (III-B: the model is built from "two images of a static scene")."""
+    return image_motion(visit, capture, 0, f_px, capture.model_settle_ms)
+
+
+def image_motion(visit: Visit, capture: CaptureParams, image: int, f_px: float,
+                 delay_ms: float | None = None) -> Exposure:
+    """The ring-down during image ``image``'s exposure (the burst starting ``delay_ms`` after the stop, default
+    ``capture.delay_ms``): its rotation at mid-exposure and a path sampled evenly in time
     so that consecutive samples move the image by at most ``capture.blur_step_px``: f_px |delta r| bounds the motion
     of a pixel under a small rotation r, and |delta r| <= the largest rate over the exposure x the time between
     samples (the rate taken at RATE_SAMPLES instants: a 5 ms exposure is a small part of a 10 Hz swing). One sample,
     the mid-exposure rotation, when the image moves less than that in the whole exposure."""
-    t0, t1 = exposure_times(capture, image)
+    t0, t1 = exposure_times(capture, image, delay_ms)
     rate = np.abs(visit.ring_down.angular_rate(np.linspace(t0, t1, RATE_SAMPLES))).max()
     extent_px = f_px * float(rate) * (t1 - t0)
     if extent_px <= capture.blur_step_px:

@@ -20,12 +20,13 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from poseintegrity.lens import Camera, write_camera_yaml
-from poseintegrity.calibration import Calibration, CharucoSpec, calibrate
+from poseintegrity.boards import Charuco
+from poseintegrity.calibration import Calibration, calibrate
 from poseintegrity.poses import pose_matrix
 from poseintegrity.staging import staged
 from poseintegrity.scenes import mesh, optics, renderer
 from poseintegrity.scenes.camera import true_camera
-from poseintegrity.scenes.catalog import print_errors
+from poseintegrity.scenes.catalog import measured_scale, print_errors
 from poseintegrity.scenes.foam import ReliefVolume
 from poseintegrity.scenes.params import GenerateParams
 from poseintegrity.scenes.textures import build_atlas, to_u8
@@ -47,19 +48,23 @@ class CalibrationSession:
     calibration: Calibration
 
 
-def charuco_spec(params: GenerateParams) -> CharucoSpec:
+def charuco_spec(params: GenerateParams, measured: bool = True) -> Charuco:
+    """The calibration board: as the lab measured it with calipers (``printed_boards.caliper_std_mm``; what the
+    calibration uses), or as drawn (``measured`` False: what is printed, before the printer's scale)."""
     board = params.calibration.board
-    return CharucoSpec(board.squares_x, board.squares_y, board.square_mm, board.marker_mm, board.dictionary)
+    drawing = Charuco(board.dictionary, board.squares_x, board.squares_y, board.square_mm, board.marker_mm)
+    return drawing if not measured else Charuco(board.dictionary, board.squares_x, board.squares_y, board.square_mm,
+                                                board.marker_mm, measured_scale(params, "charuco", drawing))
 
 
 @lru_cache(maxsize=2)
-def _board_geometry(spec: CharucoSpec, lights: tuple[float, float, float, float], scale: tuple[float, float],
+def _board_geometry(spec: Charuco, lights: tuple[float, float, float, float], scale: tuple[float, float],
                     sag_mm: float) -> renderer.SceneGeometry:
     """The printed board as a textured plane in its own frame (x right, y down, facing -z), gray paper white
     (0.85) and black ink (0.06) as the ArUco board of the scenes, printed at ``scale`` and bowed by ``sag_mm``
     (:func:`~.mesh.printed_sheet`)."""
     width_mm, height_mm = spec.size_mm
-    printed = spec.board().generateImage((round(width_mm * PX_PER_MM), round(height_mm * PX_PER_MM)), marginSize=0)
+    printed = spec.cv_board().generateImage((round(width_mm * PX_PER_MM), round(height_mm * PX_PER_MM)), marginSize=0)
     texture = to_u8(0.06 + 0.79 * printed.astype(np.float32) / 255)
     # the renderer puts the first and last texel centres on the plane's edges (texture coordinates 0 and 1): texel c
     # of the print lies at (c + 1/2) / PX_PER_MM, so the plane spans the texel centres, (n - 1) / PX_PER_MM, about the
@@ -74,7 +79,7 @@ def _board_geometry(spec: CharucoSpec, lights: tuple[float, float, float, float]
                                               np.array([0.3, -0.5, -1.0]), lights, FLAT)
 
 
-def view_pose(camera: Camera, spec: CharucoSpec, distance_mm: tuple[float, float], max_tilt_deg: float,
+def view_pose(camera: Camera, spec: Charuco, distance_mm: tuple[float, float], max_tilt_deg: float,
               rng: np.random.Generator) -> np.ndarray:
     """T_cam_board (4, 4, mm) of one calibration view (module docstring)."""
     u = rng.uniform(CENTRE_MARGIN, 1 - CENTRE_MARGIN) * (camera.width - 1)
@@ -95,7 +100,8 @@ def render_view(params: GenerateParams, T_cam_board: np.ndarray, rng: np.random.
     camera = true_camera(params.camera)
     K_canvas, width, height = camera.canvas
     scale, sag_mm = print_errors(params, "charuco", params.printed_boards.calibration_sag_std_mm)
-    frame = renderer.render(_board_geometry(charuco_spec(params), params.lights.intensities(), scale, sag_mm),
+    frame = renderer.render(_board_geometry(charuco_spec(params, measured=False), params.lights.intensities(), scale,
+                                            sag_mm),
                             K_canvas, width, height, T_cam_board)  # the geometry's world frame is the board's
     focus_mm = float(np.mean(params.calibration.distance_mm))
     irradiance = optics.lens(frame.radiance, frame.depth_mm, focus_mm, params.sensor.blur_sigma_px, params.camera)

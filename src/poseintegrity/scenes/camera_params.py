@@ -4,16 +4,24 @@ stop's images are captured, the calibration session and the printed boards (:mod
 
 from __future__ import annotations
 
-from typing import Annotated
+from typing import Annotated, Literal
 
 import cv2
 import numpy as np
 from pydantic import Field, field_validator, model_validator
 
+from poseintegrity.boards import ArucoGrid, Board, Charuco
 from poseintegrity.lens import LensError, check_folding
 from poseintegrity.schema import FromList, KeyRule, Section, ordered_range
 
 MIN_IMAGE_PX = 64  # the rendered image's shorter side: below it no target keeps enough pixels to be localized
+# Zhang's method takes the focal length from how the board's plane turns between views (views of parallel planes add
+# no constraint, Zhang 2000, section 3.3): with views tilted by at most max_tilt_deg the calibration of params.yaml's
+# session still converges with an RMS of 0.07-0.09 px at any tilt, but its focal length is off by up to 3590 % at
+# 0 deg, 39 % at 2, 10 % at 5, 3.9 % at 10, 2.4 % at 15, 1.6 % at 20 and 1.1 % at params.yaml's 40 deg (worst of 3
+# sessions, benchmarks/bench_calibration_tilt.py): below 20 deg the error grows as the tilt shrinks, past 1.5 times
+# what more tilt reaches
+MIN_CALIBRATION_TILT_DEG = 20.0
 MAX_SENSOR_PX = 4096  # a side of the sensor: larger frames take GBs of z-buffer per worker
 
 
@@ -91,7 +99,10 @@ class PrintedBoardParams(Section):
     scale_std: float = Field(ge=0, le=0.01, description="per axis: laser printers scale by ~0.1-0.3 %; 1 % would be "
                                                         "seen with a ruler")
     calibration_sag_std_mm: float = Field(ge=0, le=5, description="bow of the ChArUco card at its centre")
-    board_sag_std_mm: float = Field(ge=0, le=5, description="bow of the ground-truth board glued on its pedestal")
+    board_sag_std_mm: float = Field(ge=0, le=5, description="bow of the ground-truth board glued on its stand")
+    caliper_std_mm: float | None = Field(
+        ge=0, le=5, description="the lab measures the printed ground-truth board's width and height with calipers "
+        "(this error each) and uses the measured size; null: the drawing's size is used, unmeasured")
 
 
 class CharucoParams(Section):
@@ -123,6 +134,64 @@ class CharucoParams(Section):
         return self
 
 
+class GroundTruthBoardParams(Section):
+    """The scenes' ground-truth board (IV-C: "an ArUco marker board [35]"; its size and layout are unpublished, ours
+    are chosen by measurement: docs/references.md, "Ground-truth boards"). ``aruco_grid`` needs markers_x, markers_y,
+    marker_length_mm and separation_mm; ``charuco`` squares_x, squares_y, square_mm and marker_mm (the other kind's
+    keys are refused). ``placement``: ``facing_camera`` (on a post, facing the model camera, where along every
+    trajectory of its scene no target covers it and it covers none: scenes/board_placement.py) or ``flat`` (lying on
+    a pedestal beside the target, the layout before issue 30)."""
+
+    type: Literal["aruco_grid", "charuco"]
+    dictionary: str = Field(pattern=r"^DICT_\w+$")
+    markers_x: int | None = Field(None, ge=1, le=20)
+    markers_y: int | None = Field(None, ge=1, le=20)
+    marker_length_mm: float | None = Field(None, gt=0, le=200)
+    separation_mm: float | None = Field(None, ge=0, le=100)
+    squares_x: int | None = Field(None, ge=3, le=40)
+    squares_y: int | None = Field(None, ge=3, le=40)
+    square_mm: float | None = Field(None, gt=0, le=200)
+    marker_mm: float | None = Field(None, gt=0, le=200)
+    margin_mm: float = Field(ge=0, le=100, description="white paper around the pattern")
+    px_per_mm: float = Field(ge=2, le=32, description="texels per mm of the printed board's texture")
+    placement: Literal["facing_camera", "flat"]
+
+    @field_validator("dictionary")
+    @classmethod
+    def _known(cls, name: str) -> str:
+        if not isinstance(getattr(cv2.aruco, name, None), int):
+            raise ValueError(f"OpenCV has no ArUco dictionary {name!r}")
+        return name
+
+    @model_validator(mode="after")
+    def _fields_of_its_type(self) -> "GroundTruthBoardParams":
+        mine = {"aruco_grid": ("markers_x", "markers_y", "marker_length_mm", "separation_mm"),
+                "charuco": ("squares_x", "squares_y", "square_mm", "marker_mm")}
+        for key in mine[self.type]:
+            if getattr(self, key) is None:
+                raise KeyRule(key, f"required by a {self.type} board")
+        for kind, keys in mine.items():
+            for key in keys:
+                if kind != self.type and getattr(self, key) is not None:
+                    raise KeyRule(key, f"a key of a {kind} board; this board is {self.type}")
+        if self.type == "charuco" and self.marker_mm >= self.square_mm:
+            raise KeyRule("marker_mm", f"a marker lies inside its square: must be < square_mm ({self.square_mm:g})")
+        board = self.drawing()
+        n_markers = (board.markers_x * board.markers_y if isinstance(board, ArucoGrid)
+                     else board.squares_x * board.squares_y // 2)
+        size = cv2.aruco.getPredefinedDictionary(getattr(cv2.aruco, self.dictionary)).bytesList.shape[0]
+        if n_markers > size:
+            raise KeyRule("dictionary", f"the board holds {n_markers} markers, {self.dictionary} has {size}")
+        return self
+
+    def drawing(self, scale: tuple[float, float] = (1.0, 1.0)) -> Board:
+        """The board as drawn (:mod:`poseintegrity.boards`), or as measured with ``scale`` (printed / drawn)."""
+        if self.type == "charuco":
+            return Charuco(self.dictionary, self.squares_x, self.squares_y, self.square_mm, self.marker_mm, scale)
+        return ArucoGrid(self.dictionary, self.markers_x, self.markers_y, self.marker_length_mm, self.separation_mm,
+                         0, scale)
+
+
 class CalibrationParams(Section):
     """The camera's calibration session before any data (:mod:`.calibration_views`): the board shown in ``n_views``
     poses; the estimate is what the pipeline uses as the camera."""
@@ -132,9 +201,19 @@ class CalibrationParams(Section):
     distance_mm: ordered_range(ge=100, le=2000) = Field(
         description="camera to board centre, drawn per view: within [100, 2000] mm, where the lens focuses and the "
                     "board covers more than a few pixels")
-    max_tilt_deg: float = Field(ge=0, le=70, description="board tilt from facing the camera, drawn per view")
+    max_tilt_deg: float = Field(ge=0, le=70, description="board tilt from facing the camera, drawn per view (at "
+                                                         "least MIN_CALIBRATION_TILT_DEG, checked below)")
     max_rms_px: float = Field(gt=0, le=5, description="a calibration whose reprojection RMS exceeds this stops "
                                                       "stage 01: its camera would not be worth using")
+
+    @field_validator("max_tilt_deg")
+    @classmethod
+    def _tilted_enough(cls, tilt: float) -> float:
+        if tilt < MIN_CALIBRATION_TILT_DEG:
+            raise ValueError(f"views tilted by at most {tilt:g} deg are nearly parallel to the image, and Zhang's "
+                             f"calibration cannot tell the focal length from the distance (off by 10 % at 5 deg, 3.9 % "
+                             f"at 10 deg): must be >= {MIN_CALIBRATION_TILT_DEG:g}")
+        return tilt
 
 
 class CaptureParams(Section):
@@ -147,6 +226,9 @@ class CaptureParams(Section):
     exposure_ms: float = Field(gt=0, le=200, description="shutter time; with the ring light a few ms suffice")
     blur_step_px: float = Field(gt=0, le=5, description="motion blur: sub-exposures no further apart in the image than "
                                                         "this (1 sub-exposure when the image moves less)")
+    model_settle_ms: float = Field(ge=0, le=60000, description="the model pair is exposed this long after the robot "
+                                   "reports each model pose, once the arm has rung down (III-B: 'two images of a "
+                                   "static scene'); the stops' bursts keep their ring-down")
 
     @model_validator(mode="after")
     def _one_at_a_time(self) -> "CaptureParams":

@@ -1,4 +1,4 @@
-"""The physical world of the experiments: targets, clutter, the ArUco board and the table (Fig. 3-4).
+"""The physical world of the experiments: targets, clutter, the ground-truth board and the table (Fig. 3-4).
 
 Targets are the same physical objects in every scene they appear in (their meshes and textures are seeded by name
 from ``generate.seed``), arranged differently per scene:
@@ -21,17 +21,22 @@ from functools import lru_cache
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from poseintegrity.boards import Board
 from poseintegrity.seeding import keyed_rng
+from poseintegrity.scenes import board_placement
 from poseintegrity.scenes import mesh as meshes
 from poseintegrity.scenes import textures as tex
 from poseintegrity.poses import pose_matrix
+from poseintegrity.protocol import ProtocolParams
 from poseintegrity.scenes.params import TEXTURE_NAMES, GenerateParams, SceneSpec
+from poseintegrity.scenes.camera import Intrinsics
 from poseintegrity.scenes.scapula import scapula_mesh
 
 PRINTED_CLUTTER = ("clutter_a", "clutter_b", "clutter_c", "clutter_print")
 BLOCK_SIZE_MM = (72.0, 64.0, 58.0)
 STAND_RADIUS_MM = 8.0
 PHANTOM_CLEARANCE_MM = 20.0  # lowest point of a held phantom above the table
+CLUTTER_MAX_HEIGHT_MM = 160.0  # the tallest clutter object
 BOARD_BELOW_AIM_MM = 60.0  # the board's pedestal brings it this far below the aim point (never below the table)
 
 
@@ -85,7 +90,8 @@ class Scene:
     """A laid-out scene: placed meshes, which of them are targets, the board, the model-view direction (the
     textures of its meshes: :func:`scene_textures`).
 
-    T_world_target is the frame of the first target; ``aim`` is the point the camera looks at and the arcs turn
+    T_world_target is the frame of the first target; ``board`` the ground-truth board as the lab measured it
+    (:func:`measured_board`), T_world_board its frame; ``aim`` is the point the camera looks at and the arcs turn
     about (the glenoid centre of a single scapula: the paper's robot keeps its guide wire in the drill hole).
     """
 
@@ -94,10 +100,11 @@ class Scene:
     target_objects: tuple[str, ...]
     T_world_target: np.ndarray
     T_world_board: np.ndarray
-    board: tex.BoardSpec
+    board: Board
     aim: np.ndarray
     view_dir: np.ndarray
     light_dir: np.ndarray
+    placement: board_placement.BoardPlacement | None = None  # a standing board's place (None: lying flat)
 
 
 def _model_view_frame(view_dir: np.ndarray) -> np.ndarray:
@@ -128,8 +135,15 @@ def _held_phantom(name: str, params: "GenerateParams", spec: "SceneSpec", view_d
     return T, [(name, placed), (f"{name}_stand", stand)]
 
 
-def build_scene(spec: "SceneSpec", index: int, params: "GenerateParams") -> Scene:
-    """Lay out scene ``spec`` (index = its position in params, seeds the arrangement with ``params.seed``)."""
+def build_scene(spec: "SceneSpec", index: int, params: "GenerateParams", protocol: "ProtocolParams",
+                session: str = "arc", placement: board_placement.BoardPlacement | None = None) -> Scene:
+    """Lay out scene ``spec`` (index = its position in params, seeds the arrangement with ``params.seed``) for one
+    session: its arcs (``"arc"``) or, on the lines' scene, its lines (``"line"``). Each session has its own model pair
+    (IV-D), and the lab stands the ground-truth board where that session's trajectories (``protocol``) keep it in view;
+    targets, their stands and the table are the same in both, the clutter keeps clear of the board's sight lines. A
+    board that fits nowhere raises :class:`~.board_placement.PlacementError`; ``placement``: the board's place found
+    by an earlier call for the same session (the search is skipped: workers rebuild a scene the main process laid
+    out)."""
     rng = keyed_rng(params.seed, "scene", index)
     yaw = np.deg2rad(rng.uniform(-20, 20))  # direction of the model camera around the target
     elev = np.deg2rad(spec.elevation_deg)
@@ -150,40 +164,108 @@ def build_scene(spec: "SceneSpec", index: int, params: "GenerateParams") -> Scen
         target_poses.append(T)
     aim = np.mean([T[:3, 3] for T in target_poses], axis=0)
 
-    # the ArUco board lies flat beside the target, printed side up (board z points down), on the table or, beside a
-    # held phantom, on a pedestal BOARD_BELOW_AIM_MM below the aim point, so that both stay in view along the arcs
-    board = tex.BoardSpec()
+    board = params.board.drawing()
+    board_yaw = yaw + np.pi + rng.uniform(-0.3, 0.3)  # drawn for either placement: the clutter after it lies alike
+    if params.board.placement == "flat":
+        T_world_board, board_objects, board_centre = _flat_board(params, board, board_yaw, target_poses[0], yaw, aim,
+                                                                 view_dir)
+        sight, placement = None, None
+    else:
+        placement, board_objects, sight = _standing_board(params, protocol, spec, session, board, placed, aim,
+                                                          view_dir, placement)
+        T_world_board, board_centre = placement.T_world_board, placement.post_foot[:2]
+    placed += board_objects
+    placed += _clutter(spec, params, rng, aim, view_dir[:2] / np.linalg.norm(view_dir[:2]), board_centre, sight)
+
+    light_dir = np.array([rng.uniform(-0.5, 0.5), rng.uniform(-0.5, 0.3), 1.0])
+    return Scene(spec.name, placed, tuple(spec.targets), target_poses[0], T_world_board, measured_board(params), aim,
+                 view_dir, light_dir, placement)
+
+
+def _board_sheet(params: "GenerateParams", board: Board) -> meshes.Mesh:
+    """The printed board in its own frame (x right, y down, facing -z, origin at the pattern's top-left corner), as
+    printed: scaled and bowed (:func:`print_errors`). The plane spans the texture's texel centres (the renderer maps
+    texture coordinates 0 and 1 onto its edges): a plane of the print's full size would stretch the board by
+    n / (n - 1) texels (calibration_views.py)."""
     bw, bh = board.size_mm
-    m = board.margin_mm
-    # board x points away from the target, so its origin (the model origin, where E_t is measured) is a corner
-    # of the edge facing the target
-    board_yaw = yaw + np.pi + rng.uniform(-0.3, 0.3)
+    n_x, n_y = tex.board_texture(board, params.board.px_per_mm, params.board.margin_mm).shape[::-1]
+    sheet = meshes.plane((n_x - 1) / params.board.px_per_mm, (n_y - 1) / params.board.px_per_mm, 12, 9, "board",
+                         material=meshes.Material(0.02, 10.0))
+    # plane() faces +z with texture v along -y; flip about x so it faces -z (the printed side) with v along +y
+    sheet = sheet.transformed(pose_matrix(np.diag([1.0, -1.0, -1.0]), [bw / 2, bh / 2, 0.0]))
+    return meshes.printed_sheet(sheet, np.array([bw / 2, bh / 2]), (n_x - 1) / params.board.px_per_mm / 2,
+                                *print_errors(params, "aruco", params.printed_boards.board_sag_std_mm))
+
+
+def _flat_board(params: "GenerateParams", board: Board, board_yaw: float, T_world_target: np.ndarray, yaw: float,
+                aim: np.ndarray, view_dir: np.ndarray) -> tuple[np.ndarray, list[tuple[str, meshes.Mesh]], np.ndarray]:
+    """Placement ``flat`` (the layout before issue 30): the board lies beside the target, printed side up (board z
+    points down), on the table or, beside a held phantom, on a pedestal BOARD_BELOW_AIM_MM below the aim point; board x
+    points away from the target, so that its origin (the model origin, where E_t is measured) is a corner of the edge
+    facing the target. Returns T_world_board, the meshes, the board's centre on the table (2,)."""
+    bw, bh = board.size_mm
+    m = params.board.margin_mm
     x_b = np.array([np.cos(board_yaw), np.sin(board_yaw), 0.0])
     R_world_board = np.column_stack([x_b, np.cross([0.0, 0.0, -1.0], x_b), [0.0, 0.0, -1.0]])
     toward_cam = view_dir[:2] / np.linalg.norm(view_dir[:2])
-    board_centre = target_poses[0][:2, 3] - 92.0 * np.array([np.cos(yaw), np.sin(yaw)]) + 20.0 * toward_cam
+    board_centre = T_world_target[:2, 3] - 92.0 * np.array([np.cos(yaw), np.sin(yaw)]) + 20.0 * toward_cam
     height = max(aim[2] - BOARD_BELOW_AIM_MM, 0.0)
+    objects = []
     if height > 0:
         pedestal = meshes.box((bw + 2 * m, bh + 2 * m, height), "clutter_b", n_sub=4)
-        placed.append(("board_pedestal", pedestal.transformed(pose_matrix(R_world_board @ np.diag([1.0, -1.0, -1.0]),
-                                                                    [*board_centre, height / 2]))))
+        objects.append(("board_pedestal", pedestal.transformed(pose_matrix(R_world_board @ np.diag([1.0, -1.0, -1.0]),
+                                                                             [*board_centre, height / 2]))))
     origin = np.append(board_centre, height + 0.4) - R_world_board @ np.array([bw / 2, bh / 2, 0.0])
     T_world_board = pose_matrix(R_world_board, origin)
-    # plane() faces +z with texture v along -y; flip about x so it faces -z (the board's printed side) with v along +y
-    # the plane spans the texture's texel centres (the renderer maps texture coordinates 0 and 1 onto its edges): a
-    # plane of the print's full size would stretch the board by n / (n - 1) texels (calibration_views.py)
-    n_x, n_y = board.texture_size
-    board_mesh = meshes.plane((n_x - 1) / board.px_per_mm, (n_y - 1) / board.px_per_mm, 12, 9, "aruco_board",
-                              material=meshes.Material(0.02, 10.0))
-    board_mesh = board_mesh.transformed(pose_matrix(np.diag([1.0, -1.0, -1.0]), [bw / 2, bh / 2, 0.0]))
-    board_mesh = meshes.printed_sheet(board_mesh, np.array([bw / 2, bh / 2]), (n_x - 1) / board.px_per_mm / 2,
-                                      *print_errors(params, "aruco", params.printed_boards.board_sag_std_mm))
-    placed.append(("aruco_board", board_mesh.transformed(T_world_board)))
-    placed += _clutter(spec, params, rng, aim, toward_cam, board_centre)
+    objects.append(("board", _board_sheet(params, board).transformed(T_world_board)))
+    return T_world_board, objects, board_centre
 
-    light_dir = np.array([rng.uniform(-0.5, 0.5), rng.uniform(-0.5, 0.3), 1.0])
-    return Scene(spec.name, placed, tuple(spec.targets), target_poses[0], T_world_board, board, aim, view_dir,
-                 light_dir)
+
+def _standing_board(params: "GenerateParams", protocol: "ProtocolParams", spec: "SceneSpec", session: str,
+                    board: Board, placed: list[tuple[str, meshes.Mesh]], aim: np.ndarray, view_dir: np.ndarray,
+                    placement: board_placement.BoardPlacement | None):
+    """Placement ``facing_camera`` (:mod:`.board_placement`): the board on a post, facing the session's model camera,
+    clear of the targets along every trajectory of the session (``placement``, when given, is where it was found).
+    Returns the placement, the meshes (board, post) and what clutter must keep clear of: the board's paper corners
+    (4, 3) and the session's poses."""
+    cam = Intrinsics.from_params(params.camera)
+    if session == "line":
+        lines = params.lines
+        poses = board_placement.line_poses(aim, view_dir, lines.distance_mm, params.model_baseline_mm,
+                                           lines.offsets_deg, protocol.line_length_mm, lines.n_stops)
+    else:
+        poses = board_placement.arc_poses(aim, view_dir, spec.distance_mm, params.model_baseline_mm,
+                                          params.arcs.azimuths_deg, protocol.arc_span_deg, params.arcs.n_stops)
+    targets = [mesh.vertices for name, mesh in placed if name in spec.targets]
+    if placement is None:
+        placement = board_placement.place_board(board.size_mm, params.board.margin_mm, targets, aim, poses[0], poses,
+                                                cam.K, cam.width, cam.height, f"scene {spec.name}")
+    T = placement.T_world_board
+    post = meshes.cylinder(board_placement.POST_RADIUS_MM, float(placement.post_top[2]), "clutter_c")
+    objects = [("board", _board_sheet(params, board).transformed(T)),
+               ("board_post", post.transformed(pose_matrix(np.eye(3), placement.post_foot)))]
+    bw, bh, m = *board.size_mm, params.board.margin_mm
+    paper = (T[:3, :3] @ np.array([[-m, -m, 0], [bw + m, -m, 0], [bw + m, bh + m, 0], [-m, bh + m, 0]]).T).T + T[:3, 3]
+    return placement, objects, (paper, poses)
+
+
+def measured_board(params: "GenerateParams") -> Board:
+    """The ground-truth board as the lab knows it: the drawing scaled by the printed size the lab measured
+    (:func:`measured_scale`)."""
+    drawing = params.board.drawing()
+    return params.board.drawing(measured_scale(params, "aruco", drawing))
+
+
+def measured_scale(params: "GenerateParams", board: str, drawing: Board) -> tuple[float, float]:
+    """The printed size over the drawn size of ``board`` ("aruco": the ground truth's, "charuco": the calibration
+    board) as the lab measured it with calipers along x and y (``printed_boards.caliper_std_mm`` on the drawing's
+    width and height), drawn from ``keyed_rng(seed, "caliper", board)`` around the printer's true scale
+    (:func:`print_errors`); (1, 1), the drawing, when the lab does not measure (null)."""
+    if params.printed_boards.caliper_std_mm is None:
+        return 1.0, 1.0
+    scale, _ = print_errors(params, board, 0.0)
+    error = params.printed_boards.caliper_std_mm * keyed_rng(params.seed, "caliper", board).standard_normal(2)
+    return float(scale[0] + error[0] / drawing.size_mm[0]), float(scale[1] + error[1] / drawing.size_mm[1])
 
 
 def print_errors(params: "GenerateParams", board: str, sag_std_mm: float) -> tuple[tuple[float, float], float]:
@@ -196,18 +278,21 @@ def print_errors(params: "GenerateParams", board: str, sag_std_mm: float) -> tup
 
 def scene_textures(scene: Scene, params: "GenerateParams") -> dict[str, np.ndarray]:
     """The albedo map of every texture the scene's meshes use: an image file of ``generate.textures`` or the
-    procedural texture of that name, and the printed ArUco board."""
+    procedural texture of that name, and the printed ground-truth board."""
     used = {m.texture for _, m in scene.placed if m.texture is not None}
     textures = {name: (tex.load_texture(params.textures[name]) if name in params.textures
-                       else procedural_texture(name, params.seed)) for name in used if name != "aruco_board"}
-    textures["aruco_board"] = scene.board.texture()
+                       else procedural_texture(name, params.seed)) for name in used if name != "board"}
+    textures["board"] = tex.board_texture(params.board.drawing(), params.board.px_per_mm, params.board.margin_mm)
     return textures
 
 
 def _clutter(spec: "SceneSpec", params: "GenerateParams", rng: np.random.Generator, aim: np.ndarray,
-             toward_cam: np.ndarray, board_centre: np.ndarray) -> list[tuple[str, meshes.Mesh]]:
+             toward_cam: np.ndarray, board_centre: np.ndarray,
+             sight: tuple[np.ndarray, list[np.ndarray]] | None) -> list[tuple[str, meshes.Mesh]]:
     """``spec.n_clutter`` objects around the target, off the line of sight of the model view and off the board:
-    printed boxes and cylinders, and (one in three) bone-foam offcuts, a block or a shaft."""
+    printed boxes and cylinders, and (one in three) bone-foam offcuts, a block or a shaft. ``sight``: a standing
+    board's paper corners (4, 3) and the scene's poses; no object (as tall as any can be) may cover the board at any
+    of them."""
     occupied = [(aim[:2], 90.0 + 130.0 * (len(spec.targets) - 1)), (board_centre, 80.0)]
     foam = params.bone_foam.material()
     placed, attempts = [], 0
@@ -220,6 +305,9 @@ def _clutter(spec: "SceneSpec", params: "GenerateParams", rng: np.random.Generat
         if offset @ toward_cam > 0 and abs(toward_cam[0] * offset[1] - toward_cam[1] * offset[0]) < 120:
             continue
         if any(np.linalg.norm(xy - c) < radius + rc for c, rc in occupied):
+            continue
+        if sight is not None and board_placement.covers(xy, radius, CLUTTER_MAX_HEIGHT_MM, *sight,
+                                                        Intrinsics.from_params(params.camera).K):
             continue
         occupied.append((xy, radius))
         kind = rng.random()

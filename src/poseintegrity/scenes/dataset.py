@@ -14,7 +14,7 @@ How an image comes about:
    serves all its datasets; the robot returns to the first model view to start each arc (a new visit).
 2. Once the robot reports a stop, the camera takes a burst of ``images_per_stop`` exposures (``capture``) while
    the arm rings down (:mod:`.ringdown`): each image sees the stop's view turned by a small rotation, and blurred
-   along its path during the exposure.
+   along its path during the exposure. A model image is taken once the arm has settled (``model_settle_ms``).
 3. The view is rendered once per visit on the lens' ideal canvas (:mod:`.renderer`), blurred by the lens and the
    depth of field (:mod:`.optics`), warped per image by its ring-down rotation and distorted by the lens onto the
    sensor, then exposed (sensor noise).
@@ -29,7 +29,7 @@ from __future__ import annotations
 import json
 import shutil
 from collections import OrderedDict
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import lru_cache, partial
 from pathlib import Path
 
@@ -46,7 +46,8 @@ from poseintegrity.poses import inverse
 from poseintegrity.protocol import ProtocolParams
 from poseintegrity.staging import partial_folder
 from poseintegrity.scenes import catalog, optics, renderer, trajectories
-from poseintegrity.scenes.acquisition import Route, image_motion, image_pose, rotation_maps, visits
+from poseintegrity.scenes.acquisition import Route, image_motion, image_pose, model_motion, rotation_maps, visits
+from poseintegrity.scenes.board_placement import BoardPlacement, PlacementError
 from poseintegrity.scenes.calibration_views import CalibrationSession, calibration_session, write_calibration
 from poseintegrity.scenes.camera import Intrinsics, true_camera
 from poseintegrity.scenes.foam import ReliefVolume
@@ -124,25 +125,34 @@ def scenes_key(world: str) -> str:
     return "generate.scenes" if world == "main" else f"generate.{world}.scenes"
 
 
-def check_world(params: GenerateParams, protocol: ProtocolParams, world: str = "main") -> list[catalog.Scene]:
-    """Lay out every scene before any rendering, naming the key, when one cannot be rendered as the protocol
-    needs; returns the scenes. Every scene is built (an unreadable mesh or a hole outside the bone raises
-    :class:`~.mesh.MeshError` here); each target must lie mostly inside both model views of its arcs and, for
-    the lines' scene, of the lines' model pair (a mesh scaled far too large or too small, or a distance that puts
+def sessions(params: GenerateParams) -> list[tuple[int, str]]:
+    """(scene index, session) of every layout a world renders: each scene's arcs, and the lines' scene's lines
+    (:func:`~.catalog.build_scene`)."""
+    names = [spec.name for spec in params.scenes]
+    lines = [] if params.lines is None else [(names.index(params.lines.scene), "line")]
+    return [(index, "arc") for index in range(len(names))] + lines
+
+
+def check_world(params: GenerateParams, protocol: ProtocolParams, world: str = "main") -> dict[tuple[int, str], catalog.Scene]:
+    """Lay out every scene's sessions before any rendering, naming the key, when one cannot be rendered as the
+    protocol needs; returns the scenes by (index, session). Every scene is built (an unreadable mesh or a hole outside
+    the bone raises :class:`~.mesh.MeshError` here, a board with no place a :class:`WorldError`); each target must lie
+    mostly inside both model views of its session (a mesh scaled far too large or too small, or a distance that puts
     the target out of the picture). The robot's reach is checked by :func:`drive`."""
     cam = Intrinsics.from_params(params.camera)
-    scenes = [catalog.build_scene(spec, index, params) for index, spec in enumerate(params.scenes)]
-    for index, scene in enumerate(scenes):
-        distances = [params.scenes[index].distance_mm]
-        if params.lines is not None and params.lines.scene == scene.name:
-            distances.append(params.lines.distance_mm)
-        for distance in distances:
-            for T_world_cam in trajectories.model_pair(scene.aim, scene.view_dir, distance, params.model_baseline_mm):
-                T_cam_world = inverse(T_world_cam)
-                for name, mesh in scene.placed:
-                    if name in scene.target_objects:
-                        _check_in_view(mesh.vertices @ T_cam_world[:3, :3].T + T_cam_world[:3, 3], cam,
-                                       f"{scenes_key(world)}.{index}", name, distance)
+    scenes = {}
+    for index, session in sessions(params):
+        try:
+            scene = scenes[index, session] = catalog.build_scene(params.scenes[index], index, params, protocol, session)
+        except PlacementError as error:
+            raise WorldError(f"{scenes_key(world)}.{index} ({session}s): {error}") from None
+        distance = params.scenes[index].distance_mm if session == "arc" else params.lines.distance_mm
+        for T_world_cam in trajectories.model_pair(scene.aim, scene.view_dir, distance, params.model_baseline_mm):
+            T_cam_world = inverse(T_world_cam)
+            for name, mesh in scene.placed:
+                if name in scene.target_objects:
+                    _check_in_view(mesh.vertices @ T_cam_world[:3, :3].T + T_cam_world[:3, 3], cam,
+                                   f"{scenes_key(world)}.{index}", name, distance)
     return scenes
 
 
@@ -197,14 +207,17 @@ class World:
 
 
 _WORLDS: OrderedDict[tuple[str, int], World] = OrderedDict()
-WORLDS_KEPT = 2  # per process: the shots of one scene run together, a worker seldom goes back to an earlier one
+WORLDS_KEPT = 2  # per process: the shots of one session run together, a worker seldom goes back to an earlier one
 
 
-def world(params: GenerateParams, scene_index: int) -> World:
-    """The scene and its renderable geometry, built once per process and scene (the last WORLDS_KEPT kept)."""
-    key = (params.model_dump_json(), scene_index)
+def world(params: GenerateParams, protocol: ProtocolParams, scene_index: int, session: str,
+          placement: BoardPlacement | None = None) -> World:
+    """The scene of one session and its renderable geometry, built once per process (the last WORLDS_KEPT kept);
+    ``placement``: its board's place, found when the world was planned (:func:`~.catalog.build_scene`)."""
+    key = (params.model_dump_json(), protocol.model_dump_json(), scene_index, session,
+           None if placement is None else placement.T_world_board.tobytes())
     if key not in _WORLDS:
-        _WORLDS[key] = _build_world(params, scene_index)
+        _WORLDS[key] = _build_world(params, protocol, scene_index, session, placement)
         while len(_WORLDS) > WORLDS_KEPT:
             _WORLDS.popitem(last=False)
     _WORLDS.move_to_end(key)
@@ -217,8 +230,9 @@ def _relief(bone_foam: BoneFoamParams, seed: int) -> ReliefVolume:
     return bone_foam.relief(seed)
 
 
-def _build_world(params: GenerateParams, scene_index: int) -> World:
-    scene = catalog.build_scene(params.scenes[scene_index], scene_index, params)
+def _build_world(params: GenerateParams, protocol: ProtocolParams, scene_index: int, session: str,
+                 placement: BoardPlacement | None) -> World:
+    scene = catalog.build_scene(params.scenes[scene_index], scene_index, params, protocol, session, placement)
     atlas = build_atlas(catalog.scene_textures(scene, params))
     geometry = renderer.SceneGeometry.from_meshes(scene.placed, atlas, scene.light_dir, params.lights.intensities(),
                                                   _relief(params.bone_foam, params.seed))
@@ -241,18 +255,21 @@ class Exposure:
 
 @dataclass(frozen=True)
 class Shot:
-    """One visit of the camera (T_world_cam at the reported stop) in scene ``scene_index``, the lens focused at
-    ``focus_mm``: rendered once, then exposed for every image taken there."""
+    """One visit of the camera (T_world_cam at the reported stop) in scene ``scene_index``'s ``session`` ("arc" or
+    "line"), the lens focused at ``focus_mm``: rendered once, then exposed for every image taken there."""
 
     scene_index: int
+    session: str
     T_world_cam: np.ndarray
     focus_mm: float
     exposures: tuple[Exposure, ...]
+    placement: BoardPlacement | None = None  # the session's board (found when the world was planned)
 
 
-def plan_shots(params: GenerateParams, plans: list[DatasetPlan], trips: list[Trip], routes: list[Route]) -> list[Shot]:
+def plan_shots(params: GenerateParams, plans: list[DatasetPlan], trips: list[Trip], routes: list[Route],
+               placements: dict[tuple[int, str], BoardPlacement | None]) -> list[Shot]:
     """Every image of every dataset, one shot per visit (a scene's model pair once for all datasets sharing it), the
-    shots of a scene together (a worker then builds each scene once)."""
+    shots of a scene together (a worker then builds each scene once); ``placements``: each session's board."""
     f_px = Intrinsics.from_params(params.camera).K[0, 0]
     shots: dict[tuple, Shot] = {}
     for plan, trip, route in zip(plans, trips, routes):
@@ -260,20 +277,22 @@ def plan_shots(params: GenerateParams, plans: list[DatasetPlan], trips: list[Tri
             key = (plan.scene_index, "model", plan.trajectory, k)
             if key in shots:  # the scene's other datasets of this kind share the images
                 shot = shots[key]
-                shots[key] = Shot(shot.scene_index, shot.T_world_cam, shot.focus_mm,
-                                  tuple(Exposure((*e.datasets, plan.dataset), e.file, e.rng_key, e.rotations, e.mask)
-                                        for e in shot.exposures))
+                shots[key] = replace(shot, exposures=tuple(
+                    Exposure((*e.datasets, plan.dataset), e.file, e.rng_key, e.rotations, e.mask)
+                    for e in shot.exposures))
                 continue
-            motion = image_motion(visit, params.capture, 0, f_px)
-            shots[key] = Shot(plan.scene_index, visit.T_world_cam, trip.distance_mm, (Exposure(
+            motion = model_motion(visit, params.capture, f_px)
+            shots[key] = Shot(plan.scene_index, plan.trajectory, visit.T_world_cam, trip.distance_mm, (Exposure(
                 (plan.dataset,), f"model/model_{k}.png", ("model", plan.scene_index, plan.trajectory, k),
-                motion.path, f"model/mask_{k}.png"),))
+                motion.path, f"model/mask_{k}.png"),), placements[plan.scene_index, plan.trajectory])
         for s, visit in enumerate(route.stops):
             exposures = tuple(Exposure((plan.dataset,), file, (plan.dataset, s, i),
                                        image_motion(visit, params.capture, i, f_px).path)
                               for i, file in enumerate(_image_files(s, params.images_per_stop)))
-            shots[(plan.dataset, s)] = Shot(plan.scene_index, visit.T_world_cam, trip.distance_mm, exposures)
-    return sorted(shots.values(), key=lambda shot: shot.scene_index)  # stable: the datasets' order within a scene
+            shots[(plan.dataset, s)] = Shot(plan.scene_index, plan.trajectory, visit.T_world_cam, trip.distance_mm,
+                                            exposures, placements[plan.scene_index, plan.trajectory])
+    # stable: the datasets' order within a session; a worker then builds each session's scene once
+    return sorted(shots.values(), key=lambda shot: (shot.scene_index, shot.session))
 
 
 def _image_files(stop: int, images_per_stop: int) -> tuple[str, ...]:
@@ -286,11 +305,11 @@ def _partial(root: Path, dataset: str) -> Path:
     return partial_folder(root / dataset)
 
 
-def take_shot(params: GenerateParams, root: Path, shot: Shot) -> None:
+def take_shot(params: GenerateParams, protocol: ProtocolParams, root: Path, shot: Shot) -> None:
     """Render ``shot`` on the lens' ideal canvas, blur it by the lens and the depth of field, and for every image
     turn it by the image's ring-down path, distort it onto the sensor and expose it; write the images (and masks)
     into the datasets' partial folders under ``root``."""
-    scene_world = world(params, shot.scene_index)
+    scene_world = world(params, protocol, shot.scene_index, shot.session, shot.placement)
     lens = true_camera(params.camera)  # its canvas and sensor maps are computed once per process
     K_canvas, width, height = lens.canvas
     frame = renderer.render(scene_world.geometry, K_canvas, width, height, inverse(shot.T_world_cam))
@@ -343,7 +362,7 @@ def finish_dataset(params: GenerateParams, root: Path, plan: DatasetPlan, trip: 
     truth = true_camera(params.camera)
     f_px = truth.K[0, 0]
     tmp, final = _partial(root, plan.dataset), root / plan.dataset
-    model_poses = [image_pose(visit, image_motion(visit, params.capture, 0, f_px)) for visit in route.model]
+    model_poses = [image_pose(visit, model_motion(visit, params.capture, f_px)) for visit in route.model]
     T_cam1_cam0 = inverse(trip.model_views[1]) @ trip.model_views[0]  # what the robot says it did (III-B)
     model = {
         "images": [f"model/model_{k}.png" for k in range(len(route.model))],
@@ -385,7 +404,7 @@ class WorldPlan:
     name: str
     params: GenerateParams
     calibration: CalibrationSession
-    scenes: list[catalog.Scene]
+    scenes: dict[tuple[int, str], catalog.Scene]
     plans: list[DatasetPlan]
     trips: list[Trip]
     routes: list[Route]
@@ -405,13 +424,15 @@ def plan_worlds(params: GenerateParams, protocol: ProtocolParams, workers: Worke
     worlds = params.worlds()
     scenes = {name: check_world(world_params, protocol, name) for name, world_params in worlds.items()}
     plans = {name: plan_datasets(world_params, name) for name, world_params in worlds.items()}
-    trips = {name: [plan_trip(worlds[name], protocol, plan, scenes[name][plan.scene_index]) for plan in plans[name]]
+    trips = {name: [plan_trip(worlds[name], protocol, plan, scenes[name][plan.scene_index, plan.trajectory])
+                    for plan in plans[name]]
              for name in worlds}
-    drives = [(name, scene_index) for name in worlds for scene_index in range(len(scenes[name]))
-              if any(plan.scene_index == scene_index for plan in plans[name])]
+    # a scene's robot and aim are those of its arcs' session (arcs and lines have their own board places)
+    drives = [(name, scene_index) for name in worlds for scene_index, session in scenes[name]
+              if session == "arc" and any(plan.scene_index == scene_index for plan in plans[name])]
     tasks = [partial(drive_scene, worlds[name], [(plan, trip) for plan, trip in zip(plans[name], trips[name])
                                                  if plan.scene_index == scene_index],
-                     scenes[name][scene_index], scene_index, name) for name, scene_index in drives]
+                     scenes[name][scene_index, "arc"], scene_index, name) for name, scene_index in drives]
     tasks += [partial(calibration_session, world_params, "generate.calibration" if name == "main"
                       else f"generate.{name}.calibration") for name, world_params in worlds.items()]
     results = workers.map(_call, tasks, desc=f"robot drives of {len(drives)} scenes and {len(worlds)} camera "
@@ -422,7 +443,7 @@ def plan_worlds(params: GenerateParams, protocol: ProtocolParams, workers: Worke
     for name, world_params in worlds.items():
         routes = {dataset: route for (world, _), (scene_routes, _) in driven.items() if world == name
                   for dataset, route in scene_routes.items()}
-        robot_accuracy = {scenes[name][scene_index].name: summary for (world, scene_index), (_, summary)
+        robot_accuracy = {scenes[name][scene_index, "arc"].name: summary for (world, scene_index), (_, summary)
                           in driven.items() if world == name}
         planned[name] = WorldPlan(name, world_params, sessions[name], scenes[name], plans[name], trips[name],
                                   [routes[plan.dataset] for plan in plans[name]], robot_accuracy)
@@ -446,10 +467,10 @@ def generate(params: GenerateParams, protocol: ProtocolParams, root: Path, worke
             shutil.rmtree(tmp, ignore_errors=True)
             (tmp / "model").mkdir(parents=True)
             (tmp / "images").mkdir()
-        shots = plan_shots(w.params, w.plans, w.trips, w.routes)
-        workers.map(partial(take_shot, w.params, root), shots,
+        shots = plan_shots(w.params, w.plans, w.trips, w.routes, {key: s.placement for key, s in w.scenes.items()})
+        workers.map(partial(take_shot, w.params, protocol, root), shots,
                     desc=f"camera poses of {len(w.plans)} datasets ({w.name} world)", progress=progress)
-        rows += [finish_dataset(w.params, root, plan, trip, route, w.scenes[plan.scene_index],
+        rows += [finish_dataset(w.params, root, plan, trip, route, w.scenes[plan.scene_index, plan.trajectory],
                                 w.calibration.calibration.camera) for plan, trip, route in zip(w.plans, w.trips, w.routes)]
     index = pd.DataFrame(rows)
     index.to_parquet(root / "index.parquet", index=False)

@@ -60,3 +60,20 @@ def calibration_errors(worlds: dict) -> pd.DataFrame:
 def folder_size_bytes(root: Path) -> int:
     """Total size of the files below ``root``."""
     return sum(p.stat().st_size for p in Path(root).rglob("*") if p.is_file())
+
+
+def board_layout(worlds: dict) -> pd.DataFrame:
+    """Per world, scene and session (``dataset.generate``'s plans): where the ground-truth board stands. Columns:
+    ``lever_arm_mm``, the distance from the board origin (where E_t is measured, IV-C) to the aim point the arcs turn
+    about (the target); ``in_view``, the share of the board inside the image at its worst commanded pose (standing
+    boards; NaN when it lies flat); ``scale_x``, ``scale_y``, the printed size over the drawn size as the lab
+    measured it."""
+    rows = []
+    for name, w in worlds.items():
+        for (index, session), scene in w.scenes.items():
+            rows.append({"world": name, "scene": scene.name, "session": session,
+                         "placement": w.params.board.placement, "board": w.params.board.type,
+                         "lever_arm_mm": float(np.linalg.norm(scene.T_world_board[:3, 3] - scene.aim)),
+                         "in_view": scene.placement.in_view if scene.placement is not None else np.nan,
+                         "scale_x": scene.board.scale[0], "scale_y": scene.board.scale[1]})
+    return pd.DataFrame(rows)

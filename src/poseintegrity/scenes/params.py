@@ -18,7 +18,7 @@ import numpy as np
 from pydantic import Field, ValidationError, ValidationInfo, field_validator, model_validator
 
 from poseintegrity.scenes.camera_params import (
-    CalibrationParams, CameraParams, CaptureParams, PrintedBoardParams, SensorParams,
+    CalibrationParams, CameraParams, CaptureParams, GroundTruthBoardParams, PrintedBoardParams, SensorParams,
 )
 from poseintegrity.scenes.foam import VOXEL_MM, ReliefVolume, relief_volume
 from poseintegrity.scenes.mesh import Material, read_mesh
@@ -209,6 +209,7 @@ class GenerateParams(Section):
     sensor: SensorParams
     calibration: CalibrationParams
     printed_boards: PrintedBoardParams
+    board: GroundTruthBoardParams
     capture: CaptureParams
     robot: RobotParams
     arcs: ArcParams

@@ -1,4 +1,4 @@
-"""Textures: procedural albedo maps (printed blocks, table, clutter, ArUco board), image files
+"""Textures: procedural albedo maps (printed blocks, table, clutter, the ground-truth board), image files
 as overrides, and the mip-mapped atlas the renderer samples.
 
 Albedo maps are 8-bit grayscale (the camera is the monochrome U3-3060CP-M); 255 means a white Lambertian surface.
@@ -11,6 +11,8 @@ from pathlib import Path
 
 import cv2
 import numpy as np
+
+from poseintegrity.boards import Board, Charuco
 
 N_MIP_LEVELS = 6
 PAD_PX = 2 ** (N_MIP_LEVELS - 1)  # replicated border around each texture, so coarse mip levels do not bleed
@@ -68,52 +70,15 @@ def wood_texture(rng: np.random.Generator, size: int = 2048) -> np.ndarray:
     return to_u8(0.42 + 0.05 * grain + 0.03 * rings)
 
 
-@dataclass(frozen=True)
-class BoardSpec:
-    """An ArUco GridBoard (cv2.aruco.GridBoard); the board frame is that of ``board.getObjPoints()`` (mm)."""
-
-    dictionary: str = "DICT_4X4_50"
-    markers_x: int = 3
-    markers_y: int = 2
-    marker_length_mm: float = 24.0
-    separation_mm: float = 6.0
-    first_id: int = 0
-    margin_mm: float = 8.0
-    px_per_mm: float = 8.0
-
-    def board(self) -> "cv2.aruco.GridBoard":
-        dictionary = cv2.aruco.getPredefinedDictionary(getattr(cv2.aruco, self.dictionary))
-        ids = np.arange(self.first_id, self.first_id + self.markers_x * self.markers_y)
-        return cv2.aruco.GridBoard((self.markers_x, self.markers_y), self.marker_length_mm, self.separation_mm,
-                                   dictionary, ids)
-
-    @property
-    def size_mm(self) -> tuple[float, float]:
-        """Width and height of the markers' area (without the white margin)."""
-        return (self.markers_x * self.marker_length_mm + (self.markers_x - 1) * self.separation_mm,
-                self.markers_y * self.marker_length_mm + (self.markers_y - 1) * self.separation_mm)
-
-    @property
-    def margin_px(self) -> int:
-        return int(round(self.margin_mm * self.px_per_mm))
-
-    @property
-    def texture_size(self) -> tuple[int, int]:
-        """(width, height) of :meth:`texture` in texels: the markers' area and the margin on each side."""
-        w_mm, h_mm = self.size_mm
-        return (int(round(w_mm * self.px_per_mm)) + 2 * self.margin_px,
-                int(round(h_mm * self.px_per_mm)) + 2 * self.margin_px)
-
-    def texture(self) -> np.ndarray:
-        """The printed board with its white margin; gray paper white (0.85), black ink (0.06)."""
-        img = self.board().generateImage(self.texture_size, marginSize=self.margin_px, borderBits=1)
-        img = img.astype(np.float32) / 255
-        return to_u8(0.06 + 0.79 * img)
-
-    def as_dict(self) -> dict:
-        return {"dictionary": self.dictionary, "markers_x": self.markers_x, "markers_y": self.markers_y,
-                "marker_length_mm": self.marker_length_mm, "separation_mm": self.separation_mm,
-                "first_id": self.first_id}
+def board_texture(board: Board, px_per_mm: float, margin_mm: float) -> np.ndarray:
+    """The printed ground-truth board (:mod:`poseintegrity.boards`, as drawn) with a white margin, (h, w) uint8 at
+    ``px_per_mm``: gray paper white (0.85), black ink (0.06). The pattern spans its drawing's size, centred."""
+    margin = int(round(margin_mm * px_per_mm))
+    w_mm, h_mm = board.size_mm
+    size = (int(round(w_mm * px_per_mm)) + 2 * margin, int(round(h_mm * px_per_mm)) + 2 * margin)
+    extra = {} if isinstance(board, Charuco) else {"borderBits": 1}
+    img = board.cv_board().generateImage(size, marginSize=margin, **extra).astype(np.float32) / 255
+    return to_u8(0.06 + 0.79 * img)
 
 
 def load_texture(path: Path) -> np.ndarray:

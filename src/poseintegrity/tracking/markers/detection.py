@@ -31,7 +31,7 @@ import numba
 import numpy as np
 
 from poseintegrity.defaults import published
-from poseintegrity.errors import PoseIntegrityError
+from poseintegrity.errors import ArgumentError, PoseIntegrityError, check_intrinsics, check_pose
 from poseintegrity.tracking.markers.geometry import transform_points
 from poseintegrity.tracking.params import DetectionParams
 
@@ -48,7 +48,9 @@ def validate_frame(ir: np.ndarray, depth_mm: np.ndarray, unproject: np.ndarray) 
 
     ir : (H, W) uint8/uint16/float; depth_mm : (H, W) numeric, millimetres; unproject : (3, 3) K or (H, W, 2) LUT.
     Depth whose valid (positive, finite) median is below 10 is taken to be in metres; an all-zero or
-    non-finite lookup table cannot unproject anything (both read on every 8th row and column).
+    non-finite lookup table cannot unproject anything (both read on every 8th row and column); nor can a K that is
+    not a finite [[fx, s, cx], [0, fy, cy], [0, 0, 1]] with fx, fy > 0, or whose image corners lie beyond the
+    lookup table's bound (a focal length of a fraction of a pixel).
     """
     ir, depth_mm, unproject = np.asarray(ir), np.asarray(depth_mm), np.asarray(unproject)
     if ir.ndim != 2 or ir.size == 0:
@@ -61,6 +63,16 @@ def validate_frame(ir: np.ndarray, depth_mm: np.ndarray, unproject: np.ndarray) 
         return f"unproject must be a numeric K or lookup table, got dtype {unproject.dtype}"
     if unproject.shape != (3, 3) and unproject.shape != ir.shape + (2,):
         return f"unproject must be a 3x3 K or an (H, W, 2) = {ir.shape + (2,)} lookup table, got {unproject.shape}"
+    if unproject.shape == (3, 3):
+        try:
+            K = check_intrinsics("unproject (a 3x3 K)", unproject)
+        except ArgumentError as error:
+            return f"{error}: it cannot unproject pixels"
+        corners = np.array([[0.0, 0.0], [ir.shape[1] - 1.0, ir.shape[0] - 1.0]])
+        if not np.all(np.abs(unit_plane_coordinates(corners, K)) <= MAX_UNIT_PLANE):
+            return (f"unproject (a 3x3 K): fx {K[0, 0]:g}, fy {K[1, 1]:g} px put the image corners beyond "
+                    f"{MAX_UNIT_PLANE:g} on the unit plane (a field of view over "
+                    f"{2 * np.degrees(np.arctan(MAX_UNIT_PLANE)):.0f} deg): it cannot unproject pixels")
     grid = (slice(None, None, 8), slice(None, None, 8))  # the unit checks read every 8th row and column (fast)
     lut = unproject[grid] if unproject.shape != (3, 3) else None
     if lut is not None and (not np.all(np.abs(lut) <= MAX_UNIT_PLANE) or not np.any(lut)):
@@ -402,10 +414,13 @@ def detect_markers(
     (0 or NaN = invalid); unproject : (3, 3) pinhole K or (H, W, 2) unit-plane LUT, lut[v, u] = (x, y);
     detection : the detector's constants (``track.detection``; None: the published defaults); T_world_cam : (4, 4) extrinsics, identity if
     None.  depth_offset_mm is added along the ray (the sphere radius: from the reflecting surface to the centre).
-    Blobs without a valid depth are dropped.  An unusable frame (see :func:`validate_frame`) gives an
-    empty (0, 3) array and a ``RuntimeWarning`` naming the reason; it never raises.
+    Blobs without a valid depth are dropped.  An unusable frame (see :func:`validate_frame`: IR, depth, K or lookup
+    table) gives an empty (0, 3) array and a ``RuntimeWarning`` naming the reason; a frame never raises.
+    T_world_cam that is not a finite rigid (4, 4) transform is refused (:class:`~poseintegrity.errors.ArgumentError`
+    naming it): points through NaN extrinsics would be NaN.
     """
     detection = published("track.detection") if detection is None else detection
+    T_world_cam = None if T_world_cam is None else check_pose("T_world_cam", T_world_cam)
     reason = validate_frame(ir, depth_mm, unproject)
     if reason:
         warnings.warn(f"detect_markers: {reason}", RuntimeWarning, stacklevel=2)

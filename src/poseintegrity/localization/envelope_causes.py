@@ -1,0 +1,80 @@
+"""Why each envelope ends (issue 30): per dataset and tolerance, the limit that ends theta_a and what caused it.
+
+theta_a (IV-E, :mod:`.envelope`) ends where a stop's criterion first exceeds its bound. This table says, for the
+headline PnP method and failed-frame rule:
+
+- ``limit``: the criterion that crosses first: ``translation`` (mean E_t), ``rotation`` (mean E_r), ``no_pose`` (the
+  share of frames without a pose), ``censored`` (none: the envelope lasts to the trajectory's end), ``unmeasured``
+  (theta_a could not be read);
+- ``cause``: ``no_pose`` when localization gave no pose; for an error limit, whether the estimate was off or its
+  ground truth was: at the first failing stop the same criterion is taken against the renderer's exact pose
+  (``E_*_exact``), and if it stays within the bound the envelope ended on the ground truth (``ground_truth``), else
+  on the estimate (``estimate``). Recorded data have no exact pose: the board's own consistency at that stop stands in
+  (``ground_truth`` when its frames' board poses were not trusted or dropped markers, ``estimate`` otherwise; the
+  ``board_*`` columns give the numbers);
+- ``theta_a`` beside ``theta_a_exact`` (the same envelope against the exact pose, a diagnostic), and the mean n_i
+  at theta_a (linearly interpolated between the stops' means).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from poseintegrity.localization.envelope import CRITERIA, EXACT_ERRORS, actual_envelope, stop_criteria
+from poseintegrity.protocol import EnvelopeParams, tolerance_name
+
+COLUMNS = ["world", "dataset", "trajectory", "tolerance", "theta_a", "censored", "theta_a_exact", "limit", "cause",
+           "n_inliers_at_theta_a", "board_untrusted_share", "board_dropped_share", "board_sigma_t_mm"]
+
+
+def envelope_causes(table: pd.DataFrame, tolerances: list[tuple[float, float]], envelope: EnvelopeParams,
+                    method: str) -> pd.DataFrame:
+    """One row per dataset and tolerance (:data:`COLUMNS`, module docstring) of ``method``'s usable artifact rows
+    ``table`` under the headline rule ``envelope.failed_frames``. The ``board_*`` columns describe the frames of the
+    first failing stop (the last stop when the envelope is censored)."""
+    rows = []
+    for (world, dataset, trajectory), frames in table[table["method"] == method].groupby(
+            ["world", "dataset", "trajectory"], sort=True):
+        position = "x_mm" if trajectory == "line" else "theta_deg"
+        per_stop = frames.groupby("stop", sort=True)
+        stops, theta = per_stop[position].mean().index.to_numpy(), per_stop[position].mean().to_numpy()
+        n_inliers = per_stop["n_inliers"].mean().to_numpy()
+        has_exact = bool(frames[list(EXACT_ERRORS)].notna().any().any())
+        for tolerance in tolerances:
+            criteria, bounds = stop_criteria(frames, tolerance, envelope.failed_frames, envelope)
+            theta_a, censored, _, criterion = actual_envelope(theta, criteria, bounds)
+            exact = (stop_criteria(frames, tolerance, envelope.failed_frames, envelope, EXACT_ERRORS)
+                     if has_exact else None)
+            with np.errstate(invalid="ignore"):
+                failing_stops = np.flatnonzero(np.any(criteria > bounds, axis=1))
+            failing = int(failing_stops[0]) if len(failing_stops) else len(stops) - 1
+            at_stop = frames[frames["stop"] == stops[failing]]
+            row = dict(world=world, dataset=dataset, trajectory=trajectory, tolerance=tolerance_name(tolerance),
+                       theta_a=theta_a, censored=censored,
+                       theta_a_exact=actual_envelope(theta, *exact).theta_a if exact is not None else float("nan"),
+                       n_inliers_at_theta_a=float(np.interp(theta_a, theta, n_inliers)) if np.isfinite(theta_a)
+                       else float("nan"),
+                       board_untrusted_share=float((at_stop["board_status"] != "ok").mean()),
+                       board_dropped_share=float((at_stop["board_n_dropped"] > 0).mean()),
+                       board_sigma_t_mm=float(at_stop["board_sigma_t_mm"].median()))
+            row["limit"], row["cause"] = _limit_and_cause(theta_a, censored, criterion, failing, bounds, exact, row)
+            rows.append(row)
+    return pd.DataFrame(rows, columns=COLUMNS)
+
+
+def _limit_and_cause(theta_a: float, censored: bool, criterion: int, failing: int, bounds: np.ndarray,
+                     exact: tuple[np.ndarray, np.ndarray] | None, row: dict) -> tuple[str, str]:
+    """(limit, cause) of one envelope (module docstring); ``failing``: the first failing stop's index."""
+    if not np.isfinite(theta_a):
+        return "unmeasured", "unmeasured"
+    if censored:
+        return "censored", "censored"
+    limit = CRITERIA[criterion]
+    if limit == "no_pose":
+        return limit, "no_pose"
+    if exact is not None:
+        value = exact[0][failing, criterion]
+        return limit, "ground_truth" if np.isfinite(value) and value <= bounds[criterion] else "estimate"
+    suspect = row["board_untrusted_share"] > 0 or row["board_dropped_share"] > 0
+    return limit, "ground_truth" if suspect else "estimate"
