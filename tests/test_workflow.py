@@ -197,6 +197,24 @@ def test_dvc_lock_was_written_by_the_committed_sources():
     assert not changed, f"sources changed since dvc.lock was written (re-run make repro): {changed}"
 
 
+def test_the_pnp_cache_stage_05_adds_to_stage_02s_output_is_ignored_by_dvc():
+    """Stage 05 caches its PnP results beside the SIFT features in data/features, an output of stage 02: DVC must
+    not count them (.dvcignore), or stage 02 would be out of date after every stage 05 and re-run."""
+    from types import SimpleNamespace
+
+    from dvc.repo import Repo
+
+    from poseintegrity.localization.extract import FrameTask
+
+    evidence = ROOT / "data" / "features" / "main_arc_0" / "images" / "s00_i00.evidence.npz"
+    pnp = FrameTask.pnp_path.fget(SimpleNamespace(evidence_path=evidence))
+    assert pnp.parent == evidence.parent and pnp != evidence
+    with Repo(str(ROOT)) as repo:
+        assert repo.dvcignore.is_ignored_file(str(pnp))
+        assert not any(repo.dvcignore.is_ignored_file(str(evidence.with_name(name)))
+                       for name in (evidence.name, "s00_i00.npz"))  # what stage 02 computes stays its output
+
+
 SHIPPED = ["src", "notebooks", "benchmarks", "docs", "README.md", "params.yaml", "dvc.yaml", "Makefile"]
 def test_outside_references_finds_what_a_clone_cannot_follow():
     text = "see NOTES_ELSEWHERE.md, ../../elsewhere/papers and /home/someone/data; README.md and ../params.yaml are fine"

@@ -50,19 +50,23 @@ def test_features_evidence_and_model_are_cached_per_image(table, synthetic_data_
     cache = synthetic_data_dir / extract_params.features_dir / "arc_a"
     assert len(list((cache / "images").glob("s*_i*[0-9].npz"))) == 8  # SIFT
     assert len(list((cache / "images").glob("*.evidence.npz"))) == 8  # matches to M_t and the ArUco pose
+    assert len(list((cache / "images").glob("*.pnp.npz"))) == 8  # every method's PnP result
     assert sorted(p.name for p in (cache / "model").glob("*.npz")) == ["0.npz", "1.npz", "M_t.npz"]
 
 
 def test_a_second_run_reuses_every_frame_evidence_and_gives_the_same_rows(
         table, synthetic_data_dir, extract_params, workers, monkeypatch):
-    """Stage 05 on stage 02's frames: no decoding, SIFT, matching or board detection again, the same values."""
+    """Stage 05 on stage 02's frames: no decoding, SIFT, matching or board detection again; a rerun with the same
+    methods and settings (after an edit of the package or of ``parallel``) no PnP either; the same values."""
     import poseintegrity.localization.evidence as evidence
+    import poseintegrity.localization.frame_pnp as frame_pnp
 
     def never(*args, **kwargs):
         raise AssertionError("recomputed what the evidence cache holds")
 
     for name in ("decode_gray", "cached_features", "correspondences", "board_pose"):
         monkeypatch.setattr(evidence, name, never)
+    monkeypatch.setattr(frame_pnp, "solve_methods", never)
     params = extract_params.model_copy(update=dict(datasets=["arc_a", "line_a"]))
     again = E.extract_all(synthetic_data_dir, params, METHODS, workers, progress=False)
     assert parquet_bytes(again) == parquet_bytes(table)

@@ -5,31 +5,14 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from scipy.spatial.transform import Rotation
 
 from poseintegrity.poses import pose_errors
 from poseintegrity.errors import PoseIntegrityError
 from poseintegrity.localization.pnp import (
-    CLASSIC_FLAGS, FAILURES, METHODS, reprojection_errors, solve_checked, solve_pnp_ransac,
+    CLASSIC_FLAGS, EPNP_KERNEL, FAILURES, METHODS, reprojection_errors, solve_checked, solve_methods, solve_pnp_ransac,
 )
 from poseintegrity.localization.ransac import minimal_sample_size, ransac_iterations
-
-K = np.array([[700.0, 0.0, 480.0], [0.0, 700.0, 300.0], [0.0, 0.0, 1.0]])
-
-
-def scene(seed, n=200, outlier_fraction=0.5, noise_px=0.3, displacement_px=(30, 200)):
-    """Non-planar points (mm) seen from a known pose; outliers (the first ones) displaced by ``displacement_px``."""
-    rng = np.random.default_rng(seed)
-    X = rng.uniform([-60, -40, -20], [60, 40, 20], (n, 3))
-    T = np.eye(4)
-    T[:3, :3] = Rotation.from_rotvec(rng.normal(0, 0.3, 3)).as_matrix()
-    T[:3, 3] = [rng.uniform(-20, 20), rng.uniform(-20, 20), rng.uniform(250, 400)]
-    x, _ = cv2.projectPoints(X, cv2.Rodrigues(T[:3, :3])[0], T[:3, 3], K, None)
-    x = x.reshape(-1, 2) + rng.normal(0, noise_px, (n, 2))
-    n_out = int(outlier_fraction * n)
-    direction = rng.normal(size=(n_out, 2))
-    x[:n_out] += direction / np.linalg.norm(direction, axis=1, keepdims=True) * rng.uniform(*displacement_px, (n_out, 1))
-    return X, x, T, n - n_out
+from pnp_scenes import K, scene
 
 
 @pytest.mark.parametrize("method", METHODS)
@@ -212,3 +195,59 @@ def test_the_budget_of_the_inlier_ratio_finds_what_100_iterations_miss():
 
     assert 2 <= misses(100) <= 15  # 8.3 expected, +- 3 sd
     assert misses(N) == 0
+
+
+def assert_same_result(shared, alone, label):
+    """Two PnP results equal value for value: pose (NaN where both are), inliers, OpenCV's count, status, reason."""
+    assert shared.status == alone.status and shared.reason == alone.reason, label
+    assert np.array_equal(shared.T_cam_model, alone.T_cam_model, equal_nan=True), label
+    assert np.array_equal(shared.inliers, alone.inliers) and shared.n_inliers_reported == alone.n_inliers_reported, label
+
+
+@settings(deadline=None, max_examples=40)
+@given(seed=st.integers(0, 10_000), n=st.integers(4, 150), outlier_fraction=st.floats(0.0, 0.95),
+       noise_px=st.floats(0.0, 2.0), threshold_px=st.floats(0.5, 3.0), cap=st.integers(1, 150),
+       methods=st.permutations(METHODS).flatmap(lambda order: st.integers(1, len(order)).map(lambda k: order[:k])))
+def test_shared_ransac_gives_each_method_its_own_result(seed, n, outlier_fraction, noise_px, threshold_px, cap,
+                                                        methods):
+    """solve_methods (one classic RANSAC for EPnP, SQPnP and iterative, each refit on its consensus) against one
+    solvePnPRansac per method, on random frames: the same results to the bit, failures and their reasons included
+    (EPNP_KERNEL: the proof from OpenCV's source)."""
+    X, x, _, _ = scene(seed, n=n, outlier_fraction=outlier_fraction, noise_px=noise_px)
+    caps = {method: cap if method in EPNP_KERNEL else cap + seed % 7 for method in methods}
+    shared = solve_methods(X, x, K, methods, threshold_px, 0.999, caps, seed, refine_lm=True)
+    assert list(shared) == list(methods)
+    for method in methods:
+        alone = solve_checked(X, x, K, method, threshold_px, 0.999, caps[method], seed, refine_lm=True)
+        assert_same_result(shared[method], alone, method)
+
+
+@pytest.mark.parametrize("methods", [("epnp", "sqpnp", "iterative"), ("sqpnp", "epnp"), ("iterative", "sqpnp")])
+@pytest.mark.parametrize("outlier_fraction", [0.5, 1.0])  # a consensus, and none (pure outliers: no pose at all)
+def test_the_methods_of_the_epnp_kernel_run_one_ransac(methods, outlier_fraction, monkeypatch):
+    """One solvePnPRansac call for the group, whose leader is the first of EPNP_KERNEL present; the others are refit
+    with solvePnP on its consensus, or fail with it when there is none."""
+    X, x, _, _ = scene(seed=8, n=120, outlier_fraction=outlier_fraction, noise_px=0.5)
+    calls = []
+    ransac = cv2.solvePnPRansac
+    monkeypatch.setattr(cv2, "solvePnPRansac",
+                        lambda *args, **kwargs: calls.append(kwargs["flags"]) or ransac(*args, **kwargs))
+    caps = dict.fromkeys(methods, 300)
+    shared = solve_methods(X, x, K, methods, 1.0, 0.999, caps, 3, refine_lm=True)
+    leader = next(method for method in EPNP_KERNEL if method in methods)
+    assert calls == [CLASSIC_FLAGS[leader]]
+    assert {result.status for result in shared.values()} == ({"ok"} if outlier_fraction < 1 else {"no_consensus"})
+    monkeypatch.setattr(cv2, "solvePnPRansac", ransac)
+    for method in methods:
+        assert_same_result(shared[method], solve_checked(X, x, K, method, 1.0, 0.999, 300, 3, True), method)
+
+
+@pytest.mark.parametrize("n", [4, 5, 6])
+def test_frames_opencv_does_not_sample_are_solved_per_method(n):
+    """4 or 5 matches: OpenCV solves them at once (P3P, EPnP) with no RANSAC and no refit, so nothing is shared; 6:
+    the smallest frame whose RANSAC is shared. Every method gets its own call's result."""
+    X, x, _, _ = scene(seed=9, n=n, outlier_fraction=0.0, noise_px=0.3)
+    methods = ("epnp", "sqpnp", "iterative")
+    shared = solve_methods(X, x, K, methods, 1.0, 0.999, dict.fromkeys(methods, 50), 2, refine_lm=True)
+    for method in methods:
+        assert_same_result(shared[method], solve_checked(X, x, K, method, 1.0, 0.999, 50, 2, True), method)

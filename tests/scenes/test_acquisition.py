@@ -4,13 +4,14 @@ burst's exposure times, the sub-exposures of the motion blur, and the image's po
 from dataclasses import replace
 
 import cv2
+import numba
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
 from poseintegrity.config import load_params
 from poseintegrity.scenes.acquisition import (
-    Visit, exposure_times, image_motion, image_pose, model_motion, rotation_maps,
+    Visit, _homography_maps, exposure_times, image_motion, image_pose, model_motion, rotation_maps,
 )
 from poseintegrity.scenes.ringdown import RingDown
 from repository import ROOT
@@ -28,6 +29,38 @@ def test_the_rotation_warp_is_the_homography_of_a_turned_camera():
     H = K @ Rotation.from_rotvec(rotation).as_matrix() @ np.linalg.inv(K)
     reference = cv2.warpPerspective(image, H, (320, 240), flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP)
     np.testing.assert_allclose(ours[20:-20, 20:-20], reference[20:-20, 20:-20], atol=2e-3)
+
+
+def numpy_rotation_maps(K, rotation, map_x, map_y):
+    """The numpy code rotation_maps replaced (the reference of its compiled pass)."""
+    H = K @ Rotation.from_rotvec(rotation).as_matrix() @ np.linalg.inv(K)
+    w = H[2, 0] * map_x + H[2, 1] * map_y + H[2, 2]
+    return ((H[0, 0] * map_x + H[0, 1] * map_y + H[0, 2]) / w).astype(np.float32), (
+        (H[1, 0] * map_x + H[1, 1] * map_y + H[1, 2]) / w).astype(np.float32)
+
+
+@pytest.mark.parametrize("dtype", [np.float32, np.float64])
+def test_the_compiled_rotation_maps_are_numpys_to_the_bit(dtype):
+    """Random rotations of ring-down size and larger, on distorted sensor maps like the lens' (float32, and float64):
+    the compiled pass gives numpy's float64 arithmetic rounded to float32, bit for bit (no FMA, no reordering)."""
+    rng = np.random.default_rng(3)
+    x, y = np.meshgrid(np.arange(320.0), np.arange(240.0))
+    r2 = ((x - 160) ** 2 + (y - 120) ** 2) / 500.0**2
+    map_x = (x + (x - 160) * 0.06 * r2 + rng.normal(0, 1e-3, x.shape)).astype(dtype)
+    map_y = (y + (y - 120) * 0.06 * r2).astype(dtype)
+    for scale in (1e-4, 1e-3, 1e-2, 0.3):
+        rotation = rng.normal(0.0, scale, 3)
+        ours, reference = rotation_maps(K, rotation, map_x, map_y), numpy_rotation_maps(K, rotation, map_x, map_y)
+        for a, b in zip(ours, reference):
+            assert a.dtype == np.float32 and np.array_equal(a.view(np.uint32), b.view(np.uint32)), scale
+    # Rounding to float32 hides almost every last-bit difference of the float64 values: a fused multiply-add would
+    # flip one map value in ~10^9 (a handful per stage-01 run), too rare to see here. The machine code must have none.
+    # numba shows no machine code of a kernel loaded from its cache: a fresh copy, compiled with the same options
+    options = {key: value for key, value in _homography_maps.targetoptions.items() if key != "nopython"}
+    fresh = numba.njit(**options)(_homography_maps.py_func)
+    fresh(np.eye(3), map_x, map_y, np.empty(map_x.shape, np.float32), np.empty(map_x.shape, np.float32))
+    assembly = fresh.inspect_asm(fresh.signatures[0]).lower()
+    assert "vdiv" in assembly and not any(fused in assembly for fused in ("vfmadd", "vfmsub", "vfnmadd", "vfnmsub"))
 
 
 def test_a_world_point_lands_where_the_turned_camera_sees_it():

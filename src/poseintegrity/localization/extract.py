@@ -8,7 +8,8 @@ workers of the ``parallel`` section (:class:`~poseintegrity.parallel.Workers`):
    camera.yaml's image size stops the stage naming it. M_t is stored beside the SIFT cache, and every frame task
    loads it from there once per worker process (a task carries its path, not its 1-2 MB of descriptors);
 2. per frame (one task, results in frame order): its evidence (:mod:`evidence`: image check, CLAHE + SIFT, ratio-test
-   matches to M_t, the board's checked pose; cached, so stage 05 reuses stage 02's), then PnP-RANSAC per method ->
+   matches to M_t, the board's checked pose; cached, so stage 05 reuses stage 02's), then PnP-RANSAC per method
+   (:mod:`frame_pnp`: cached per frame, the classic RANSAC shared by EPnP, SQPnP and iterative) ->
    artifacts (III-C) and E_t/E_r against the ground truth, the board pose of the frame (IV-C): ``E_t_mm``,
    ``E_r_deg`` (NaN without a pose, and without a trusted board pose: ``board_status`` other than "ok", e.g.
    ``bad_ground_truth`` with its ``board_reason``; such a frame keeps its localization status and n_i, it is only
@@ -45,9 +46,10 @@ from poseintegrity.localization.dataset import Dataset, DatasetError, load_datas
 from poseintegrity.localization.evidence import FrameEvidence, frame_evidence, model_digest
 from poseintegrity.localization.features import cached_features, read_gray, write_npz
 from poseintegrity.localization.frame_artifacts import frame_artifacts
+from poseintegrity.localization.frame_pnp import frame_pnp
 from poseintegrity.localization.ground_truth import BoardPose, board_from_dict, board_pose, no_pose, truth_error
 from poseintegrity.localization.params import ExtractParams
-from poseintegrity.localization.pnp import failed, solve_checked
+from poseintegrity.localization.pnp import PnPResult, failed, solve_checked
 from poseintegrity.localization.ransac import minimal_sample_size, ransac_iterations
 from poseintegrity.poses import NAN_POSE, pose_errors
 from poseintegrity.localization.target_model import TargetModel, build_target_model
@@ -83,6 +85,14 @@ def localize(
         object_points, image_points, K, method, params.reprojection_threshold_px, params.ransac_confidence,
         iteration_cap(method, params), seed, params.usac_refine_lm,
     )
+    return located(result, object_points, image_points, n_keypoints, model_size, K)
+
+
+def located(
+    result: PnPResult, object_points: np.ndarray, image_points: np.ndarray, n_keypoints: int, model_size: int,
+    K: np.ndarray,
+) -> tuple[np.ndarray, dict[str, Any], str, str]:
+    """What :func:`localize` returns for a PnP result of its correspondences."""
     artifacts = frame_artifacts(result, object_points, image_points, K, n_keypoints, model_size)
     if n_keypoints == 0:
         return result.T_cam_model, artifacts, "no_keypoints", "SIFT found no keypoints in the frame"
@@ -135,6 +145,11 @@ class FrameTask:
     params: ExtractParams
     ground_truth: str = "board"  # meta.json's ground_truth: "board" (IV-C) or "poses" (frames.parquet's)
     T_cam0_board_exact: np.ndarray | None = None  # model image 0's exact board pose (rendered data: R11)
+
+    @property
+    def pnp_path(self) -> Path:
+        """The cache of the frame's PnP results (:mod:`frame_pnp`), beside its evidence."""
+        return self.evidence_path.with_name(self.evidence_path.name.removesuffix(".evidence.npz") + ".pnp.npz")
 
 
 def dataset_model(dataset: Dataset, params: ExtractParams, cache_dir: Path) -> tuple[TargetModel, BoardPose]:
@@ -214,6 +229,10 @@ def frame_rows(task: FrameTask) -> list[dict[str, Any]]:
     E_t_truth_mm, E_r_truth_deg = truth_error(board.T_cam_board, T_cam_board, model.anchor.T_cam_board, exact_0)
     E_t_placement_mm, E_r_placement_deg = map(float, pose_errors(model.anchor.T_cam_board, exact_0))
     seed = frame_seed(task.params.seed, frame["dataset"], int(frame["stop"]), int(frame["image"]))
+    caps = {method: iteration_cap(method, task.params) for method in task.methods}
+    results = {} if evidence.image_problem else frame_pnp(  # cached per frame; the classic RANSAC shared
+        task.pnp_path, evidence.object_points, evidence.image_points, task.camera.K, model.digest, task.methods, caps,
+        task.params, seed)
     rows = []
     for method in task.methods:
         if evidence.image_problem:
@@ -221,9 +240,9 @@ def frame_rows(task: FrameTask) -> list[dict[str, Any]]:
                                                                 evidence.image_points, task.camera.K, 0,
                                                                 model.size)
         else:
-            T_est, artifacts, pnp_status, pnp_reason = localize(
-                evidence.object_points, evidence.image_points, evidence.n_keypoints, model.size, task.camera.K, method,
-                task.params, seed,
+            T_est, artifacts, pnp_status, pnp_reason = located(
+                results[method], evidence.object_points, evidence.image_points, evidence.n_keypoints, model.size,
+                task.camera.K,
             )
         E_t_mm, E_r_deg = map(float, pose_errors(T_est, truth))  # IV-C: the board is the truth (or the poses)
         E_t_exact_mm, E_r_exact_deg = map(float, pose_errors(T_est, T_cam_board))

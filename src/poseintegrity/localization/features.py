@@ -140,6 +140,10 @@ def write_npz(path: Path, **arrays) -> None:
     half-written entry."""
     path.parent.mkdir(parents=True, exist_ok=True)
     handle, tmp_path = tempfile.mkstemp(dir=path.parent, suffix=".npz")
-    with os.fdopen(handle, "wb") as stream:
-        np.savez(stream, **arrays)
-    os.replace(tmp_path, path)
+    try:
+        with os.fdopen(handle, "wb") as stream:
+            np.savez(stream, **arrays)
+        os.replace(tmp_path, path)
+    except BaseException:  # an error or an interrupt: no staging file is left behind
+        Path(tmp_path).unlink(missing_ok=True)
+        raise

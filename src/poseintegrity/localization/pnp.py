@@ -21,6 +21,11 @@ for every flag but P3P/AP3P, which draw 4 (:mod:`~poseintegrity.localization.ran
 iteration count").
 A frame with a lower inlier ratio may then fail: a budget, not a guarantee.
 
+Shared RANSAC: EPnP, SQPnP and iterative draw the same samples, solve them with EPnP and differ only in the final
+refit (:data:`EPNP_KERNEL`, with the proof from OpenCV's source). :func:`solve_methods` runs that RANSAC once per
+frame and refits each of the others on its consensus with ``cv2.solvePnP``: the same results as a call per method
+at about a third of their cost.
+
 Failures: every run without a pose has a status of :data:`FAILURES` and a reason that says why, with its numbers.
 
 n_i: classic RANSAC reports the inliers of the best *hypothesis*, not of the refined pose it returns (OpenCV
@@ -30,6 +35,7 @@ issue 29573; docs/references.md, "OpenCV 5"). For every method the inliers are t
 
 from __future__ import annotations
 
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import cv2
@@ -48,6 +54,24 @@ CLASSIC_FLAGS = {
     "iterative": cv2.SOLVEPNP_ITERATIVE,
 }
 METHODS = ("usac_magsac", *CLASSIC_FLAGS)
+# The classic methods whose solvePnPRansac is one and the same RANSAC, differing only in the refit on its consensus
+# (OpenCV 5, github.com/opencv/opencv, modules/geometry/src/solvepnp.cpp and ptsetreg.cpp; docs/references.md,
+# "RANSAC iteration count"). In solvePnPRansac (classic branch), for any flag but P3P/AP3P:
+#   1. the points are converted to float32 (opoints0.convertTo(opoints, CV_32F), the same for ipoints);
+#   2. with more than 5 of them, model_points = 5 and ransac_kernel_method = SOLVEPNP_EPNP whatever the flag, and the
+#      callback PnPRansacCallback(cameraMatrix, distCoeffs, SOLVEPNP_EPNP, useExtrinsicGuess, rvec, tvec) is made
+#      from them alone: its runKernel solves each sample with solvePnP(..., EPNP) (EPnP ignores the uninitialised
+#      rvec/tvec guess) and its computeError projects with projectPoints; neither reads the flag;
+#   3. createRANSACPointSetRegistrator(cb, 5, reprojectionError, confidence, iterationsCount)->run(opoints, ipoints)
+#      (ptsetreg.cpp, RANSACPointSetRegistrator::run) starts its generator from RNG((uint64)-1) on every call and
+#      draws, solves, scores and stops (RANSACUpdateNumIters) from those inputs only: the same best model and the
+#      same inlier mask for the three flags;
+#   4. only then does the flag act: solvePnP on the consensus (the float32 points converted back to float64,
+#      compressed in order by the mask) with the flag, SOLVEPNP_ITERATIVE starting from the best model
+#      (_local_model, which only its own call sees: hence it leads). The refit of EPnP and of the iterative solver
+#      gives one pose whenever it returns (solvePnPGeneric), so a leader's "no pose" means no consensus; SQPnP's
+#      can give none (solvePnPRansac then returns false).
+EPNP_KERNEL = ("iterative", "epnp", "sqpnp")  # in leading order
 MIN_CORRESPONDENCES = 4  # a unique pose needs 4 points; P3P with 3 leaves up to 4 solutions
 FAILURES = (
     "too_few_matches",    # fewer than MIN_CORRESPONDENCES matches
@@ -187,32 +211,126 @@ def solve_checked(
 ) -> PnPResult:
     """:func:`solve_pnp_ransac` without its argument checks: for a per-frame loop whose K comes from a checked
     :class:`~poseintegrity.lens.Camera` and whose points are the matches of checked features."""
-    object_points = np.ascontiguousarray(object_points, dtype=np.float64).reshape(-1, 3)
-    image_points = np.ascontiguousarray(image_points, dtype=np.float64).reshape(-1, 2)
-    K = np.asarray(K, dtype=np.float64)
+    object_points, image_points, K = _float64(object_points, image_points, K)
     n = len(object_points)
-    if n < MIN_CORRESPONDENCES:
-        return failed("too_few_matches", f"{n} matches, a pose needs {MIN_CORRESPONDENCES}")
-    if _is_degenerate(object_points):
-        return failed("degenerate_points", f"the {n} matched model points are (nearly) collinear or coincident")
+    if (early := _unsolvable(object_points)) is not None:
+        return early
     try:
         if method == "usac_magsac":
             usac = _usac_params(threshold_px, confidence, max_iterations, seed)
             found, _, rvec, tvec, reported = cv2.solvePnPRansac(object_points, image_points, K, None, params=usac)
         else:
-            order = np.random.default_rng(seed).permutation(n)  # OpenCV's fixed sampler, seeded
-            found, rvec, tvec, reported = cv2.solvePnPRansac(
-                object_points[order], image_points[order], K, None, iterationsCount=max_iterations,
-                reprojectionError=threshold_px, confidence=confidence, flags=CLASSIC_FLAGS[method],
-            )
+            order = _sample_order(seed, n)
+            found, rvec, tvec, reported = _classic_ransac(object_points[order], image_points[order], K, method,
+                                                          threshold_px, confidence, max_iterations)
     except cv2.error as error:
         return failed("opencv_error", f"cv2.error in {error.func}: {error.err}")
+    return _outcome(found, rvec, tvec, 0 if reported is None else len(reported), object_points, image_points, K,
+                    method, threshold_px, max_iterations, refine_lm)
+
+
+def solve_methods(
+    object_points: np.ndarray, image_points: np.ndarray, K: np.ndarray, methods: Sequence[str], threshold_px: float,
+    confidence: float, max_iterations: Mapping[str, int], seed: int, refine_lm: bool,
+) -> dict[str, PnPResult]:
+    """:func:`solve_checked` of every method of ``methods`` on the same correspondences (``max_iterations``: each
+    method's cap), the classic RANSAC run once for the methods of :data:`EPNP_KERNEL` that share it.
+
+    Equal, value for value, to one :func:`solve_checked` call per method (``tests/localization/test_pnp.py``): those
+    methods' classic ``solvePnPRansac`` calls draw the same samples, solve them with EPnP and score them alike, and
+    differ only in the refit on the consensus (proof at :data:`EPNP_KERNEL`). The first of them in
+    :data:`EPNP_KERNEL` order runs its own ``solvePnPRansac``; each other one refits on the consensus it returns
+    with ``cv2.solvePnP`` and its own flag, on the points rounded as OpenCV's RANSAC holds them (float32). Anything
+    else (a USAC or P3P/AP3P method, a single method of the group, a frame the RANSAC would not sample, an OpenCV
+    error) takes :func:`solve_checked`.
+    """
+    object_points, image_points, K = _float64(object_points, image_points, K)
+    group = [method for method in EPNP_KERNEL if method in methods]
+    results = {}
+    if len(group) > 1 and len({max_iterations[method] for method in group}) == 1:
+        results = _shared_ransac(object_points, image_points, K, group, threshold_px, confidence,
+                                 max_iterations[group[0]], seed)
+    return {method: results[method] if method in results else
+            solve_checked(object_points, image_points, K, method, threshold_px, confidence, max_iterations[method],
+                          seed, refine_lm)
+            for method in methods}
+
+
+def _shared_ransac(
+    object_points: np.ndarray, image_points: np.ndarray, K: np.ndarray, group: list[str], threshold_px: float,
+    confidence: float, max_iterations: int, seed: int,
+) -> dict[str, PnPResult]:
+    """The results of the ``group`` methods (:data:`EPNP_KERNEL` order) from one classic RANSAC; {} when OpenCV
+    would not sample (fewer than 6 matches, degenerate points) or raised (each method then runs on its own)."""
+    n = len(object_points)
+    if n <= minimal_sample_size(group[0]) or _unsolvable(object_points) is not None:
+        return {}  # 4 or 5 matches: OpenCV solves them at once (P3P, EPnP), no RANSAC to share
+    order = _sample_order(seed, n)
+    X, x = object_points[order], image_points[order]
+    leader, followers = group[0], group[1:]
+    try:
+        found, rvec, tvec, reported = _classic_ransac(X, x, K, leader, threshold_px, confidence, max_iterations)
+    except cv2.error:
+        return {}
+    n_reported = 0 if reported is None else len(reported)
+    results = {leader: _outcome(found, rvec, tvec, n_reported, object_points, image_points, K, leader, threshold_px,
+                                max_iterations, refine_lm=False)}
+    if not found:  # the leader's refit (EPnP, iterative) always gives a pose: the RANSAC found no consensus
+        return results | {method: failed("no_consensus", _no_pose(method, n, threshold_px, max_iterations))
+                          for method in followers}
+    consensus = reported.ravel()  # ascending indices of X, x: OpenCV's compressElems keeps the order
+    X_consensus = X.astype(np.float32).astype(np.float64)[consensus]  # as solvePnPRansac converts them, both ways
+    x_consensus = x.astype(np.float32).astype(np.float64)[consensus]
+    for method in followers:
+        try:
+            found, rvec, tvec = cv2.solvePnP(X_consensus, x_consensus, K, None, flags=CLASSIC_FLAGS[method])
+        except cv2.error:
+            continue  # solve_checked says what failed
+        results[method] = _outcome(found, rvec, tvec, n_reported, object_points, image_points, K, method,
+                                   threshold_px, max_iterations, refine_lm=False)
+    return results
+
+
+def _float64(object_points: np.ndarray, image_points: np.ndarray, K: np.ndarray) -> tuple[np.ndarray, ...]:
+    return (np.ascontiguousarray(object_points, dtype=np.float64).reshape(-1, 3),
+            np.ascontiguousarray(image_points, dtype=np.float64).reshape(-1, 2), np.asarray(K, dtype=np.float64))
+
+
+def _unsolvable(object_points: np.ndarray) -> PnPResult | None:
+    """The failure of correspondences no PnP can solve (too few, degenerate), None otherwise."""
+    n = len(object_points)
+    if n < MIN_CORRESPONDENCES:
+        return failed("too_few_matches", f"{n} matches, a pose needs {MIN_CORRESPONDENCES}")
+    if _is_degenerate(object_points):
+        return failed("degenerate_points", f"the {n} matched model points are (nearly) collinear or coincident")
+    return None
+
+
+def _sample_order(seed: int, n: int) -> np.ndarray:
+    """The order in which the classic path hands the n matches to OpenCV: its fixed sampler, seeded."""
+    return np.random.default_rng(seed).permutation(n)
+
+
+def _classic_ransac(
+    X: np.ndarray, x: np.ndarray, K: np.ndarray, method: str, threshold_px: float, confidence: float,
+    max_iterations: int,
+) -> tuple[bool, np.ndarray | None, np.ndarray | None, np.ndarray | None]:
+    """OpenCV's classic solvePnPRansac with the method's flag: (found, rvec, tvec, its inlier indices)."""
+    return cv2.solvePnPRansac(X, x, K, None, iterationsCount=max_iterations, reprojectionError=threshold_px,
+                              confidence=confidence, flags=CLASSIC_FLAGS[method])
+
+
+def _outcome(
+    found: bool, rvec: np.ndarray | None, tvec: np.ndarray | None, n_reported: int, object_points: np.ndarray,
+    image_points: np.ndarray, K: np.ndarray, method: str, threshold_px: float, max_iterations: int, refine_lm: bool,
+) -> PnPResult:
+    """The result of OpenCV's answer: its pose checked, (USAC with ``refine_lm``) polished, its inliers recounted."""
+    n = len(object_points)
     if not found or rvec is None:
         return failed("no_consensus", _no_pose(method, n, threshold_px, max_iterations))
     if not (np.all(np.isfinite(rvec)) and np.all(np.isfinite(tvec))):
         return failed("non_finite_pose", f"OpenCV returned a non-finite pose: rvec {np.ravel(rvec)}, "
                                          f"tvec {np.ravel(tvec)}")
-    n_reported = 0 if reported is None else len(reported)
     T_cam_model = pose_from_rvec_tvec(rvec, tvec)
     inliers = np.flatnonzero(reprojection_errors(object_points, image_points, K, T_cam_model) <= threshold_px)
     if method == "usac_magsac" and refine_lm and len(inliers) >= MIN_CORRESPONDENCES:

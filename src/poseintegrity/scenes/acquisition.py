@@ -8,6 +8,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import numba
 import numpy as np
 from scipy.spatial.transform import Rotation
 
@@ -83,8 +84,22 @@ def image_pose(visit: Visit, motion: Exposure) -> np.ndarray:
 def rotation_maps(K: np.ndarray, rotation: np.ndarray, map_x: np.ndarray, map_y: np.ndarray
                    ) -> tuple[np.ndarray, np.ndarray]:
     """Sampling maps of the view turned by ``rotation`` (3,) rad (camera frame): the canvas pixel p' an output
-    pixel sees through (map_x, map_y) is where the unturned camera saw that ray, p = K R K^-1 p' (pure rotation)."""
+    pixel sees through (map_x, map_y) (h, w) is where the unturned camera saw that ray, p = K R K^-1 p' (pure
+    rotation). Returns (h, w) float32 maps, computed in float64 (one compiled pass; the values of numpy's
+    ``(H[0, 0] * map_x + H[0, 1] * map_y + H[0, 2]) / w`` to the bit)."""
     H = K @ Rotation.from_rotvec(rotation).as_matrix() @ np.linalg.inv(K)
-    w = H[2, 0] * map_x + H[2, 1] * map_y + H[2, 2]
-    return ((H[0, 0] * map_x + H[0, 1] * map_y + H[0, 2]) / w).astype(np.float32), (
-        (H[1, 0] * map_x + H[1, 1] * map_y + H[1, 2]) / w).astype(np.float32)
+    out_x, out_y = np.empty(np.shape(map_x), np.float32), np.empty(np.shape(map_x), np.float32)
+    _homography_maps(H, map_x, map_y, out_x, out_y)
+    return out_x, out_y
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")  # no fastmath: IEEE float64, no reassociation or FMA
+def _homography_maps(H, map_x, map_y, out_x, out_y):
+    """out = float32 of H (3, 3) applied to the points (map_x, map_y) (h, w), divided by their third coordinate, in
+    float64 with numpy's order of operations (((a x + b y) + c) / w)."""
+    for i in range(map_x.shape[0]):
+        for j in range(map_x.shape[1]):
+            x, y = np.float64(map_x[i, j]), np.float64(map_y[i, j])
+            w = H[2, 0] * x + H[2, 1] * y + H[2, 2]
+            out_x[i, j] = np.float32((H[0, 0] * x + H[0, 1] * y + H[0, 2]) / w)
+            out_y[i, j] = np.float32((H[1, 0] * x + H[1, 1] * y + H[1, 2]) / w)

@@ -174,34 +174,27 @@ def _check_in_view(points_cam: np.ndarray, cam: Intrinsics, key: str, name: str,
                          f"to be seen; {hint}")
 
 
-def drive(params: GenerateParams, plans: list[DatasetPlan], trips: list[Trip],
-          scenes: dict[tuple[int, str], catalog.Scene], world: str = "main") -> tuple[list[Route], dict[str, dict[str, float]]]:
-    """The world's robot (drawn from its seed) placed in each scene where it reaches every commanded pose, then
-    driven: the routes of ``plans`` (same order) and, per scene, how far it lands from what was commanded
-    (:func:`.robot.accuracy`). A scene the robot cannot serve raises :class:`WorldError` naming it."""
+def drive_scene(params: GenerateParams, mine: list[tuple[DatasetPlan, Trip]], scene: catalog.Scene,
+                scene_index: int, world: str = "main") -> tuple[dict[str, Route], dict[str, float]]:
+    """The world's robot (drawn from its seed) placed in one scene where it reaches every commanded pose of the
+    scene's datasets ``mine`` (their plans and trips), then driven: each dataset's route, and how far it lands from
+    what was commanded (:func:`.robot.accuracy`). A scene the robot cannot serve raises :class:`WorldError` naming
+    it. Every draw is keyed by the world's seed and the scene or dataset: scenes can be driven in any order, apart."""
     robot = Robot.from_params(params.robot, keyed_rng(params.seed, "robot"))
-    routes: dict[str, Route] = {}
-    summary = {}
-    for (scene_index, session), scene in scenes.items():
-        if session != "arc":  # a scene's robot and aim are those of its arcs' session
-            continue
-        mine = [(plan, trip) for plan, trip in zip(plans, trips) if plan.scene_index == scene_index]
-        if not mine:
-            continue
-        try:
-            placed = robot.placed([trip_path(trip) for _, trip in mine], scene.aim, scene.name)
-        except ValueError as error:
-            raise WorldError(f"{scenes_key(world)}.{scene_index}: {error}") from None
-        first_trip = {plan.trajectory: trip for plan, trip in reversed(mine)}  # arcs share one model pair, lines one
-        model = {kind: visits(placed, trip.model_views, params, "model", scene_index, kind)
-                 for kind, trip in first_trip.items()}
-        for plan, trip in mine:
-            stops = visits(placed, trip_path(trip), params, plan.dataset)[len(trip.model_views):]
-            routes[plan.dataset] = Route(model[plan.trajectory], stops)
-        summary[scene.name] = accuracy(placed, [t for p, t in mine if p.trajectory == "arc"],
-                                       [t for p, t in mine if p.trajectory == "line"],
-                                       keyed_rng(params.seed, "accuracy", scene_index))
-    return [routes[plan.dataset] for plan in plans], summary
+    try:
+        placed = robot.placed([trip_path(trip) for _, trip in mine], scene.aim, scene.name)
+    except ValueError as error:
+        raise WorldError(f"{scenes_key(world)}.{scene_index}: {error}") from None
+    first_trip = {plan.trajectory: trip for plan, trip in reversed(mine)}  # arcs share one model pair, lines one
+    model = {kind: visits(placed, trip.model_views, params, "model", scene_index, kind)
+             for kind, trip in first_trip.items()}
+    routes = {}
+    for plan, trip in mine:
+        stops = visits(placed, trip_path(trip), params, plan.dataset)[len(trip.model_views):]
+        routes[plan.dataset] = Route(model[plan.trajectory], stops)
+    return routes, accuracy(placed, [t for p, t in mine if p.trajectory == "arc"],
+                            [t for p, t in mine if p.trajectory == "line"],
+                            keyed_rng(params.seed, "accuracy", scene_index))
 
 
 @dataclass(frozen=True)
@@ -418,15 +411,43 @@ class WorldPlan:
     robot_accuracy: dict[str, dict[str, float]]
 
 
-def plan_world(params: GenerateParams, protocol: ProtocolParams, name: str) -> WorldPlan:
-    """Check one world (:func:`check_world`), calibrate its camera (a calibration error names the key), plan its
-    datasets and drive its robot (:func:`drive`): every error comes here, before any dataset is rendered."""
-    scenes = check_world(params, protocol, name)
-    session = calibration_session(params, "generate.calibration" if name == "main" else f"generate.{name}.calibration")
-    plans = plan_datasets(params, name)
-    trips = [plan_trip(params, protocol, plan, scenes[plan.scene_index, plan.trajectory]) for plan in plans]
-    routes, robot_accuracy = drive(params, plans, trips, scenes, name)
-    return WorldPlan(name, params, session, scenes, plans, trips, routes, robot_accuracy)
+def _call(task: partial):
+    return task()
+
+
+def plan_worlds(params: GenerateParams, protocol: ProtocolParams, workers: Workers,
+                progress: bool = True) -> dict[str, WorldPlan]:
+    """Every world of ``params`` checked (:func:`check_world`) and its datasets planned, then, on ``workers``, each
+    world's camera calibrated (:func:`calibration_session`; a calibration error names the key) and its robot driven
+    in each scene (:func:`drive_scene`): every error comes here, before any dataset is rendered. The results do not
+    depend on where the tasks run (keyed draws): the same as one after the other, world by world."""
+    worlds = params.worlds()
+    scenes = {name: check_world(world_params, protocol, name) for name, world_params in worlds.items()}
+    plans = {name: plan_datasets(world_params, name) for name, world_params in worlds.items()}
+    trips = {name: [plan_trip(worlds[name], protocol, plan, scenes[name][plan.scene_index, plan.trajectory])
+                    for plan in plans[name]]
+             for name in worlds}
+    # a scene's robot and aim are those of its arcs' session (arcs and lines have their own board places)
+    drives = [(name, scene_index) for name in worlds for scene_index, session in scenes[name]
+              if session == "arc" and any(plan.scene_index == scene_index for plan in plans[name])]
+    tasks = [partial(drive_scene, worlds[name], [(plan, trip) for plan, trip in zip(plans[name], trips[name])
+                                                 if plan.scene_index == scene_index],
+                     scenes[name][scene_index, "arc"], scene_index, name) for name, scene_index in drives]
+    tasks += [partial(calibration_session, world_params, "generate.calibration" if name == "main"
+                      else f"generate.{name}.calibration") for name, world_params in worlds.items()]
+    results = workers.map(_call, tasks, desc=f"robot drives of {len(drives)} scenes and {len(worlds)} camera "
+                          f"calibrations", progress=progress)
+    driven = dict(zip(drives, results))
+    sessions = dict(zip(worlds, results[len(drives):]))
+    planned = {}
+    for name, world_params in worlds.items():
+        routes = {dataset: route for (world, _), (scene_routes, _) in driven.items() if world == name
+                  for dataset, route in scene_routes.items()}
+        robot_accuracy = {scenes[name][scene_index, "arc"].name: summary for (world, scene_index), (_, summary)
+                          in driven.items() if world == name}
+        planned[name] = WorldPlan(name, world_params, sessions[name], scenes[name], plans[name], trips[name],
+                                  [routes[plan.dataset] for plan in plans[name]], robot_accuracy)
+    return planned
 
 
 def generate(params: GenerateParams, protocol: ProtocolParams, root: Path, workers: Workers, *,
@@ -434,7 +455,7 @@ def generate(params: GenerateParams, protocol: ProtocolParams, root: Path, worke
     """Render every world's datasets under ``root`` and its calibration session under ``calibration_dir / world``
     (every world planned, calibrated and checked first), the shots on ``workers``; returns the index (also written)
     and each world's plan (its calibration and robot accuracy)."""
-    worlds = {name: plan_world(world_params, protocol, name) for name, world_params in params.worlds().items()}
+    worlds = plan_worlds(params, protocol, workers, progress)
     root = Path(root)
     root.mkdir(parents=True, exist_ok=True)
     (root / "index.parquet").unlink(missing_ok=True)
