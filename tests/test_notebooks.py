@@ -96,8 +96,18 @@ def test_stage_02_flags_the_spoiled_frames_and_writes_tables_metrics_and_figures
     for key in ("min_abs_spearman", "error_ratio_low_vs_high_inliers", "n_uncensored_4mm10deg",
                 "min_theta_a_2mm3deg", "cv_theta_a_2mm3deg"):
         assert key in found["realism"]
-    for figure in ("02_inliers_vs_theta", "02_error_vs_inliers", "02_theta_a_distribution"):
+    for figure in ("02_inliers_vs_theta", "02_error_vs_inliers", "02_theta_a_distribution", "02_envelope_causes"):
         assert (reports / "figures" / f"{figure}.png").stat().st_size > 0
+    exact = pd.read_parquet(data / "artifacts" / "envelopes_exact.parquet")  # the diagnostic against the exact pose
+    assert list(exact.columns) == list(env.columns) and set(exact["dataset"]) == set(env["dataset"])
+    causes = pd.DataFrame(found["envelope_causes"])  # one row per dataset of the main world and tolerance
+    assert len(causes) == (index.world == "main").sum() * len(TINY.protocol.tolerances)
+    assert set(causes["cause"]) <= {"estimate", "ground_truth", "no_pose", "censored"}
+    assert sum(sum(c.values()) for c in found["envelope_cause_counts"].values()) == len(causes)
+    truth = found["realism"]["truth_accuracy"]  # R11 on rendered data: measured against the exact pose
+    assert 0 < truth["trusted_share"] <= 1 and np.isfinite(truth["p99_E_t_truth_mm"])
+    assert found["realism"]["passed"]["r11_truth_accuracy"] == (truth["p99_E_t_truth_mm"] <= 0.5
+                                                                and truth["p99_E_r_truth_deg"] <= 0.5)
 
 
 def test_stage_05_writes_one_row_per_frame_and_method_with_stage_02s_evidence(pipeline):
@@ -153,6 +163,8 @@ def test_stage_04_scores_every_predictor_on_both_worlds_and_draws_every_figure(p
     assert {"straight_line", "pnp", "loso", "live", "fit_status", "tails", "envelope_rules",
             "model_choice"} <= set(found)
     assert set(found["model_choice"]["main"]) == set(TINY.predict.model_choice)  # every candidate, scored
+    for predictor in ("static", "long_range"):  # the exact-pose rows: a named diagnostic, never the headline
+        assert set(protocol.tolerance_names) <= set(found["exact_pose_diagnostic"][predictor])
     validation = metrics(reports, "validation.json")
     for predictor in ("static", "long_range", "mlp", "next_step"):  # the keys
         for tolerance in protocol.tolerance_names:

@@ -31,6 +31,7 @@ ARTIFACT_COLUMNS = ("world", "dataset", "trajectory", "stop", "image", "theta_de
                     "n_inliers", "E_t_mm", "E_r_deg")
 ENVELOPE_KEYS = ("dataset", "trajectory", "method", "tolerance")  # and "rule" when the table has one
 ENVELOPE_COLUMNS = ("world", "dataset", "trajectory", "method", "tolerance", "theta_a", "censored")
+NOT_MEASURED = "not_measured"  # an envelope row's status when its theta_a could not be read (localization.envelope)
 FIG2_KEYS = ("trajectory", "dataset", "k", "model")
 FIG2_COLUMNS = ("trajectory", "dataset", "k", "model", "rmse", "status", "reason", "n_samples")
 
@@ -109,11 +110,15 @@ def check_envelopes(table: pd.DataFrame, name: str = "the envelopes table", *,
                     datasets: Iterable[str] | None = None) -> pd.DataFrame:
     """An envelopes table (stage 02 / 05, or one rule's rows of it), checked: its columns, rows, one row per
     (dataset, trajectory, method, tolerance, and rule when it has that column), a known trajectory, theta_a a
-    finite number >= 0 (NaN is an envelope stage 02 could not read: refused naming the dataset), censored
-    booleans, every dataset of ``datasets`` present. Returns it unchanged."""
+    finite number >= 0, censored booleans, every dataset of ``datasets`` present. NaN theta_a is an envelope stage
+    02 could not read: allowed only on a row whose ``status`` says so (``not_measured``: no trusted ground truth
+    before the envelope ends; such rows are left out of the scoring, prediction.sweeps.attach_envelopes), refused
+    naming the dataset otherwise. Returns it unchanged."""
     keys = (*ENVELOPE_KEYS, *(["rule"] if "rule" in getattr(table, "columns", ()) else []))
     _structure(table, name, ENVELOPE_COLUMNS, keys)
-    _numeric(table, name, "theta_a", keys, low=0)
+    unread = table["status"].eq(NOT_MEASURED) if "status" in table.columns else pd.Series(False, index=table.index)
+    _numeric(table[~unread], name, "theta_a", keys, low=0)
+    _numeric(table[unread], name, "theta_a", keys, low=0, nan=True)
     if table["censored"].dtype.kind != "b":
         raise TableError(f"{name}: column censored must hold booleans, got dtype {table['censored'].dtype}")
     if unknown := sorted(set(table["trajectory"].astype(str)) - set(TRAJECTORIES)):

@@ -242,3 +242,18 @@ def test_free_width_variants_have_rows_of_their_own_beside_the_papers(swept, tin
             (mean_ours - mean_paper) / mean_paper, nan_ok=True)
     assert set(metrics["tails"]) == {"long_range", "long_range_free_width"}
     assert set(metrics["tails"]["long_range"]) == set(protocol.tolerance_names)
+
+
+def test_an_envelope_stage_02_could_not_read_is_left_out_of_the_scoring_by_name(swept, tables, protocol):
+    """theta_a NaN is allowed only where stage 02 says it could not be read (status not_measured: no trusted ground
+    truth before the envelope ends); those rows leave the scores, named in a warning, and the rest are unchanged."""
+    theta_p, _, _ = swept
+    envelopes = tables[1].assign(status="ok", reason="")
+    unread = envelopes.dataset == envelopes.dataset.iloc[0]
+    spoiled = envelopes.assign(theta_a=envelopes.theta_a.mask(unread), status=envelopes.status.mask(unread, "not_measured"))
+    with pytest.warns(UserWarning, match=f"1 dataset.* left out of the scoring.*{envelopes.dataset.iloc[0]}"):
+        scored = attach_envelopes(theta_p, spoiled, protocol)
+    full = attach_envelopes(theta_p, envelopes, protocol)
+    pd.testing.assert_frame_equal(scored, full[full.dataset != envelopes.dataset.iloc[0]].reset_index(drop=True))
+    with pytest.raises(ValueError, match="non-finite theta_a"):  # a NaN stage 02 did not flag
+        attach_envelopes(theta_p, spoiled.assign(status="ok"), protocol)

@@ -31,8 +31,8 @@ discrete sampled points"): it is skipped, never read as within tolerance, and th
 at the unmeasured stop (our first reading) made the envelope end where nothing was measured, later than the
 measured stops say: an optimistic envelope. A criterion not measured before the stop where it fails, or at no stop at
 all, leaves no envelope to read: theta_a is then NaN (``censored`` False, ``status`` ``not_measured``), warned about
-naming the dataset, unless the first stop already fails; the envelopes table's NaN is refused by the prediction stage
-(prediction.sweeps.attach_envelopes) naming the dataset.
+naming the dataset, unless the first stop already fails; the prediction stage leaves such a dataset out of the
+scoring, naming it (prediction.sweeps.attach_envelopes), and any other NaN theta_a is refused (tables.check_envelopes).
 """
 
 from __future__ import annotations
@@ -45,6 +45,7 @@ import pandas as pd
 
 from poseintegrity.errors import ArgumentError, check_array, check_increasing, check_same_length
 from poseintegrity.protocol import FAILED_FRAME_RULES, EnvelopeParams, tolerance_name
+from poseintegrity.tables import NOT_MEASURED
 
 ENVELOPE_INPUT = ("world", "dataset", "trajectory", "stop", "image", "theta_deg", "x_mm", "method", "status",
                   "E_t_mm", "E_r_deg")  # what envelopes reads of an artifacts table
@@ -186,7 +187,7 @@ def flag(theta_a: float, unmeasured: tuple[float, ...], unit: str) -> dict[str, 
     error were skipped (named, in ``unit``); ``not_measured`` when theta_a could not be read (NaN)."""
     stops = ", ".join(f"{t:g}" for t in unmeasured)
     if np.isnan(theta_a):
-        return dict(status="not_measured", reason="no pose error measured before the first failing stop (board never "
+        return dict(status=NOT_MEASURED, reason="no pose error measured before the first failing stop (board never "
                                                   "detected or trusted?)" + (f"; unmeasured stops at {stops} {unit}" if stops else ""))
     if unmeasured:
         return dict(status="unmeasured_stops", reason=f"no pose error measured at the stop(s) at {stops} {unit} (no "

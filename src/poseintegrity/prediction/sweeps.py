@@ -21,6 +21,7 @@ are counted in predictors.json (``fit_status``).
 
 from __future__ import annotations
 
+import warnings
 from functools import partial
 
 import numpy as np
@@ -195,7 +196,9 @@ def attach_envelopes(theta_p: pd.DataFrame, envelopes: pd.DataFrame, protocol: P
     (a duplicated row would count a dataset twice in every curve), their tolerances are those of ``protocol`` (a
     tolerance the params name would otherwise find no row, and its figures would silently be NaN), theta_a in
     [0, range end], and an envelope for every (dataset, trajectory, method) of ``theta_p`` (one missing would
-    drop that dataset from every curve): :class:`~poseintegrity.tables.TableError` naming them.
+    drop that dataset from every curve): :class:`~poseintegrity.tables.TableError` naming them. An envelope stage 02
+    could not read (theta_a NaN, status ``not_measured``) is left out of the scoring with a warning naming its
+    datasets: there is nothing to score a prediction against.
     """
     missing = [column for column in ENVELOPE_COLUMNS if column not in envelopes.columns]
     if missing:
@@ -211,7 +214,7 @@ def attach_envelopes(theta_p: pd.DataFrame, envelopes: pd.DataFrame, protocol: P
         raise TableError(f"the envelopes have tolerances {sorted(set(envelopes['tolerance']))}, protocol.tolerances "
                          f"are {protocol.tolerance_names}: was stage 02 run with another protocol?")
     end = envelopes["trajectory"].map(protocol.range_end)
-    outside = envelopes[~envelopes["theta_a"].between(0.0, end)]
+    outside = envelopes[~envelopes["theta_a"].between(0.0, end) & envelopes["theta_a"].notna()]
     if len(outside):
         row = outside.iloc[0]
         raise TableError(f"{len(outside)} envelopes lie outside [0, the protocol's range end], e.g. {row.dataset} "
@@ -226,4 +229,10 @@ def attach_envelopes(theta_p: pd.DataFrame, envelopes: pd.DataFrame, protocol: P
                          f"predictions, e.g. {shown}: they would be dropped from every curve (was stage 02 run on "
                          f"other datasets?)")
     table = theta_p.merge(envelopes[[*keys, "world", "tolerance", "theta_a", "censored"]], on=keys, how="inner")
-    return with_metrics(table)
+    unread = table[table["theta_a"].isna()]  # not_measured (check_envelopes): nothing to score a prediction against
+    if len(unread):
+        names = sorted(set(unread["dataset"]))
+        warnings.warn(f"{len(names)} dataset(s) left out of the scoring: their actual envelope could not be read (no "
+                      f"trusted ground truth before it ends; stage 02's envelopes, status not_measured): {names}",
+                      stacklevel=2)
+    return with_metrics(table[table["theta_a"].notna()].reset_index(drop=True))
