@@ -50,8 +50,10 @@ def test_an_unmeasured_stop_is_skipped_interpolating_from_the_last_measured_one(
     infinite = errors.copy()
     infinite[3] = np.inf  # a frame without a pose at the failing stop: the crossing is the last measured stop
     assert actual_envelope(THETA, infinite, TOLERANCE)[:3] == (0.0, False, (2.25, 4.5))
-    # an unmeasured last stop: censored where every criterion was last measured, not at the unmeasured end
-    assert actual_envelope(THETA, errors[[0, 3, 1, 2]] * [0.1, 1], TOLERANCE)[:3] == (2.25, True, (4.5, 6.75))
+    # unmeasured last stops and no failure: no end was seen, so none is read (neither the unmeasured end nor a
+    # censoring at 2.25, which would score every prediction beyond 2.25 deg as an incursion)
+    theta_a, censored, unmeasured, _ = actual_envelope(THETA, errors[[0, 3, 1, 2]] * [0.1, 1], TOLERANCE)
+    assert np.isnan(theta_a) and not censored and unmeasured == (4.5, 6.75)
     # measured stops only: the paper's definition, unchanged (the interpolation of the first test)
     assert actual_envelope(THETA[[0, 3]], errors[[0, 3]], TOLERANCE)[:2] == (pytest.approx(2.25), False)
 

@@ -22,7 +22,10 @@ Rules common to all: a tolerance is a pair (E_t mm, E_r deg) and a stop fails wh
 theta_a is the earliest crossing, each criterion linearly interpolated between the last stop where it was measured
 and passed and the first stop where it fails (a criterion that is infinite at the failing stop crosses at that last
 passing stop); a dataset whose first stop (the model view, IV-D; x = 0 on lines) already fails has theta_a = that
-stop; one that never fails is censored (``censored`` True) at the last stop where every criterion was measured.
+stop; one that never fails is censored (``censored`` True) at its last stop. When none fails but the last stops are
+unmeasured, no end was seen: theta_a is NaN (``not_measured``, below). Censoring it at the last measured stop would
+read a ground truth that stopped being trusted as the end of the trajectory, and every prediction beyond it as an
+incursion.
 
 A criterion is *unmeasured* at a stop when it is NaN there: every frame of the stop lacks the error (no trusted
 board pose in its posed frames). An unmeasured stop is no sampled point of that criterion (IV-E interpolates "between
@@ -72,9 +75,9 @@ def actual_envelope(theta: np.ndarray, criteria: np.ndarray, bounds: np.ndarray)
                average: unmeasured) never fails a stop and is no sampled point of its criterion
     bounds : (b,) the bound of each criterion
     theta_a is the earliest of the criteria's crossings, each interpolated between the criterion's last measured
-    stop before its first failing stop and that stop; censored at the last stop where every criterion was measured
-    when none fails. (NaN, False) when a criterion is measured at no stop before the one where it fails (or at no
-    stop) and the first stop does not fail: nothing measured, no envelope can be read. Refused
+    stop before its first failing stop and that stop; censored at the last stop when none fails. (NaN, False) when
+    none fails but the last stops are unmeasured, or when a criterion is measured at no stop before the one where it
+    fails (or at no stop) and the first stop does not fail: no end was seen, no envelope can be read. Refused
     (:class:`~poseintegrity.errors.ArgumentError` naming the argument): theta empty, not finite or not increasing;
     criteria not (m, b) of theta's length; bounds not b finite numbers.
     """
@@ -110,8 +113,11 @@ def actual_envelope(theta: np.ndarray, criteria: np.ndarray, bounds: np.ndarray)
         after = int(fails[0])
         fraction = (bound - values[j, c]) / (values[after, c] - values[j, c]) if np.isfinite(values[after, c]) else 0.0
         ends.append((float(theta[j] + fraction * (theta[after] - theta[j])), False, c))
-    theta_a, censored, criterion = min(ends, key=lambda end: end[:2])  # the earliest; a crossing before a censored
-    return Envelope(theta_a, censored, unmeasured, criterion)  # end at the same position
+    # the earliest end; a crossing comes before a censored end at the same position
+    theta_a, censored, criterion = min(ends, key=lambda end: end[:2])
+    if censored and theta_a < theta[-1]:  # none failed, but the measurements stop short of the trajectory's end
+        return Envelope(float("nan"), False, unmeasured)
+    return Envelope(theta_a, censored, unmeasured, criterion)
 
 
 GROUND_TRUTH_ERRORS = ("E_t_mm", "E_r_deg")  # against the ground truth (IV-C): the paper's metric
@@ -178,7 +184,7 @@ def envelopes(table: pd.DataFrame, tolerances: list[tuple[float, float]], envelo
     if len(unknown):
         names = sorted(set(unknown["dataset"]))
         warnings.warn(f"envelopes: {len(unknown)} theta_a of dataset(s) {names[:5]}{' ...' if len(names) > 5 else ''} "
-                      f"are NaN: no pose error was measured at any stop (board never detected or trusted?)", stacklevel=2)
+                      f"are NaN: not measured up to their end (board not detected or not trusted)", stacklevel=2)
     return result
 
 
@@ -187,8 +193,10 @@ def flag(theta_a: float, unmeasured: tuple[float, ...], unit: str) -> dict[str, 
     error were skipped (named, in ``unit``); ``not_measured`` when theta_a could not be read (NaN)."""
     stops = ", ".join(f"{t:g}" for t in unmeasured)
     if np.isnan(theta_a):
-        return dict(status=NOT_MEASURED, reason="no pose error measured before the first failing stop (board never "
-                                                  "detected or trusted?)" + (f"; unmeasured stops at {stops} {unit}" if stops else ""))
+        return dict(status=NOT_MEASURED, reason="theta_a cannot be read: no pose error measured before the first "
+                                                  "failing stop, or none fails and the last stops are unmeasured "
+                                                  "(board not detected or not trusted)"
+                                                  + (f"; unmeasured stops at {stops} {unit}" if stops else ""))
     if unmeasured:
         return dict(status="unmeasured_stops", reason=f"no pose error measured at the stop(s) at {stops} {unit} (no "
                                                       f"trusted board pose in their posed frames): skipped, theta_a read "
