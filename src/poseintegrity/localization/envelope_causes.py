@@ -24,6 +24,7 @@ import pandas as pd
 from poseintegrity.localization.envelope import CRITERIA, EXACT_ERRORS, actual_envelope, stop_criteria
 from poseintegrity.protocol import EnvelopeParams, tolerance_name
 
+CAUSES = ("estimate", "ground_truth", "no_pose", "censored", "unmeasured")  # every value of the cause column
 COLUMNS = ["world", "dataset", "trajectory", "tolerance", "theta_a", "censored", "theta_a_exact", "limit", "cause",
            "n_inliers_at_theta_a", "board_untrusted_share", "board_dropped_share", "board_sigma_t_mm"]
 

@@ -92,7 +92,8 @@ def realism_metrics(
     posed = rows[rows["status"] == "ok"]
     median_low = posed.loc[posed["n_inliers"] < 15, "E_t_mm"].median()
     median_high = posed.loc[posed["n_inliers"] > 50, "E_t_mm"].median()
-    arc_envelopes = envelope_table[(envelope_table["method"] == method) & (envelope_table["trajectory"] == "arc")]
+    read = envelope_table[envelope_table["theta_a"].notna()]  # an envelope that could not be read judges nothing
+    arc_envelopes = read[(read["method"] == method) & (read["trajectory"] == "arc")]
 
     def theta_a(tolerance: tuple[float, float]) -> pd.DataFrame:
         return arc_envelopes.loc[arc_envelopes["tolerance"] == tolerance_name(tolerance)].set_index("dataset")
@@ -117,8 +118,8 @@ def realism_metrics(
     rmse = base_function_rmse(rows, sampled, protocol.range_end("arc"), realism.max_nfev)
     others = {name: value for name, value in rmse.items() if name != "emg"}
     decay_arc, decay_line = decay_ratios(rows, "arc", sampled), decay_ratios(rows, "line", sampled)
-    lines = envelope_table[(envelope_table["method"] == method) & (envelope_table["trajectory"] == "line")
-                           & (envelope_table["tolerance"] == tolerance_name((2.0, 3.0)))]
+    lines = read[(read["method"] == method) & (read["trajectory"] == "line")
+                 & (read["tolerance"] == tolerance_name((2.0, 3.0)))]
     stop_theta = per_stop["theta"].groupby("dataset").apply(np.asarray).to_dict()
     first_stops = arcs[arcs["stop"].isin(np.sort(arcs["stop"].unique())[:sampled]) & (arcs["status"] == "ok")]
     uncensored = strict[~strict["censored"]]
@@ -128,6 +129,8 @@ def realism_metrics(
         method=method,
         n_datasets=int(rows["dataset"].nunique()),
         n_arc_datasets=n_arcs,
+        not_measured_datasets=sorted(set(envelope_table.loc[envelope_table["theta_a"].isna()
+                                                            & (envelope_table["method"] == method), "dataset"])),
         spearman_theta_vs_mean_inliers=spearman,
         min_abs_spearman=_nanmin([-rho for rho in spearman.values()]),  # a one-stop dataset has no rho
         spearman_to_failure=spearman_to_failure,

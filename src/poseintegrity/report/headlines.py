@@ -263,7 +263,8 @@ def _cause_rows(stage: str, prefix: str, section: str, world: str = "") -> list[
     for tolerance in paper.TOLERANCES:
         label = paper.TOLERANCE_LABELS[tolerance]
         for cause, text in (("estimate", "on the estimate"), ("ground_truth", "on a ground-truth fault"),
-                            ("no_pose", "without a pose"), ("censored", "never (censored)")):
+                            ("no_pose", "without a pose"), ("censored", "never (censored)"),
+                            ("unmeasured", "unread: not measured to its end (no trusted ground truth)")):
             rows.append(Headline(stage, f"{prefix}envelope_cause_counts.{tolerance}.{cause}",
                                  f"{at}envelopes ending {text}, {label}",
                                  target="0" if cause == "ground_truth" and tolerance == "2mm_3deg" else "-",
