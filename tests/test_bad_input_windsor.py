@@ -208,7 +208,7 @@ def test_unmeasured_errors_are_flagged_not_read_as_within_tolerance():
     frames = _artifacts().assign(E_t_mm=np.nan, E_r_deg=np.nan)
     from poseintegrity.protocol import EnvelopeParams
     params = EnvelopeParams.model_validate(dict(failed_frames="fail_fraction", cap_factor=2.0, max_failed_fraction=0.5))
-    with pytest.warns(UserWarning, match=r"arc_00.*NaN: no pose error was measured"):
+    with pytest.warns(UserWarning, match=r"arc_00.*NaN: not measured up to their end"):
         table = envelope_module.envelopes(frames, [(2.0, 3.0)], params)
     assert table.theta_a.isna().all() and not table.censored.any() and set(table.status) == {"not_measured"}
 

@@ -18,6 +18,7 @@ from notebook_run import TINY_PARAMS, execute, stage_06
 from poseintegrity.artifact_models import FIT_STATUSES
 from poseintegrity.artifact_models.names import distinct_theta_needed
 from poseintegrity.config import load_params
+from poseintegrity.localization.envelope_causes import CAUSES
 from poseintegrity.localization.summaries import FAILURE_STATUSES
 from poseintegrity.prediction import FITTED_PREDICTORS, FREE_WIDTH_PREDICTORS, NO_FIT
 from repository import ROOT
@@ -102,7 +103,7 @@ def test_stage_02_flags_the_spoiled_frames_and_writes_tables_metrics_and_figures
     assert list(exact.columns) == list(env.columns) and set(exact["dataset"]) == set(env["dataset"])
     causes = pd.DataFrame(found["envelope_causes"])  # one row per dataset of the main world and tolerance
     assert len(causes) == (index.world == "main").sum() * len(TINY.protocol.tolerances)
-    assert set(causes["cause"]) <= {"estimate", "ground_truth", "no_pose", "censored"}
+    assert set(causes["cause"]) <= set(CAUSES)
     assert sum(sum(c.values()) for c in found["envelope_cause_counts"].values()) == len(causes)
     truth = found["realism"]["truth_accuracy"]  # R11 on rendered data: measured against the exact pose
     assert 0 < truth["trusted_share"] <= 1 and np.isfinite(truth["p99_E_t_truth_mm"])
