@@ -59,3 +59,43 @@ def test_dvc_exp_run_gives_its_stage_the_venvs_python(tmp_path):
                  ["git", "commit", "-qm", "toy"], [dvc, "exp", "run", "-S", "x=2"]):
         subprocess.run(argv, cwd=tmp_path, env=FOREIGN, capture_output=True, text=True, check=True)
     assert (tmp_path / "out.txt").read_text().strip() == sys.executable
+
+
+def test_the_readmes_experiment_commands_run_as_written(tmp_path):
+    """README "Changing a parameter", on a one-stage project with a metric and a plot: named runs of three RANSAC
+    thresholds (run directly here; the README queues them, whose workers are checked by hand, above), then
+    `dvc exp show`, `dvc exp show --only-changed`, `dvc plots diff` of the three and `dvc exp apply` of one, each
+    line as the README writes it (run from the project's folder, so `.venv/bin/dvc` is this venv's dvc)."""
+    (tmp_path / ".venv").symlink_to(Path(sys.executable).parents[1])
+    (tmp_path / "dvc.yaml").write_text(
+        "stages:\n  fit:\n    cmd: python fit.py\n    deps: [fit.py]\n    params: [extract.reprojection_threshold_px]\n"
+        "    metrics: [{metrics.json: {cache: false}}]\n    plots: [{curve.csv: {cache: false, x: theta, y: n_i}}]\n")
+    (tmp_path / "fit.py").write_text(
+        "import json, yaml\nt = yaml.safe_load(open('params.yaml'))['extract']['reprojection_threshold_px']\n"
+        "json.dump({'theta_a': 10 * t}, open('metrics.json', 'w'))\n"
+        "open('curve.csv', 'w').write('theta,n_i\\n' + ''.join(f'{k},{100 - k * t}\\n' for k in range(5)))\n")
+    (tmp_path / "params.yaml").write_text("extract:\n  reprojection_threshold_px: 0.6\n")
+    (tmp_path / ".gitignore").write_text(".venv\n")
+    dvc = ".venv/bin/dvc"
+    setup = (["git", "init", "-q"], ["git", "config", "user.email", "test@example.org"],
+             ["git", "config", "user.name", "test"], [dvc, "init", "-q"], [dvc, "repro", "-q"], ["git", "add", "-A"],
+             ["git", "commit", "-qm", "toy"])
+    for t in ("0.4", "0.6", "0.9"):
+        setup += ([dvc, "exp", "run", "-n", f"ransac-{t}", "-S", f"extract.reprojection_threshold_px={t}"],)
+    for argv in setup:
+        subprocess.run(argv, cwd=tmp_path, env=FOREIGN, capture_output=True, text=True, check=True)
+
+    def readme(line: str) -> str:
+        return subprocess.run(line, shell=True, cwd=tmp_path, env=FOREIGN, capture_output=True, text=True,
+                              check=True).stdout
+
+    shown = readme(".venv/bin/dvc exp show")
+    assert all(f"ransac-{t}" in shown for t in ("0.4", "0.6", "0.9"))
+    changed = readme(".venv/bin/dvc exp show --only-changed")
+    assert "theta_a" in changed and "reprojection_threshold_px" in changed
+    readme(".venv/bin/dvc plots diff ransac-0.4 ransac-0.6 ransac-0.9")
+    page = (tmp_path / "dvc_plots" / "index.html").read_text()
+    assert all(f"ransac-{t}" in page for t in ("0.4", "0.6", "0.9"))
+    readme(".venv/bin/dvc exp apply ransac-0.9")
+    assert "0.9" in (tmp_path / "params.yaml").read_text()
+    assert json.loads((tmp_path / "metrics.json").read_text()) == {"theta_a": 9.0}
