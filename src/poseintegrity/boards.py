@@ -34,6 +34,11 @@ def aruco_dictionary(name: object, key: str = "board.dictionary") -> int:
     return value
 
 
+def dictionary_size(name: str) -> int:
+    """How many markers the predefined ArUco dictionary ``name`` holds (:func:`aruco_dictionary` checks the name)."""
+    return int(cv2.aruco.getPredefinedDictionary(aruco_dictionary(name)).bytesList.shape[0])
+
+
 @dataclass(frozen=True)
 class ArucoGrid:
     """An ArUco GridBoard: markers_x x markers_y markers of ``marker_length_mm``, ``separation_mm`` apart, ids from
@@ -48,8 +53,12 @@ class ArucoGrid:
     scale: tuple[float, float] = (1.0, 1.0)
     type: str = field(default="aruco_grid", init=False)
 
+    @property
+    def n_markers(self) -> int:
+        return self.markers_x * self.markers_y
+
     def cv_board(self) -> "cv2.aruco.GridBoard":
-        ids = np.arange(self.first_id, self.first_id + self.markers_x * self.markers_y)
+        ids = np.arange(self.first_id, self.first_id + self.n_markers)
         return cv2.aruco.GridBoard((self.markers_x, self.markers_y), self.marker_length_mm, self.separation_mm,
                                    cv2.aruco.getPredefinedDictionary(aruco_dictionary(self.dictionary)), ids)
 
@@ -77,6 +86,11 @@ class Charuco:
     marker_mm: float
     scale: tuple[float, float] = (1.0, 1.0)
     type: str = field(default="charuco", init=False)
+
+    @property
+    def n_markers(self) -> int:
+        """One marker in every white square."""
+        return self.squares_x * self.squares_y // 2
 
     def cv_board(self) -> "cv2.aruco.CharucoBoard":
         return cv2.aruco.CharucoBoard((self.squares_x, self.squares_y), self.square_mm, self.marker_mm,
@@ -120,16 +134,12 @@ def board_from_dict(spec: dict[str, Any], where: str = "board") -> Board:
     scale = tuple(_checked(s, f"{where}.scale", integer=False) for s in scale)
     if kind == "aruco_grid":
         values["first_id"] = _checked(spec.get("first_id", 0), f"{where}.first_id", integer=True, allow_zero=True)
-        first, n_markers = values["first_id"], values["markers_x"] * values["markers_y"]
-    else:
-        first, n_markers = 0, values["squares_x"] * values["squares_y"] // 2
-    size = cv2.aruco.getPredefinedDictionary(aruco_dictionary(spec["dictionary"])).bytesList.shape[0]
-    if first + n_markers > size:
-        raise ArgumentError(f"{where}: markers {first} .. {first + n_markers - 1} do not fit {spec['dictionary']} "
+    board = Charuco(**values, scale=scale) if kind == "charuco" else ArucoGrid(**values, scale=scale)
+    first, size = getattr(board, "first_id", 0), dictionary_size(board.dictionary)
+    if first + board.n_markers > size:
+        raise ArgumentError(f"{where}: markers {first} .. {first + board.n_markers - 1} do not fit {board.dictionary} "
                             f"({size} markers)")
-    if kind == "charuco":
-        return Charuco(**values, scale=scale)
-    return ArucoGrid(**values, scale=scale)
+    return board
 
 
 def _checked(value: object, key: str, integer: bool, allow_zero: bool = False) -> int | float:

@@ -32,13 +32,12 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
-import cv2
 import numpy as np
 import pandas as pd
 import pyarrow
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
-from poseintegrity.boards import aruco_dictionary
+from poseintegrity.boards import aruco_dictionary, dictionary_size
 from poseintegrity.errors import ArgumentError, PoseIntegrityError, not_numbers
 from poseintegrity.lens import Camera, CameraFileError, read_camera_yaml
 
@@ -118,7 +117,7 @@ class BoardMeta(_Read):
             first, last = 0, self.squares_x * self.squares_y // 2
         else:
             first, last = self.first_id, self.first_id + self.markers_x * self.markers_y
-        size = cv2.aruco.getPredefinedDictionary(aruco_dictionary(self.dictionary)).bytesList.shape[0]
+        size = dictionary_size(self.dictionary)
         if last > size:
             raise ValueError(f"board: markers {first} .. {last - 1} do not fit {self.dictionary}, which has "
                              f"{size} markers")

@@ -8,9 +8,9 @@ from typing import Annotated, Literal
 
 import cv2
 import numpy as np
-from pydantic import Field, field_validator, model_validator
+from pydantic import AfterValidator, Field, field_validator, model_validator
 
-from poseintegrity.boards import ArucoGrid, Board, Charuco
+from poseintegrity.boards import ArucoGrid, Board, Charuco, dictionary_size
 from poseintegrity.lens import LensError, check_folding
 from poseintegrity.schema import FromList, KeyRule, Section, ordered_range
 
@@ -27,6 +27,15 @@ MAX_SENSOR_PX = 4096  # a side of the sensor: larger frames take GBs of z-buffer
 
 Radial = Annotated[float, Field(ge=-2, le=2)]  # k_i beyond +-2 describe a fisheye, which plumb_bob does not model
 Tangential = Annotated[float, Field(ge=-0.05, le=0.05)]  # a lens decentred enough for p_i = 0.05 is broken
+
+
+def _known_dictionary(name: str) -> str:
+    if not isinstance(getattr(cv2.aruco, name, None), int):
+        raise ValueError(f"OpenCV has no ArUco dictionary {name!r}")
+    return name
+
+
+Dictionary = Annotated[str, Field(pattern=r"^DICT_\w+$"), AfterValidator(_known_dictionary)]  # both boards' dictionary
 
 
 class CameraParams(Section):
@@ -112,22 +121,14 @@ class CharucoParams(Section):
     squares_y: int = Field(ge=3, le=40)
     square_mm: float = Field(gt=0, le=200)
     marker_mm: float = Field(gt=0, le=200, description="the ArUco marker inside each white square")
-    dictionary: str = Field(pattern=r"^DICT_\w+$", description="an OpenCV ArUco dictionary, e.g. DICT_5X5_100")
-
-    @field_validator("dictionary")
-    @classmethod
-    def _known(cls, name: str) -> str:
-        if not isinstance(getattr(cv2.aruco, name, None), int):
-            raise ValueError(f"OpenCV has no ArUco dictionary {name!r}")
-        return name
+    dictionary: Dictionary = Field(description="an OpenCV ArUco dictionary, e.g. DICT_5X5_100")
 
     @model_validator(mode="after")
     def _marker_inside(self) -> "CharucoParams":
         if self.marker_mm >= self.square_mm:
             raise KeyRule("marker_mm", f"a marker lies inside its square: must be < square_mm ({self.square_mm:g}), "
                                        f"got {self.marker_mm:g}")
-        n_markers = (self.squares_x * self.squares_y) // 2
-        size = cv2.aruco.getPredefinedDictionary(getattr(cv2.aruco, self.dictionary)).bytesList.shape[0]
+        n_markers, size = self.squares_x * self.squares_y // 2, dictionary_size(self.dictionary)
         if n_markers > size:
             raise KeyRule("dictionary", f"{self.squares_x} x {self.squares_y} squares hold {n_markers} markers, "
                                         f"{self.dictionary} has {size}")
@@ -143,7 +144,7 @@ class GroundTruthBoardParams(Section):
     a pedestal beside the target, the layout before issue 30)."""
 
     type: Literal["aruco_grid", "charuco"]
-    dictionary: str = Field(pattern=r"^DICT_\w+$")
+    dictionary: Dictionary
     markers_x: int | None = Field(None, ge=1, le=20)
     markers_y: int | None = Field(None, ge=1, le=20)
     marker_length_mm: float | None = Field(None, gt=0, le=200)
@@ -155,13 +156,6 @@ class GroundTruthBoardParams(Section):
     margin_mm: float = Field(ge=0, le=100, description="white paper around the pattern")
     px_per_mm: float = Field(ge=2, le=32, description="texels per mm of the printed board's texture")
     placement: Literal["facing_camera", "flat"]
-
-    @field_validator("dictionary")
-    @classmethod
-    def _known(cls, name: str) -> str:
-        if not isinstance(getattr(cv2.aruco, name, None), int):
-            raise ValueError(f"OpenCV has no ArUco dictionary {name!r}")
-        return name
 
     @model_validator(mode="after")
     def _fields_of_its_type(self) -> "GroundTruthBoardParams":
@@ -176,10 +170,7 @@ class GroundTruthBoardParams(Section):
                     raise KeyRule(key, f"a key of a {kind} board; this board is {self.type}")
         if self.type == "charuco" and self.marker_mm >= self.square_mm:
             raise KeyRule("marker_mm", f"a marker lies inside its square: must be < square_mm ({self.square_mm:g})")
-        board = self.drawing()
-        n_markers = (board.markers_x * board.markers_y if isinstance(board, ArucoGrid)
-                     else board.squares_x * board.squares_y // 2)
-        size = cv2.aruco.getPredefinedDictionary(getattr(cv2.aruco, self.dictionary)).bytesList.shape[0]
+        n_markers, size = self.drawing().n_markers, dictionary_size(self.dictionary)
         if n_markers > size:
             raise KeyRule("dictionary", f"the board holds {n_markers} markers, {self.dictionary} has {size}")
         return self
