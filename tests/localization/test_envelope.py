@@ -170,6 +170,8 @@ def _causes_table(truth_errors, exact_errors, posed=None, board_status="ok"):
 @pytest.mark.parametrize("truth, exact, posed, cause, limit", [
     ([0.5, 1.0, 3.0, 4.0], [0.5, 1.0, 3.0, 4.0], None, "estimate", "translation"),
     ([0.5, 1.0, 3.0, 4.0], [0.4, 0.5, 0.6, 0.7], None, "ground_truth", "translation"),
+    ([0.5, 1.0, 2.2, 4.0], [0.5, 1.0, 1.9, 1.9], None, "resolution", "translation"),  # moved by 0.3 <= R11's 0.5 mm
+    ([0.5, 1.0, 2.6, 4.0], [0.5, 1.0, 1.9, 1.9], None, "ground_truth", "translation"),  # moved by 0.7 > 0.5 mm
     ([0.5, 0.5, 0.5, 0.5], [0.5, 0.5, 0.5, 0.5], [True, True, False, False], "no_pose", "no_pose"),
     ([0.5, 0.5, 0.5, 0.5], [0.5, 0.5, 0.5, 0.5], None, "censored", "censored"),
 ])
@@ -177,9 +179,21 @@ def test_each_envelope_end_gets_its_limit_and_cause(truth, exact, posed, cause, 
     causes = envelope_causes(_causes_table(truth, exact, posed), [(2.0, 3.0)], RULES, "usac_magsac")
     row = causes.iloc[0]
     assert (row["limit"], row["cause"]) == (limit, cause)
-    if cause == "ground_truth":  # against the exact pose the envelope lasts to the arc's end
-        assert row["theta_a"] == pytest.approx(2.25 + 2.25 / 2) and row["theta_a_exact"] == pytest.approx(6.75)
-        assert row["n_inliers_at_theta_a"] == pytest.approx(70.0)
+    if cause in ("ground_truth", "resolution"):  # against the exact pose the envelope lasts to the arc's end
+        assert row["theta_a_exact"] == pytest.approx(6.75)
+        assert row["truth_shift"] == pytest.approx(truth[2] - exact[2])
+    if truth == [0.5, 1.0, 3.0, 4.0] and cause == "ground_truth":
+        assert row["theta_a"] == pytest.approx(2.25 + 2.25 / 2) and row["n_inliers_at_theta_a"] == pytest.approx(70.0)
+
+
+def test_the_exact_pose_judges_the_frames_the_ground_truth_judged():
+    # stop 2: image 0's board pose is not trusted (no E_t), image 1's is, and the estimate there is off by 2.4 mm
+    # against either pose; image 0 is fine against the exact pose and would pull the exact mean to 1.45 mm
+    table = _causes_table([0.5, 1.0, 2.5, 4.0], [0.5, 1.0, 2.4, 4.0])
+    at = (table.stop == 2) & (table.image == 0)
+    table.loc[at, ["E_t_mm", "E_t_exact_mm", "board_status"]] = [np.nan, 0.5, "bad_ground_truth"]
+    row = envelope_causes(table, [(2.0, 3.0)], RULES, "usac_magsac").iloc[0]
+    assert (row["cause"], row["truth_shift"]) == ("estimate", pytest.approx(0.1))
 
 
 def test_without_exact_poses_the_boards_own_checks_stand_in():

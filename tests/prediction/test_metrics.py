@@ -8,6 +8,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from poseintegrity.prediction.tables import deciding_datasets
 from poseintegrity.prediction import (
     best_operating_point,
     incursion,
@@ -72,3 +73,17 @@ def test_incursion_rate_lies_in_zero_one(pairs):
 def test_relative_improvement_as_in_table_one():
     assert relative_improvement(12.9, 7.0) == pytest.approx(0.8429, abs=1e-4)  # paper: 84.1 % (rounded inputs)
     assert np.isnan(relative_improvement(3.0, 0.0)) and np.isnan(relative_improvement(3.0, np.nan))
+
+
+def test_the_arcs_that_hold_an_operating_point_are_those_incurring_at_the_next_bolder_one():
+    # n_t 10 lets d0 past its envelope, n_t 5 lets d0 and d1 past: n_t 20 (none) is held by d0 alone
+    table = _table({5.0: [9.0, 8.0, 2.0], 10.0: [7.0, 5.0, 2.0], 20.0: [5.0, 5.0, 2.0]}, [6.0, 6.0, 6.0])
+    best = best_operating_point(operating_curves(table), 0.0, conservative_high=True)
+    assert best[1] == 20.0
+    assert deciding_datasets(table, "long_range", "m", "arc", "t", best[1]) == ["d0"]
+    assert deciding_datasets(table, "long_range", "m", "arc", "t", 10.0) == ["d0", "d1"]
+    assert deciding_datasets(table, "long_range", "m", "arc", "t", 5.0) == []
+    assert deciding_datasets(table, "long_range", "m", "arc", "t", np.nan) == []
+    # the static baseline: a larger envelope size is bolder
+    sizes = _table({4.0: [4.0, 4.0], 6.0: [6.0, 6.0], 8.0: [8.0, 8.0]}, [7.0, 9.0]).assign(predictor="static")
+    assert deciding_datasets(sizes, "static", "m", "arc", "t", 6.0) == ["d0"]

@@ -8,8 +8,13 @@ headline PnP method and failed-frame rule:
   (theta_a could not be read);
 - ``cause``: ``no_pose`` when localization gave no pose; for an error limit, whether the estimate was off or its
   ground truth was: at the first failing stop the same criterion is taken against the renderer's exact pose
-  (``E_*_exact``), and if it stays within the bound the envelope ended on the ground truth (``ground_truth``), else
-  on the estimate (``estimate``). Recorded data have no exact pose: the board's own consistency at that stop stands in
+  (``E_*_exact``) *on the same frames* (those whose board pose was trusted). If it exceeds the bound too, the
+  envelope ended on the estimate (``estimate``). If it stays within, the ground truth moved the criterion across the
+  bound by ``truth_shift`` (criterion against the ground truth minus against the exact pose): by more than the
+  ground truth's own accuracy bar (R11, :data:`~poseintegrity.localization.truth_accuracy.R11_BAR`) that is a fault of
+  the ground truth (``ground_truth``); by no more, the ground truth was as good as R11 asks and the estimate's error
+  lay within its resolution of the bound (``resolution``): no ground truth of that accuracy can say on which side of
+  the bound that stop falls. Recorded data have no exact pose: the board's own consistency at that stop stands in
   (``ground_truth`` when its frames' board poses were not trusted or dropped markers, ``estimate`` otherwise; the
   ``board_*`` columns give the numbers);
 - ``theta_a`` beside ``theta_a_exact`` (the same envelope against the exact pose, a diagnostic), and the mean n_i
@@ -21,12 +26,14 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from poseintegrity.localization.envelope import CRITERIA, EXACT_ERRORS, actual_envelope, stop_criteria
+from poseintegrity.localization.envelope import (CRITERIA, EXACT_ERRORS, GROUND_TRUTH_ERRORS, actual_envelope,
+                                                 stop_criteria)
+from poseintegrity.localization.truth_accuracy import R11_BAR
 from poseintegrity.protocol import EnvelopeParams, tolerance_name
 
-CAUSES = ("estimate", "ground_truth", "no_pose", "censored", "unmeasured")  # every value of the cause column
+CAUSES = ("estimate", "ground_truth", "resolution", "no_pose", "censored", "unmeasured")  # every value of ``cause``
 COLUMNS = ["world", "dataset", "trajectory", "tolerance", "theta_a", "censored", "theta_a_exact", "limit", "cause",
-           "n_inliers_at_theta_a", "board_untrusted_share", "board_dropped_share", "board_sigma_t_mm"]
+           "truth_shift", "n_inliers_at_theta_a", "board_untrusted_share", "board_dropped_share", "board_sigma_t_mm"]
 
 
 def envelope_causes(table: pd.DataFrame, tolerances: list[tuple[float, float]], envelope: EnvelopeParams,
@@ -47,6 +54,8 @@ def envelope_causes(table: pd.DataFrame, tolerances: list[tuple[float, float]], 
             theta_a, censored, _, criterion = actual_envelope(theta, criteria, bounds)
             exact = (stop_criteria(frames, tolerance, envelope.failed_frames, envelope, EXACT_ERRORS)
                      if has_exact else None)
+            same_frames = (stop_criteria(_exact_where_truth(frames), tolerance, envelope.failed_frames, envelope,
+                                         EXACT_ERRORS)[0] if has_exact else None)
             with np.errstate(invalid="ignore"):
                 failing_stops = np.flatnonzero(np.any(criteria > bounds, axis=1))
             failing = int(failing_stops[0]) if len(failing_stops) else len(stops) - 1
@@ -59,23 +68,38 @@ def envelope_causes(table: pd.DataFrame, tolerances: list[tuple[float, float]], 
                        board_untrusted_share=float((at_stop["board_status"] != "ok").mean()),
                        board_dropped_share=float((at_stop["board_n_dropped"] > 0).mean()),
                        board_sigma_t_mm=float(at_stop["board_sigma_t_mm"].median()))
-            row["limit"], row["cause"] = _limit_and_cause(theta_a, censored, criterion, failing, bounds, exact, row)
+            row["limit"], row["cause"], row["truth_shift"] = _limit_and_cause(theta_a, censored, criterion, failing,
+                                                                              criteria, bounds, same_frames, row)
             rows.append(row)
     return pd.DataFrame(rows, columns=COLUMNS)
 
 
-def _limit_and_cause(theta_a: float, censored: bool, criterion: int, failing: int, bounds: np.ndarray,
-                     exact: tuple[np.ndarray, np.ndarray] | None, row: dict) -> tuple[str, str]:
-    """(limit, cause) of one envelope (module docstring); ``failing``: the first failing stop's index."""
+def _exact_where_truth(frames: pd.DataFrame) -> pd.DataFrame:
+    """``frames`` with the exact-pose errors blanked where the ground truth's are missing (board not trusted): the
+    criterion against the exact pose taken over the frames that the ground truth's criterion was taken over."""
+    blank = frames[list(GROUND_TRUTH_ERRORS)].isna().to_numpy()
+    exact = frames[list(EXACT_ERRORS)].to_numpy(dtype=float, copy=True)
+    exact[blank] = np.nan
+    return frames.assign(**dict(zip(EXACT_ERRORS, exact.T)))
+
+
+def _limit_and_cause(theta_a: float, censored: bool, criterion: int, failing: int, criteria: np.ndarray,
+                     bounds: np.ndarray, same_frames: np.ndarray | None, row: dict) -> tuple[str, str, float]:
+    """(limit, cause, truth_shift) of one envelope (module docstring); ``failing``: the first failing stop's index;
+    ``criteria`` (m, b) against the ground truth, ``same_frames`` (m, b) against the exact pose on the same frames
+    (None without exact poses). truth_shift is NaN where no error limit was compared with the exact pose."""
     if not np.isfinite(theta_a):
-        return "unmeasured", "unmeasured"
+        return "unmeasured", "unmeasured", float("nan")
     if censored:
-        return "censored", "censored"
+        return "censored", "censored", float("nan")
     limit = CRITERIA[criterion]
     if limit == "no_pose":
-        return limit, "no_pose"
-    if exact is not None:
-        value = exact[0][failing, criterion]
-        return limit, "ground_truth" if np.isfinite(value) and value <= bounds[criterion] else "estimate"
+        return limit, "no_pose", float("nan")
+    if same_frames is not None:
+        value = same_frames[failing, criterion]
+        shift = float(criteria[failing, criterion] - value)
+        if not (np.isfinite(value) and value <= bounds[criterion]):
+            return limit, "estimate", shift
+        return limit, "ground_truth" if shift > R11_BAR[criterion] else "resolution", shift
     suspect = row["board_untrusted_share"] > 0 or row["board_dropped_share"] > 0
-    return limit, "ground_truth" if suspect else "estimate"
+    return limit, "ground_truth" if suspect else "estimate", float("nan")

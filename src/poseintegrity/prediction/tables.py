@@ -2,6 +2,7 @@
 
     best_table        per predictor, PnP method, trajectory and tolerance: max mean SPL at zero incursion and its
                       operating point (Tables I-III)
+    deciding_datasets the datasets that hold an operating point where it is (they incur at the next bolder one)
     live_trials       the simulated live trials (V-C): next-step supervision at one fixed n_t vs the static baseline
     table_metrics     one world's Tables I-III, Figs. 6-7, fit statuses and tails (the validation world's figures)
     headline_metrics  the keys of ``reports/metrics/predictors.json`` (the main world: table_metrics, LOSO, live)
@@ -16,7 +17,8 @@ import pandas as pd
 from poseintegrity.artifact_models import FIT_STATUSES
 from poseintegrity.artifact_models.fitted import OK
 from poseintegrity.prediction.loso import loso_summary
-from poseintegrity.prediction.metrics import best_operating_point, operating_curves, relative_improvement
+from poseintegrity.prediction.metrics import (best_operating_point, operating_curves, relative_improvement,
+                                               with_metrics)
 from poseintegrity.prediction.params import PredictParams
 from poseintegrity.prediction.predictors import NO_FIT
 from poseintegrity.prediction.sweeps import (
@@ -37,6 +39,25 @@ def best_table(curves: pd.DataFrame, max_incursion_rate: float = 0.0) -> pd.Data
         rows.append(dict(predictor=predictor, method=method, trajectory=trajectory, tolerance=tolerance,
                          max_mean_spl=spl, best_operating_point=point))  # fmt: skip
     return pd.DataFrame(rows)
+
+
+def deciding_datasets(table: pd.DataFrame, predictor: str, method: str, trajectory: str, tolerance: str,
+                      point: float) -> list[str]:
+    """The datasets that decide a headline: those incurring (eq. 4) at the nearest operating point bolder than
+    ``point`` (a smaller n_t; a larger static size, :data:`~.sweeps.CONSERVATIVE_HIGH`) at which any dataset incurs.
+    Sorted; empty when ``point`` is NaN or no bolder point incurs. table : prediction rows (theta_p, theta_a)."""
+    rows = table[(table["predictor"] == predictor) & (table["method"] == method) & (table["trajectory"] == trajectory)
+                 & (table["tolerance"] == tolerance)]
+    if not np.isfinite(point) or rows.empty:
+        return []
+    rows = with_metrics(rows) if "incursion" not in rows else rows
+    high = CONSERVATIVE_HIGH.get(predictor, True)
+    bolder = rows[(rows["operating_point"] < point) if high else (rows["operating_point"] > point)]
+    incurring = bolder[bolder["incursion"] == 1.0]
+    if incurring.empty:
+        return []
+    nearest = incurring["operating_point"].max() if high else incurring["operating_point"].min()
+    return sorted(incurring.loc[incurring["operating_point"] == nearest, "dataset"].unique().tolist())
 
 
 def live_trials(table: pd.DataFrame, best: pd.DataFrame, predict: PredictParams, protocol: ProtocolParams
@@ -90,7 +111,8 @@ def table_metrics(table: pd.DataFrame, curves: pd.DataFrame, predict: PredictPar
 
     <predictor>.<tolerance>.{max_mean_spl_zero_incursion, best_n_t} on the arc datasets of the paper's PnP path
     (best_n_t is null for "static", whose operating point is ``best_size``, and for the relative-threshold
-    predictors, whose operating point is ``best_fraction``); <predictor>.relative_improvement
+    predictors, whose operating point is ``best_fraction``), and for the paper's predictors ``decided_by``, the arcs
+    that hold that operating point (:func:`deciding_datasets`); <predictor>.relative_improvement
     over static on the mean across tolerances (Tables I, II), long_range.relative_improvement_vs_mlp,
     next_step.relative_improvement_vs_long_range; straight_line.relative_improvement (Fig. 7);
     pnp.<method>.{max_mean_spl_zero_incursion, static_max_mean_spl_zero_incursion} (Fig. 6);
@@ -115,6 +137,9 @@ def table_metrics(table: pd.DataFrame, curves: pd.DataFrame, predict: PredictPar
         for tolerance in tolerances:
             spl, point = get(predictor, "arc", tolerance)
             entry[tolerance] = {"max_mean_spl_zero_incursion": spl, point_key: point}
+            if predictor in PAPER_PREDICTORS:
+                entry[tolerance]["decided_by"] = deciding_datasets(table, predictor, protocol.pnp_method, "arc",
+                                                                   tolerance, point)
             if point_key != "best_n_t":
                 entry[tolerance]["best_n_t"] = None
         mean_spl = float(np.mean([entry[t]["max_mean_spl_zero_incursion"] for t in tolerances]))

@@ -257,12 +257,14 @@ def _truth_rows(stage: str, prefix: str, section: str, world: str = "") -> list[
 
 def _cause_rows(stage: str, prefix: str, section: str, world: str = "") -> list[Headline]:
     """artifacts.json ``envelope_cause_counts``: per tolerance, how many envelopes (arcs and lines) end on the
-    estimate, on the ground truth, without a pose, or never (censored)."""
+    estimate, on a ground-truth fault, within the ground truth's resolution, without a pose, never (censored), or
+    unread (:mod:`~poseintegrity.localization.envelope_causes`)."""
     at = f"{world} world: " if world else ""
     rows = []
     for tolerance in paper.TOLERANCES:
         label = paper.TOLERANCE_LABELS[tolerance]
         for cause, text in (("estimate", "on the estimate"), ("ground_truth", "on a ground-truth fault"),
+                            ("resolution", "within the ground truth's resolution (moved across by <= R11's bar)"),
                             ("no_pose", "without a pose"), ("censored", "never (censored)"),
                             ("unmeasured", "unread: not measured to its end (no trusted ground truth)")):
             rows.append(Headline(stage, f"{prefix}envelope_cause_counts.{tolerance}.{cause}",

@@ -11,6 +11,7 @@ import json
 from pathlib import Path
 
 from poseintegrity.parallel import describe_backend
+from poseintegrity.report.deciding import deciding_section
 from poseintegrity.report.headlines import HEADLINES, RECORDED_TITLES, SECTIONS
 from poseintegrity.report.recorded import recorded_section, recorded_source
 from poseintegrity.timing import StageTiming
@@ -60,7 +61,8 @@ def timing_table(timings: list[StageTiming]) -> list[str]:
 
 
 def render_summary(metrics: dict[str, dict], timings: list[StageTiming]) -> str:
-    """Markdown: one table per stage, ours beside the paper's and the target; then the stage wall times.
+    """Markdown: one table per stage, ours beside the paper's and the target; the arcs that decide each headline
+    (:func:`~poseintegrity.report.deciding.deciding_section`); then the stage wall times.
 
     On recorded data (:func:`~poseintegrity.report.recorded.recorded_source`) the section on the user's datasets
     comes first and replaces stage 01's rendered-world rows; no target is shown (the rendered world's bars are not
@@ -92,6 +94,7 @@ def render_summary(metrics: dict[str, dict], timings: list[StageTiming]) -> str:
         described = lookup(metrics, stage, "realism.description_only")  # recorded data: no bar is judged
         lines += ["", f"Realism bars: {described}."] if isinstance(described, str) else []
         lines.append("")
+    lines += deciding_section(metrics)
     lines += ["## Same numbers on another machine", "", MACHINE_NOTE, "", "## Stage wall times", "", *timing_table(timings)]
     return "\n".join(lines)
 

@@ -1,0 +1,63 @@
+"""The summary's table of the arcs that decide each headline, and why each of them ends (issue 30).
+
+A headline of Tables I-III is the largest mean SPL at zero incursion; its operating point (n_t, or the static
+envelope size) is held where it is by the arcs that would incur at the next bolder point (``predictors.json`` /
+``validation.json`` ``<predictor>.<tolerance>.decided_by``, :func:`~poseintegrity.prediction.tables.deciding_datasets`).
+Beside each such arc: how its envelope ends (``artifacts.json`` ``envelope_causes``, of its world and tolerance,
+:mod:`~poseintegrity.localization.envelope_causes`): theta_a against the ground truth and against the exact pose, the
+limit, the cause, what the ground truth moved the criterion by, and n_i at theta_a.
+"""
+
+from __future__ import annotations
+
+import math
+
+HEADER = ["| world | tolerance | predictor | max mean SPL (deg) | operating point | decided by | theta_a (deg) | "
+          "theta_a, exact pose (deg) | limit | ends on | ground truth moved it by | n_i at theta_a |",
+          "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
+
+
+def _number(value, fmt: str = "{:.2f}") -> str:
+    return "-" if value is None or (isinstance(value, float) and math.isnan(value)) else fmt.format(value)
+
+
+def _causes(metrics: dict[str, dict], world: str | None) -> dict[tuple[str, str], dict]:
+    """(dataset, tolerance) -> that envelope's row of ``artifacts.json``'s cause table: the first world's (top
+    level) when ``world`` is None, else ``worlds.<world>``'s."""
+    artifacts = metrics.get("artifacts", {})
+    rows = artifacts.get("envelope_causes") if world is None else artifacts.get("worlds", {}).get(world, {}).get(
+        "envelope_causes")
+    return {(row["dataset"], row["tolerance"]): row for row in rows or []}
+
+
+def deciding_section(metrics: dict[str, dict]) -> list[str]:
+    """Markdown lines: the table of the module docstring for the main world (``predictors.json``) and the held-out
+    one (``validation.json``); no lines when neither stage wrote ``decided_by``."""
+    lines = []
+    for stage in ("predictors", "validation"):
+        table = metrics.get(stage, {})
+        world = table.get("world") if stage == "validation" else None  # predictors.json: the first world's
+        causes = _causes(metrics, world)
+        for predictor, entries in table.items():
+            for tolerance, entry in sorted(entries.items()) if isinstance(entries, dict) else ():
+                if not isinstance(entry, dict) or "decided_by" not in entry:
+                    continue
+                point = entry.get("best_n_t") if entry.get("best_n_t") is not None else entry.get("best_size")
+                head = (f"| {world or 'main'} | {tolerance} | {predictor} | "
+                        f"{_number(entry['max_mean_spl_zero_incursion'])} | {_number(point, '{:g}')} |")
+                for dataset in entry["decided_by"] or [None]:
+                    row = causes.get((dataset, tolerance), {})
+                    lines.append(f"{head} {dataset or 'none'} | {_number(row.get('theta_a'))} | "
+                                 f"{_number(row.get('theta_a_exact'))} | {row.get('limit', '-')} | "
+                                 f"{row.get('cause', '-')} | {_number(row.get('truth_shift'), '{:.3f}')} | "
+                                 f"{_number(row.get('n_inliers_at_theta_a'), '{:.1f}')} |")
+    if not lines:
+        return []
+    return ["## Which arcs decide each headline, and why they end", "",
+            "The arcs that hold each predictor's operating point where it is: at the next bolder point (a smaller n_t, "
+            "a larger static size) they are the ones that incur. Beside each, how its envelope ends "
+            "(`artifacts.json` `envelope_causes`): `estimate` (the estimate's error crosses the tolerance against the "
+            "exact pose too), `resolution` (it stays within against the exact pose, and the ground truth, within "
+            "R11's bar, moved it across by the amount shown: the estimate's error lies within the ground truth's "
+            "resolution of the tolerance), `ground_truth` (moved across by more: a fault), `no_pose`.", "",
+            *HEADER, *lines, ""]
