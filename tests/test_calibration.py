@@ -20,7 +20,11 @@ TINY_PARAMS = ROOT / "tests" / "params_tiny.yaml"
 
 @pytest.fixture(scope="module")
 def generate():
-    return parse_params(read_raw(TINY_PARAMS)[0], base_dir=ROOT).generate
+    """The tiny world's camera (a quarter of the resolution) with params.yaml's session (the tiny overlay's 15 views
+    only keep the other tests fast)."""
+    tiny = parse_params(read_raw(TINY_PARAMS)[0], base_dir=ROOT).generate
+    session = parse_params(read_raw(ROOT / "params.yaml")[0], base_dir=ROOT).generate.calibration
+    return tiny.model_copy(update={"calibration": session})
 
 
 @pytest.fixture(scope="module")
