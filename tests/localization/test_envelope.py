@@ -193,7 +193,10 @@ def test_the_exact_pose_judges_the_frames_the_ground_truth_judged():
     at = (table.stop == 2) & (table.image == 0)
     table.loc[at, ["E_t_mm", "E_t_exact_mm", "board_status"]] = [np.nan, 0.5, "bad_ground_truth"]
     row = envelope_causes(table, [(2.0, 3.0)], RULES, "usac_magsac").iloc[0]
-    assert (row["cause"], row["truth_shift"]) == ("estimate", pytest.approx(0.1))
+    assert (row["cause"], row["truth_shift"], row["unmeasured_stops"]) == ("estimate", pytest.approx(0.1), 0)
+    table.loc[table.stop == 1, ["E_t_mm", "E_r_deg", "board_status"]] = [np.nan, np.nan, "bad_ground_truth"]
+    row = envelope_causes(table, [(2.0, 3.0)], RULES, "usac_magsac").iloc[0]  # theta_a read across stop 1
+    assert row["unmeasured_stops"] == 1 and row["theta_a"] == pytest.approx(1.5 / 2.0 * 4.5)  # 0.5 at 0, 2.5 at 4.5
 
 
 def test_without_exact_poses_the_boards_own_checks_stand_in():

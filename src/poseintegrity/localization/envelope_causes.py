@@ -18,7 +18,9 @@ headline PnP method and failed-frame rule:
   (``ground_truth`` when its frames' board poses were not trusted or dropped markers, ``estimate`` otherwise; the
   ``board_*`` columns give the numbers);
 - ``theta_a`` beside ``theta_a_exact`` (the same envelope against the exact pose, a diagnostic), and the mean n_i
-  at theta_a (linearly interpolated between the stops' means).
+  at theta_a (linearly interpolated between the stops' means);
+- ``unmeasured_stops``: how many stops up to the first failing one had no error to average (no trusted ground truth
+  in any posed frame): theta_a was read across them (:func:`~.envelope.actual_envelope` skips them).
 """
 
 from __future__ import annotations
@@ -33,7 +35,7 @@ from poseintegrity.protocol import EnvelopeParams, tolerance_name
 
 CAUSES = ("estimate", "ground_truth", "resolution", "no_pose", "censored", "unmeasured")  # every value of ``cause``
 COLUMNS = ["world", "dataset", "trajectory", "tolerance", "theta_a", "censored", "theta_a_exact", "limit", "cause",
-           "truth_shift", "n_inliers_at_theta_a", "board_untrusted_share", "board_dropped_share", "board_sigma_t_mm"]
+           "truth_shift", "n_inliers_at_theta_a", "unmeasured_stops", "board_untrusted_share", "board_dropped_share", "board_sigma_t_mm"]
 
 
 def envelope_causes(table: pd.DataFrame, tolerances: list[tuple[float, float]], envelope: EnvelopeParams,
@@ -65,6 +67,7 @@ def envelope_causes(table: pd.DataFrame, tolerances: list[tuple[float, float]], 
                        theta_a_exact=actual_envelope(theta, *exact).theta_a if exact is not None else float("nan"),
                        n_inliers_at_theta_a=float(np.interp(theta_a, theta, n_inliers)) if np.isfinite(theta_a)
                        else float("nan"),
+                       unmeasured_stops=int(np.isnan(criteria[: failing + 1, :2]).all(axis=1).sum()),
                        board_untrusted_share=float((at_stop["board_status"] != "ok").mean()),
                        board_dropped_share=float((at_stop["board_n_dropped"] > 0).mean()),
                        board_sigma_t_mm=float(at_stop["board_sigma_t_mm"].median()))

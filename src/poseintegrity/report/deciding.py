@@ -5,7 +5,8 @@ envelope size) is held where it is by the arcs that would incur at the next bold
 ``validation.json`` ``<predictor>.<tolerance>.decided_by``, :func:`~poseintegrity.prediction.tables.deciding_datasets`).
 Beside each such arc: how its envelope ends (``artifacts.json`` ``envelope_causes``, of its world and tolerance,
 :mod:`~poseintegrity.localization.envelope_causes`): theta_a against the ground truth and against the exact pose, the
-limit, the cause, what the ground truth moved the criterion by, and n_i at theta_a.
+limit, the cause, what the ground truth moved the criterion by, n_i at theta_a, and how many stops before it had no
+trusted ground truth (theta_a was read across them).
 """
 
 from __future__ import annotations
@@ -13,8 +14,8 @@ from __future__ import annotations
 import math
 
 HEADER = ["| world | tolerance | predictor | max mean SPL (deg) | operating point | decided by | theta_a (deg) | "
-          "theta_a, exact pose (deg) | limit | ends on | ground truth moved it by | n_i at theta_a |",
-          "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
+          "theta_a, exact pose (deg) | limit | ends on | ground truth moved it by | n_i at theta_a | stops unmeasured |",
+          "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
 
 
 def _number(value, fmt: str = "{:.2f}") -> str:
@@ -50,7 +51,8 @@ def deciding_section(metrics: dict[str, dict]) -> list[str]:
                     lines.append(f"{head} {dataset or 'none'} | {_number(row.get('theta_a'))} | "
                                  f"{_number(row.get('theta_a_exact'))} | {row.get('limit', '-')} | "
                                  f"{row.get('cause', '-')} | {_number(row.get('truth_shift'), '{:.3f}')} | "
-                                 f"{_number(row.get('n_inliers_at_theta_a'), '{:.1f}')} |")
+                                 f"{_number(row.get('n_inliers_at_theta_a'), '{:.1f}')} | "
+                                 f"{_number(row.get('unmeasured_stops'), '{:d}')} |")
     if not lines:
         return []
     return ["## Which arcs decide each headline, and why they end", "",
