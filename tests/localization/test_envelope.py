@@ -205,3 +205,14 @@ def test_without_exact_poses_the_boards_own_checks_stand_in():
     table.loc[table.stop == 2, "board_n_dropped"] = 1
     row = envelope_causes(table, [(2.0, 3.0)], RULES, "usac_magsac").iloc[0]
     assert row["cause"] == "ground_truth" and row["board_dropped_share"] == 1.0 and np.isnan(row["theta_a_exact"])
+
+
+def test_the_cause_is_read_where_the_ending_criterion_fails_not_where_another_one_does():
+    # stop 1: posed, board not trusted; stop 2: no pose at all (the no-pose share fails there, crossing at 3.375 deg);
+    # E_t is read across both, 0.5 at 0 deg to 4.0 at 6.75 deg: translation ends first (2.89 deg), failing at stop 3,
+    # where the exact pose says 1.0 mm: the ground truth moved it by 3 mm
+    table = _causes_table([0.5, 0.5, 0.5, 4.0], [0.5, 0.5, 0.5, 1.0], posed=[True, True, False, True])
+    table.loc[table.stop == 1, ["E_t_mm", "E_r_deg", "board_status"]] = [np.nan, np.nan, "bad_ground_truth"]
+    row = envelope_causes(table, [(2.0, 3.0)], RULES, "usac_magsac").iloc[0]
+    assert row["theta_a"] == pytest.approx(1.5 / 3.5 * 6.75) and row["limit"] == "translation"
+    assert (row["cause"], row["truth_shift"], row["unmeasured_stops"]) == ("ground_truth", pytest.approx(3.0), 2)

@@ -7,7 +7,7 @@ headline PnP method and failed-frame rule:
   share of frames without a pose), ``censored`` (none: the envelope lasts to the trajectory's end), ``unmeasured``
   (theta_a could not be read);
 - ``cause``: ``no_pose`` when localization gave no pose; for an error limit, whether the estimate was off or its
-  ground truth was: at the first failing stop the same criterion is taken against the renderer's exact pose
+  ground truth was: at the first stop where that limit's criterion exceeds its bound (the failing stop) the criterion is taken against the renderer's exact pose
   (``E_*_exact``) *on the same frames* (those whose board pose was trusted). If it exceeds the bound too, the
   envelope ended on the estimate (``estimate``). If it stays within, the ground truth moved the criterion across the
   bound by ``truth_shift`` (criterion against the ground truth minus against the exact pose): by more than the
@@ -58,9 +58,9 @@ def envelope_causes(table: pd.DataFrame, tolerances: list[tuple[float, float]], 
                      if has_exact else None)
             same_frames = (stop_criteria(_exact_where_truth(frames), tolerance, envelope.failed_frames, envelope,
                                          EXACT_ERRORS)[0] if has_exact else None)
-            with np.errstate(invalid="ignore"):
-                failing_stops = np.flatnonzero(np.any(criteria > bounds, axis=1))
-            failing = int(failing_stops[0]) if len(failing_stops) else len(stops) - 1
+            with np.errstate(invalid="ignore"):  # the first stop where the criterion that ends theta_a exceeds its bound
+                over = criteria[:, criterion] > bounds[criterion] if criterion >= 0 else np.any(criteria > bounds, axis=1)
+            failing = int(np.flatnonzero(over)[0]) if over.any() else len(stops) - 1
             at_stop = frames[frames["stop"] == stops[failing]]
             row = dict(world=world, dataset=dataset, trajectory=trajectory, tolerance=tolerance_name(tolerance),
                        theta_a=theta_a, censored=censored,
