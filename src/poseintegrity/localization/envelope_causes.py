@@ -7,9 +7,9 @@ headline PnP method and failed-frame rule:
   share of frames without a pose), ``censored`` (none: the envelope lasts to the trajectory's end), ``unmeasured``
   (theta_a could not be read);
 - ``cause``: ``no_pose`` when localization gave no pose; for an error limit, whether the estimate was off or its
-  ground truth was: at the first stop where that limit's criterion exceeds its bound (the failing stop) the criterion is taken against the renderer's exact pose
-  (``E_*_exact``) *on the same frames* (those whose board pose was trusted). If it exceeds the bound too, the
-  envelope ended on the estimate (``estimate``). If it stays within, the ground truth moved the criterion across the
+  ground truth was: at the first stop where that limit's criterion exceeds its bound (the failing stop) the
+  criterion is taken against the renderer's exact pose (``E_*_exact``) *on the same frames* (those whose board pose
+  was trusted). If it exceeds the bound too, the envelope ended on the estimate (``estimate``). If it stays within, the ground truth moved the criterion across the
   bound by ``truth_shift`` (criterion against the ground truth minus against the exact pose): by more than the
   ground truth's own accuracy bar (R11, :data:`~poseintegrity.localization.truth_accuracy.R11_BAR`) that is a fault of
   the ground truth (``ground_truth``); by no more, the ground truth was as good as R11 asks and the estimate's error
@@ -35,7 +35,8 @@ from poseintegrity.protocol import EnvelopeParams, tolerance_name
 
 CAUSES = ("estimate", "ground_truth", "resolution", "no_pose", "censored", "unmeasured")  # every value of ``cause``
 COLUMNS = ["world", "dataset", "trajectory", "tolerance", "theta_a", "censored", "theta_a_exact", "limit", "cause",
-           "truth_shift", "n_inliers_at_theta_a", "unmeasured_stops", "board_untrusted_share", "board_dropped_share", "board_sigma_t_mm"]
+           "truth_shift", "n_inliers_at_theta_a", "unmeasured_stops", "board_untrusted_share", "board_dropped_share",
+           "board_sigma_t_mm"]
 
 
 def envelope_causes(table: pd.DataFrame, tolerances: list[tuple[float, float]], envelope: EnvelopeParams,
@@ -58,8 +59,9 @@ def envelope_causes(table: pd.DataFrame, tolerances: list[tuple[float, float]], 
                      if has_exact else None)
             same_frames = (stop_criteria(_exact_where_truth(frames), tolerance, envelope.failed_frames, envelope,
                                          EXACT_ERRORS)[0] if has_exact else None)
-            with np.errstate(invalid="ignore"):  # the first stop where the criterion that ends theta_a exceeds its bound
-                over = criteria[:, criterion] > bounds[criterion] if criterion >= 0 else np.any(criteria > bounds, axis=1)
+            with np.errstate(invalid="ignore"):  # the failing stop: where the criterion ending theta_a first fails
+                over = (criteria[:, criterion] > bounds[criterion] if criterion >= 0
+                        else np.any(criteria > bounds, axis=1))
             failing = int(np.flatnonzero(over)[0]) if over.any() else len(stops) - 1
             at_stop = frames[frames["stop"] == stops[failing]]
             row = dict(world=world, dataset=dataset, trajectory=trajectory, tolerance=tolerance_name(tolerance),

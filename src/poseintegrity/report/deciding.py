@@ -14,7 +14,8 @@ from __future__ import annotations
 import math
 
 HEADER = ["| world | tolerance | predictor | max mean SPL (deg) | operating point | decided by | theta_a (deg) | "
-          "theta_a, exact pose (deg) | limit | ends on | ground truth moved it by | n_i at theta_a | stops unmeasured |",
+          "theta_a, exact pose (deg) | limit | ends on | ground truth moved it by | n_i at theta_a | "
+          "stops unmeasured |",
           "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
 
 
