@@ -21,8 +21,3 @@ def execute(name: str, work: Path, params_path: Path = TINY_PARAMS) -> Path:
     )
     return work
 
-
-def stage_06(folder: Path) -> None:
-    """Stage 06's notebook into ``folder``: the tracking study depends on no other stage, so the tests run it once per
-    session (``run_once("stage_06", stage_06)``) for tests/tracking/test_notebook_06.py and the chain's report."""
-    execute("06_marker_tracking", folder)

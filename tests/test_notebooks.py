@@ -3,8 +3,8 @@
 One module fixture runs the chain in one temporary folder (each notebook reads the data of the one before), once:
 the tests below each check one stage's outputs. Two frames are spoiled after stage 01, as a recording may hold
 them (an image file that is not an image, a NaN ground-truth pose): every later stage must run on with them flagged.
-Stage 06 depends on no other stage: its notebook runs once per session (tests/tracking/test_notebook_06.py, on the
-other worker) and the report reads its metrics.
+Stage 06 depends on no other stage: it runs once per session (tests/project_copy.py, stage_06_project) and the
+report reads its metrics.
 """
 
 import json
@@ -14,13 +14,14 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from notebook_run import TINY_PARAMS, execute, stage_06
+from notebook_run import TINY_PARAMS, execute
 from poseintegrity.artifact_models import FIT_STATUSES
 from poseintegrity.artifact_models.names import distinct_theta_needed
 from poseintegrity.config import load_params
 from poseintegrity.localization.envelope_causes import CAUSES
 from poseintegrity.localization.summaries import FAILURE_STATUSES
 from poseintegrity.prediction import FITTED_PREDICTORS, FREE_WIDTH_PREDICTORS, NO_FIT
+from project_copy import stage_06_project
 from repository import ROOT
 
 pytestmark = pytest.mark.notebook
@@ -57,7 +58,7 @@ def pipeline(tmp_path_factory, run_once):
     spoil_two_frames(work / "data")
     for name in ("02_extract_artifacts", "05_pnp_variants", "03_fit_artifact_models", "04_predictor_sweeps"):
         execute(name, work)
-    shutil.copytree(run_once("stage_06", stage_06) / "reports", work / "reports", dirs_exist_ok=True)
+    shutil.copytree(run_once("stage_06", stage_06_project) / "reports", work / "reports", dirs_exist_ok=True)
     execute("07_report", work)
     return work / "data", work / "reports"
 

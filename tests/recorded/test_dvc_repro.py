@@ -12,19 +12,24 @@ yaml and csv, never the exporter):
   world; colour 16-bit TIFF with board ground truth, mono 8-bit PNG of two sizes with pose ground truth.
 
 Every output dvc.yaml declares must exist, and the summary must say what was measured on the data without judging
-a rendered world. Each run prints its wall time and CPU seconds (`pytest -s`).
+a rendered world. Each run starts from the session's project copy in which stage 06 (marker tracking, which reads no
+recording) is done (tests/project_copy.py, stage_06_project): DVC finds it unchanged and runs the other six stages.
+Each run prints its wall time and CPU seconds (`pytest -s`).
 """
 
 from __future__ import annotations
 
 import json
+import shutil
 
 import cv2
+import pandas as pd
 import pytest
 import yaml
 
 from foreign_datasets import Folder, write_folder
-from project_copy import DVC, project_copy, run
+from poseintegrity.localization.dataset import load_dataset, recorded_worlds
+from project_copy import DVC, run, stage_06_project, write_params
 from repository import ROOT
 
 RUNS = {
@@ -41,32 +46,42 @@ RUNS = {
 }
 
 
-@pytest.fixture(scope="session")
-def cache_dir(tmp_path_factory):
-    """The DVC cache of the session's runs. (DVC's run cache cannot spare the second run stage 06: a stage with an
-    uncached output that is neither a metric nor a plot, its timing file, is never saved to it.)"""
-    return tmp_path_factory.mktemp("dvc_cache")
-
-
 def declared_outputs() -> list[str]:
     stages = yaml.safe_load((ROOT / "dvc.yaml").read_text())["stages"]
     return [next(iter(out)) if isinstance(out, dict) else out for stage in stages.values() for out in stage["outs"]]
 
 
-@pytest.mark.notebook
-@pytest.mark.parametrize("name", list(RUNS))
-def test_dvc_repro_runs_recorded_data_end_to_end(name, tmp_path, cache_dir):
-    """One test per run (xdist spreads them over its workers; a run's checks share its one repro)."""
+def repro(name, tmp_path, run_once):
+    """The run ``name``: its recordings written, `dvc repro` in a copy of the stage-06 project, every declared output
+    there; the stage 01 and summary checks."""
+    shutil.copytree(run_once("stage_06", stage_06_project), tmp_path, dirs_exist_ok=True,
+                    ignore=shutil.ignore_patterns(".done"))
     folders, overlay = RUNS[name]
     for folder in folders:
         write_folder(tmp_path / "recordings", folder)
-    project_copy(tmp_path, {"generate": {"source": "recordings"}, **overlay}, cache_dir)
+    write_params(tmp_path, {"generate": {"source": "recordings"}, **overlay})
     output, seconds, cpu = run([str(DVC), "repro"], tmp_path)
     print(f"dvc repro of {name}: {seconds:.0f} s wall, {cpu:.0f} s CPU")
+    assert "'06_marker_tracking' didn't change" in output  # the copy's stage 06 was taken as done
     missing = [out for out in declared_outputs() if not (tmp_path / out).exists()]
     assert not missing, f"declared outputs not written: {missing}\n{output[-3000:]}"
     check_stage_01(name, tmp_path)
     check_summary(name, tmp_path)
+
+
+# A class per run: xdist's --dist loadscope gives each class, not only each module, to one worker, so the two runs
+# go to both workers at once.
+@pytest.mark.notebook
+class TestArcs:
+    def test_dvc_repro_runs_recorded_data_end_to_end(self, tmp_path, run_once):
+        repro("arcs", tmp_path, run_once)
+        check_ground_truth_kinds(tmp_path)
+
+
+@pytest.mark.notebook
+class TestWorlds:
+    def test_dvc_repro_runs_recorded_data_end_to_end(self, tmp_path, run_once):
+        repro("worlds", tmp_path, run_once)
 
 
 def check_stage_01(name, copy):
@@ -108,3 +123,20 @@ def check_summary(name, copy):
         assert validation["world"] == "lab_b" and validation["chosen_on"] == "lab_a"
         assert "No arcs in this world" in section and "Held-out world `lab_b`" in section
         assert "No arcs in `lab_a`: no arc operating point to apply." in section and "| lines: predictor |" in section
+
+
+def check_ground_truth_kinds(copy):
+    """The arcs run holds both kinds of ground truth: arc_poses_jpeg is measured against its recorded poses (no board
+    judged), arc_board_16 against the board in its images; nothing is rendered, calibrated or judged as a world."""
+    data = copy / "data"
+    assert load_dataset(data, "datasets/arc_poses_jpeg").meta["ground_truth"] == "poses"
+    assert load_dataset(data, "datasets/arc_board_16").meta["ground_truth"] == "board"
+    rows = pd.read_parquet(data / "artifacts" / "artifacts.parquet")
+    poses = rows[rows.dataset == "arc_poses_jpeg"]
+    assert set(poses.board_status) == {"no_board"} and (poses.status == "ok").any()
+    assert poses.loc[poses.status == "ok", "E_t_mm"].notna().all()  # measured against the recorded poses
+    assert (rows.loc[rows.dataset == "arc_board_16", "board_status"] == "ok").any()
+    assert recorded_worlds(data) == {"recorded"} and not (data / "calibration" / "recorded").exists()
+    realism = json.loads((copy / "reports" / "metrics" / "artifacts.json").read_text())["realism"]
+    assert "passed" not in realism and "recorded data" in realism["description_only"]  # described, not judged
+    assert "Realism bars: recorded data" in (copy / "reports" / "summary.md").read_text()

@@ -18,22 +18,38 @@ from repository import ROOT
 
 FOREIGN_PATH = "/usr/bin:/bin"  # a user's PATH: whatever `python` is there, it is not the project's venv
 DVC = Path(sys.executable).parent / "dvc"  # the venv's dvc, as `.venv/bin/dvc repro`
+TINY_PARAMS = ROOT / "tests" / "params_tiny.yaml"
 
 
-def project_copy(folder: Path, overlay: dict, cache_dir: Path) -> Path:
+def project_copy(folder: Path, overlay: dict) -> Path:
     """``folder`` made a DVC project: the repository's dvc.yaml, .dvcignore, notebooks and src, and a params.yaml of
-    tests/params_tiny.yaml merged with ``overlay``; its DVC cache is ``cache_dir``."""
+    tests/params_tiny.yaml merged with ``overlay`` (:func:`write_params`); its DVC cache is its own (.dvc/cache)."""
     folder.mkdir(parents=True, exist_ok=True)
     for name in ("dvc.yaml", ".dvcignore"):
         shutil.copy(ROOT / name, folder / name)
     for name in ("notebooks", "src"):
         shutil.copytree(ROOT / name, folder / name, ignore=shutil.ignore_patterns("__pycache__", "*.egg-info"))
-    raw, _ = read_raw(ROOT / "tests" / "params_tiny.yaml")
-    (folder / "params.yaml").write_text(yaml.safe_dump(merge(raw, overlay), sort_keys=False))
-    (folder / ".dvc").mkdir()  # what `dvc init --no-scm` and `dvc config --local cache.dir` write, without two dvc starts
+    (folder / ".dvc").mkdir()  # what `dvc init --no-scm` writes, without a dvc start
     (folder / ".dvc" / "config").write_text("[core]\n    no_scm = True\n")
-    (folder / ".dvc" / "config.local").write_text(f"[cache]\n    dir = {cache_dir}\n")
+    return write_params(folder, overlay)
+
+
+def write_params(folder: Path, overlay: dict) -> Path:
+    """``folder / "params.yaml"``: tests/params_tiny.yaml merged with ``overlay``; returns ``folder``."""
+    raw, _ = read_raw(TINY_PARAMS)
+    (folder / "params.yaml").write_text(yaml.safe_dump(merge(raw, overlay), sort_keys=False))
     return folder
+
+
+def stage_06_project(folder: Path) -> None:
+    """A project copy on the tiny parameters in ``folder`` with stage 06 run by `dvc repro 06_marker_tracking`.
+
+    The marker-tracking study depends on no other stage and on no ``generate`` key, so the tests run it once per
+    session (``run_once("stage_06", stage_06_project)``): tests/tracking/test_notebook_06.py checks its outputs, the
+    notebook chain's report reads its metrics, and each recorded `dvc repro` starts from a copy of this project, where
+    DVC finds stage 06 done (its lock entry, outputs and cache) and runs the other six."""
+    project_copy(folder, {})
+    run([str(DVC), "repro", "06_marker_tracking"], folder)
 
 
 def run(argv: list[str], cwd: Path) -> tuple[str, float, float]:
