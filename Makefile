@@ -44,5 +44,8 @@ repro: $(VENV)/.installed $(PATH_HOOK) ## run the paper-scale pipeline (dvc repr
 	$(BIN)/dvc repro
 	@$(BIN)/python -m poseintegrity.timing reports/metrics/timing
 
+# pytest keeps each test module with its assertions rewritten in __pycache__, and Python our own modules, unless
+# PYTHONDONTWRITEBYTECODE is set (as on our machines): then every xdist worker rewrote all ~270 test modules on every
+# run (7 of its 25 s of collection) and every notebook kernel compiled the package again. Unset for the suite only.
 test: $(VENV)/.installed $(PATH_HOOK) ## run the pytest suite (notebooks executed with tiny parameters)
-	$(BIN)/python -m pytest -n 2
+	PYTHONDONTWRITEBYTECODE= $(BIN)/python -m pytest -n 2

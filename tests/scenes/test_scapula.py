@@ -8,7 +8,7 @@ import trimesh
 
 from poseintegrity.config import ParamsError, load_params, parse_params, read_raw
 from poseintegrity.scenes.dataset import WorldError, check_world
-from poseintegrity.scenes.mesh import MeshError, read_mesh
+from poseintegrity.scenes.mesh import MeshError, check_mesh, read_mesh
 from poseintegrity.scenes.scapula import scapula_mesh
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -64,6 +64,24 @@ def test_unreadable_or_open_mesh_files_are_named(tmp_path):
     open_box.export(path)
     with pytest.raises(MeshError, match="open.stl is not a closed manifold"):
         read_mesh(path, "generate.scapula.mesh")
+
+
+def test_a_mesh_checked_once_is_checked_again_when_the_file_changes(tmp_path):
+    """check_mesh remembers a closed mesh by path, size and modification time: the same file is not read again, but
+    an open mesh written in its place is refused, and a refusal is never remembered."""
+    path = tmp_path / "target.stl"
+    box = trimesh.creation.box((10.0, 10.0, 10.0))
+    box.export(path)
+    check_mesh(path, "generate.scapula.mesh")
+    check_mesh(path, "generate.scapula.mesh")  # from memory
+    trimesh.Trimesh(box.vertices, box.faces[:-2]).export(path)  # one face removed: not closed, another size
+    for _ in range(2):
+        with pytest.raises(MeshError, match="generate.scapula.mesh: .*target.stl is not a closed manifold"):
+            check_mesh(path, "generate.scapula.mesh")
+    box.export(path)
+    check_mesh(path, "generate.scapula.mesh")  # closed again
+    with pytest.raises(MeshError, match="generate.scapula.mesh: cannot read mesh file .*gone.stl"):
+        check_mesh(tmp_path / "gone.stl", "generate.scapula.mesh")
 
 
 def test_params_validation_names_a_bad_mesh_before_any_work(tmp_path):

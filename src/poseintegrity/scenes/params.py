@@ -21,7 +21,7 @@ from poseintegrity.scenes.camera_params import (
     CalibrationParams, CameraParams, CaptureParams, GroundTruthBoardParams, PrintedBoardParams, SensorParams,
 )
 from poseintegrity.scenes.foam import VOXEL_MM, ReliefVolume, relief_volume
-from poseintegrity.scenes.mesh import Material, read_mesh
+from poseintegrity.scenes.mesh import Material, check_mesh
 from poseintegrity.scenes.robot_params import RobotParams
 from poseintegrity.errors import ArgumentError
 from poseintegrity.schema import FromList, KeyRule, ProjectPath, Section, Seed, distinct
@@ -77,7 +77,7 @@ class ScapulaParams(Section):
     @field_validator("mesh")
     @classmethod
     def _closed_mesh(cls, path: Path) -> Path:
-        read_mesh(path, "mesh")  # unreadable or not closed: a MeshError naming the file, before any work
+        check_mesh(path, "mesh")  # unreadable or not closed: a MeshError naming the file, before any work
         return path
 
     @field_validator("glenoid_normal")
