@@ -11,6 +11,8 @@ from pathlib import Path
 import pytest
 from hypothesis import settings
 
+import poseintegrity.stage  # noqa: F401 (before any papermill or nbformat import: without jsonschema's IRI grammars,
+# 2.7 s of every xdist worker's collection; stage.py)
 from poseintegrity.config import parse_params, read_raw
 
 # Property tests explore new random examples on every local run; on CI (CI=true) they replay a fixed set, so a
