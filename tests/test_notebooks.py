@@ -18,6 +18,7 @@ from notebook_run import TINY_PARAMS, execute
 from poseintegrity.artifact_models import FIT_STATUSES
 from poseintegrity.artifact_models.names import distinct_theta_needed
 from poseintegrity.config import load_params
+from poseintegrity.localization.dataset import recorded_worlds
 from poseintegrity.localization.envelope_causes import CAUSES
 from poseintegrity.localization.summaries import FAILURE_STATUSES
 from poseintegrity.prediction import FITTED_PREDICTORS, FREE_WIDTH_PREDICTORS, NO_FIT
@@ -94,6 +95,7 @@ def test_stage_02_flags_the_spoiled_frames_and_writes_tables_metrics_and_figures
                                  "status", "reason"]
     found = metrics(reports, "artifacts.json")
     assert found["flagged_frames"] == {"bad_image": 1, "bad_pose": 1}
+    assert recorded_worlds(data) == set()  # rendered: its realism is judged (the recorded runs': described only)
     assert found["status_counts"]["bad_image"] == found["status_counts"]["bad_pose"] == 1
     for key in ("min_abs_spearman", "error_ratio_low_vs_high_inliers", "n_uncensored_4mm10deg",
                 "min_theta_a_2mm3deg", "cv_theta_a_2mm3deg"):
