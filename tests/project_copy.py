@@ -13,17 +13,18 @@ from pathlib import Path
 
 import yaml
 
+from notebook_run import TINY_PARAMS
 from poseintegrity.config import merge, read_raw
 from repository import ROOT
 
 FOREIGN_PATH = "/usr/bin:/bin"  # a user's PATH: whatever `python` is there, it is not the project's venv
 DVC = Path(sys.executable).parent / "dvc"  # the venv's dvc, as `.venv/bin/dvc repro`
-TINY_PARAMS = ROOT / "tests" / "params_tiny.yaml"
 
 
-def project_copy(folder: Path, overlay: dict) -> Path:
-    """``folder`` made a DVC project: the repository's dvc.yaml, .dvcignore, notebooks and src, and a params.yaml of
-    tests/params_tiny.yaml merged with ``overlay`` (:func:`write_params`); its DVC cache is its own (.dvc/cache)."""
+def project_copy(folder: Path) -> Path:
+    """``folder`` made a DVC project: the repository's dvc.yaml, .dvcignore, notebooks and src, and
+    tests/params_tiny.yaml as its params.yaml (:func:`write_params` changes it); its DVC cache is its own
+    (.dvc/cache)."""
     folder.mkdir(parents=True, exist_ok=True)
     for name in ("dvc.yaml", ".dvcignore"):
         shutil.copy(ROOT / name, folder / name)
@@ -31,7 +32,7 @@ def project_copy(folder: Path, overlay: dict) -> Path:
         shutil.copytree(ROOT / name, folder / name, ignore=shutil.ignore_patterns("__pycache__", "*.egg-info"))
     (folder / ".dvc").mkdir()  # what `dvc init --no-scm` writes, without a dvc start
     (folder / ".dvc" / "config").write_text("[core]\n    no_scm = True\n")
-    return write_params(folder, overlay)
+    return write_params(folder, {})
 
 
 def write_params(folder: Path, overlay: dict) -> Path:
@@ -48,7 +49,7 @@ def stage_06_project(folder: Path) -> None:
     session (``run_once("stage_06", stage_06_project)``): tests/tracking/test_notebook_06.py checks its outputs, the
     notebook chain's report reads its metrics, and each recorded `dvc repro` starts from a copy of this project, where
     DVC finds stage 06 done (its lock entry, outputs and cache) and runs the other six."""
-    project_copy(folder, {})
+    project_copy(folder)
     run([str(DVC), "repro", "06_marker_tracking"], folder)
 
 
