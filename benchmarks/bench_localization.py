@@ -89,13 +89,15 @@ def pipeline_ratios(dataset, model, params, cache: Path, repeats: int) -> float:
 
         def pipeline(method: str = "usac_magsac"):
             features = detect_features(image, params.clahe, params.sift)
-            X, x = correspondences(features, model, params.ratio_test, dataset.camera)
-            return localize(X, x, features.n_keypoints, model.size, dataset.K, method, params, seed=1)
+            index, x = correspondences(features, model, params.ratio_test, dataset.camera)
+            X = model.points[index]
+            return localize(X, x, model.covariances[index], features.n_keypoints, model.size, dataset.K, method, params, seed=1)
 
         features = detect_features(image, params.clahe, params.sift)
-        X, x = correspondences(features, model, params.ratio_test, dataset.camera)
+        index, x = correspondences(features, model, params.ratio_test, dataset.camera)
+        X = model.points[index]
         functions = {"sift": lambda: sift.detectAndCompute(image, None), "pipeline": pipeline}
-        functions |= {m: lambda m=m: localize(X, x, features.n_keypoints, model.size, dataset.K, m, params, 1)
+        functions |= {m: lambda m=m: localize(X, x, model.covariances[index], features.n_keypoints, model.size, dataset.K, m, params, 1)
                       for m in CLASSIC_FLAGS}
         functions["board"] = lambda: board_pose(image, board, dataset.camera)
         features_path, evidence_path = cache / f"{stop}.npz", cache / f"{stop}.evidence.npz"
@@ -136,8 +138,9 @@ def budget_ratios(dataset, model, params, t_sift: float) -> None:
     misses = {key: 0 for key in seconds}
     for frame in frames.itertuples():
         image = read_gray(dataset.path(frame.file), dataset.image_size)
-        X, x = correspondences(detect_features(image, params.clahe, params.sift), model, params.ratio_test,
-                               dataset.camera)
+        index, x = correspondences(detect_features(image, params.clahe, params.sift), model, params.ratio_test,
+                                   dataset.camera)
+        X = model.points[index]
         seed = frame_seed(params.seed, dataset.name, int(frame.stop), int(frame.image))
         for m in CLASSIC_FLAGS:
             for budget in ("old", "new"):  # alternately, so that both see the same machine load

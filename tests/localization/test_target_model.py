@@ -45,3 +45,23 @@ def test_empty_mask_gives_an_empty_model(extract_params):
                                extract_params.ratio_test,
                                extract_params.model_max_reprojection_px)
     assert model.size == 0 and model.points.shape == (0, 3) and model.descriptors.shape == (0, 128)
+    assert model.covariances.shape == (0, 3, 3) and np.isnan(model.pixel_noise_px)
+
+
+def test_model_points_carry_their_triangulation_covariance_along_the_model_rays(extract_params):
+    """Each point's covariance (board frame) is symmetric positive definite, elongated along model camera 0's ray
+    through it (the depth of a 20 mm pair), and its pixel noise is what the kept points' residuals say."""
+    features, masks, poses = model_views(np.random.default_rng(1), extract_params)
+    model = build_target_model(features, masks, poses[1] @ np.linalg.inv(poses[0]), poses[0], synthetic.CAMERA,
+                               extract_params.ratio_test, extract_params.model_max_reprojection_px)
+    assert 0.0 < model.pixel_noise_px < extract_params.model_max_reprojection_px
+    cov = model.covariances
+    assert cov.shape == (model.size, 3, 3)
+    np.testing.assert_allclose(cov, np.swapaxes(cov, 1, 2), atol=1e-12)
+    values, vectors = np.linalg.eigh(cov)
+    assert np.all(values > 0)
+    centre = np.linalg.inv(poses[0])[:3, 3]  # camera 0 in the board frame
+    rays = model.points - centre
+    rays /= np.linalg.norm(rays, axis=1, keepdims=True)
+    assert np.all(np.abs(np.sum(vectors[:, :, 2] * rays, axis=1)) > 0.99)
+    assert np.all(values[:, 2] > 10 * values[:, 1])

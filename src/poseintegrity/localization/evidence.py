@@ -32,7 +32,8 @@ from poseintegrity.localization.matching import match_ratio_test
 from poseintegrity.localization.params import ExtractParams
 from poseintegrity.localization.target_model import TargetModel
 
-EVIDENCE_VERSION = 3  # bump when the cached content or its layout changes (3: the checked board pose, issue 30)
+EVIDENCE_VERSION = 4  # bump when the cached content or its layout changes (3: the checked board pose, issue 30;
+# 4: the matched model points' indices, whose covariances the predicted error needs, issue 38)
 
 
 @dataclass(frozen=True)
@@ -41,6 +42,7 @@ class FrameEvidence:
 
     image_problem : why the image is unusable ("" if it is fine; then nothing else was computed)
     object_points : (k, 3) float64, M_t points of the k ratio-test matches, board frame, mm
+    model_index : (k,) int, their indices in M_t (whose covariances they carry)
     image_points : (k, 2) float64, the frame's keypoints of those matches, undistorted (ideal pinhole px of K)
     n_keypoints : SIFT keypoints in the frame
     board : the board's checked pose (the ground truth, :mod:`~poseintegrity.localization.ground_truth`)
@@ -48,6 +50,7 @@ class FrameEvidence:
 
     image_problem: str
     object_points: np.ndarray
+    model_index: np.ndarray
     image_points: np.ndarray
     n_keypoints: int
     board: BoardPose
@@ -55,7 +58,8 @@ class FrameEvidence:
 
 def bad_image(problem: str) -> FrameEvidence:
     """The evidence of a frame whose image failed its check: no correspondences, no board."""
-    return FrameEvidence(problem, np.empty((0, 3)), np.empty((0, 2)), 0, no_pose("bad_image", problem))
+    return FrameEvidence(problem, np.empty((0, 3)), np.empty(0, np.intp), np.empty((0, 2)), 0,
+                         no_pose("bad_image", problem))
 
 
 def model_digest(model: TargetModel) -> str:
@@ -76,11 +80,11 @@ def evidence_key(features_key_: str, digest: str, params: ExtractParams, board: 
 def correspondences(features, model: TargetModel, ratio: float, camera: Camera) -> tuple[np.ndarray, np.ndarray]:
     """2D-3D correspondences of a frame: ratio-test matches of its descriptors to M_t (III-B).
 
-    Returns object points (k, 3, board frame, mm) and image points (k, 2), undistorted by ``camera`` (ideal pinhole
-    px of its K).
+    Returns the matched points' indices in M_t (k,) and image points (k, 2), undistorted by ``camera`` (ideal
+    pinhole px of its K); the object points are ``model.points[index]`` (k, 3, board frame, mm).
     """
     pairs = match_ratio_test(features.descriptors, model.descriptors, ratio)
-    return model.points[pairs[:, 1]], camera.undistort(features.points[pairs[:, 0]])
+    return pairs[:, 1].astype(np.intp), camera.undistort(features.points[pairs[:, 0]])
 
 
 def _load(path: Path, key: str) -> FrameEvidence | None:
@@ -91,7 +95,8 @@ def _load(path: Path, key: str) -> FrameEvidence | None:
             board = BoardPose(stored["board_T_cam_board"], str(stored["board_status"]), str(stored["board_reason"]),
                               *(int(stored[k]) for k in ("board_n_points", "board_n_dropped")),
                               *(float(stored[k]) for k in ("board_rms_px", "board_sigma_t_mm", "board_sigma_r_deg")))
-            return FrameEvidence("", stored["object_points"], stored["image_points"], int(stored["n_keypoints"]), board)
+            return FrameEvidence("", stored["object_points"], stored["model_index"].astype(np.intp),
+                                 stored["image_points"], int(stored["n_keypoints"]), board)
     except (OSError, ValueError, KeyError):
         return None  # missing, truncated or foreign: recomputed
 
@@ -114,11 +119,12 @@ def frame_evidence(
     except ImageReadError as error:
         return bad_image(str(error))
     features = cached_features(image_path, features_path, params.clahe, params.sift, data=data, image=image)
-    object_points, image_points = correspondences(features, model, params.ratio_test, camera)
+    model_index, image_points = correspondences(features, model, params.ratio_test, camera)
+    object_points = model.points[model_index]
     truth = (board_pose(image, board_from_dict(board), camera, params.ground_truth) if board is not None
              else no_pose("no_board", "recorded poses are the ground truth"))  # no board: recorded poses instead
-    write_npz(evidence_path, key=key, object_points=object_points, image_points=image_points,
+    write_npz(evidence_path, key=key, object_points=object_points, model_index=model_index, image_points=image_points,
               n_keypoints=features.n_keypoints, board_T_cam_board=truth.T_cam_board, board_status=truth.status,
               board_reason=truth.reason, board_n_points=truth.n_points, board_n_dropped=truth.n_dropped,
               board_rms_px=truth.rms_px, board_sigma_t_mm=truth.sigma_t_mm, board_sigma_r_deg=truth.sigma_r_deg)
-    return FrameEvidence("", object_points, image_points, features.n_keypoints, truth)
+    return FrameEvidence("", object_points, model_index, image_points, features.n_keypoints, truth)

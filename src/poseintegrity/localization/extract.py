@@ -71,8 +71,8 @@ def frame_seed(seed: int, dataset: str, stop: int, image: int) -> int:
 
 
 def localize(
-    object_points: np.ndarray, image_points: np.ndarray, n_keypoints: int, model_size: int, K: np.ndarray,
-    method: str, params: ExtractParams, seed: int,
+    object_points: np.ndarray, image_points: np.ndarray, point_covariances: np.ndarray, n_keypoints: int,
+    model_size: int, K: np.ndarray, method: str, params: ExtractParams, seed: int,
 ) -> tuple[np.ndarray, dict[str, Any], str, str]:
     """PnP-RANSAC of one frame's correspondences with one method: (T_cam_board estimate (4, 4), artifacts, status,
     reason).
@@ -85,15 +85,16 @@ def localize(
         object_points, image_points, K, method, params.reprojection_threshold_px, params.ransac_confidence,
         iteration_cap(method, params), seed, params.usac_refine_lm,
     )
-    return located(result, object_points, image_points, n_keypoints, model_size, K)
+    return located(result, object_points, image_points, point_covariances, n_keypoints, model_size, K)
 
 
 def located(
-    result: PnPResult, object_points: np.ndarray, image_points: np.ndarray, n_keypoints: int, model_size: int,
-    K: np.ndarray,
+    result: PnPResult, object_points: np.ndarray, image_points: np.ndarray, point_covariances: np.ndarray,
+    n_keypoints: int, model_size: int, K: np.ndarray,
 ) -> tuple[np.ndarray, dict[str, Any], str, str]:
-    """What :func:`localize` returns for a PnP result of its correspondences."""
-    artifacts = frame_artifacts(result, object_points, image_points, K, n_keypoints, model_size)
+    """What :func:`localize` returns for a PnP result of its correspondences (point_covariances : (k, 3, 3) mm^2,
+    the matched model points' covariances)."""
+    artifacts = frame_artifacts(result, object_points, image_points, K, n_keypoints, model_size, point_covariances)
     if n_keypoints == 0:
         return result.T_cam_model, artifacts, "no_keypoints", "SIFT found no keypoints in the frame"
     return result.T_cam_model, artifacts, result.status, result.reason
@@ -122,13 +123,15 @@ class ModelTask:
 
 @dataclass(frozen=True)
 class StoredModel:
-    """Where a dataset's M_t is stored, its digest (part of every evidence key) and size; ``anchor``: the board's
-    checked pose in model image 0 that placed M_t in the board frame (status ``no_board`` with recorded poses)."""
+    """Where a dataset's M_t is stored, its digest (part of every evidence key), size and the model pair's measured
+    pixel noise; ``anchor``: the board's checked pose in model image 0 that placed M_t in the board frame (status
+    ``no_board`` with recorded poses)."""
 
     path: Path
     digest: str
     size: int
     anchor: BoardPose
+    pixel_noise_px: float
 
 @dataclass(frozen=True)
 class FrameTask:
@@ -186,14 +189,15 @@ def store_model(task: ModelTask) -> StoredModel:
     """Build M_t of a dataset (a worker task) and store it for the frame tasks (unless stored already)."""
     model, anchor = dataset_model(task.dataset, task.params, task.cache_dir)
     digest = model_digest(model)
-    try:
+    try:  # the covariances do not enter the digest (no evidence depends on them): compared themselves
         with np.load(task.path) as stored:
-            current = str(stored["digest"]) == digest
+            current = str(stored["digest"]) == digest and np.array_equal(stored["covariances"], model.covariances)
     except (OSError, ValueError, KeyError):
         current = False
     if not current:
-        write_npz(task.path, digest=digest, points=model.points, descriptors=model.descriptors)
-    return StoredModel(task.path, digest, model.size, anchor)
+        write_npz(task.path, digest=digest, points=model.points, descriptors=model.descriptors,
+                  covariances=model.covariances, pixel_noise_px=model.pixel_noise_px)
+    return StoredModel(task.path, digest, model.size, anchor, model.pixel_noise_px)
 
 
 @lru_cache(maxsize=4)
@@ -202,16 +206,19 @@ def load_model(path: Path, digest: str) -> TargetModel:
     with np.load(path) as stored:
         if str(stored["digest"]) != digest:
             raise DatasetError(f"target model {path} was replaced while this stage ran (another run on the same data?)")
-        return TargetModel(stored["points"], stored["descriptors"])
+        return TargetModel(stored["points"], stored["descriptors"], stored["covariances"],
+                           float(stored["pixel_noise_px"]))
 
 
 def frame_rows(task: FrameTask) -> list[dict[str, Any]]:
     """All rows (one per method) of one frame; runs in a worker."""
     frame, model = task.frame, task.model
+    M_t = load_model(model.path, model.digest)
     evidence: FrameEvidence = frame_evidence(
-        task.image_path, task.features_path, task.evidence_path, load_model(model.path, model.digest), model.digest,
-        task.board, task.camera, task.params, frame["file"],
+        task.image_path, task.features_path, task.evidence_path, M_t, model.digest, task.board, task.camera,
+        task.params, frame["file"],
     )
+    point_covariances = M_t.covariances[evidence.model_index]
     known = frame["T_cam_board"] is not None  # None: a recorded frame without a pose (board ground truth)
     truth_problem = pose_problem(frame["T_cam_board"]) if known else None
     T_cam_board = NAN_POSE if truth_problem or not known else np.asarray(frame["T_cam_board"],
@@ -238,11 +245,11 @@ def frame_rows(task: FrameTask) -> list[dict[str, Any]]:
         if evidence.image_problem:
             T_est, artifacts = NAN_POSE.copy(), frame_artifacts(failed("bad_image", reason), evidence.object_points,
                                                                 evidence.image_points, task.camera.K, 0,
-                                                                model.size)
+                                                                model.size, point_covariances)
         else:
             T_est, artifacts, pnp_status, pnp_reason = located(
-                results[method], evidence.object_points, evidence.image_points, evidence.n_keypoints, model.size,
-                task.camera.K,
+                results[method], evidence.object_points, evidence.image_points, point_covariances,
+                evidence.n_keypoints, model.size, task.camera.K,
             )
         E_t_mm, E_r_deg = map(float, pose_errors(T_est, truth))  # IV-C: the board is the truth (or the poses)
         E_t_exact_mm, E_r_exact_deg = map(float, pose_errors(T_est, T_cam_board))
@@ -250,7 +257,8 @@ def frame_rows(task: FrameTask) -> list[dict[str, Any]]:
             E_t_mm = E_r_deg = np.nan
         rows.append(
             {key: frame[key] for key in FRAME_COLUMNS}
-            | dict(method=method, status=status or pnp_status, reason=reason or pnp_reason, model_size=model.size)
+            | dict(method=method, status=status or pnp_status, reason=reason or pnp_reason, model_size=model.size,
+                   model_pixel_noise_px=model.pixel_noise_px)
             | artifacts
             | dict(
                 E_t_mm=E_t_mm, E_r_deg=E_r_deg, E_t_exact_mm=E_t_exact_mm, E_r_exact_deg=E_r_exact_deg,

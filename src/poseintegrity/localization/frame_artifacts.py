@@ -11,6 +11,15 @@ Artifacts of one PnP-RANSAC run (columns of ``artifacts.parquet``):
 - ``inlier_hull_area_px2``: area of the convex hull of the inlier keypoints (coverage; Windsor et al. [4]
   studied keypoint distribution artifacts)
 - ``model_coverage``: n_i / |M_t|, the fraction of the target model seen
+
+Beyond the paper, the error the pose is expected to have (issue 38, :mod:`pose_covariance`), propagated to first
+order from the inliers' residual and their model points' triangulation covariances:
+
+- ``sigma_px``: the pixel noise the inliers' residual gives, sqrt(RSS / (2 n_i - 6))
+- ``sigma_t_pred_mm``, ``sigma_r_pred_deg``: predicted RMS E_t (at the board origin) and E_r
+- ``sigma_t_model_mm``, ``sigma_r_model_deg``: the model points' share of them (the rest is the residual's, in
+  quadrature)
+- ``covariance_status``: "ok", or why there is no prediction ("no_pose", "too_few_points", "degenerate_points")
 """
 
 from __future__ import annotations
@@ -20,20 +29,24 @@ from typing import Any
 import cv2
 import numpy as np
 from poseintegrity.localization.pnp import PnPResult, reprojection_errors
+from poseintegrity.localization.pose_covariance import propagated_covariance
 
 ARTIFACT_COLUMNS = [
     "n_inliers", "n_inliers_reported", "n_keypoints", "n_matches", "inlier_ratio", "reproj_error_px",
-    "inlier_spread_px", "inlier_hull_area_px2", "model_coverage",
+    "inlier_spread_px", "inlier_hull_area_px2", "model_coverage", "sigma_px", "sigma_t_pred_mm", "sigma_r_pred_deg",
+    "sigma_t_model_mm", "sigma_r_model_deg", "covariance_status",
 ]
 
 
 def frame_artifacts(
-    result: PnPResult, object_points: np.ndarray, image_points: np.ndarray, K: np.ndarray, n_keypoints: int, model_size: int
+    result: PnPResult, object_points: np.ndarray, image_points: np.ndarray, K: np.ndarray, n_keypoints: int,
+    model_size: int, point_covariances: np.ndarray,
 ) -> dict[str, Any]:
     """Artifact values of one PnP result.
 
-    object_points : (n, 3) mm and image_points : (n, 2) px are the n ratio-test matches given to PnP.
-    A failed result has n_i = 0 and NaN for the inlier geometry.
+    object_points : (n, 3) mm and image_points : (n, 2) px are the n ratio-test matches given to PnP;
+    point_covariances : (n, 3, 3) mm^2 their model points' covariances (M_t's, board frame).
+    A failed result has n_i = 0 and NaN for the inlier geometry and the predicted error.
     """
     n_matches = len(image_points)
     row = dict(
@@ -41,6 +54,8 @@ def frame_artifacts(
         n_matches=n_matches, inlier_ratio=result.n_inliers / n_matches if n_matches else 0.0,
         reproj_error_px=np.nan, inlier_spread_px=np.nan, inlier_hull_area_px2=np.nan,
         model_coverage=result.n_inliers / model_size if model_size else 0.0,
+        sigma_px=np.nan, sigma_t_pred_mm=np.nan, sigma_r_pred_deg=np.nan, sigma_t_model_mm=np.nan,
+        sigma_r_model_deg=np.nan, covariance_status="no_pose",
     )
     if result.status != "ok":
         return row
@@ -49,4 +64,9 @@ def frame_artifacts(
     row["reproj_error_px"] = float(errors.mean())
     row["inlier_spread_px"] = float(np.sqrt(np.mean(np.sum((x - x.mean(axis=0)) ** 2, axis=1))))
     row["inlier_hull_area_px2"] = float(cv2.contourArea(cv2.convexHull(x.astype(np.float32))))
+    covariance = propagated_covariance(object_points[result.inliers], x, result.T_cam_model, K,
+                                       point_covariances[result.inliers], None)
+    row.update(sigma_px=covariance.sigma_px, sigma_t_pred_mm=covariance.sigma_t_mm(),
+               sigma_r_pred_deg=covariance.sigma_r_deg(), sigma_t_model_mm=covariance.sigma_t_mm("model"),
+               sigma_r_model_deg=covariance.sigma_r_deg("model"), covariance_status=covariance.status)
     return row

@@ -6,6 +6,9 @@ keep points on the target (the paper trims by hand; we keep keypoints inside the
 images) -> coordinates in the board frame, through the ArUco board's pose in the first model image (IV-C: "the
 origin of the model reference frame was transformed to be coincident with the origin of the ArUco board"), so that
 a PnP pose of the model is directly an estimate of T_cam_board.
+
+Beyond the paper, every point carries its triangulation covariance (:mod:`pose_covariance`, (b)), from the pixel noise
+the model pair's own residuals measure: what the predicted localization error of every later frame is built on.
 """
 
 from __future__ import annotations
@@ -20,6 +23,7 @@ from poseintegrity.lens import Camera
 from poseintegrity.localization.features import Features
 from poseintegrity.localization.matching import match_ratio_test
 from poseintegrity.localization.pnp import reprojection_errors
+from poseintegrity.localization.pose_covariance import triangulation_covariances, triangulation_sigma
 
 
 @dataclass(frozen=True)
@@ -28,10 +32,15 @@ class TargetModel:
 
     points : (n, 3) float64, board frame, mm
     descriptors : (n, 128) float32, SIFT descriptors from the first model image
+    covariances : (n, 3, 3) float64, each point's triangulation covariance, board frame, mm^2
+    pixel_noise_px : the keypoint noise of the model pair, measured from its triangulation residuals (NaN when
+        empty)
     """
 
     points: np.ndarray
     descriptors: np.ndarray
+    covariances: np.ndarray
+    pixel_noise_px: float
 
     @property
     def size(self) -> int:
@@ -54,6 +63,12 @@ def triangulate(K: np.ndarray, T_cam1_cam0: np.ndarray, x0: np.ndarray, x1: np.n
     X_h = cv2.triangulatePoints(P0, P1, x0.T.astype(np.float64), x1.T.astype(np.float64))
     with np.errstate(divide="ignore", invalid="ignore"):
         return (X_h[:3] / X_h[3]).T
+
+
+def _residuals(X_cam: np.ndarray, x: np.ndarray, K: np.ndarray) -> np.ndarray:
+    """(n, 2) px: pixels x minus the projections of camera points X_cam (n, 3) by the pinhole K."""
+    projected = X_cam @ K.T
+    return x - projected[:, :2] / projected[:, 2:3]
 
 
 def _inside(mask: np.ndarray, x: np.ndarray) -> np.ndarray:
@@ -83,7 +98,9 @@ def build_target_model(
     camera : the calibrated camera: keypoints are undistorted before any geometry (masks are looked up raw)
     A point is kept when it lies in front of both cameras, reprojects within ``max_reprojection_px`` in both
     images and its keypoints lie inside both masks. An empty model (no texture, no overlap) is returned
-    as such; every frame then fails with ``too_few_matches``.
+    as such; every frame then fails with ``too_few_matches``. The kept points' residuals measure the pixel noise
+    (:func:`~poseintegrity.localization.pose_covariance.triangulation_sigma`), and each point's covariance follows
+    from it, the baseline and its depth.
     """
     if not isinstance(camera, Camera):
         raise ArgumentError(f"camera: expected a poseintegrity.lens.Camera, got {type(camera).__name__}")
@@ -110,7 +127,13 @@ def build_target_model(
         & _inside(masks[0], raw0)
         & _inside(masks[1], raw1)
     )
+    X_cam0 = X_cam0[keep].reshape(-1, 3)
+    sigma_px = triangulation_sigma(_residuals(X_cam0, x0[keep], K),
+                                   _residuals(X_cam0 @ T_cam1_cam0[:3, :3].T + T_cam1_cam0[:3, 3], x1[keep], K))
+    covariances = (triangulation_covariances(X_cam0, T_cam1_cam0, K, sigma_px) if len(X_cam0)
+                   else np.empty((0, 3, 3)))
     T_board_cam0 = np.linalg.inv(T_cam0_board)
-    points = X_cam0[keep] @ T_board_cam0[:3, :3].T + T_board_cam0[:3, 3]
+    R = T_board_cam0[:3, :3]
+    points = X_cam0 @ R.T + T_board_cam0[:3, 3]
     descriptors = features[0].descriptors[pairs[keep, 0]]
-    return TargetModel(points.reshape(-1, 3), descriptors.reshape(-1, 128).astype(np.float32))
+    return TargetModel(points, descriptors.reshape(-1, 128).astype(np.float32), R @ covariances @ R.T, sigma_px)
