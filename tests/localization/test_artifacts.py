@@ -22,7 +22,8 @@ def test_inlier_geometry_of_a_known_square():
     x = X[:, :2].copy()
     x[4] += 40.0  # the outlier
     result = PnPResult(T, np.arange(4), 4, "ok")
-    row = frame_artifacts(result, X, x, K, n_keypoints=10, model_size=8, point_covariances=np.zeros((5, 3, 3)))
+    row = frame_artifacts(result, X, x, K, n_keypoints=10, model_size=8, point_covariances=np.zeros((5, 3, 3)),
+                          inlier_threshold_px=0.6)
     assert row["covariance_status"] == "ok"  # exact pixels of exact points: nothing to expect an error from
     assert row["sigma_px"] == pytest.approx(0.0) and row["sigma_t_pred_mm"] == pytest.approx(0.0)
     assert row["n_inliers"] == 4 and row["n_matches"] == 5 and row["inlier_ratio"] == pytest.approx(0.8)
@@ -34,7 +35,7 @@ def test_inlier_geometry_of_a_known_square():
 
 def test_failed_result_has_zero_inliers_and_nan_geometry():
     row = frame_artifacts(failed("no_consensus", "no consensus: none of 100 samples ..."), np.zeros((2, 3)),
-                          np.zeros((2, 2)), K, 10, 8, np.zeros((2, 3, 3)))
+                          np.zeros((2, 2)), K, 10, 8, np.zeros((2, 3, 3)), 0.6)
     assert row["n_inliers"] == 0 and row["inlier_ratio"] == 0.0 and np.isnan(row["inlier_spread_px"])
     assert row["covariance_status"] == "no_pose" and np.isnan(row["sigma_t_pred_mm"])
 

@@ -214,3 +214,32 @@ def test_points_behind_the_camera_are_refused():
     behind = X * [1.0, 1.0, -1.0]
     with pytest.raises(ArgumentError, match="in front of the camera"):
         pose_covariance(behind, project(X, T), np.eye(4), K)
+
+
+def test_inlier_conditioning_matches_truncated_normal_moments():
+    """(c) along one direction: the error e = n + m (variances s^2, v) kept when |e| <= tau; the model part's
+    variance by regression, against scipy's truncated normal (an independent reference) and a Monte Carlo."""
+    from scipy.stats import truncnorm
+    from poseintegrity.localization.pose_covariance import inlier_conditioned
+    v, noise, tau = 1.5, 0.04, 0.6
+    C = np.array([[[v, 0.0], [0.0, 0.0]]])
+    conditioned = inlier_conditioned(C, noise, np.array([tau]))[0]
+    w = v + noise
+    truncated = truncnorm.var(-tau / np.sqrt(w), tau / np.sqrt(w), scale=np.sqrt(w))
+    assert conditioned[0, 0] == pytest.approx((v / w) ** 2 * truncated + v * noise / w, rel=1e-9)
+    assert conditioned[1, 1] == pytest.approx(0.0, abs=1e-12)
+    rng = np.random.default_rng(11)
+    m, n = rng.normal(0.0, np.sqrt(v), 2_000_000), rng.normal(0.0, np.sqrt(noise), 2_000_000)
+    assert conditioned[0, 0] == pytest.approx(np.var(m[np.abs(m + n) <= tau]), rel=0.02)
+
+
+def test_a_threshold_nothing_exceeds_leaves_the_covariance_unconditioned():
+    rng = np.random.default_rng(12)
+    X, T = scene(rng)
+    cov = triangulation_covariances(X + ORIGIN, BASELINE, K, 0.3)
+    u = project(X, T)
+    loose = pose_covariance(X, u, T, K, point_covariances=cov, sigma_px=0.2, inlier_threshold_px=1e6)
+    np.testing.assert_allclose(loose.model, loose.unconditioned, rtol=1e-9, atol=1e-15)
+    tight = pose_covariance(X, u, T, K, point_covariances=cov, sigma_px=0.2, inlier_threshold_px=0.6)
+    assert tight.sigma_t_mm("model") < 0.5 * tight.sigma_t_mm("unconditioned")  # 20 deg away: most errors > 0.6 px
+    assert tight.sigma_t_mm("total_unconditioned") == pytest.approx(loose.sigma_t_mm())

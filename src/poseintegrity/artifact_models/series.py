@@ -26,6 +26,8 @@ class Series:
     stop : (m,) int, 0-based;  theta : (m,) float, deg (arc) or mm (line);  n_inliers : (m,) float
     theta_end : end of the trajectory's range (protocol.arc_span_deg or line_length_mm): where the search for
     theta_p ends and the MLP's artificial point (theta_end, 0) lies (III-D, III-E)
+    sigma_t, sigma_r : (m,) float or None, each image's predicted RMS E_t (mm) and E_r (deg) (stage 02's
+    ``sigma_t_pred_mm``, ``sigma_r_pred_deg``; NaN without a pose), the error predictors' input (ours, issue 38)
     """
 
     dataset: str
@@ -34,6 +36,8 @@ class Series:
     theta: np.ndarray
     n_inliers: np.ndarray
     theta_end: float
+    sigma_t: np.ndarray | None = None
+    sigma_r: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         """Checked once when made (every predictor takes a Series): theta and n_inliers (m,) numbers (NaN / inf are
@@ -43,6 +47,12 @@ class Series:
         n_inliers = check_array("Series.n_inliers", self.n_inliers, shape=(None,), finite=False)
         stop = check_array("Series.stop", self.stop, shape=(None,), dtype="int")
         check_same_length(**{"Series.theta": theta, "Series.n_inliers": n_inliers, "Series.stop": stop})
+        for name in ("sigma_t", "sigma_r"):
+            if getattr(self, name) is not None:
+                sigma = check_array(f"Series.{name}", getattr(self, name), shape=(len(theta),), finite=False)
+                if (sigma[np.isfinite(sigma)] < 0).any():
+                    raise ArgumentError(f"Series.{name}: a predicted RMS error is >= 0 (NaN: none)")
+                object.__setattr__(self, name, sigma)
         if (stop < 0).any() or (np.diff(stop) < 0).any():
             raise ArgumentError("Series.stop: expected stop indices >= 0 in stop order")
         if (np.abs(theta[np.isfinite(theta)]) > MAX_THETA).any():
@@ -62,6 +72,7 @@ class Series:
 
 
 REQUIRED_COLUMNS = ("dataset", "trajectory", "stop", "image", "theta_deg", "x_mm", "method", "n_inliers")
+PREDICTED_ERROR_COLUMNS = ("sigma_t_pred_mm", "sigma_r_pred_deg")  # read into Series.sigma_t / sigma_r when present
 
 
 def dataset_series(artifacts: pd.DataFrame, pnp_method: str, protocol: ProtocolParams) -> list[Series]:
@@ -89,6 +100,8 @@ def dataset_series(artifacts: pd.DataFrame, pnp_method: str, protocol: ProtocolP
             theta=group[VARIABLE[trajectory]].to_numpy(dtype=float),
             n_inliers=group["n_inliers"].to_numpy(dtype=float),
             theta_end=protocol.range_end(trajectory),
+            **{name: group[column].to_numpy(dtype=float) if column in group else None
+               for name, column in zip(("sigma_t", "sigma_r"), PREDICTED_ERROR_COLUMNS)},
         )
         _check(one)
         series.append(one)

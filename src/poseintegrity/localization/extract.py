@@ -85,16 +85,18 @@ def localize(
         object_points, image_points, K, method, params.reprojection_threshold_px, params.ransac_confidence,
         iteration_cap(method, params), seed, params.usac_refine_lm,
     )
-    return located(result, object_points, image_points, point_covariances, n_keypoints, model_size, K)
+    return located(result, object_points, image_points, point_covariances, n_keypoints, model_size, K,
+                   params.reprojection_threshold_px)
 
 
 def located(
     result: PnPResult, object_points: np.ndarray, image_points: np.ndarray, point_covariances: np.ndarray,
-    n_keypoints: int, model_size: int, K: np.ndarray,
+    n_keypoints: int, model_size: int, K: np.ndarray, threshold_px: float,
 ) -> tuple[np.ndarray, dict[str, Any], str, str]:
     """What :func:`localize` returns for a PnP result of its correspondences (point_covariances : (k, 3, 3) mm^2,
-    the matched model points' covariances)."""
-    artifacts = frame_artifacts(result, object_points, image_points, K, n_keypoints, model_size, point_covariances)
+    the matched model points' covariances; threshold_px: RANSAC's inlier threshold)."""
+    artifacts = frame_artifacts(result, object_points, image_points, K, n_keypoints, model_size, point_covariances,
+                                threshold_px)
     if n_keypoints == 0:
         return result.T_cam_model, artifacts, "no_keypoints", "SIFT found no keypoints in the frame"
     return result.T_cam_model, artifacts, result.status, result.reason
@@ -245,11 +247,12 @@ def frame_rows(task: FrameTask) -> list[dict[str, Any]]:
         if evidence.image_problem:
             T_est, artifacts = NAN_POSE.copy(), frame_artifacts(failed("bad_image", reason), evidence.object_points,
                                                                 evidence.image_points, task.camera.K, 0,
-                                                                model.size, point_covariances)
+                                                                model.size, point_covariances,
+                                                                task.params.reprojection_threshold_px)
         else:
             T_est, artifacts, pnp_status, pnp_reason = located(
                 results[method], evidence.object_points, evidence.image_points, point_covariances,
-                evidence.n_keypoints, model.size, task.camera.K,
+                evidence.n_keypoints, model.size, task.camera.K, task.params.reprojection_threshold_px,
             )
         E_t_mm, E_r_deg = map(float, pose_errors(T_est, truth))  # IV-C: the board is the truth (or the poses)
         E_t_exact_mm, E_r_exact_deg = map(float, pose_errors(T_est, T_cam_board))

@@ -49,6 +49,30 @@ class UncertaintyParams(Section):
     n_bootstrap: int = Field(ge=2, le=10_000, description="bootstrap refits per dataset (method bootstrap)")
 
 
+class ErrorPredictorParams(Section):
+    """Ours (issue 38): the predictors that stop where k x the predicted localization error reaches the tolerance
+    (prediction/error_predictors.py). The operating point is the safety factor k, swept geometrically."""
+
+    k_min: float = Field(gt=0, le=1e3, description="smallest safety factor of the sweep")
+    k_max: float = Field(gt=0, le=1e3, description="largest safety factor of the sweep")
+    n_k: int = Field(ge=2, le=GRID, description="safety factors swept, k_min .. k_max in geometric steps")
+    live_k: float | None = Field(description="fixed k of the simulated live trials of error_next_step (as live_n_t "
+                                             "of the paper's); null: the k of the main world's Table III at "
+                                             "live_tolerance")
+
+    @model_validator(mode="after")
+    def _check(self) -> ErrorPredictorParams:
+        if self.k_max <= self.k_min:
+            raise KeyRule("k_max", f"must be > k_min ({self.k_min}), got {self.k_max}")
+        return self
+
+    @property
+    def factors(self) -> np.ndarray:
+        """The swept safety factors k : (n_k,) float, geometric from k_min to k_max (rounded to 1e-9, so that the
+        grids of two worlds agree exactly)."""
+        return np.round(np.geomspace(self.k_min, self.k_max, self.n_k), 9)
+
+
 class PredictParams(Section):
     """Stage 04: predictors, the n_t sweep, the static baseline, LOSO threshold choice, live-trial simulation."""
 
@@ -77,6 +101,7 @@ class PredictParams(Section):
         " choice; first = headline"
     )
     uncertainty: UncertaintyParams
+    error: ErrorPredictorParams
     tail_n_t_max: int = Field(
         ge=1, le=GRID, description="the tail diagnosis: an arc whose long range theta_p exceeds theta_a at every swept n_t up"
         " to this one, one of n_t_min .. n_t_max"

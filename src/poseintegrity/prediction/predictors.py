@@ -229,6 +229,23 @@ def next_step(
     "bad_threshold". Fits stop once every threshold has stopped. A threshold's fit status is the most severe
     status among the fits it went by (up to and including the one that stopped it): its path relied on each.
     """
+    _, theta_stops = stop_positions(series)
+
+    def boundary(stops: np.ndarray, moving: np.ndarray) -> tuple[np.ndarray, str, str]:
+        fitted, _, _ = fit_stops(series, stops, model, fit, fit_rng(seed, method, series, stops.size))
+        return (envelope_prediction(fitted.predict, moving, theta_stops[0], series.theta_end, n_grid).theta_p,
+                fitted.status, fitted.reason)
+
+    return supervise(series, k0, thresholds, boundary)
+
+
+def supervise(series: Series, k0: int, thresholds: np.ndarray,
+              boundary: Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, str, str]]) -> NextStep:
+    """III-E's next-step supervision for every operating point at once, whatever predicts the boundary.
+
+    boundary(stops, operating_points) -> (theta_p (T',), fit status, fit reason): the boundary predicted from the
+    samples of ``stops`` (all stops so far) for each operating point still moving. From the k0-th stop on, an
+    operating point whose theta_p < theta_i + theta_b stops the robot at theta_i (:func:`next_step`)."""
     thresholds = _thresholds(thresholds)
     stops, theta_stops = stop_positions(series)
     no_fit = np.full(np.shape(thresholds), NO_FIT)
@@ -237,7 +254,7 @@ def next_step(
         return NextStep(flagged(thresholds, "too_few_stops"), nan, no_fit, np.full(nan.shape, "too few stops"), 0)
     theta_b = sampling_interval(theta_stops)
     stop_at = np.full(np.shape(thresholds), theta_stops[-1])
-    boundary = np.full(np.shape(thresholds), np.nan)
+    boundary_at = np.full(np.shape(thresholds), np.nan)
     moving = np.isfinite(thresholds)
     severity = np.zeros(np.shape(thresholds), dtype=int)  # index into FIT_STATUSES
     fit_reason = np.full(np.shape(thresholds), OK, dtype=object)
@@ -245,21 +262,20 @@ def next_step(
     for i in range(k0 - 1, stops.size):
         if not moving.any():
             break
-        fitted, _, _ = fit_stops(series, stops[: i + 1], model, fit, fit_rng(seed, method, series, i + 1))
+        theta_p, status, reason = boundary(stops[: i + 1], thresholds[moving])
         n_fits += 1
-        worse = moving & (FIT_STATUSES.index(fitted.status) > severity)
-        severity[worse], fit_reason[worse] = FIT_STATUSES.index(fitted.status), f"fit on {i + 1} stops: {fitted.reason}"
-        theta_p = envelope_prediction(fitted.predict, thresholds[moving], theta_stops[0], series.theta_end, n_grid).theta_p
+        worse = moving & (FIT_STATUSES.index(status) > severity)
+        severity[worse], fit_reason[worse] = FIT_STATUSES.index(status), f"fit on {i + 1} stops: {reason}"
         stop = next_step_stops(theta_p, theta_stops[i], theta_b)
         index = moving.nonzero()[0][stop]
-        stop_at[index], boundary[index] = theta_stops[i], theta_p[stop]
+        stop_at[index], boundary_at[index] = theta_stops[i], theta_p[stop]
         moving[index] = False
     status = np.where(moving, "end_of_path", "stopped").astype(object)
     bad = ~np.isfinite(thresholds)
     stop_at[bad], status[bad] = np.nan, "bad_threshold"
     fit_status = np.where(bad, NO_FIT, np.array(FIT_STATUSES)[severity])
     fit_reason[bad] = "bad threshold"
-    return NextStep(Boundaries(stop_at, status.astype(str)), boundary, fit_status, fit_reason.astype(str), n_fits)
+    return NextStep(Boundaries(stop_at, status.astype(str)), boundary_at, fit_status, fit_reason.astype(str), n_fits)
 
 
 def first_stop_mean(series: Series) -> float:

@@ -11,7 +11,12 @@ prediction interval, :mod:`.uncertainty`), "mlp", "next_step", "static", and bey
 "long_range_relative" / "next_step_relative", whose operating point is n_t as a fraction of the dataset's mean n_i
 at the first stop (the same fits as "long_range" / "next_step"), and "long_range_free_width" /
 "next_step_free_width", the same predictors on a second artifact model (``predict.models``: the free-width EMG).
-Only "long_range" and "static" run on PnP methods other than ``protocol.pnp_method`` (Fig. 6).
+Ours beside them (issue 38, :mod:`.error_predictors`): "error_long_range" and "error_next_step", which stop where
+k x the predicted localization error reaches the tolerance (operating point: the safety factor k). Their theta_p
+depends on the tolerance, so their rows name it (column ``tolerance``; empty for every other predictor, whose
+theta_p serves every tolerance). "error_combined", the earlier stop of the error predictor and the paper's at its
+chosen n_t, is made from both after the operating points are chosen (:func:`combined_rows`).
+Only "long_range", "error_long_range" and "static" run on PnP methods other than ``protocol.pnp_method`` (Fig. 6).
 
 Every row says how its theta_p was found (``status``, predictors.py) and what the fit behind it was worth
 (``fit_status``: ok / at_bound / non_physical / fallback, artifact_models/fitted.py; "no_fit" for the static
@@ -33,6 +38,7 @@ from poseintegrity.artifact_models.series import REQUIRED_COLUMNS, Series, datas
 from poseintegrity.parallel import Workers
 from poseintegrity.tables import TableError, check_artifacts, check_envelopes
 from poseintegrity.prediction.metrics import with_metrics
+from poseintegrity.prediction.error_predictors import combined, error_long_range, error_next_step
 from poseintegrity.prediction.params import PredictParams
 from poseintegrity.prediction.predictors import (
     NO_FIT,
@@ -49,28 +55,30 @@ from poseintegrity.protocol import ProtocolParams
 
 COLUMNS = [
     "predictor", "model", "method", "trajectory", "dataset", "operating_point", "theta_p", "status", "fit_status",
-    "reason",
+    "reason", "tolerance",
 ]  # fmt: skip
 PAPER_PREDICTORS = ("static", "long_range", "mlp", "next_step")  # the keys of predictors.json
 RELATIVE_PREDICTORS = ("long_range_relative", "next_step_relative")  # beyond the paper
 FREE_WIDTH_PREDICTORS = ("long_range_free_width", "next_step_free_width")  # ours: on the free-width EMG
+ERROR_PREDICTORS = ("error_long_range", "error_next_step", "error_combined")  # ours: on the predicted error
 FITTED_PREDICTORS = ("long_range", "long_range_lower", "mlp", "next_step", *RELATIVE_PREDICTORS,
-                     *FREE_WIDTH_PREDICTORS)  # fmt: skip
+                     *FREE_WIDTH_PREDICTORS, *ERROR_PREDICTORS)  # fmt: skip
 PAPER_COUNTERPART = {"long_range_free_width": "long_range", "next_step_free_width": "next_step"}  # same predictor
 CONSERVATIVE_HIGH = {"static": False}  # a larger operating point is more conservative for n_t, not for a size
 OPERATING_POINT_KEY = {"static": "best_size", "long_range_relative": "best_fraction",
-                       "next_step_relative": "best_fraction"}  # predictors.json name of the best operating point
+                       "next_step_relative": "best_fraction"} | {p: "best_k" for p in ERROR_PREDICTORS}
+# predictors.json name of the best operating point
 
 
 def prediction_rows(
     predictor: str, model: str, method: str, series: Series, operating_point: np.ndarray, found: Boundaries,
-    fit_status: str | np.ndarray, reason: str | np.ndarray,
+    fit_status: str | np.ndarray, reason: str | np.ndarray, tolerance: str = "",
 ) -> pd.DataFrame:  # fmt: skip
     return pd.DataFrame(
         {
             "predictor": predictor, "model": model, "method": method, "trajectory": series.trajectory,
             "dataset": series.dataset, "operating_point": operating_point, "theta_p": found.theta_p,
-            "status": found.status, "fit_status": fit_status, "reason": reason,
+            "status": found.status, "fit_status": fit_status, "reason": reason, "tolerance": tolerance,
         },
         columns=COLUMNS,
     )  # fmt: skip
@@ -106,7 +114,8 @@ def predict_dataset(
     absolute, relative = _split(answer.prediction, n_t.size)
     fit_status, reason = fit_of(answer)
     tables.append(prediction_rows("long_range", models.long_range, method, series, n_t, absolute, fit_status, reason))
-    if method != protocol.pnp_method:  # Fig. 6: the long range predictor alone on the other PnP methods
+    tables += error_rows(series, method, predict, fit, protocol, with_next_step=method == protocol.pnp_method)
+    if method != protocol.pnp_method:  # Fig. 6: the long range predictors alone on the other PnP methods
         return pd.concat(tables, ignore_index=True)
     tables.append(prediction_rows("long_range_relative", models.long_range, method, series, fractions, relative, fit_status,
                         reason))  # fmt: skip
@@ -137,6 +146,26 @@ def predict_dataset(
     return pd.concat(tables, ignore_index=True)
 
 
+def error_rows(series: Series, method: str, predict: PredictParams, fit: FitParams, protocol: ProtocolParams,
+               with_next_step: bool) -> list[pd.DataFrame]:
+    """The error predictors' rows of one dataset and method, per tolerance (:mod:`.error_predictors`; none when the
+    artifacts table carries no predicted error, e.g. one written before issue 38)."""
+    if series.sigma_t is None or series.sigma_r is None:
+        return []
+    factors, k, models, rows = predict.error.factors, protocol.stops_sampled(series.trajectory), predict.models, []
+    for tolerance, name in zip(protocol.tolerances, protocol.tolerance_names):
+        found, status, reason = error_long_range(series, k, models.long_range, factors, tolerance, fit,
+                                                 fit_rng(predict.seed, method, series, k), predict.n_grid)
+        rows.append(prediction_rows("error_long_range", models.long_range, method, series, factors, found, status,
+                                    reason, name))
+        if with_next_step:
+            step = error_next_step(series, k, models.next_step, factors, tolerance, fit, predict.seed, method,
+                                   predict.n_grid)
+            rows.append(prediction_rows("error_next_step", models.next_step, method, series, factors,
+                                        step.prediction, step.fit_status, step.fit_reason, name))
+    return rows
+
+
 def _predict_task(task: tuple[Series, str], predict: PredictParams, fit: FitParams, protocol: ProtocolParams
                   ) -> pd.DataFrame:  # fmt: skip
     series, method = task
@@ -160,6 +189,27 @@ def sweep(
     results = workers.map(partial(_predict_task, predict=predict, fit=fit, protocol=protocol), tasks,
                           desc="predictor sweep (dataset, PnP method)", progress=progress)  # fmt: skip
     return pd.concat(results, ignore_index=True)
+
+
+def combined_rows(theta_p: pd.DataFrame, best: pd.DataFrame, error: str = "error_next_step",
+                  inliers: str = "next_step") -> pd.DataFrame:
+    """The rows of "error_combined" (ours, issue 38): per dataset, method, tolerance and safety factor k, the earlier
+    stop of ``error``'s theta_p(k) and of ``inliers``' theta_p at the n_t chosen for that tolerance, method and
+    trajectory in ``best`` (the first world's Tables I-III, :func:`~.tables.best_table`), each guarding what the
+    other cannot see (:func:`~.error_predictors.combined`). Its status and fit are those of the predictor that
+    stops first. No rows where ``best`` has no zero-incursion n_t."""
+    chosen = best.loc[best["predictor"] == inliers, ["method", "trajectory", "tolerance", "best_operating_point"]]
+    chosen = chosen.dropna().rename(columns={"best_operating_point": "n_t"})
+    paper = theta_p.loc[theta_p["predictor"] == inliers, ["dataset", "method", "trajectory", "operating_point",
+                                                            "theta_p", "status", "fit_status", "reason"]]
+    rows = theta_p[theta_p["predictor"] == error].merge(chosen, on=["method", "trajectory", "tolerance"])
+    rows = rows.merge(paper.rename(columns={"operating_point": "n_t"}), on=["dataset", "method", "trajectory", "n_t"],
+                      suffixes=("", "_inliers"))
+    earlier = rows["theta_p_inliers"] < rows["theta_p"]
+    rows = rows.assign(predictor="error_combined", theta_p=combined(rows["theta_p"], rows["theta_p_inliers"]),
+                       **{column: rows[f"{column}_inliers"].where(earlier, rows[column])
+                          for column in ("status", "fit_status", "reason")})
+    return rows[COLUMNS].reset_index(drop=True)
 
 
 def with_pnp_variants(
@@ -196,7 +246,8 @@ def attach_envelopes(theta_p: pd.DataFrame, envelopes: pd.DataFrame, protocol: P
     (a duplicated row would count a dataset twice in every curve), their tolerances are those of ``protocol`` (a
     tolerance the params name would otherwise find no row, and its figures would silently be NaN), theta_a in
     [0, range end], and an envelope for every (dataset, trajectory, method) of ``theta_p`` (one missing would
-    drop that dataset from every curve): :class:`~poseintegrity.tables.TableError` naming them. An envelope stage 02
+    drop that dataset from every curve): :class:`~poseintegrity.tables.TableError` naming them. A sweep row that names
+    a tolerance (the error predictors') is scored on that tolerance's envelope only. An envelope stage 02
     could not read (theta_a NaN, status ``not_measured``) is left out of the scoring with a warning naming its
     datasets: there is nothing to score a prediction against.
     """
@@ -228,7 +279,12 @@ def attach_envelopes(theta_p: pd.DataFrame, envelopes: pd.DataFrame, protocol: P
         raise TableError(f"the envelopes table has no envelope for {len(absent)} (dataset, trajectory, method) of the "
                          f"predictions, e.g. {shown}: they would be dropped from every curve (was stage 02 run on "
                          f"other datasets?)")
-    table = theta_p.merge(envelopes[[*keys, "world", "tolerance", "theta_a", "censored"]], on=keys, how="inner")
+    scored = envelopes[[*keys, "world", "tolerance", "theta_a", "censored"]]
+    tolerance_free = theta_p["tolerance"].fillna("") == "" if "tolerance" in theta_p else pd.Series(True, theta_p.index)
+    table = pd.concat([  # a row made for one tolerance is scored on it alone, the others on every tolerance
+        theta_p[tolerance_free].drop(columns="tolerance", errors="ignore").merge(scored, on=keys, how="inner"),
+        theta_p[~tolerance_free].merge(scored, on=[*keys, "tolerance"], how="inner"),
+    ], ignore_index=True)
     unread = table[table["theta_a"].isna()]  # not_measured (check_envelopes): nothing to score a prediction against
     if len(unread):
         names = sorted(set(unread["dataset"]))

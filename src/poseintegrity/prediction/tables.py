@@ -16,14 +16,15 @@ import pandas as pd
 
 from poseintegrity.artifact_models import FIT_STATUSES
 from poseintegrity.artifact_models.fitted import OK
+from poseintegrity.prediction.ceiling import ceiling, ceiling_share
 from poseintegrity.prediction.loso import loso_summary
 from poseintegrity.prediction.metrics import (best_operating_point, operating_curves, relative_improvement,
                                                with_metrics)
 from poseintegrity.prediction.params import PredictParams
 from poseintegrity.prediction.predictors import NO_FIT
 from poseintegrity.prediction.sweeps import (
-    CONSERVATIVE_HIGH, FITTED_PREDICTORS, FREE_WIDTH_PREDICTORS, OPERATING_POINT_KEY, PAPER_COUNTERPART,
-    PAPER_PREDICTORS, RELATIVE_PREDICTORS, attach_envelopes,
+    CONSERVATIVE_HIGH, ERROR_PREDICTORS, FITTED_PREDICTORS, FREE_WIDTH_PREDICTORS, OPERATING_POINT_KEY,
+    PAPER_COUNTERPART, PAPER_PREDICTORS, RELATIVE_PREDICTORS, attach_envelopes,
 )
 from poseintegrity.prediction.tails import tail_metrics
 from poseintegrity.protocol import FAILED_FRAME_RULES, ProtocolParams
@@ -60,9 +61,10 @@ def deciding_datasets(table: pd.DataFrame, predictor: str, method: str, trajecto
     return sorted(incurring.loc[incurring["operating_point"] == nearest, "dataset"].unique().tolist())
 
 
-def live_trials(table: pd.DataFrame, best: pd.DataFrame, predict: PredictParams, protocol: ProtocolParams
-                ) -> pd.DataFrame:  # fmt: skip
-    """The simulated live trials (V-C): next-step at n_t = live_n_t vs the static baseline at its best size.
+def live_trials(table: pd.DataFrame, best: pd.DataFrame, predict: PredictParams, protocol: ProtocolParams,
+                predictor: str = "next_step", operating_point: float | None = None) -> pd.DataFrame:
+    """The simulated live trials (V-C): next-step at n_t = live_n_t vs the static baseline at its best size; for
+    ``predictor`` "error_next_step" (ours) at the safety factor ``operating_point``.
 
     best : :func:`best_table`; the static baseline runs at its largest zero-incursion size on the arcs of
     ``protocol.pnp_method`` at ``predict.live_tolerance`` (the paper's comparison; NaN rows if it has none).
@@ -77,7 +79,8 @@ def live_trials(table: pd.DataFrame, best: pd.DataFrame, predict: PredictParams,
     static_best = best[(best["predictor"] == "static") & (best["trajectory"] == "arc")
                        & (best["method"] == protocol.pnp_method) & (best["tolerance"] == predict.live_tolerance)]
     static_size = float(static_best["best_operating_point"].iloc[0]) if len(static_best) else np.nan  # fmt: skip
-    ours = rows[(rows["predictor"] == "next_step") & (rows["operating_point"] == predict.live_n_t)]
+    point = predict.live_n_t if operating_point is None else operating_point
+    ours = rows[(rows["predictor"] == predictor) & np.isclose(rows["operating_point"], point)]
     static = rows[(rows["predictor"] == "static") & np.isclose(rows["operating_point"], static_size)]
     merged = ours.merge(static[["dataset", "spl", "incursion"]], on="dataset", how="left", suffixes=("", "_static"))
     return pd.DataFrame(
@@ -94,7 +97,10 @@ def fit_status_shares(table: pd.DataFrame) -> dict[str, dict]:
     """predictor -> {n_rows, ok, at_bound, non_physical, fallback, no_fit}: the share of the predictor's rows (every
     dataset, PnP method, trajectory and operating point of the table, once whatever the tolerances joined) whose
     theta_p rests on a fit of that status."""
-    table = table.drop_duplicates(["predictor", "method", "trajectory", "dataset", "operating_point"])
+    # a sweep row serves every tolerance, but the error predictors' rows were made for one (sweeps.py)
+    once = ["predictor", "method", "trajectory", "dataset", "operating_point"]
+    table = table.assign(made_for=table["tolerance"].where(table["predictor"].isin(ERROR_PREDICTORS), ""))
+    table = table.drop_duplicates([*once, "made_for"])
     shares = {}
     for predictor in FITTED_PREDICTORS:
         rows = table.loc[table["predictor"] == predictor, "fit_status"]
@@ -130,14 +136,17 @@ def table_metrics(table: pd.DataFrame, curves: pd.DataFrame, predict: PredictPar
 
     tolerances = sorted(table["tolerance"].unique())
     static_mean = float(np.mean([get("static", "arc", t)[0] for t in tolerances]))
-    metrics: dict = {}
-    for predictor in (*PAPER_PREDICTORS, "long_range_lower", *RELATIVE_PREDICTORS, *FREE_WIDTH_PREDICTORS):
+    limits = ceiling(table, best, protocol.pnp_method, tolerances)
+    metrics: dict = {"ceiling": limits}
+    for predictor in (*PAPER_PREDICTORS, "long_range_lower", *RELATIVE_PREDICTORS, *FREE_WIDTH_PREDICTORS,
+                      *ERROR_PREDICTORS):
         point_key = OPERATING_POINT_KEY.get(predictor, "best_n_t")
         entry: dict = {}
         for tolerance in tolerances:
             spl, point = get(predictor, "arc", tolerance)
-            entry[tolerance] = {"max_mean_spl_zero_incursion": spl, point_key: point}
-            if predictor in PAPER_PREDICTORS:
+            entry[tolerance] = {"max_mean_spl_zero_incursion": spl, point_key: point,
+                                "ceiling_share": ceiling_share(spl, limits[tolerance])}
+            if predictor in (*PAPER_PREDICTORS, *ERROR_PREDICTORS):
                 entry[tolerance]["decided_by"] = deciding_datasets(table, predictor, protocol.pnp_method, "arc",
                                                                    tolerance, point)
             if point_key != "best_n_t":
@@ -160,6 +169,7 @@ def table_metrics(table: pd.DataFrame, curves: pd.DataFrame, predict: PredictPar
     metrics["straight_line"] = {
         "tolerance": tol,
         "long_range_max_mean_spl_zero_incursion": get("long_range", "line", tol)[0],
+        "error_long_range_max_mean_spl_zero_incursion": get("error_long_range", "line", tol)[0],
         "static_max_mean_spl_zero_incursion": get("static", "line", tol)[0],
         "relative_improvement": relative_improvement(get("long_range", "line", tol)[0], get("static", "line", tol)[0]),
     }
@@ -168,6 +178,7 @@ def table_metrics(table: pd.DataFrame, curves: pd.DataFrame, predict: PredictPar
             "tolerance": tol,
             "max_mean_spl_zero_incursion": get("long_range", "arc", tol, method)[0],
             "best_n_t": get("long_range", "arc", tol, method)[1],
+            "error_long_range_max_mean_spl_zero_incursion": get("error_long_range", "arc", tol, method)[0],
             "static_max_mean_spl_zero_incursion": get("static", "arc", tol, method)[0],
         }
         for method in sorted(table["method"].unique())
@@ -179,29 +190,40 @@ def table_metrics(table: pd.DataFrame, curves: pd.DataFrame, predict: PredictPar
 
 def headline_metrics(
     table: pd.DataFrame, curves: pd.DataFrame, loso: pd.DataFrame, live: pd.DataFrame, predict: PredictParams,
-    protocol: ProtocolParams,
+    protocol: ProtocolParams, error_live: pd.DataFrame | None = None, error_live_k: float = np.nan,
 ) -> dict:
     """The content of ``reports/metrics/predictors.json``, of the main world: :func:`table_metrics`, and
-    loso.<predictor>.<tolerance>.{heldout_incursion_rate, heldout_mean_spl, ...} at the first target rate;
-    live.{n_t, incursions, n_trials, envelope_share, n_flagged_fits, static_*} (V-C)."""
+    loso.<predictor>.<tolerance>.{heldout_incursion_rate, heldout_mean_spl, ceiling_share, ...} at the first target
+    rate (the held-out mean SPL's share of the world's ceiling); live.{n_t, incursions, n_trials, envelope_share,
+    n_flagged_fits, static_*} (V-C), and live.error_next_step.{k, incursions, n_trials, envelope_share,
+    n_flagged_fits} for ``error_live`` (:func:`live_trials` of "error_next_step" at ``error_live_k``, ours)."""
     metrics = table_metrics(table, curves, predict, protocol)
     metrics["loso"] = loso_summary(loso, predict.loso_target_rates[0])
+    for entry in metrics["loso"].values():
+        for tolerance, figures in entry.items():
+            figures["ceiling_share"] = ceiling_share(figures["heldout_mean_spl"], metrics["ceiling"][tolerance])
     metrics["live"] = {
-        "n_t": predict.live_n_t, "tolerance": predict.live_tolerance, "n_trials": int(len(live)),
-        "incursions": float(live["incursion"].sum()), "envelope_share": float(live["share"].mean()),
-        "n_flagged_fits": int((~live["fit_status"].isin([OK])).sum()),
+        "n_t": predict.live_n_t, "tolerance": predict.live_tolerance, **_live_figures(live),
         "static_size": float(live["static_size"].iloc[0]) if len(live) else np.nan,
         "static_incursions": float(live["static_incursion"].sum()),
         "static_envelope_share": float(live["static_share"].mean()),
     }  # fmt: skip
+    if error_live is not None:
+        metrics["live"]["error_next_step"] = {"k": float(error_live_k), **_live_figures(error_live)}
     return metrics
+
+
+def _live_figures(live: pd.DataFrame) -> dict:
+    """n_trials, incursions, envelope_share, n_flagged_fits of :func:`live_trials` rows."""
+    return {"n_trials": int(len(live)), "incursions": float(live["incursion"].sum()),
+            "envelope_share": float(live["share"].mean()), "n_flagged_fits": int((~live["fit_status"].isin([OK])).sum())}
 
 
 def rule_metrics(theta_p: pd.DataFrame, envelopes: pd.DataFrame, protocol: ProtocolParams,
                  predictors: tuple[str, ...] = PAPER_PREDICTORS) -> dict:
     """Tables I-III under every failed-frame rule of theta_a (:mod:`poseintegrity.localization.envelope`):
-    <rule>.<predictor>.<tolerance>.{max_mean_spl_zero_incursion, best_operating_point} on the arcs of the paper's PnP
-    path, and <rule>.<predictor>.relative_improvement over static (mean of the tolerances). Every tolerance of
+    <rule>.<predictor>.<tolerance>.{max_mean_spl_zero_incursion, best_operating_point, ceiling_share} on the arcs of
+    the paper's PnP path, and <rule>.<predictor>.relative_improvement over static (mean of the tolerances). Every tolerance of
     ``protocol`` has its entry, NaN where nothing was measured (a world without arcs).
 
     theta_p : :func:`~.sweeps.sweep` rows (those of datasets without an envelope, e.g. of another world, are left
@@ -210,14 +232,16 @@ def rule_metrics(theta_p: pd.DataFrame, envelopes: pd.DataFrame, protocol: Proto
     metrics: dict = {}
     theta_p = theta_p[theta_p["dataset"].isin(envelopes["dataset"])]  # this world's rows (other worlds' are left out)
     for rule in FAILED_FRAME_RULES:
-        best = best_table(operating_curves(attach_envelopes(theta_p, envelopes[envelopes["rule"] == rule]
-                                                            .drop(columns="rule"), protocol)))
+        table = attach_envelopes(theta_p, envelopes[envelopes["rule"] == rule].drop(columns="rule"), protocol)
+        best = best_table(operating_curves(table))
+        limits = ceiling(table, best, protocol.pnp_method, protocol.tolerance_names)
         best = best[(best["trajectory"] == "arc") & (best["method"] == protocol.pnp_method)]
         entry: dict = {}
         for predictor in predictors:
             rows = best[best["predictor"] == predictor].set_index("tolerance").reindex(protocol.tolerance_names)
             entry[predictor] = {tol: {"max_mean_spl_zero_incursion": float(row.max_mean_spl),
-                                      "best_operating_point": float(row.best_operating_point)}
+                                      "best_operating_point": float(row.best_operating_point),
+                                      "ceiling_share": ceiling_share(float(row.max_mean_spl), limits[tol])}
                                 for tol, row in rows.iterrows()}
             entry[predictor]["mean_max_mean_spl_zero_incursion"] = float(rows["max_mean_spl"].mean())
         static = entry["static"]["mean_max_mean_spl_zero_incursion"] if "static" in entry else np.nan

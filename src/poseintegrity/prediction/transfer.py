@@ -12,6 +12,8 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from poseintegrity.prediction.ceiling import ceiling_share
+
 KEYS = ["predictor", "method", "trajectory", "tolerance"]
 DECIMALS = 9  # operating points of both worlds come from the same grids; rounding makes them comparable exactly
 
@@ -34,15 +36,20 @@ def transfer(best: pd.DataFrame, curves: pd.DataFrame) -> pd.DataFrame:
 
 
 def transfer_metrics(transferred: pd.DataFrame, predictors: tuple[str, ...], method: str,
-                     trajectory: str = "arc") -> dict:
-    """``<predictor>.<tolerance>.{operating_point, incursion_rate, mean_spl}`` of :func:`transfer` rows (NaN: none)."""
+                     trajectory: str = "arc", limits: dict | None = None) -> dict:
+    """``<predictor>.<tolerance>.{operating_point, incursion_rate, mean_spl}`` of :func:`transfer` rows (NaN: none),
+    and ``ceiling_share`` of that mean SPL where ``limits`` (the world's :func:`~.ceiling.ceiling`) is given. A
+    transferred operating point that incurs on the other world keeps its mean SPL and share: its incursion rate
+    says what they cost."""
     rows = transferred[(transferred["method"] == method) & (transferred["trajectory"] == trajectory)]
     metrics: dict = {}
     for predictor in predictors:
         entry = {}
         for row in rows[rows["predictor"] == predictor].itertuples():
+            mean_spl = float(row.mean_spl) if np.isfinite(row.mean_spl) else np.nan
             entry[row.tolerance] = {"operating_point": float(row.operating_point),
-                                    "incursion_rate": float(row.incursion_rate),
-                                    "mean_spl": float(row.mean_spl) if np.isfinite(row.mean_spl) else np.nan}
+                                    "incursion_rate": float(row.incursion_rate), "mean_spl": mean_spl}
+            if limits is not None:
+                entry[row.tolerance]["ceiling_share"] = ceiling_share(mean_spl, limits[row.tolerance])
         metrics[predictor] = entry
     return metrics

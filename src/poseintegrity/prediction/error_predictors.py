@@ -1,0 +1,145 @@
+"""Predictors that stop where the predicted localization error reaches the tolerance (ours, issue 38).
+
+Windsor et al. stop the robot where the fitted inlier count falls to a threshold n_t chosen by experiment, and name
+"thresholds based on task specific localization accuracy requirements" as future work (VI). Stage 02 gives every
+posed frame a predicted RMS error (sigma_t mm, sigma_r deg; :mod:`poseintegrity.localization.pose_covariance`): the
+tolerance itself can then be the threshold, and the operating point is a safety factor k (a stop is unsafe once
+k x sigma reaches the tolerance of either criterion).
+
+How the predicted error grows (:class:`ErrorGrowth`). The pose covariance is N^-1 (...) N^-1 with N = J^T J summed
+over the inliers, so per inlier it scales as 1 / n_i; its model-point term grows as the view turns away from the
+model view, where M_t's depth errors lie along the rays (~ sin^2 theta of the turn; on a straight line the view
+does not turn and the term grows with the distance instead, first order in x). So per image
+
+    sigma^2 n_i = a + b h(theta),   h = sin^2 theta (arcs, theta in deg) or x (lines, mm),   a, b >= 0
+
+is fitted by non-negative least squares to the sampled images with a pose, for E_t and E_r each, and the count
+n_i(theta) comes from the paper's own artifact model (eq. 1) fitted to the same stops: sigma(theta) =
+sqrt((a + b h(theta)) / n(theta)). The eq. 1 curve carries what n_i says (a falling count raises the error as
+1 / sqrt(n_i)); the propagation adds what it cannot see (the model points' errors entering the image as the view
+turns). Where the fitted count reaches zero the predicted error is infinite.
+
+    error_long_range   fit the first k stops (4 on arcs, 5 on lines, as the long range predictor); theta_p where
+                       k x sigma(theta) first reaches the tolerance (III-E's search, :func:`envelope_prediction`)
+    error_next_step    refit at every stop from the k-th on and stop where the robot stands once theta_p is less
+                       than one step ahead: III-E's rule (:func:`~poseintegrity.prediction.predictors.supervise`)
+
+The search runs on the safety margin m(theta) = min(tol_t / sigma_t, tol_r / sigma_r), which falls as the error
+grows: theta_p(k) is where m falls to k, for every k at once.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import nnls
+
+from poseintegrity.artifact_models import FitParams, FittedModel
+from poseintegrity.errors import ArgumentError
+from poseintegrity.artifact_models.fitted import FALLBACK
+from poseintegrity.artifact_models.series import Series
+from poseintegrity.prediction.predictors import (
+    Boundaries, NextStep, envelope_prediction, fit_rng, fit_stops, flagged, stop_positions, supervise,
+)
+
+NO_ERROR = "no predicted error at the sampled stops"  # fit reason of a dataset without one (a fallback fit)
+
+
+def growth_regressor(trajectory: str, theta: np.ndarray) -> np.ndarray:
+    """h(theta) (module docstring): sin^2 theta on arcs (theta deg), theta itself on lines (mm). (m,) -> (m,)."""
+    theta = np.asarray(theta, dtype=float)
+    return np.sin(np.radians(theta)) ** 2 if trajectory == "arc" else theta
+
+
+@dataclass(frozen=True)
+class ErrorGrowth:
+    """sigma^2 n = a + b h(theta) for E_t (mm^2) and E_r (deg^2), and the eq. 1 fit n(theta) (module docstring)."""
+
+    trajectory: str
+    coefficients_t: tuple[float, float]
+    coefficients_r: tuple[float, float]
+    inliers: FittedModel
+
+    def sigma(self, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(sigma_t (m,) mm, sigma_r (m,) deg) predicted at theta (m,); inf where the fitted count is <= 0."""
+        h = growth_regressor(self.trajectory, theta)
+        n = np.asarray(self.inliers.predict(theta), dtype=float)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return tuple(np.where(n > 0, np.sqrt((a + b * h) / np.where(n > 0, n, 1.0)), np.inf)
+                         for a, b in (self.coefficients_t, self.coefficients_r))
+
+    def margin(self, theta: np.ndarray, tolerance: tuple[float, float]) -> np.ndarray:
+        """m(theta) = min(tol_t / sigma_t, tol_r / sigma_r) (m,): the safety factor left at theta (0 where the
+        predicted error is infinite, inf where it is zero)."""
+        sigma_t, sigma_r = self.sigma(theta)
+        with np.errstate(divide="ignore"):
+            return np.minimum(tolerance[0] / sigma_t, tolerance[1] / sigma_r)
+
+
+def fit_growth(series: Series, stops: np.ndarray, model: str, fit: FitParams, rng: np.random.Generator
+               ) -> tuple[ErrorGrowth, str, str]:
+    """The error growth fitted to the images of ``stops``: (growth, fit status, reason). The status is the eq. 1
+    fit's (artifact_models/fitted.py), "fallback" when fewer than two distinct theta have a predicted error (the
+    growth then holds the error of the images there, constant: b = 0; none at all: an infinite error, theta_p 0)."""
+    fitted, _, _ = fit_stops(series, stops, model, fit, rng)
+    keep = np.isin(series.stop, stops) & np.isfinite(series.sigma_t) & np.isfinite(series.sigma_r) \
+        & (series.n_inliers > 0)
+    theta, n_i = series.theta[keep], series.n_inliers[keep]
+    h = growth_regressor(series.trajectory, theta)
+    columns = np.column_stack([np.ones_like(h), h]) if np.unique(theta).size >= 2 else np.ones((h.size, 1))
+    coefficients = []
+    for sigma in (series.sigma_t[keep], series.sigma_r[keep]):
+        if h.size == 0:
+            coefficients.append((np.inf, 0.0))
+            continue
+        solution, _ = nnls(columns, sigma**2 * n_i)
+        coefficients.append((float(solution[0]), float(solution[1]) if solution.size > 1 else 0.0))
+    status, reason = fitted.status, fitted.reason
+    if np.unique(theta).size < 2:
+        status, reason = FALLBACK, NO_ERROR if h.size == 0 else f"{NO_ERROR} but one: the error held constant"
+    return ErrorGrowth(series.trajectory, coefficients[0], coefficients[1], fitted), status, reason
+
+
+def _check_predicted(series: Series) -> None:
+    if series.sigma_t is None or series.sigma_r is None:
+        raise ArgumentError(f"series: dataset {series.dataset}: the series carries no predicted error (stage 02's "
+                         f"sigma_t_pred_mm, sigma_r_pred_deg)")
+
+
+def error_long_range(series: Series, k: int, model: str, factors: np.ndarray, tolerance: tuple[float, float],
+                     fit: FitParams, rng: np.random.Generator, n_grid: int) -> tuple[Boundaries, str, str]:
+    """theta_p for every safety factor of ``factors`` (F,) from the growth fitted to the first k stops, for one
+    tolerance (E_t mm, E_r deg): (Boundaries, fit status, fit reason). "too_few_stops" (NaN) with fewer than k
+    stops with a valid inlier count."""
+    _check_predicted(series)
+    stops, theta_stops = stop_positions(series)
+    if stops.size < k:
+        return flagged(factors, "too_few_stops"), "no_fit", "too few stops"
+    growth, status, reason = fit_growth(series, stops[:k], model, fit, rng)
+    found = envelope_prediction(lambda theta: growth.margin(theta, tolerance), factors, theta_stops[0],
+                                series.theta_end, n_grid)
+    return found, status, reason
+
+
+def error_next_step(series: Series, k0: int, model: str, factors: np.ndarray, tolerance: tuple[float, float],
+                    fit: FitParams, seed: int, method: str, n_grid: int) -> NextStep:
+    """The next-step predictor of III-E on the predicted error: from the k0-th stop on, the growth is refitted on
+    all stops so far and the robot stops where it stands for every safety factor whose theta_p < theta_i + theta_b
+    (:func:`~poseintegrity.prediction.predictors.supervise`)."""
+    _check_predicted(series)
+    _, theta_stops = stop_positions(series)
+
+    def boundary(stops: np.ndarray, moving: np.ndarray) -> tuple[np.ndarray, str, str]:
+        growth, status, reason = fit_growth(series, stops, model, fit, fit_rng(seed, method, series, stops.size))
+        found = envelope_prediction(lambda theta: growth.margin(theta, tolerance), moving, theta_stops[0],
+                                    series.theta_end, n_grid)
+        return found.theta_p, status, reason
+
+    return supervise(series, k0, factors, boundary)
+
+
+def combined(theta_p_error: np.ndarray, theta_p_inliers: float) -> np.ndarray:
+    """The earlier stop of the error predictor (per safety factor, (F,)) and the inlier predictor at its chosen n_t:
+    each guards what the other cannot see. NaN where either is NaN (a flagged row)."""
+    return np.minimum(np.asarray(theta_p_error, dtype=float), theta_p_inliers)
