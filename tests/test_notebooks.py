@@ -21,7 +21,8 @@ from poseintegrity.config import load_params
 from poseintegrity.localization.dataset import recorded_worlds
 from poseintegrity.localization.envelope_causes import CAUSES
 from poseintegrity.localization.summaries import FAILURE_STATUSES
-from poseintegrity.prediction import FITTED_PREDICTORS, FREE_WIDTH_PREDICTORS, NO_FIT
+from poseintegrity.prediction import (ERROR_PREDICTORS, FITTED_PREDICTORS, FREE_WIDTH_PREDICTORS, NO_FIT,
+                                      PAPER_PREDICTORS)
 from project_copy import stage_06_project
 from repository import ROOT
 
@@ -39,8 +40,8 @@ METRICS = {  # notebook -> the metrics file it must write
     "07_report": None,
 }
 SPOILED = "scene_a_arc000"  # its frames (stop 1, image 0): not an image; (stop 2, image 1): a NaN ground-truth pose
-FIGURES_04 = ["04_fig5_long_range.png", "04_fig6_pnp.png", "04_fig7_straight_line.png", "04_fig8_next_step.png",
-              "04_free_width.png", "04_loso.png", "04_model_choice.png", "04_relative_thresholds.png", "04_tails.png",
+FIGURES_04 = ["04_ceiling.png", "04_fig5_long_range.png", "04_fig6_pnp.png", "04_fig7_straight_line.png",
+              "04_fig8_next_step.png", "04_free_width.png", "04_loso.png", "04_model_choice.png", "04_relative_thresholds.png", "04_tails.png",
               "04_uncertainty.png"]  # fmt: skip
 
 
@@ -100,8 +101,16 @@ def test_stage_02_flags_the_spoiled_frames_and_writes_tables_metrics_and_figures
     for key in ("min_abs_spearman", "error_ratio_low_vs_high_inliers", "n_uncensored_4mm10deg",
                 "min_theta_a_2mm3deg", "cv_theta_a_2mm3deg"):
         assert key in found["realism"]
-    for figure in ("02_inliers_vs_theta", "02_error_vs_inliers", "02_theta_a_distribution", "02_envelope_causes"):
+    for figure in ("02_inliers_vs_theta", "02_error_vs_inliers", "02_theta_a_distribution", "02_envelope_causes",
+                   "02_error_calibration"):
         assert (reports / "figures" / f"{figure}.png").stat().st_size > 0
+    posed = table[table.status == "ok"]  # issue 38: every posed frame's predicted error, or why it has none
+    assert (posed.covariance_status.isin(["ok", "too_few_points", "degenerate_points"])).all()
+    assert (posed.loc[posed.covariance_status == "ok", ["sigma_t_pred_mm", "sigma_r_pred_deg"]] > 0).all().all()
+    assert (table.loc[table.n_inliers == 0, "covariance_status"] == "no_pose").all()  # PnP gave no pose
+    calibration = found["error_prediction"]["main"][TINY.protocol.tolerance_names[0]]
+    assert 0 <= calibration["within_1sigma_t"] <= calibration["within_2sigma_t"] <= 1
+    assert calibration["n_frames"] > 0 and calibration["pixel_noise_px"] > 0
     exact = pd.read_parquet(data / "artifacts" / "envelopes_exact.parquet")  # the diagnostic against the exact pose
     assert list(exact.columns) == list(env.columns) and set(exact["dataset"]) == set(env["dataset"])
     causes = pd.DataFrame(found["envelope_causes"])  # one row per dataset of the main world and tolerance
@@ -162,8 +171,17 @@ def test_stage_04_scores_every_predictor_on_both_worlds_and_draws_every_figure(p
     data, reports = pipeline
     protocol = TINY.protocol
     found = metrics(reports, "predictors.json")
-    for predictor in ("static", "long_range", "mlp", "next_step", *FREE_WIDTH_PREDICTORS):
+    for predictor in ("static", "long_range", "mlp", "next_step", *FREE_WIDTH_PREDICTORS, *ERROR_PREDICTORS):
         assert set(protocol.tolerance_names) <= set(found[predictor])
+    for tolerance in protocol.tolerance_names:  # issue 38: the ceiling, and every predictor's share of it
+        limit = found["ceiling"][tolerance]
+        assert limit["gain"] == pytest.approx(limit["mean_theta_a"] / limit["min_theta_a"] - 1)
+        for predictor in (*PAPER_PREDICTORS, *ERROR_PREDICTORS):
+            spl, share = (np.nan if v is None else v for v in (found[predictor][tolerance]["max_mean_spl_zero_incursion"],
+                                                                found[predictor][tolerance]["ceiling_share"]))
+            gap = limit["mean_theta_a"] - limit["static_spl"]
+            assert share == pytest.approx((spl - limit["static_spl"]) / gap if gap > 0 else np.nan, nan_ok=True)
+    assert {"k", "incursions", "envelope_share"} <= set(found["live"]["error_next_step"])
     assert {"straight_line", "pnp", "loso", "live", "fit_status", "tails", "envelope_rules",
             "model_choice"} <= set(found)
     assert set(found["model_choice"]["main"]) == set(TINY.predict.model_choice)  # every candidate, scored
@@ -181,8 +199,10 @@ def test_stage_04_scores_every_predictor_on_both_worlds_and_draws_every_figure(p
             assert counted == {"n_overshooting": len(listed), "datasets": sorted(listed.dataset)}
     table = pd.read_parquet(data / "predictions" / "predictions.parquet")
     table = table[table.world == "main"]  # predictors.json: the main world (validation.json the other)
-    for predictor in FITTED_PREDICTORS:
-        rows = table[(table.predictor == predictor) & (table.tolerance == protocol.tolerance_names[0])]
+    for predictor in FITTED_PREDICTORS:  # a row per tolerance swept (the error predictors'), or one for all
+        rows = table[(table.predictor == predictor) & ((table.tolerance == protocol.tolerance_names[0])
+                                                       | table.predictor.isin(ERROR_PREDICTORS))]
         assert found["fit_status"][predictor]["n_rows"] == len(rows)
-        assert found["fit_status"][predictor][NO_FIT] == pytest.approx((rows.fit_status == NO_FIT).mean())
+        share = found["fit_status"][predictor][NO_FIT]  # null: no rows (error_combined without a Table III n_t)
+        assert (np.nan if share is None else share) == pytest.approx((rows.fit_status == NO_FIT).mean(), nan_ok=True)
     assert sorted(p.name for p in (reports / "figures").glob("04_*.png")) == FIGURES_04

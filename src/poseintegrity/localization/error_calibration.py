@@ -11,7 +11,9 @@ not a wrong consensus), that have a prediction and a measured error:
 - ``median_ratio_t`` / ``median_ratio_r``: median of measured / predicted (1: calibrated; above 1: under-predicted);
 - ``spearman_t``: the rank correlation of sigma_t with E_t per frame, beside ``spearman_n_i_t``, that of -n_i with
   E_t (how well the inlier count alone orders the errors);
-- ``pixel_noise_px``: the median over datasets of the model pair's measured keypoint noise.
+- ``pixel_noise_px``: the median over datasets of the model pair's measured keypoint noise;
+- ``unconditioned``: ``within_1sigma_t``, ``within_2sigma_t`` and ``median_ratio_t`` of the plain first-order
+  prediction, without the inlier test's conditioning (pose_covariance.py, (c)).
 """
 
 from __future__ import annotations
@@ -22,7 +24,7 @@ from scipy.stats import spearmanr
 
 CALIBRATION_COLUMNS = ("world", "dataset", "trajectory", "stop", "theta_deg", "x_mm", "method", "status",
                        "n_inliers", "E_t_mm", "E_r_deg", "E_t_exact_mm", "sigma_t_pred_mm", "sigma_r_pred_deg",
-                       "covariance_status", "model_pixel_noise_px")
+                       "sigma_t_unconditioned_mm", "covariance_status", "model_pixel_noise_px")
 
 
 def calibration_frames(artifacts: pd.DataFrame, envelopes: pd.DataFrame, method: str) -> pd.DataFrame:
@@ -54,9 +56,8 @@ def calibration_metrics(frames: pd.DataFrame) -> dict:
     metrics: dict = {}
     for (world, tolerance), rows in frames.groupby(["world", "tolerance"], sort=True):
         judged = rows[rows["E_t_mm"].notna()]
-        with np.errstate(divide="ignore", invalid="ignore"):
-            ratio_t = (judged["E_t_mm"] / judged["sigma_t_pred_mm"]).median()
-            ratio_r = (judged["E_r_deg"] / judged["sigma_r_pred_deg"]).median()
+        ratio_t = (judged["E_t_mm"] / judged["sigma_t_pred_mm"]).median()
+        ratio_r = (judged["E_r_deg"] / judged["sigma_r_pred_deg"]).median()
         metrics.setdefault(str(world), {})[str(tolerance)] = {
             "n_frames": int(len(judged)),
             "within_1sigma_t": _share_within(judged["E_t_mm"], judged["sigma_t_pred_mm"], 1.0),
@@ -68,5 +69,10 @@ def calibration_metrics(frames: pd.DataFrame) -> dict:
             "spearman_t": _spearman(judged["sigma_t_pred_mm"], judged["E_t_mm"]),
             "spearman_n_i_t": _spearman(-judged["n_inliers"], judged["E_t_mm"]),
             "pixel_noise_px": float(rows.drop_duplicates("dataset")["model_pixel_noise_px"].median()),
+            "unconditioned": {
+                "within_1sigma_t": _share_within(judged["E_t_mm"], judged["sigma_t_unconditioned_mm"], 1.0),
+                "within_2sigma_t": _share_within(judged["E_t_mm"], judged["sigma_t_unconditioned_mm"], 2.0),
+                "median_ratio_t": float((judged["E_t_mm"] / judged["sigma_t_unconditioned_mm"]).median()),
+            },
         }
     return metrics

@@ -9,6 +9,8 @@
     transfer.py     operating points chosen on the main world, applied unchanged to the validation world
     loso.py         n_t from a target incursion rate by leave-one-scene-out cross-validation (VI, future work), pooled
     tails.py        ours: the arcs whose long range theta_p overshoots theta_a at every n_t (eq. 1's long tail)
+    error_predictors.py  ours: long range / next step on the predicted localization error, operating point k
+    ceiling.py      ours: the ceiling of any predictor's gain over static, and each predictor's share of it
     uncertainty.py  a prediction interval on theta_p (fit covariance or bootstrap) and its lower bound
     supervisor.py   NextStepSupervisor: the next-step predictor as a component of a robot loop
 """
@@ -32,9 +34,11 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
         ],
         "supervisor": ["Decision", "NextStepSupervisor"],
         "tails": ["TAIL_PREDICTORS", "TailFit", "overshooting_arcs", "tail_fits", "tail_metrics"],
+        "ceiling": ["ceiling", "ceiling_share"],
+        "error_predictors": ["ErrorGrowth", "error_long_range", "error_next_step", "fit_growth"],
         "sweeps": [
-            "FITTED_PREDICTORS", "FREE_WIDTH_PREDICTORS", "PAPER_PREDICTORS", "RELATIVE_PREDICTORS",
-            "attach_envelopes", "predict_dataset", "sweep", "with_pnp_variants",
+            "ERROR_PREDICTORS", "FITTED_PREDICTORS", "FREE_WIDTH_PREDICTORS", "PAPER_PREDICTORS", "RELATIVE_PREDICTORS",
+            "attach_envelopes", "combined_rows", "predict_dataset", "sweep", "with_pnp_variants",
         ],
         "tables": ["best_table", "fit_status_shares", "headline_metrics", "live_trials", "rule_metrics",
                    "table_metrics"],
