@@ -161,8 +161,9 @@ TRACKER_ACCEPTS = {"points": {"one_element", "one_fewer", "nan", "inf", "huge"}}
 def _entries() -> list[EntryPoint]:
     from poseintegrity import boards, config, lens, poses, tables, timing
     from poseintegrity.artifact_models.models import fit_model
-    from poseintegrity.localization import dataset, envelope, features, ground_truth, matching, pnp, target_model
-    from poseintegrity.prediction import metrics, predictors
+    from poseintegrity.localization import (dataset, envelope, features, ground_truth, matching, pnp, pose_covariance,
+                                            target_model)
+    from poseintegrity.prediction import error_predictors, metrics, predictors
     from poseintegrity.recorded import __main__ as recorded_cli, export, geometry, materialize, reader, rosbag
     from poseintegrity.tracking import replay
     from poseintegrity.tracking.io import hl2_recordings, recording
@@ -221,6 +222,22 @@ def _entries() -> list[EntryPoint]:
                    flagged=lambda result: bool(result.unmeasured) or bool(np.isnan(result.theta_a)),
                    accepts={"criteria": {"inf", "huge"}},
                    cases={"criteria": {"unmeasured_stop": lambda v, _: np.where(np.arange(len(v))[:, None] == 3, np.nan, v)}}),
+        EntryPoint("localization.pose_covariance",
+                   lambda a: pose_covariance.pose_covariance(a["points_model"], a["image_points"], a["T_cam_model"],
+                                                             a["K"], a["point_covariances"], inlier_threshold_px=0.6),
+                   lambda tmp: {"points_model": loc()["object_points"], "image_points": loc()["image_points"],
+                                "T_cam_model": loc()["T"], "K": loc()["K"],
+                                "point_covariances": np.tile(np.diag([0.01, 0.01, 1.0]), (60, 1, 1))},
+                   {"points_model": "points", "image_points": "points", "T_cam_model": "matrix", "K": "matrix",
+                    "point_covariances": "array"},
+                   flagged=lambda result: result.status != "ok",  # too few points: NaN and a status, no error
+                   accepts={"point_covariances": {"None"}}),  # None: exact model points (the residual term alone)
+        EntryPoint("localization.triangulation_covariances",
+                   lambda a: pose_covariance.triangulation_covariances(a["points_cam0"], a["T_cam1_cam0"], a["K"], 0.3),
+                   lambda tmp: {"points_cam0": loc()["object_points"] + [0.0, 0.0, 300.0],
+                                "T_cam1_cam0": _two_views()["T_cam1_cam0"], "K": loc()["K"]},
+                   {"points_cam0": "points", "T_cam1_cam0": "matrix", "K": "matrix"},
+                   accepts={"points_cam0": {"empty"} | FEWER}),  # fewer points: fewer covariances
         EntryPoint("boards.board_from_dict", lambda a: boards.board_from_dict(a["board"]),
                    lambda tmp: {"board": dict(__import__("loc_synthetic").BOARD)}, {"board": "mapping"}),
         EntryPoint("localization.load_index", lambda a: dataset.load_index(a["index"].parents[1]),
@@ -283,6 +300,17 @@ def _entries() -> list[EntryPoint]:
                    flagged=lambda r: bool((~np.isin(r.fit_status, ["ok"])).any()
                                           or (~np.isin(r.prediction.status, ["stopped", "end_of_path"])).any()),
                    accepts=SERIES_ACCEPTS),
+        EntryPoint("prediction.error_long_range",
+                   lambda a: error_predictors.error_long_range(
+                       _series(a["theta"], a["n_inliers"], a["sigma_t"]), 4, "emg", a["factors"], (2.0, 3.0), P().fit,
+                       np.random.default_rng(0), 64),
+                   lambda tmp: {"theta": inlier_series()[0], "n_inliers": inlier_series()[1],
+                                "sigma_t": 0.3 * np.sqrt(inlier_series()[1][0] / inlier_series()[1]),
+                                "factors": np.array([1.0, 3.0])},
+                   {"theta": "array", "n_inliers": "array", "sigma_t": "array", "factors": "array"},
+                   flagged=lambda r: _boundaries_flagged(r[0]) or r[1] != "ok",
+                   accepts=SERIES_ACCEPTS | {"sigma_t": {"nan", "inf", "huge"},  # no usable error at an image
+                                             "factors": FEWER | {"huge"}}),
         # ---- tracking
         EntryPoint("tracking.detect_markers",
                    lambda a: _warned(detection.detect_markers, a["ir"], a["depth_mm"], a["unproject"],
@@ -593,12 +621,14 @@ def _dataset_dir(tmp: Path) -> Path:
     return data_dir / "datasets" / "index.parquet"
 
 
-def _series(theta: np.ndarray, n_inliers: np.ndarray):
+def _series(theta: np.ndarray, n_inliers: np.ndarray, sigma_t: np.ndarray | None = None):
+    """A Series of these samples; with ``sigma_t``, its predicted errors too (E_r's: 0.1 x E_t's, in deg)."""
     from poseintegrity.artifact_models.series import Series
 
     theta = np.asarray(theta)  # the stops of the valid series (3 images each), as long as theta has entries
     stop = np.arange(theta.shape[0]) // 3 if theta.dtype.kind in "iuf" and theta.ndim == 1 else theta
-    return Series("scene_1_arc000", "arc", stop, theta, n_inliers, 45.0)
+    sigma_r = None if sigma_t is None else 0.1 * np.asarray(sigma_t, dtype=float) if np.asarray(sigma_t).dtype.kind in "iuf" else sigma_t
+    return Series("scene_1_arc000", "arc", stop, theta, n_inliers, 45.0, sigma_t, sigma_r)
 
 
 def _boundaries_flagged(b) -> bool:

@@ -46,7 +46,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.special import ndtr
 
-from poseintegrity.errors import ArgumentError, check_array, check_intrinsics, check_pose, check_scalar
+from poseintegrity.errors import (ArgumentError, check_array, check_intrinsics, check_pose, check_same_length,
+                                  check_scalar)
 
 MIN_POINTS = 4  # a pose (6 parameters) needs more measurements (2 n) than parameters, and a residual
 MAX_CONDITION = 1e12  # of N = J^T J: beyond it the inliers do not fix the pose (collinear, coincident)
@@ -155,10 +156,12 @@ def pose_covariance(
     shape or values are refused (:class:`~poseintegrity.errors.ArgumentError` naming them).
     """
     points_model = check_array("points_model", points_model, shape=(None, 3))
-    image_points = check_array("image_points", image_points, shape=(len(points_model), 2))
+    image_points = check_array("image_points", image_points, shape=(None, 2))
     T_cam_model, K = check_pose("T_cam_model", T_cam_model), check_intrinsics("K", K)
     if point_covariances is not None:
-        point_covariances = check_array("point_covariances", point_covariances, shape=(len(points_model), 3, 3))
+        point_covariances = check_array("point_covariances", point_covariances, shape=(None, 3, 3))
+        check_same_length(points_model=points_model, point_covariances=point_covariances)
+    check_same_length(points_model=points_model, image_points=image_points)
     if sigma_px is not None:
         check_scalar("sigma_px", sigma_px, low=0.0)
     if inlier_threshold_px is not None:

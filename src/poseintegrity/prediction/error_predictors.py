@@ -36,7 +36,7 @@ import numpy as np
 from scipy.optimize import nnls
 
 from poseintegrity.artifact_models import FitParams, FittedModel
-from poseintegrity.errors import ArgumentError
+from poseintegrity.errors import ArgumentError, check_array
 from poseintegrity.artifact_models.fitted import FALLBACK
 from poseintegrity.artifact_models.series import Series
 from poseintegrity.prediction.predictors import (
@@ -83,17 +83,19 @@ def fit_growth(series: Series, stops: np.ndarray, model: str, fit: FitParams, rn
     fit's (artifact_models/fitted.py), "fallback" when fewer than two distinct theta have a predicted error (the
     growth then holds the error of the images there, constant: b = 0; none at all: an infinite error, theta_p 0)."""
     fitted, _, _ = fit_stops(series, stops, model, fit, rng)
-    keep = np.isin(series.stop, stops) & np.isfinite(series.sigma_t) & np.isfinite(series.sigma_r) \
-        & (series.n_inliers > 0)
-    theta, n_i = series.theta[keep], series.n_inliers[keep]
+    with np.errstate(over="ignore", invalid="ignore"):  # an image without a pose or a usable error is no sample
+        y_t, y_r = series.sigma_t**2 * series.n_inliers, series.sigma_r**2 * series.n_inliers
+    keep = (np.isin(series.stop, stops) & np.isfinite(series.theta) & (series.n_inliers > 0) & np.isfinite(y_t)
+            & np.isfinite(y_r))
+    theta = series.theta[keep]
     h = growth_regressor(series.trajectory, theta)
     columns = np.column_stack([np.ones_like(h), h]) if np.unique(theta).size >= 2 else np.ones((h.size, 1))
     coefficients = []
-    for sigma in (series.sigma_t[keep], series.sigma_r[keep]):
+    for y in (y_t[keep], y_r[keep]):
         if h.size == 0:
             coefficients.append((np.inf, 0.0))
             continue
-        solution, _ = nnls(columns, sigma**2 * n_i)
+        solution, _ = nnls(columns, y)
         coefficients.append((float(solution[0]), float(solution[1]) if solution.size > 1 else 0.0))
     status, reason = fitted.status, fitted.reason
     if np.unique(theta).size < 2:
@@ -101,10 +103,16 @@ def fit_growth(series: Series, stops: np.ndarray, model: str, fit: FitParams, rn
     return ErrorGrowth(series.trajectory, coefficients[0], coefficients[1], fitted), status, reason
 
 
-def _check_predicted(series: Series) -> None:
+def _checked(series: Series, factors: object) -> np.ndarray:
+    """The safety factors (F,) float, once a series with a predicted error is given (ArgumentError naming the
+    argument otherwise; a NaN factor is flagged "bad_threshold", not refused)."""
     if series.sigma_t is None or series.sigma_r is None:
         raise ArgumentError(f"series: dataset {series.dataset}: the series carries no predicted error (stage 02's "
-                         f"sigma_t_pred_mm, sigma_r_pred_deg)")
+                            f"sigma_t_pred_mm, sigma_r_pred_deg)")
+    factors = np.atleast_1d(check_array("factors", factors, finite=False))
+    if factors.ndim != 1:
+        raise ArgumentError(f"factors: expected a number or a (F,) array of safety factors, got shape {factors.shape}")
+    return factors
 
 
 def error_long_range(series: Series, k: int, model: str, factors: np.ndarray, tolerance: tuple[float, float],
@@ -112,7 +120,7 @@ def error_long_range(series: Series, k: int, model: str, factors: np.ndarray, to
     """theta_p for every safety factor of ``factors`` (F,) from the growth fitted to the first k stops, for one
     tolerance (E_t mm, E_r deg): (Boundaries, fit status, fit reason). "too_few_stops" (NaN) with fewer than k
     stops with a valid inlier count."""
-    _check_predicted(series)
+    factors = _checked(series, factors)
     stops, theta_stops = stop_positions(series)
     if stops.size < k:
         return flagged(factors, "too_few_stops"), "no_fit", "too few stops"
@@ -127,7 +135,7 @@ def error_next_step(series: Series, k0: int, model: str, factors: np.ndarray, to
     """The next-step predictor of III-E on the predicted error: from the k0-th stop on, the growth is refitted on
     all stops so far and the robot stops where it stands for every safety factor whose theta_p < theta_i + theta_b
     (:func:`~poseintegrity.prediction.predictors.supervise`)."""
-    _check_predicted(series)
+    factors = _checked(series, factors)
     _, theta_stops = stop_positions(series)
 
     def boundary(stops: np.ndarray, moving: np.ndarray) -> tuple[np.ndarray, str, str]:
