@@ -1,10 +1,15 @@
-"""Every notebook runs, in pipeline order, on tiny parameters, and writes its tables, metrics and figures.
+"""Every notebook runs as it is when opened in JupyterLab, in pipeline order, on tiny parameters, and writes its
+tables, metrics and figures where `dvc repro` writes them.
 
-One module fixture runs the chain in one temporary folder (each notebook reads the data of the one before), once:
-the tests below each check one stage's outputs. Two frames are spoiled after stage 01, as a recording may hold
+One module fixture runs the chain once, in a project copy on the tiny parameters (tests/project_copy.py; each
+notebook reads the data of the one before): a Jupyter server started there opens each notebook through its REST API,
+its kernel starting in notebooks/, and runs every code cell over the kernel's channels, with no parameters injected
+(tests/notebook_run.py). The notebooks' relative paths resolve against the project's root (poseintegrity.project);
+papermill with injected parameters, from the root, is the stage runner's way (tests/recorded/test_dvc_repro.py). The
+tests below each check one stage's outputs. Two frames are spoiled after stage 01, as a recording may hold
 them (an image file that is not an image, a NaN ground-truth pose): every later stage must run on with them flagged.
-Stage 06 depends on no other stage: it runs once per session (tests/project_copy.py, stage_06_project) and the
-report reads its metrics.
+Stage 06 depends on no other stage: it runs once per session (tests/project_copy.py, stage_06_project), the report
+reads its metrics, and tests/tracking/test_notebook_06.py runs its notebook in JupyterLab.
 """
 
 import json
@@ -14,7 +19,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from notebook_run import TINY_PARAMS, execute
+from notebook_run import TINY_PARAMS, NotebookServer
 from poseintegrity.artifact_models import FIT_STATUSES
 from poseintegrity.artifact_models.names import distinct_theta_needed
 from poseintegrity.config import load_params
@@ -23,7 +28,7 @@ from poseintegrity.localization.envelope_causes import CAUSES
 from poseintegrity.localization.summaries import FAILURE_STATUSES
 from poseintegrity.prediction import (ERROR_PREDICTORS, FITTED_PREDICTORS, FREE_WIDTH_PREDICTORS, NO_FIT,
                                       PAPER_PREDICTORS)
-from project_copy import stage_06_project
+from project_copy import project_copy, stage_06_project
 from repository import ROOT
 
 pytestmark = pytest.mark.notebook
@@ -55,13 +60,14 @@ def spoil_two_frames(data_dir):
 
 @pytest.fixture(scope="module")
 def pipeline(tmp_path_factory, run_once):
-    work = tmp_path_factory.mktemp("pipeline")
-    execute("01_generate_datasets", work)
-    spoil_two_frames(work / "data")
-    for name in ("02_extract_artifacts", "05_pnp_variants", "03_fit_artifact_models", "04_predictor_sweeps"):
-        execute(name, work)
-    shutil.copytree(run_once("stage_06", stage_06_project) / "reports", work / "reports", dirs_exist_ok=True)
-    execute("07_report", work)
+    work = project_copy(tmp_path_factory.mktemp("pipeline"))
+    with NotebookServer(work) as server:
+        server.run("notebooks/01_generate_datasets.ipynb")
+        spoil_two_frames(work / "data")
+        for name in ("02_extract_artifacts", "05_pnp_variants", "03_fit_artifact_models", "04_predictor_sweeps"):
+            server.run(f"notebooks/{name}.ipynb")
+        shutil.copytree(run_once("stage_06", stage_06_project) / "reports", work / "reports", dirs_exist_ok=True)
+        server.run("notebooks/07_report.ipynb")
     return work / "data", work / "reports"
 
 

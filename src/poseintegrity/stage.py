@@ -38,6 +38,7 @@ from traitlets.config import Config  # noqa: E402
 
 from poseintegrity.config import ParamsError, load_section  # noqa: E402
 from poseintegrity.parallel import worker_count  # noqa: E402
+from poseintegrity.project import ProjectError, project_root  # noqa: E402
 from poseintegrity.timing import StageTiming, usage_error  # noqa: E402
 
 KERNEL = "python3"  # the kernelspec `make install` writes into .venv's share/jupyter (kernel_search_path)
@@ -88,10 +89,22 @@ class StageOutputs:
         return self.reports_dir / "metrics" / "timing" / f"{self.name}.json"
 
 
+def notebook_parameter(path: Path) -> str:
+    """``path`` (relative to the current folder, as a command line gives it) as the notebook reads it: the notebook
+    resolves a relative path against the project's root (:mod:`poseintegrity.project`), so a path inside the project
+    is passed relative to its root (``params.yaml`` stays ``params.yaml`` under ``dvc repro``, which runs in the
+    root), any other absolute."""
+    path = Path(os.path.abspath(path))  # `..` folded
+    try:
+        return str(path.relative_to(project_root()))
+    except (ProjectError, ValueError):
+        return str(path)
+
+
 def run_stage(notebook: Path, params_path: Path, data_dir: Path, reports_dir: Path,
               started: float | None = None) -> StageTiming:
-    """Execute ``notebook`` with the three pipeline parameters (passed as given; relative paths resolve against
-    the current directory, as in the kernel), export HTML, write the timing file; return its record.
+    """Execute ``notebook`` with the three pipeline parameters (relative paths resolve against the current
+    directory; :func:`notebook_parameter`), export HTML, write the timing file; return its record.
 
     The wall time runs from ``started`` (epoch s; default: now; the command line passes its process's start, so
     that its own imports count) to the written HTML. Raises ParamsError or ConnectionError before any work, and
@@ -113,7 +126,8 @@ def run_stage(notebook: Path, params_path: Path, data_dir: Path, reports_dir: Pa
 
     nb = papermill.execute_notebook(
         str(notebook), str(outputs.partial_notebook), kernel_name=KERNEL, progress_bar=False,
-        parameters={"params_path": str(params_path), "data_dir": str(data_dir), "reports_dir": str(reports_dir)},
+        parameters={"params_path": notebook_parameter(params_path), "data_dir": notebook_parameter(data_dir),
+                    "reports_dir": notebook_parameter(reports_dir)},
         stdout_file=sys.stdout, stderr_file=sys.stderr,  # the kernel's output, forwarded as it arrives
         config=kernel_config(), on_cell_execute=announce_cell,
         coalesce_streams=True,  # the saved notebook keeps a tqdm bar's last state, not every redraw
