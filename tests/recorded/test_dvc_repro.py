@@ -29,6 +29,7 @@ import yaml
 
 from foreign_datasets import Folder, write_folder
 from poseintegrity.localization.dataset import load_dataset, recorded_worlds
+from poseintegrity.report.claims import TITLE
 from project_copy import DVC, run, stage_06_project, write_params
 from repository import ROOT
 
@@ -106,6 +107,14 @@ def check_summary(name, copy):
     for folder in RUNS[name][0]:
         assert f"| {folder.world or 'recorded'} | {folder.name} | {folder.trajectory} |" in section
     assert "Stage 01 · rendered robot datasets" not in summary and "realism bars passed" not in summary
+    # the first screen (report/claims.py): the claims on the user's worlds, before any stage table
+    first = summary.split(f"## {TITLE}", 1)[1].split("\n## ", 1)[0].splitlines()
+    assert len(first) <= 40 and summary.index(f"## {TITLE}") < summary.index("## Your recorded data")
+    worlds = {folder.world or "recorded" for folder in RUNS[name][0]}
+    assert {cell[len("ours: "):] for cell in next(line for line in first if line.startswith("| claim")).split(" | ")
+            if cell.startswith("ours: ")} == worlds
+    headline = json.loads((copy / "reports/metrics/headline.json").read_text())
+    assert set(headline) - {"tracking"} <= worlds and "a_markers4" in headline["tracking"]
     headlines = summary.split("## Stage wall times")[0]  # the tables "figure | ours | paper | target"
     rows = [line.split("|") for line in headlines.splitlines() if line.startswith("| ") and line.count("|") == 5]
     assert rows and all(cells[4].strip() in ("-", "---", "target") for cells in rows)  # no rendered-world target

@@ -61,9 +61,10 @@ def realism_metrics(
     - R5 (V-A) ``median_decay_ratio_arc``: median over arcs of mean n_i at the 4th (sampled) stop over the
       first stop's (bar: <= 0.75); ``median_decay_ratio_line`` the same on lines (bar: larger than on arcs)
     - R6 (Tables I-II: the static baseline's 7.0 deg at zero incursion is the smallest arc theta_a)
-      ``min_theta_a_2mm3deg`` in [6.75, 9.0] deg: the hardest arc fails just past the sampled stops
-    - R7 (Tables I-II: next step's mean SPL 13.9-14.4 deg cannot exceed the mean theta_a, 7.0 is the smallest)
-      ``arc_theta_a_mean_over_min_2mm3deg`` >= 2.0
+      ``min_theta_a_2mm3deg`` and R7 (Tables I-II: next step's mean SPL 13.9-14.4 deg cannot exceed the mean theta_a,
+      7.0 is the smallest) ``arc_theta_a_mean_over_min_2mm3deg``: comparisons with the paper's lab (7.0 deg, >= 2),
+      not bars (issue 41: a real handheld sequence gave 15.1 deg and 1.46, like our main world, so the spread belongs
+      to the lab, not to the method); the summary shows them beside the paper's
     - R8 (V-A: +46.2 % for a line predictor needs the lines' envelopes that unalike) ``line_x_a_mean_over_min_2mm3deg``
       >= 1.4
     - R9 (V-A: 2 mm/3 deg is "the accuracy limit of our pose estimation pipeline") ``median_E_t_mm_first_stops``,
@@ -186,8 +187,6 @@ def realism_metrics(
         r4_inliers_at_failure=bool(all(10 <= m <= 35 for m in median_at_failure) and all(q <= 50 for q in p90_at_failure)),
         r5_early_decay=bool(metrics["median_decay_ratio_arc"] <= 0.75
                             and metrics["median_decay_ratio_line"] > metrics["median_decay_ratio_arc"]),
-        r6_hardest_arc=bool(6.75 <= metrics["min_theta_a_2mm3deg"] <= 9.0),
-        r7_arc_spread=bool(metrics["arc_theta_a_mean_over_min_2mm3deg"] >= 2.0),
         r8_line_spread=bool(metrics["line_x_a_mean_over_min_2mm3deg"] >= 1.4),
         r9_pipeline_accuracy=bool(0.3 <= metrics["median_E_t_mm_first_stops"] <= 1.5),
         r10_interpolated=bool(metrics["share_theta_a_on_stop_2mm3deg"] <= 0.5),

@@ -56,7 +56,7 @@ def deciding_section(metrics: dict[str, dict]) -> list[str]:
                                  f"{_number(row.get('unmeasured_stops'), '{:d}')} |")
     if not lines:
         return []
-    return ["## Which arcs decide each headline, and why they end", "",
+    return ["### Which arcs decide each headline, and why they end", "",
             "The arcs that hold each predictor's operating point where it is: at the next bolder point (a smaller n_t, "
             "a larger static size) they are the ones that incur. Beside each, how its envelope ends "
             "(`artifacts.json` `envelope_causes`): `estimate` (the estimate's error crosses the tolerance against the "

@@ -22,28 +22,45 @@ class Headline:
 
     @property
     def shown_in(self) -> str:
-        return self.section or self.stage
+        return self.section or STAGE_SECTIONS.get(self.stage, self.stage)
 
 
+# The summary's sections after its first one (report/claims.py), in the order a reader asks: (title, what it holds).
+# A row is shown in its stage's section unless it names another (Headline.section).
 SECTIONS = {
-    "generate": "Stage 01 · rendered robot datasets (Windsor et al. IV-D)",
-    "artifacts": "Stage 02 · artifact extraction and the realism of the rendered world (Windsor et al. III-B, IV-C)",
-    "pnp": "Stage 05 · PnP variants (Windsor et al. V-A, Fig. 6)",
-    "fits": "Stage 03 · artifact models, mean RMSE over the whole dataset from the first 4 stops (Fig. 2)",
-    "predictors": "Stage 04 · localization-envelope predictors (Windsor et al. V, Tables I-III)",
-    "validation": "Stage 04 · the validation world, nothing tuned on it: the main world's operating points applied "
-                  "unchanged, and its own sweep",
-    "tracking": "Stage 06 · marker tracking (Black & Salcudean, IEEE TIM 2024, DOI 10.1109/TIM.2024.3398108, section III)",
+    "predictors": ("Predictors", "Stage 04 · localization-envelope predictors on the main world (Windsor et al. V, "
+                   "Tables I-III)"),
+    "validation": ("Predictors on the held-out world", "Stage 04 · the validation world, nothing tuned on it: the "
+                   "main world's operating points applied unchanged, and its own sweep"),
+    "envelopes": ("Envelopes and why they end", "Stage 02 · how each envelope ends (`artifacts.json` "
+                  "`envelope_causes`, Windsor et al. IV-C, IV-E), and the arcs that decide each headline"),
+    "fits": ("Fits", "Stage 03 · artifact models, mean RMSE over the whole dataset from the first 4 stops (Fig. 2)"),
+    "pnp": ("PnP variants", "Stage 05 · PnP variants (Windsor et al. V-A, Fig. 6), and the long range predictor on "
+            "each (stage 04)"),
+    "tracking": ("Tracking", "Stage 06 · marker tracking (Black & Salcudean, IEEE TIM 2024, DOI "
+                 "10.1109/TIM.2024.3398108, section III)"),
+    "realism": ("The rendered world's realism", "Stages 01-02 · the rendered robot datasets (Windsor et al. IV-D) and "
+                "the realism bars, properties the paper's real data had (III-B, IV-C)"),
+    "ground_truth": ("Ground truth", "Stages 01-02 · the board whose pose judges each estimate (IV-C), what it adds "
+                     "to the errors (R11), and the boards that cannot judge the tolerance"),
+}
+STAGE_SECTIONS = {"generate": "realism", "artifacts": "realism"}  # stages without a section of their own
+
+RECORDED_SECTIONS = {  # the sections' titles on recorded data (generate.source a folder): no rendered world
+    "predictors": ("Predictors", "Stage 04 · localization-envelope predictors on your first world (Windsor et al. V, "
+                   "Tables I-III)"),
+    "validation": ("Predictors on the held-out world", "Stage 04 · the held-out world (your second world): the first "
+                   "world's operating points applied unchanged, and its own sweep"),
+    "realism": ("Your datasets described", "Stage 02 · artifact extraction on your datasets (Windsor et al. III-B, "
+                "IV-C); the realism values describe them, none is judged"),
+    "tracking": ("Tracking", "Stage 06 · marker tracking on its own simulation, not on your datasets (Black & "
+                 "Salcudean, IEEE TIM 2024, DOI 10.1109/TIM.2024.3398108, section III)"),
 }
 
-RECORDED_TITLES = {  # the sections' titles on recorded data (generate.source a folder): no rendered world
-    "artifacts": "Stage 02 · artifact extraction on your datasets (Windsor et al. III-B, IV-C); the realism values "
-                 "describe them, none is judged",
-    "validation": "Stage 04 · the held-out world (your second world): the first world's operating points applied "
-                  "unchanged, and its own sweep",
-    "tracking": "Stage 06 · marker tracking on its own simulation, not on your datasets (Black & Salcudean, IEEE TIM "
-                "2024, DOI 10.1109/TIM.2024.3398108, section III)",
-}
+
+def section_heading(section: str, recorded: bool) -> tuple[str, str]:
+    """(title, what it holds) of a summary section, on recorded data or the rendered world."""
+    return RECORDED_SECTIONS.get(section, SECTIONS[section]) if recorded else SECTIONS[section]
 
 FIT_STATUS_LABELS = {"ok": "ok", "at_bound": "at a bound", "non_physical": "non-physical",
                      "fallback": "fallen back to a line"}  # the statuses of artifact_models/fitted.py
@@ -113,8 +130,8 @@ def _predictor_rows() -> list[Headline]:
                          "the other scenes: held-out R_i"),
                 Headline("predictors", f"loso.{predictor}.{tolerance}.heldout_mean_spl", "... held-out mean SPL (deg)"),
             ]
-    rows += [Headline("predictors", f"pnp.{method}.max_mean_spl_zero_incursion",
-                      f"long range on {name}, 2 mm/3 deg (deg)", "similar to USAC (Fig. 6)" if method == "epnp" else "-")
+    rows += [Headline("predictors", f"pnp.{method}.max_mean_spl_zero_incursion", f"long range on {name}, 2 mm/3 deg "
+                      "(deg)", "similar to USAC (Fig. 6)" if method == "epnp" else "-", section="pnp")
              for method, name in (("epnp", "EPnP"), ("p3p", "P3P"), ("ap3p", "AP3P"), ("sqpnp", "SQPnP"))]
     # every row of a predictor rests on a fit: the share resting on a flagged one (still counted, as the robot acted)
     for predictor in ("long_range", "mlp", "next_step"):
@@ -123,7 +140,7 @@ def _predictor_rows() -> list[Headline]:
                           else f"... {label}", fmt="{:.1%}")
                  for status, label in FIT_STATUS_LABELS.items()]
     rows.append(Headline("predictors", "live.n_flagged_fits", "simulated live trials that went by a flagged fit"))
-    return rows + _free_width_rows() + _model_choice_rows() + _rule_rows()
+    return rows + _ceiling_rows("predictors") + _free_width_rows() + _model_choice_rows() + _rule_rows()
 
 
 def _rule_rows() -> list[Headline]:
@@ -140,6 +157,27 @@ def _rule_rows() -> list[Headline]:
         rows.append(Headline("predictors", f"envelope_rules.{rule}.long_range.relative_improvement",
                              f"theta_a rule '{rule}': long range over static",
                              f"+{paper.WINDSOR_IMPROVEMENTS['long_range_vs_static']:.1%}", fmt="{:+.1%}"))
+    return rows
+
+
+def _ceiling_rows(stage: str) -> list[Headline]:
+    """Issue 38's ceiling (predictors.json, validation.json ``ceiling.<tolerance>``): the most any predictor can gain
+    over static, from the arcs' mean and smallest theta_a; and each paper predictor's share of it."""
+    rows, spl = [], paper.WINDSOR_SPL_ZERO_INCURSION
+    for tolerance in paper.TOLERANCES:
+        label, key = paper.TOLERANCE_LABELS[tolerance], f"ceiling.{tolerance}"
+        rows += [
+            Headline(stage, f"{key}.gain", f"ceiling, {label}: the arcs' mean theta_a / smallest - 1 (issue 38)",
+                     f">= {spl['next_step'][tolerance] / spl['static'][tolerance] - 1:+.0%} (next step over static)",
+                     fmt="{:+.1%}"),
+            Headline(stage, f"{key}.n_arcs", "... arcs"),
+            Headline(stage, f"{key}.mean_theta_a", "... their mean theta_a (deg)"),
+            Headline(stage, f"{key}.min_theta_a", "... their smallest theta_a (deg)"),
+            Headline(stage, f"{key}.static_spl", "... static's max mean SPL at zero incursion on them (deg)"),
+            *[Headline(stage, f"{predictor}.{tolerance}.ceiling_share", f"... {name}'s share of the ceiling",
+                       fmt="{:.0%}") for predictor, name in (("long_range", "long range"), ("next_step", "next step"),
+                                                             ("mlp", "the MLP"))],
+        ]
     return rows
 
 
@@ -255,6 +293,12 @@ def _truth_rows(stage: str, prefix: str, section: str, world: str = "") -> list[
     ]
 
 
+ENDINGS = {  # how an envelope ends (artifacts.json envelope_causes, localization/envelope_causes.py), in words
+    "estimate": "on the estimate", "ground_truth": "on a ground-truth fault",
+    "resolution": "within the ground truth's resolution (moved across by <= R11's bar)", "no_pose": "without a pose",
+    "censored": "never (censored)", "unmeasured": "unread: not measured to its end (no trusted ground truth)"}
+
+
 def _cause_rows(stage: str, prefix: str, section: str, world: str = "") -> list[Headline]:
     """artifacts.json ``envelope_cause_counts``: per tolerance, how many envelopes (arcs and lines) end on the
     estimate, on a ground-truth fault, within the ground truth's resolution, without a pose, never (censored), or
@@ -263,10 +307,7 @@ def _cause_rows(stage: str, prefix: str, section: str, world: str = "") -> list[
     rows = []
     for tolerance in paper.TOLERANCES:
         label = paper.TOLERANCE_LABELS[tolerance]
-        for cause, text in (("estimate", "on the estimate"), ("ground_truth", "on a ground-truth fault"),
-                            ("resolution", "within the ground truth's resolution (moved across by <= R11's bar)"),
-                            ("no_pose", "without a pose"), ("censored", "never (censored)"),
-                            ("unmeasured", "unread: not measured to its end (no trusted ground truth)")):
+        for cause, text in ENDINGS.items():
             rows.append(Headline(stage, f"{prefix}envelope_cause_counts.{tolerance}.{cause}",
                                  f"{at}envelopes ending {text}, {label}",
                                  target="0" if cause == "ground_truth" and tolerance == "2mm_3deg" else "-",
@@ -275,19 +316,29 @@ def _cause_rows(stage: str, prefix: str, section: str, world: str = "") -> list[
 
 
 def _world_rows() -> list[Headline]:
-    """The validation world's own realism bars and ground truth (artifacts.json), printed beside its headline: a world
-    that lacks the spread the paper's claim needs says so here."""
+    """The validation world's own realism bars, R6 and R7 (in the realism section, after the main world's), its ground
+    truth and how its envelopes end (artifacts.json ``worlds.validation``)."""
     realism = "worlds.validation.realism"
     return [
-        Headline("artifacts", f"{realism}.n_bars_passed", "validation world: realism bars passed (nothing tuned on them)",
-                 section="validation"),
-        Headline("artifacts", f"{realism}.n_bars", "... realism bars", section="validation"),
-        Headline("artifacts", f"{realism}.min_theta_a_2mm3deg", "validation world: R6, smallest arc theta_a, 2 mm/3 deg "
-                 "(deg)", "7.0", "6.75-9.0", section="validation"),
-        Headline("artifacts", f"{realism}.arc_theta_a_mean_over_min_2mm3deg", "validation world: R7, arcs' mean / "
-                 "smallest theta_a, 2 mm/3 deg", "next step's 13.9-14.4 over 7.0", ">= 2.0", section="validation"),
-        *_truth_rows("artifacts", realism, "validation", "validation"),
-        *_cause_rows("artifacts", "worlds.validation.", "validation", "validation"),
+        Headline("artifacts", f"{realism}.n_bars_passed", "validation world: realism bars passed (nothing tuned on "
+                 "them; R6 and R7 are comparisons, not bars)"),
+        Headline("artifacts", f"{realism}.n_bars", "... realism bars"),
+        *_comparison_rows(realism, "validation world: "),
+        *_truth_rows("artifacts", realism, "ground_truth", "validation"),
+        *_cause_rows("artifacts", "worlds.validation.", "envelopes", "validation"),
+    ]
+
+
+def _comparison_rows(realism: str, at: str = "") -> list[Headline]:
+    """R6 and R7 (artifacts.json ``<realism>``): the hardest arc and the arcs' spread beside the paper's lab, no bar.
+    A real handheld sequence gave 15.1 deg and 1.46, like our main world, a held-out rendered world 11.3 and 2.06
+    (issue 41): the spread belongs to the lab, not to the method; the ceiling share compares predictors across
+    worlds (report/claims.py)."""
+    return [
+        Headline("artifacts", f"{realism}.min_theta_a_2mm3deg", f"{at}R6, a comparison with the paper's lab (no bar): "
+                 "smallest arc theta_a, 2 mm/3 deg (deg)", "7.0 (static baseline at zero incursion)"),
+        Headline("artifacts", f"{realism}.arc_theta_a_mean_over_min_2mm3deg", f"{at}R7, a comparison (no bar): arcs' "
+                 "mean theta_a / smallest, 2 mm/3 deg", ">= 2 (next step's 13.9-14.4 over static's 7.0)"),
     ]
 
 
@@ -328,13 +379,14 @@ HEADLINES: list[Headline] = [
              "Franka Panda (ours: a UR5e, docs/references.md)"),
     Headline("generate", "robot.baseline_error_mm_mean", "robot: the 20 mm model baseline's error, mean (mm)"),
     Headline("generate", "robot.theta_error_deg_mean", "robot: error of the recorded viewing angle theta (deg)"),
-    Headline("generate", "board.type", "ground-truth board (generate.board)", "'an ArUco marker board [35]' (IV-C)"),
-    Headline("generate", "board.placement", "... placed"),
+    Headline("generate", "board.type", "ground-truth board (generate.board)", "'an ArUco marker board [35]' (IV-C)",
+             section="ground_truth"),
+    Headline("generate", "board.placement", "... placed", section="ground_truth"),
     Headline("generate", "board.median_lever_arm_mm", "... board origin (where E_t is measured) to the target, median "
-             "over scenes (mm)"),
-    Headline("generate", "board.max_lever_arm_mm", "... largest (mm)"),
+             "over scenes (mm)", section="ground_truth"),
+    Headline("generate", "board.max_lever_arm_mm", "... largest (mm)", section="ground_truth"),
     Headline("generate", "board.min_in_view", "... share of the board in view at its worst pose, smallest over scenes",
-             fmt="{:.0%}"),
+             fmt="{:.0%}", section="ground_truth"),
     Headline("generate", "disk_gb", "disk (GB)", "-", "<= 3"),
     Headline("generate", "wall_time_s", "stage wall time (s), both worlds", "-", "<= 480 (main world)"),
     Headline("artifacts", "realism.min_abs_spearman", "weakest decay over arcs: min of -Spearman(theta, mean n_i)",
@@ -370,10 +422,7 @@ HEADLINES: list[Headline] = [
              "4 stops suffice to fit the decay", "<= 0.75"),
     Headline("artifacts", "realism.median_decay_ratio_line", "R5: the same on straight lines",
              "'begins to decay later' (V-A)", "> arcs"),
-    Headline("artifacts", "realism.min_theta_a_2mm3deg", "R6: smallest arc theta_a at 2 mm/3 deg (deg)",
-             "7.0 (static baseline at zero incursion)", "6.75-9.0"),
-    Headline("artifacts", "realism.arc_theta_a_mean_over_min_2mm3deg", "R7: arcs' mean theta_a / smallest, 2 mm/3 deg",
-             "next step's 13.9-14.4 over static's 7.0", ">= 2.0"),
+    *_comparison_rows("realism"),
     Headline("artifacts", "realism.line_x_a_mean_over_min_2mm3deg", "R8: lines' mean x_a / smallest, 2 mm/3 deg",
              "+46.2 % for the line predictor", ">= 1.4"),
     Headline("artifacts", "realism.median_E_t_mm_first_stops",
@@ -382,10 +431,11 @@ HEADLINES: list[Headline] = [
     Headline("artifacts", "realism.share_theta_a_on_stop_2mm3deg",
              "R10: uncensored arcs whose theta_a lies within 0.01 deg of a stop", "interpolated between stops (IV-E)",
              "<= 0.5", fmt="{:.0%}"),
-    Headline("artifacts", "realism.n_bars_passed", "realism bars passed (of realism.n_bars, artifacts.json)"),
+    Headline("artifacts", "realism.n_bars_passed", "realism bars passed (of realism.n_bars, artifacts.json; R6 and R7 "
+             "are comparisons, not bars)"),
     Headline("artifacts", "realism.n_bars", "... realism bars"),
-    *_truth_rows("artifacts", "realism", "artifacts"),
-    *_cause_rows("artifacts", "", "artifacts"),
+    *_truth_rows("artifacts", "realism", "ground_truth"),
+    *_cause_rows("artifacts", "", "envelopes"),
     Headline("pnp", "methods.usac_magsac.mean_n_inliers_first_stop", "USAC (P3P + MAGSAC): mean n_i, first stop"),
     Headline("pnp", "methods.epnp.mean_n_inliers_first_stop", "EPnP: mean n_i, first stop"),
     Headline("pnp", "methods.p3p.mean_n_inliers_first_stop", "P3P: mean n_i, first stop"),
@@ -412,6 +462,7 @@ HEADLINES: list[Headline] = [
     *_exact_pose_rows("predictors"),
     *_world_rows(),
     *_validation_rows(),
+    *_ceiling_rows("validation"),
     *_exact_pose_rows("validation"),
     Headline("tracking", "rms_axis_mm.no_filter", "RMS position error per axis, no filter (mm; paper's metric)",
              f"{BLACK['rms_mm']['no_filter']:g}"),

@@ -1,0 +1,267 @@
+"""The summary's first section (report/claims.py): one screen before any stage table, every number in it the metrics
+files' value, every verdict the one its stated rule gives. The expected values and verdicts are written here from the
+metrics by hand (plain dict access and the rule as the section states it), not through the report's code."""
+
+import copy
+import json
+import re
+
+import pytest
+
+from poseintegrity import paper_results as paper
+from poseintegrity.report.claims import RULE, TITLE, gain_grade, level_grade
+from poseintegrity.report.headline_file import HEADLINE_FILE, headline_metrics
+from poseintegrity.report.summary import read_metrics, render_summary
+from repository import ROOT
+from test_report_recorded import RECORDED
+
+COMMITTED = read_metrics(ROOT / "reports" / "metrics")  # the paper-scale run: no ceiling yet (issue 38)
+TOLERANCES = paper.TOLERANCES
+WORLDS = (("predictors", ""), ("validation", "worlds.validation."))  # (stage, prefix in artifacts.json / pnp.json)
+OURS = ("error_long_range", "error_next_step", "error_combined")
+
+
+def with_issue_38(metrics: dict) -> dict:
+    """The committed metrics with the keys issue 38 adds (CONTRACTS.md), each value distinct."""
+    metrics = copy.deepcopy(metrics)
+    for w, stage in enumerate(("predictors", "validation")):
+        table = metrics[stage]
+        table["ceiling"] = {t: {"n_arcs": 17 - w - i, "mean_theta_a": 21.3 + i, "min_theta_a": 14.6 - w,
+                                "static_spl": table["static"][t]["max_mean_spl_zero_incursion"],
+                                "gain": 0.471 + 0.2 * i + w} for i, t in enumerate(TOLERANCES)}
+        for j, predictor in enumerate(("long_range", "next_step", "mlp")):
+            for i, t in enumerate(TOLERANCES):
+                table[predictor][t]["ceiling_share"] = 0.2 + 0.1 * j + 0.03 * i - 0.5 * w
+        for j, predictor in enumerate(OURS):
+            table[predictor] = {t: {"max_mean_spl_zero_incursion": 17.0 + j + i + w, "best_k": 2.5 + j,
+                                    "best_n_t": None, "decided_by": [], "ceiling_share": 0.55 + 0.01 * j - 0.1 * i}
+                                for i, t in enumerate(TOLERANCES)}
+    return metrics
+
+
+FIXTURES = {"committed": COMMITTED, "issue 38": with_issue_38(COMMITTED)}
+
+
+def section(summary: str) -> list[str]:
+    """The first section's lines, from its heading to the next heading."""
+    start = summary.index(f"## {TITLE}")
+    return summary[start:].split("\n## ", 1)[0].splitlines()
+
+
+def table(summary: str) -> dict[str, list[str]]:
+    """The first section's table: claim -> its cells (paper, ours per world, verdict, why)."""
+    rows = [line.strip("|").split(" | ") for line in section(summary) if line.startswith("| ") and "---" not in line]
+    return {cells[0].strip(): [c.strip() for c in cells[1:]] for cells in rows[1:]}
+
+
+def get(metrics: dict, stage: str, key: str):
+    """The value at a dotted key, KeyError when absent (the test's own reading)."""
+    value = metrics[stage]
+    for part in key.split("."):
+        value = value[part]
+    return value
+
+
+def numbers(cell: str) -> list[tuple[float, float]]:
+    """Each number shown in a cell as (value, half of its last digit), percentages as fractions; the tolerances' and
+    the markers' names are labels, not values."""
+    cell = re.sub(r"\d mm/\d+ deg|\(\w\)", "", cell.split("](")[0])
+    found = []
+    for sign, digits, decimals, percent in re.findall(r"(?<![\w.])([+-]?)(\d+)(?:\.(\d+))?(%?)(?![\w])", cell):
+        value = float(f"{sign}{digits}.{decimals or 0}")
+        half = 0.5 * 10.0 ** -len(decimals)
+        found.append((value / 100, half / 100) if percent else (value, half))
+    return found
+
+
+def assert_shows(cell: str, values: list, where: str):
+    """The numbers of ``cell`` are ``values`` in order (None: not shown, "none"), each within its rounding."""
+    shown, expected = numbers(cell), [v for v in values if v is not None]
+    assert len(shown) == len(expected), f"{where}: {cell!r} shows {shown}, expected {expected}"
+    for (value, half), want in zip(shown, expected):
+        assert abs(value - want) <= half * (1 + 1e-9) + 1e-12, f"{where}: {cell!r}: {value} is not {want}"
+
+
+def verdict(grades: list[int]) -> str:
+    """The rule as the section states it: the weakest world decides; no world, not applicable."""
+    return ("reproduced", "direction only", "not reproduced")[max(grades)] if grades else "not applicable"
+
+
+def grade(gain, margin: float) -> int:
+    """One world, by the rule's words: its way by >= half the paper's margin; its way by less; not its way / none."""
+    return 2 if gain is None or gain <= 0 else 0 if gain >= margin / 2 else 1
+
+
+def expectations(m: dict) -> dict[str, tuple[list[list], list, str]]:
+    """claim -> (the values each world's cell shows, the values its why shows, its verdict), from the metrics."""
+    spl = paper.WINDSOR_SPL_ZERO_INCURSION
+    out = {}
+
+    def share(stage, predictor, t):
+        return m[stage][predictor][t].get("ceiling_share")
+
+    def weakest(grades):
+        return max(range(len(grades)), key=lambda i: (grades[i], -i))
+
+    ceiling = [[x for t in TOLERANCES for x in (get(m, s, f"ceiling.{t}.gain"), get(m, s, f"ceiling.{t}.n_arcs"))]
+               if "ceiling" in m[s] else [] for s, _ in WORLDS]
+    r6r7 = [get(m, "artifacts", f"{p}realism.{k}") for _, p in WORLDS
+            for k in ("min_theta_a_2mm3deg", "arc_theta_a_mean_over_min_2mm3deg")]
+    out["ceiling"] = (ceiling, r6r7, "-")
+    for predictor, name in (("long_range", "long range"), ("next_step", "next step")):
+        for t in TOLERANCES:
+            entries = [get(m, s, f"{predictor}.{t}") for s, _ in WORLDS]
+            statics = [get(m, s, f"static.{t}.max_mean_spl_zero_incursion") for s, _ in WORLDS]
+            cells = [[e["max_mean_spl_zero_incursion"], st, e["best_n_t"], share(s, predictor, t)]
+                     for e, st, (s, _) in zip(entries, statics, WORLDS)]
+            margin = spl[predictor][t] / spl["static"][t] - 1
+            spls = [e["max_mean_spl_zero_incursion"] for e in entries]
+            grades = [grade(None if s is None else s / st - 1, margin) for s, st in zip(spls, statics)]
+            w = weakest(grades)
+            arc = entries[w]["decided_by"][0]
+            cause = next(c for c in get(m, "artifacts", f"{WORLDS[w][1]}envelope_causes")
+                         if c["dataset"] == arc and c["tolerance"] == t)
+            out[f"{name} over static, {paper.TOLERANCE_LABELS[t]}"] = (
+                cells, [entries[w]["best_n_t"], cause["theta_a"]], verdict(grades))
+    gains = [get(m, s, "long_range.relative_improvement_vs_mlp") for s, _ in WORLDS]
+    grades = [grade(g, paper.WINDSOR_IMPROVEMENTS["long_range_vs_mlp"]) for g in gains]
+    out["MLP"] = ([[get(m, s, f"mlp.{t}.max_mean_spl_zero_incursion") for t in TOLERANCES]
+                   + [share(s, "mlp", t) for t in TOLERANCES] + [g] for (s, _), g in zip(WORLDS, gains)],
+                  [get(m, WORLDS[weakest(grades)][0], "fit_status.mlp.non_physical")], verdict(grades))
+    for predictor in OURS:
+        if predictor in m["predictors"]:
+            out[f"ours: {predictor.replace('_', ' ')}"] = (
+                [[x for t in TOLERANCES for x in (get(m, s, f"{predictor}.{t}.max_mean_spl_zero_incursion"),
+                                                   get(m, s, f"{predictor}.{t}.best_k"), share(s, predictor, t))]
+                 for s, _ in WORLDS], [], "-")
+    lines = [get(m, s, "straight_line") for s, _ in WORLDS]
+    margin = paper.WINDSOR_IMPROVEMENTS["straight_line_vs_static"]
+    grades = [grade(line["relative_improvement"], margin) for line in lines]
+    r8 = f"{WORLDS[weakest(grades)][1]}realism.line_x_a_mean_over_min_2mm3deg"
+    out["straight lines"] = ([[line["relative_improvement"], line["long_range_max_mean_spl_zero_incursion"],
+                               line["static_max_mean_spl_zero_incursion"]] for line in lines],
+                             [get(m, "artifacts", r8)], verdict(grades))
+    variants = ("epnp", "p3p", "ap3p")
+    pnp = [[get(m, s, f"pnp.{v}") for v in variants] for s, _ in WORLDS]
+    grades = [max(grade(e["max_mean_spl_zero_incursion"] / e["static_max_mean_spl_zero_incursion"] - 1, 0.0)
+                  for e in entries) for entries in pnp]
+    out["PnP variants"] = ([[x for e in entries
+                             for x in (e["max_mean_spl_zero_incursion"], e["static_max_mean_spl_zero_incursion"])]
+                            for entries in pnp],
+                           [get(m, "pnp", f"{WORLDS[weakest(grades)][1]}methods.{v}.failure_rate")
+                            for v in ("usac_magsac", *variants)], verdict(grades))
+    live = m["predictors"]["live"]  # the main world's only: validation.json has none
+    margin = paper.WINDSOR_LIVE["envelope_share"] / paper.WINDSOR_LIVE["static_envelope_share"] - 1
+    grades = [2 if live["incursions"] else grade(live["envelope_share"] / live["static_envelope_share"] - 1, margin)]
+    out["live trials"] = ([[live["n_t"], live["incursions"], live["n_trials"], live["envelope_share"],
+                            live["static_envelope_share"]], []],
+                          [m["predictors"]["next_step"][live["tolerance"]]["best_n_t"]], verdict(grades))
+    rates, black = m["tracking"]["success_rates"], paper.BLACK_RESULTS
+    for n in (4, 3):
+        reached = rates[f"a_markers{n}"] >= black["success_rate"][f"markers{n}"]
+        out[f"correct pose, {n} markers"] = ([[rates[f"a_markers{n}"]], []], [rates[f"b_markers{n}"]],
+                                             verdict([0 if reached else 2]))
+    mm, deg = m["tracking"]["rms_axis_mm"], m["tracking"]["rms_euler_deg"]
+    out["accuracy"] = ([[mm["ukf"], deg["ukf"]], []], [mm["no_filter"], deg["no_filter"]],
+                       verdict([0 if mm["ukf"] <= black["rms_mm"]["ukf"] and deg["ukf"] <= black["rms_deg"]["ukf"]
+                                else 2]))
+    return out
+
+
+@pytest.mark.parametrize("fixture", FIXTURES)
+def test_every_number_of_the_first_section_is_the_metrics_value_and_every_verdict_follows_the_rule(fixture):
+    metrics = FIXTURES[fixture]
+    rows = table(render_summary(metrics, []))
+    expected = expectations(metrics)
+    assert len(rows) == len(expected)  # a row per claim, and issue 38's where the metrics hold them
+    for claim, (cells, why, word) in expected.items():
+        found = [row for label, row in rows.items() if label.startswith(claim)]
+        assert len(found) == 1, f"{claim}: {list(rows)}"
+        paper_cell, *ours, shown_verdict, shown_why = found[0]
+        assert shown_verdict == word, f"{claim}: {shown_verdict}, by the rule {word}"
+        for world, (cell, values) in enumerate(zip(ours, cells)):
+            assert_shows(cell, values, f"{claim}, world {world}")
+        assert_shows(shown_why, why, f"{claim}, why")
+        assert "](#" in shown_why  # it links to the section below that shows it
+
+
+def test_the_committed_run_lacks_the_ceiling_and_says_so():
+    rows = table(render_summary(COMMITTED, []))
+    assert rows[next(c for c in rows if c.startswith("ceiling"))][1:3] == ["not measured", "not measured"]
+    assert all("ceiling share not measured" in cell for claim, row in rows.items()
+               if claim.startswith(("long range over", "next step over", "MLP")) for cell in row[1:3])
+    assert not any(claim.startswith("ours") for claim in rows)  # issue 38's predictors: rows only once measured
+    text = render_summary(COMMITTED, [])
+    assert "(this run's stage 04 wrote no ceiling)" in text and "figures/04_ceiling.png)" not in text
+    assert "![why each envelope ends, per world and tolerance](figures/02_envelope_causes.png)" in text
+    assert "![SPL vs R_i" in render_summary(FIXTURES["issue 38"], [])  # inline once stage 04 draws it
+
+
+def test_the_rule_word_for_word():
+    """Each verdict word of the rule, at its bounds (a margin of 0.76: half is 0.38)."""
+    assert [gain_grade(g, 0.76) for g in (0.38, 0.3799, 1e-9, 0.0, -0.2, None)] == [0, 1, 1, 2, 2, 2]
+    assert gain_grade(1e-9, 0.0) == 0  # no published margin (Fig. 6): its way at all is enough
+    assert [level_grade(v, 0.9863, higher_is_better=True) for v in (0.9863, 0.99, 0.98, None)] == [0, 0, 2, 2]
+    assert [level_grade(v, 1.77, higher_is_better=False) for v in (1.77, 1.1, 1.8)] == [0, 0, 2]
+    for word in ("*reproduced*", "*direction only*", "*not reproduced*", "*not applicable*", "weakest world"):
+        assert word in RULE
+
+
+def test_nothing_run_is_not_run_and_no_world_is_not_applicable():
+    rows = table(render_summary({}, []))
+    assert rows and all(row[-2] in ("not applicable", "-") for row in rows.values())
+    assert rows[next(c for c in rows if c.startswith("long range over"))][1] == "not run"
+    no_lines = table(render_summary({"predictors": {"straight_line": {"tolerance": "2mm_3deg"}}}, []))  # no lines
+    assert no_lines[next(c for c in no_lines if c.startswith("straight"))][-2] == "not applicable"
+
+
+@pytest.mark.parametrize("metrics", [COMMITTED, FIXTURES["issue 38"], RECORDED],
+                         ids=["rendered", "issue 38", "recorded"])
+def test_the_first_section_is_one_screen_before_any_stage_table(metrics):
+    summary = render_summary(metrics, [])
+    lines = section(summary)
+    assert len(lines) <= 40
+    first_table = summary.index("| figure | ours | paper | target |")
+    assert summary.index(f"## {TITLE}") < first_table
+    assert summary.index(f"## {TITLE}") < summary.find("## Your recorded data") or "Your recorded" not in summary
+    header = next(line for line in lines if line.startswith("| claim"))
+    worlds = [cell for cell in header.split(" | ") if cell.startswith("ours: ")]
+    expected = ["ours: lab_a", "ours: lab_b"] if metrics is RECORDED else ["ours: main", "ours: validation"]
+    assert worlds == expected
+
+
+def test_the_headline_file_holds_the_headline_of_each_world():
+    """headline.json (what DVC shows): per world and tolerance the paper's four predictors and their ceiling shares,
+    issue 38's under ``ours``, R11 and the tracking success rates; a few dozen values; the committed one is stage 07's
+    from the committed metrics."""
+    full = headline_metrics(FIXTURES["issue 38"])
+    assert list(full) == ["main", "validation", "tracking"]
+    main = full["main"]["2mm_3deg"]
+    assert main["long_range"] == COMMITTED["predictors"]["long_range"]["2mm_3deg"]["max_mean_spl_zero_incursion"]
+    assert main["long_range_ceiling_share"] == FIXTURES["issue 38"]["predictors"]["long_range"]["2mm_3deg"][
+        "ceiling_share"] and "static_ceiling_share" not in main
+    assert full["validation"]["ours"]["4mm_10deg"]["error_combined"] == 17.0 + 2 + 1 + 1
+    assert full["validation"]["r11_p99_E_t_mm"] == COMMITTED["artifacts"]["worlds"]["validation"]["realism"][
+        "truth_accuracy"]["p99_E_t_truth_mm"]
+    assert full["tracking"]["a_markers3"] == COMMITTED["tracking"]["success_rates"]["a_markers3"]
+
+    def count(block):
+        return sum(count(v) if isinstance(v, dict) else 1 for v in block.values())
+
+    assert 24 <= count(headline_metrics(COMMITTED)) <= count(full) <= 72
+    committed = json.loads((ROOT / "reports" / "metrics" / HEADLINE_FILE).read_text())
+    assert committed == json.loads(json.dumps(headline_metrics(COMMITTED)))
+    recorded = headline_metrics(RECORDED)
+    assert recorded == {"lab_a": {"2mm_3deg": {"static": 20.5, "long_range": 25.0}}}  # what the metrics hold, no more
+
+
+@pytest.mark.parametrize("metrics", [COMMITTED, RECORDED], ids=["rendered", "recorded"])
+def test_every_link_of_the_first_section_leads_to_a_heading_below_it(metrics):
+    """GitHub's heading links: lower case, punctuation dropped, spaces as hyphens."""
+    summary = render_summary(metrics, [])
+    headings = {"#" + re.sub(r"[^\w\- ]", "", line.lstrip("#").strip().lower()).replace(" ", "-")
+                for line in summary.splitlines() if line.startswith("## ")}
+    links = set(re.findall(r"\]\((#[^)]+)\)", "\n".join(section(summary))))
+    assert {"#the-rendered-worlds-realism" if metrics is COMMITTED else "#your-datasets-described",
+            "#envelopes-and-why-they-end", "#predictors", "#pnp-variants", "#tracking", "#fits"} == links
+    assert links <= headings
