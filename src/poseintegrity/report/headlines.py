@@ -181,6 +181,60 @@ def _ceiling_rows(stage: str) -> list[Headline]:
     return rows
 
 
+ERROR_NAMES = {"error_long_range": "ours: long range on the predicted error",
+               "error_next_step": "ours: next step on the predicted error",
+               "error_combined": "ours: next step, the earlier of n_i's (Table III n_t) and the predicted error's"}
+
+
+def _error_predictor_rows() -> list[Headline]:
+    """Issue 38's predictors (prediction/error_predictors.py), beside the paper's: per tolerance their max mean SPL at
+    zero incursion, safety factor k and share of the ceiling on the main world, held out by scene (LOSO) and on the
+    validation world at the main world's k."""
+    rows = []
+    for tolerance in paper.TOLERANCES:
+        label = paper.TOLERANCE_LABELS[tolerance]
+        for predictor, name in ERROR_NAMES.items():
+            key = f"{predictor}.{tolerance}"
+            rows += [
+                Headline("predictors", f"{key}.max_mean_spl_zero_incursion",
+                         f"{name}, {label}: max mean SPL at zero incursion (deg)"),
+                Headline("predictors", f"{key}.best_k", "... its safety factor k"),
+                Headline("predictors", f"{key}.ceiling_share", "... its share of the ceiling", fmt="{:.0%}"),
+                Headline("predictors", f"loso.{key}.heldout_incursion_rate", "... held out by scene (LOSO): R_i"),
+                Headline("predictors", f"loso.{key}.ceiling_share", "... held out by scene: share of the ceiling",
+                         fmt="{:.0%}"),
+                Headline("validation", f"transfer.{key}.incursion_rate",
+                         f"{name}, {label}, the main world's k: R_i", "0 (live trials, V-C)"),
+                Headline("validation", f"transfer.{key}.ceiling_share", "... share of the ceiling", fmt="{:.0%}"),
+                Headline("validation", f"{key}.ceiling_share", f"{name}, {label}, its own sweep: share of the ceiling",
+                         fmt="{:.0%}"),
+            ]
+    return rows
+
+
+def _calibration_rows(world: str) -> list[Headline]:
+    """How well the predicted error is calibrated (artifacts.json error_prediction.<world>.<tolerance>, stage 02)."""
+    rows = []
+    for tolerance in paper.TOLERANCES:
+        label, key = paper.TOLERANCE_LABELS[tolerance], f"error_prediction.{world}.{tolerance}"
+        rows += [
+            Headline("artifacts", f"{key}.within_2sigma_t", f"predicted error, {world} world, frames before theta_a "
+                     f"({label}): measured E_t within 2 predicted sigma", target=">= 0.9 (else explained)",
+                     fmt="{:.0%}", section="predictors"),
+            Headline("artifacts", f"{key}.within_1sigma_t", "... within 1 sigma (a Gaussian: 61-68 %)", fmt="{:.0%}",
+                     section="predictors"),
+            Headline("artifacts", f"{key}.median_ratio_t", "... median measured / predicted E_t", fmt="{:.2f}",
+                     section="predictors"),
+            Headline("artifacts", f"{key}.unconditioned.median_ratio_t", "... the same without the inlier test's "
+                     "conditioning (plain first order)", fmt="{:.2f}", section="predictors"),
+            Headline("artifacts", f"{key}.spearman_t", "... rank correlation with E_t per frame", fmt="{:.2f}",
+                     section="predictors"),
+            Headline("artifacts", f"{key}.spearman_n_i_t", "... that of -n_i, beside it", fmt="{:.2f}",
+                     section="predictors"),
+        ]
+    return rows
+
+
 def _validation_rows() -> list[Headline]:
     """validation.json: per tolerance, each predictor at the main world's operating point (R_i, mean SPL) and at its
     own best; the relative improvements of its own sweep."""
@@ -459,6 +513,9 @@ HEADLINES: list[Headline] = [
     Headline("fits", "rmse_k4.mlp_pretrained", "MLP, EMG-pretrained + fine-tuned", "competitive with least squares"),
     *_fit_status_rows(),
     *_predictor_rows(),
+    *_error_predictor_rows(),
+    *_calibration_rows("main"),
+    *_calibration_rows("validation"),
     *_exact_pose_rows("predictors"),
     *_world_rows(),
     *_validation_rows(),
