@@ -20,7 +20,9 @@ headline PnP method and failed-frame rule:
 - ``theta_a`` beside ``theta_a_exact`` (the same envelope against the exact pose, a diagnostic), and the mean n_i
   at theta_a (linearly interpolated between the stops' means);
 - ``unmeasured_stops``: how many stops up to the first failing one had no error to average (no trusted ground truth
-  in any posed frame): theta_a was read across them (:func:`~.envelope.actual_envelope` skips them).
+  in any posed frame): theta_a was read across them (:func:`~.envelope.actual_envelope` skips them);
+- ``E_t_at_end``, ``sigma_t_pred_at_end``: at the first failing stop, the mean measured E_t and the mean predicted
+  RMS E_t of its posed frames (issue 38, :mod:`.pose_covariance`): how far the predicted error saw the end coming.
 """
 
 from __future__ import annotations
@@ -36,7 +38,7 @@ from poseintegrity.protocol import EnvelopeParams, tolerance_name
 CAUSES = ("estimate", "ground_truth", "resolution", "no_pose", "censored", "unmeasured")  # every value of ``cause``
 COLUMNS = ["world", "dataset", "trajectory", "tolerance", "theta_a", "censored", "theta_a_exact", "limit", "cause",
            "truth_shift", "n_inliers_at_theta_a", "unmeasured_stops", "board_untrusted_share", "board_dropped_share",
-           "board_sigma_t_mm"]
+           "board_sigma_t_mm", "E_t_at_end", "sigma_t_pred_at_end"]
 
 
 def envelope_causes(table: pd.DataFrame, tolerances: list[tuple[float, float]], envelope: EnvelopeParams,
@@ -72,7 +74,10 @@ def envelope_causes(table: pd.DataFrame, tolerances: list[tuple[float, float]], 
                        unmeasured_stops=int(np.isnan(criteria[: failing + 1, :2]).all(axis=1).sum()),
                        board_untrusted_share=float((at_stop["board_status"] != "ok").mean()),
                        board_dropped_share=float((at_stop["board_n_dropped"] > 0).mean()),
-                       board_sigma_t_mm=float(at_stop["board_sigma_t_mm"].median()))
+                       board_sigma_t_mm=float(at_stop["board_sigma_t_mm"].median()),
+                       E_t_at_end=float(at_stop["E_t_mm"].mean()),
+                       sigma_t_pred_at_end=float(at_stop["sigma_t_pred_mm"].mean()) if "sigma_t_pred_mm" in at_stop
+                       else float("nan"))  # a table without the predicted error (written before issue 38)
             row["limit"], row["cause"], row["truth_shift"] = _limit_and_cause(theta_a, censored, criterion, failing,
                                                                               criteria, bounds, same_frames, row)
             rows.append(row)

@@ -6,7 +6,8 @@ envelope size) is held where it is by the arcs that would incur at the next bold
 Beside each such arc: how its envelope ends (``artifacts.json`` ``envelope_causes``, of its world and tolerance,
 :mod:`~poseintegrity.localization.envelope_causes`): theta_a against the ground truth and against the exact pose, the
 limit, the cause, what the ground truth moved the criterion by, n_i at theta_a, and how many stops before it had no
-trusted ground truth (theta_a was read across them).
+trusted ground truth (theta_a was read across them); at its first failing stop, the measured mean E_t beside the
+predicted RMS E_t (issue 38: how far the predicted error saw the end coming).
 """
 
 from __future__ import annotations
@@ -15,8 +16,8 @@ import math
 
 HEADER = ["| world | tolerance | predictor | max mean SPL (deg) | operating point | decided by | theta_a (deg) | "
           "theta_a, exact pose (deg) | limit | ends on | ground truth moved it by | n_i at theta_a | "
-          "stops unmeasured |",
-          "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
+          "stops unmeasured | E_t at its end (mm) | predicted E_t there (mm) |",
+          "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
 
 
 def _number(value, fmt: str = "{:.2f}") -> str:
@@ -44,7 +45,8 @@ def deciding_section(metrics: dict[str, dict]) -> list[str]:
             for tolerance, entry in sorted(entries.items()) if isinstance(entries, dict) else ():
                 if not isinstance(entry, dict) or "decided_by" not in entry:
                     continue
-                point = entry.get("best_n_t") if entry.get("best_n_t") is not None else entry.get("best_size")
+                point = next((entry[key] for key in ("best_n_t", "best_size", "best_k") if entry.get(key) is not None),
+                             None)
                 head = (f"| {world or 'main'} | {tolerance} | {predictor} | "
                         f"{_number(entry['max_mean_spl_zero_incursion'])} | {_number(point, '{:g}')} |")
                 for dataset in entry["decided_by"] or [None]:
@@ -53,12 +55,13 @@ def deciding_section(metrics: dict[str, dict]) -> list[str]:
                                  f"{_number(row.get('theta_a_exact'))} | {row.get('limit', '-')} | "
                                  f"{row.get('cause', '-')} | {_number(row.get('truth_shift'), '{:.3f}')} | "
                                  f"{_number(row.get('n_inliers_at_theta_a'), '{:.1f}')} | "
-                                 f"{_number(row.get('unmeasured_stops'), '{:d}')} |")
+                                 f"{_number(row.get('unmeasured_stops'), '{:d}')} | "
+                                 f"{_number(row.get('E_t_at_end'))} | {_number(row.get('sigma_t_pred_at_end'))} |")
     if not lines:
         return []
     return ["### Which arcs decide each headline, and why they end", "",
-            "The arcs that hold each predictor's operating point where it is: at the next bolder point (a smaller n_t, "
-            "a larger static size) they are the ones that incur. Beside each, how its envelope ends "
+            "The arcs that hold each predictor's operating point where it is: at the next bolder point (a smaller n_t "
+            "or k, a larger static size) they are the ones that incur. Beside each, how its envelope ends "
             "(`artifacts.json` `envelope_causes`): `estimate` (the estimate's error crosses the tolerance against the "
             "exact pose too), `resolution` (it stays within against the exact pose, and the ground truth, within "
             "R11's bar, moved it across by the amount shown: the estimate's error lies within the ground truth's "
