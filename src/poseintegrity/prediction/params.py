@@ -56,7 +56,7 @@ class ErrorPredictorParams(Section):
     k_min: float = Field(gt=0, le=1e3, description="smallest safety factor of the sweep")
     k_max: float = Field(gt=0, le=1e3, description="largest safety factor of the sweep")
     n_k: int = Field(ge=2, le=GRID, description="safety factors swept, k_min .. k_max in geometric steps")
-    live_k: float | None = Field(description="fixed k of the simulated live trials of error_next_step (as live_n_t "
+    live_k: Annotated[float, Field(gt=0, le=1e3)] | None = Field(description="fixed k of the simulated live trials of error_next_step (as live_n_t "
                                              "of the paper's); null: the k of the main world's Table III at "
                                              "live_tolerance")
 
