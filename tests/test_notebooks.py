@@ -16,7 +16,7 @@ import pytest
 
 from notebook_run import TINY_PARAMS, execute
 from poseintegrity.artifact_models import FIT_STATUSES
-from poseintegrity.artifact_models.names import distinct_theta_needed
+from poseintegrity.params.model_names import distinct_theta_needed
 from poseintegrity.config import load_params
 from poseintegrity.localization.dataset import recorded_worlds
 from poseintegrity.localization.envelope_causes import CAUSES

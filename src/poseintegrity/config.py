@@ -1,7 +1,8 @@
 """Load and validate ``params.yaml`` before any work starts.
 
-Every stage of ``dvc.yaml`` owns one top-level section of ``params.yaml``; the schema of a section lives
-next to the code that uses it (``poseintegrity.<subpackage>.params``) and is collected here. The ``protocol``
+Every stage of ``dvc.yaml`` owns one top-level section of ``params.yaml``; the schema of a section lives in the
+package :mod:`poseintegrity.params` (``poseintegrity.params.<section>``), beside the other sections' and below the
+code that uses it, and is collected here. The ``protocol``
 section holds the facts several stages share (:mod:`poseintegrity.protocol`); every other section is validated
 with it at hand, so that a rule across sections (a tolerance named in ``predict`` must be one of
 ``protocol.tolerances``) names its key too. A bad value raises :class:`ParamsError` whose message names the
@@ -34,15 +35,15 @@ from typing import Any
 import yaml
 from pydantic import BaseModel, ConfigDict, ValidationError
 
-from poseintegrity.artifact_models.params import FitParams
 from poseintegrity.errors import PoseIntegrityError
-from poseintegrity.localization.params import ExtractParams
 from poseintegrity.parallel import ParallelParams
-from poseintegrity.prediction.params import PredictParams
+from poseintegrity.params.extract import ExtractParams
+from poseintegrity.params.fit import FitParams
+from poseintegrity.params.generate import GenerateParams
+from poseintegrity.params.predict import PredictParams
+from poseintegrity.params.track import TrackParams
 from poseintegrity.protocol import ProtocolParams
-from poseintegrity.scenes.params import GenerateParams
 from poseintegrity.schema import KeyRule
-from poseintegrity.tracking.params import TrackParams
 
 
 PACKAGED_PARAMS = Path(__file__).with_name("params.yaml")  # a copy of the repository's params.yaml, shipped as package data

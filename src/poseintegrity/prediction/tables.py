@@ -19,7 +19,7 @@ from poseintegrity.artifact_models.fitted import OK
 from poseintegrity.prediction.loso import loso_summary
 from poseintegrity.prediction.metrics import (best_operating_point, operating_curves, relative_improvement,
                                                with_metrics)
-from poseintegrity.prediction.params import PredictParams
+from poseintegrity.params.predict import PredictParams
 from poseintegrity.prediction.predictors import NO_FIT
 from poseintegrity.prediction.sweeps import (
     CONSERVATIVE_HIGH, FITTED_PREDICTORS, FREE_WIDTH_PREDICTORS, OPERATING_POINT_KEY, PAPER_COUNTERPART,

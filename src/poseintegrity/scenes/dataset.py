@@ -50,8 +50,8 @@ from poseintegrity.scenes.acquisition import Route, image_motion, image_pose, mo
 from poseintegrity.scenes.board_placement import BoardPlacement, PlacementError
 from poseintegrity.scenes.calibration_views import CalibrationSession, calibration_session, write_calibration
 from poseintegrity.scenes.camera import Intrinsics, true_camera
-from poseintegrity.scenes.foam import ReliefVolume
-from poseintegrity.scenes.params import BoneFoamParams, GenerateParams
+from poseintegrity.scenes.foam import ReliefVolume, bone_foam_relief
+from poseintegrity.params.generate import BoneFoamParams, GenerateParams
 from poseintegrity.scenes.robot import Robot, accuracy, trip_path
 from poseintegrity.scenes.textures import build_atlas
 from poseintegrity.seeding import keyed_rng
@@ -227,7 +227,7 @@ def world(params: GenerateParams, protocol: ProtocolParams, scene_index: int, se
 @lru_cache(maxsize=2)
 def _relief(bone_foam: BoneFoamParams, seed: int) -> ReliefVolume:
     """The foam's relief: one material, the same in every scene of a world, drawn once per process."""
-    return bone_foam.relief(seed)
+    return bone_foam_relief(bone_foam, seed)
 
 
 def _build_world(params: GenerateParams, protocol: ProtocolParams, scene_index: int, session: str,
