@@ -17,7 +17,7 @@ export JUPYTER_PATH := $(CURDIR)/$(VENV)/share/jupyter
 export MALLOC_MMAP_THRESHOLD_ := 33554432
 export MALLOC_TRIM_THRESHOLD_ := 1073741824
 
-.PHONY: help repro test install
+.PHONY: help repro test test-fast install
 
 help: ## list the targets
 	@grep -E '^[a-z]+:.*## ' $(MAKEFILE_LIST) | sed 's/:.*## /\t/'
@@ -56,3 +56,8 @@ repro: $(VENV)/.installed $(PATH_HOOK) $(KERNEL_CONFIG) ## run the paper-scale p
 # run (7 of its 25 s of collection) and every notebook kernel compiled the package again. Unset for the suite only.
 test: $(VENV)/.installed $(PATH_HOOK) $(KERNEL_CONFIG) ## run the pytest suite (notebooks executed with tiny parameters)
 	PYTHONDONTWRITEBYTECODE= $(BIN)/python -m pytest -n 2
+
+# The inner loop (README, "Development"): the suite without the tests marked `pipeline` (a notebook, the stage runner,
+# dvc, a stage's whole computation on the tiny parameters). Not a set-up command: it expects `make install` done.
+test-fast: ## run the suite without its pipeline runs (the inner loop)
+	PYTHONDONTWRITEBYTECODE= $(BIN)/python -m pytest -n 2 -m "not pipeline"

@@ -53,7 +53,7 @@ def runner(notebook: Path, root: Path, parallel: str) -> list[str]:
             "--data", str(root / "data"), "--reports", str(root / "reports")]
 
 
-@pytest.mark.notebook
+@pytest.mark.pipeline
 def test_runner_streams_output_while_running_and_writes_notebook_html_and_timing(tmp_path):
     notebook = make_notebook(tmp_path / "demo.ipynb", {"work": WORK, "handshake": HANDSHAKE, "bar": BAR,
                                                         "write": WRITE})
@@ -91,7 +91,7 @@ def test_runner_streams_output_while_running_and_writes_notebook_html_and_timing
     assert not list(reports.rglob("*partial*"))
 
 
-@pytest.mark.notebook
+@pytest.mark.pipeline
 def test_failed_stage_leaves_nothing_that_looks_complete(tmp_path):
     notebook = make_notebook(tmp_path / "demo.ipynb", {"fail": 'raise RuntimeError("boom")'})
     reports = tmp_path / "reports"
@@ -158,7 +158,7 @@ with Workers(load_section(params_path, "parallel")) as workers:
                                                  unpinned_dispatch(), in_workers]))"""
 
 
-@pytest.mark.notebook
+@pytest.mark.pipeline
 def test_the_kernel_and_its_workers_run_pinned_whatever_the_callers_environment(tmp_path):
     """dispatch: the runner imports poseintegrity, which pins the environment its kernel and workers inherit; a
     caller's OPENCV_CPU_DISABLE=AVX2 (a lower level) and OPENBLAS_CORETYPE=Sandybridge do not reach them."""

@@ -9,6 +9,8 @@ import sys
 import sysconfig
 from pathlib import Path
 
+import pytest
+
 from repository import ROOT
 
 FOREIGN = {**{k: v for k, v in os.environ.items() if k not in ("JUPYTER_PATH", "VIRTUAL_ENV")}, "PATH": "/usr/bin:/bin"}
@@ -46,6 +48,7 @@ def test_the_stage_runner_prefers_the_venvs_kernel_to_the_users(tmp_path, monkey
     assert KernelSpecManager().get_kernel_spec("python3").argv[0] == sys.executable
 
 
+@pytest.mark.pipeline
 def test_dvc_exp_run_gives_its_stage_the_venvs_python(tmp_path):
     """A one-stage project under git: `dvc exp run` (the README's parameter change) runs the cmd's `python` as the
     venv's with a PATH that has none. (Queued runs start their workers with dvc's own interpreter, dvc/daemon.py;
@@ -61,6 +64,7 @@ def test_dvc_exp_run_gives_its_stage_the_venvs_python(tmp_path):
     assert (tmp_path / "out.txt").read_text().strip() == sys.executable
 
 
+@pytest.mark.pipeline
 def test_the_readmes_experiment_commands_run_as_written(tmp_path):
     """README "Changing a parameter", on a one-stage project with a metric and a plot: named runs of three RANSAC
     thresholds (run directly here; the README queues them, whose workers are checked by hand, above), then

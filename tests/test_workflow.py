@@ -3,6 +3,7 @@ stage runner that depend on data (never on executed notebooks), params sections 
 README commands."""
 
 import json
+import tomllib
 from pathlib import Path
 
 import pytest
@@ -165,6 +166,18 @@ def test_declared_metrics_are_stage_outputs_kept_in_git():
                 outs.update(out)
     for metric in DVC["metrics"]:
         assert outs.get(metric) == {"cache": False}, metric
+
+
+def test_the_fast_tier_is_the_suite_without_its_pipeline_runs():
+    """README "Development": `make test-fast` runs pytest on both cores, leaving out the tests marked `pipeline`, a
+    marker pyproject.toml registers."""
+    import subprocess
+
+    dry = subprocess.run(["make", "-n", "test-fast"], cwd=ROOT, capture_output=True, text=True, check=True).stdout
+    assert 'pytest -n 2 -m "not pipeline"' in dry.splitlines()[-1]
+    markers = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["pytest"]["ini_options"]["markers"]
+    assert any(marker.startswith("pipeline:") for marker in markers)
+    assert "make test-fast" in (ROOT / "README.md").read_text().split("## Development", 1)[1]
 
 
 def test_readme_and_ci_use_the_two_commands():

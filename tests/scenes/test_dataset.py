@@ -44,6 +44,7 @@ def tiny_root(tmp_path_factory):
     return params, top / "datasets"
 
 
+@pytest.mark.pipeline  # tiny_root: stage 01 on the tiny parameters
 def test_layout_and_index(tiny_root):
     params, root = tiny_root
     index = pd.read_parquet(root / "index.parquet")
@@ -69,6 +70,7 @@ def test_layout_and_index(tiny_root):
         assert set(np.unique(mask)) <= {0, 255} and (mask > 0).any()
 
 
+@pytest.mark.pipeline  # tiny_root: stage 01 on the tiny parameters
 def test_images_of_a_stop_differ_only_by_noise(tiny_root):
     _, root = tiny_root
     folder = root / "scene_a_arc000"
@@ -91,6 +93,7 @@ def test_png_files_hold_exactly_the_pixels_exposed(tmp_path, flags):
         assert (cv2.imread(str(folder / name), cv2.IMREAD_UNCHANGED) == image).all()
 
 
+@pytest.mark.pipeline  # tiny_root: stage 01 on the tiny parameters
 def test_the_recorded_exact_pose_is_the_one_the_image_shows(tiny_root):
     """frames.parquet's T_cam_board (the robot's actual pose, turned by the image's ring-down) puts the board's
     ChArUco corners, through the *true* lens, where OpenCV detects them in the image: no bias (mean offset), and an
@@ -117,6 +120,7 @@ def test_the_recorded_exact_pose_is_the_one_the_image_shows(tiny_root):
         assert np.sqrt(np.mean(np.sum(offsets**2, axis=1))) < 0.5
 
 
+@pytest.mark.pipeline  # tiny_root: stage 01 on the tiny parameters
 def test_rerun_reproduces_every_file_byte_for_byte_on_two_workers(tiny_root, tmp_path):
     params, root = tiny_root
     run(params, tmp_path, n_jobs=2)
@@ -153,6 +157,7 @@ def test_building_a_world_gives_its_temporaries_back_to_the_kernel():
     assert after - before < 50 and after - trimmed < 20  # MB: the 200 MB are not resident after the build
 
 
+@pytest.mark.pipeline  # tiny_root: stage 01 on the tiny parameters
 def test_another_seed_lays_out_and_exposes_another_world(tiny_root, tmp_path):
     """Every random draw derives from generate.seed: the scene layouts (board and target poses), the textures,
     the foam and the sensor noise."""
@@ -170,6 +175,7 @@ def test_another_seed_lays_out_and_exposes_another_world(tiny_root, tmp_path):
             assert not np.allclose(*boards)
 
 
+@pytest.mark.pipeline  # tiny_root: stage 01 on the tiny parameters
 def test_interrupted_run_leaves_nothing_that_looks_complete(tiny_root, tmp_path, monkeypatch):
     params, _ = tiny_root
     calls = {"n": 0}
