@@ -22,10 +22,11 @@ import os
 import subprocess
 import sys
 
+from poseintegrity.dispatch import FIXED, SWITCH  # before numpy, as everywhere (this process only starts the rows)
+
 import numpy as np
 
-PIN = ("POSEINTEGRITY_CPU_DISPATCH", "OPENCV_CPU_DISABLE", "OPENBLAS_CORETYPE", "NPY_DISABLE_CPU_FEATURES",
-       "ATEN_CPU_CAPABILITY", "MKL_CBWR", "ONEDNN_MAX_CPU_ISA", "NUMBA_CPU_NAME")  # dispatch.py's, and its switch
+PIN = (SWITCH, "OPENCV_CPU_DISABLE", "OPENBLAS_CORETYPE", *FIXED)  # what the pin sets, and its switch
 SETTINGS = {
     "pinned": {},
     "native": {"POSEINTEGRITY_CPU_DISPATCH": "native"},

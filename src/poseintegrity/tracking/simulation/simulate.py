@@ -12,7 +12,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 import pandas as pd
-from tqdm.auto import tqdm
+from tqdm import tqdm  # text bar: tqdm.auto warns "IProgress not found" in every kernel (no ipywidgets here)
 
 from poseintegrity.tracking.markers.correspondence import match_markers_unchecked
 from poseintegrity.tracking.markers.detection import detect_markers_each, raw_threshold
