@@ -96,17 +96,17 @@ def openblas_cores() -> dict[str, str]:
     read from the libraries themselves (the files mapped into the process, /proc/self/maps: empty without it)."""
     try:
         with open("/proc/self/maps", encoding="utf-8", errors="replace") as maps:
-            paths = {fields[5] for line in maps if "openblas" in line.lower()
+            paths = {fields[5].strip() for line in maps if "openblas" in line.lower()
                      and len(fields := line.split(None, 5)) == 6 and ".so" in fields[5]}
     except OSError:
         return {}
     cores = {}
     for path in sorted(paths):
-        library = ctypes.CDLL(path.strip())  # already loaded: the same handle, nothing runs again
+        library = ctypes.CDLL(path)  # already loaded: the same handle, nothing runs again
         getter = next((getattr(library, name) for name in OPENBLAS_CORENAME if hasattr(library, name)), None)
         if getter is not None:
             getter.restype = ctypes.c_char_p
-            cores[Path(path.strip()).name] = getter().decode()
+            cores[Path(path).name] = getter().decode()
     return cores
 
 
