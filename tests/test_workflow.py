@@ -173,7 +173,8 @@ def test_the_fast_tier_is_the_suite_without_its_pipeline_runs():
     marker pyproject.toml registers."""
     import subprocess
 
-    dry = subprocess.run(["make", "-n", "test-fast"], cwd=ROOT, capture_output=True, text=True, check=True).stdout
+    dry = subprocess.run(["make", "--no-print-directory", "-n", "test-fast"], cwd=ROOT, capture_output=True, text=True,
+                         check=True).stdout  # the commands it would run (under `make test`, a sub-make's)
     assert 'pytest -n 2 -m "not pipeline"' in dry.splitlines()[-1]
     markers = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["pytest"]["ini_options"]["markers"]
     assert any(marker.startswith("pipeline:") for marker in markers)
