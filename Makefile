@@ -5,6 +5,9 @@ VENV := .venv
 BIN := $(CURDIR)/$(VENV)/bin
 # venv-on-path.pth: this venv's bin first on PATH in every process of its Python, so that dvc.yaml's `python` is it
 PATH_HOOK := $(VENV)/lib/python3.11/site-packages/venv-on-path.pth
+# The venv's Jupyter kernels import poseintegrity before any cell runs (IPython reads <venv>/etc/ipython), so that a
+# notebook opened in JupyterLab runs the pinned kernels of poseintegrity/dispatch even if it imports numpy first.
+KERNEL_CONFIG := $(VENV)/etc/ipython/ipython_kernel_config.py
 export PATH := $(BIN):$(PATH)
 # Papermill's `-k python3` must resolve to this venv's kernel, never to one of the user's.
 export JUPYTER_PATH := $(CURDIR)/$(VENV)/share/jupyter
@@ -14,7 +17,7 @@ export JUPYTER_PATH := $(CURDIR)/$(VENV)/share/jupyter
 export MALLOC_MMAP_THRESHOLD_ := 33554432
 export MALLOC_TRIM_THRESHOLD_ := 1073741824
 
-.PHONY: help repro test install
+.PHONY: help repro test test-fast install
 
 help: ## list the targets
 	@grep -E '^[a-z]+:.*## ' $(MAKEFILE_LIST) | sed 's/:.*## /\t/'
@@ -38,14 +41,23 @@ $(VENV)/.installed: requirements.lock pyproject.toml
 $(PATH_HOOK): venv-on-path.pth $(VENV)/.installed
 	cp venv-on-path.pth $@
 
-install: $(VENV)/.installed $(PATH_HOOK) ## create .venv and install the pinned dependencies
+$(KERNEL_CONFIG): $(VENV)/.installed
+	mkdir -p $(@D)
+	echo 'c.IPKernelApp.exec_lines = ["import poseintegrity"]  # make install: the pinned kernels (dispatch)' > $@
 
-repro: $(VENV)/.installed $(PATH_HOOK) ## run the paper-scale pipeline (dvc repro), then print each stage's wall time
+install: $(VENV)/.installed $(PATH_HOOK) $(KERNEL_CONFIG) ## create .venv and install the pinned dependencies
+
+repro: $(VENV)/.installed $(PATH_HOOK) $(KERNEL_CONFIG) ## run the paper-scale pipeline (dvc repro), then print each stage's wall time
 	$(BIN)/dvc repro
 	@$(BIN)/python -m poseintegrity.timing reports/metrics/timing
 
 # pytest keeps each test module with its assertions rewritten in __pycache__, and Python our own modules, unless
 # PYTHONDONTWRITEBYTECODE is set (as on our machines): then every xdist worker rewrote all ~270 test modules on every
 # run (7 of its 25 s of collection) and every notebook kernel compiled the package again. Unset for the suite only.
-test: $(VENV)/.installed $(PATH_HOOK) ## run the pytest suite (notebooks executed with tiny parameters)
+test: $(VENV)/.installed $(PATH_HOOK) $(KERNEL_CONFIG) ## run the pytest suite (notebooks executed with tiny parameters)
 	PYTHONDONTWRITEBYTECODE= $(BIN)/python -m pytest -n 2
+
+# The inner loop (README, "Development"): the suite without the tests marked `pipeline` (a notebook, the stage runner,
+# dvc, a stage's whole computation on the tiny parameters). Not a set-up command: it expects `make install` done.
+test-fast: ## run the suite without its pipeline runs (the inner loop)
+	PYTHONDONTWRITEBYTECODE= $(BIN)/python -m pytest -n 2 -m "not pipeline"

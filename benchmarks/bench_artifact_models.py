@@ -25,7 +25,7 @@ from scipy.stats import exponnorm
 
 from poseintegrity.artifact_models import EMG, emg, fig2_rmse, fit_mlp, fits_metrics, status_counts
 from poseintegrity.artifact_models.mlp import initial_weights
-from poseintegrity.artifact_models.params import MLPParams
+from poseintegrity.params.fit import MLPParams
 from poseintegrity.artifact_models.synthetic import synthetic_artifacts
 from poseintegrity.config import load_section
 from poseintegrity.parallel import Workers, worker_count

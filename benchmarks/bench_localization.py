@@ -10,7 +10,7 @@ rendered data, the synthetic scene of the tests. OpenCV runs single-threaded (on
 
 Then the classic RANSAC budget of stage 05: every classic method on one image of every stop of that arc, with
 OpenCV's default cap of 100 samples and with params.yaml's cap (extract.ransac_budget_inlier_ratio,
-localization/ransac.py), timed alternately; per method the mean time per frame under each cap, their ratio, the
+ransac.py), timed alternately; per method the mean time per frame under each cap, their ratio, the
 new one against SIFT, and how many frames each cap leaves without a pose. Frames past the envelope find no
 consensus and draw the whole cap, so the mean depends on how much of the arc lies past it.
 

@@ -29,8 +29,8 @@ ROOT = Path(__file__).resolve().parents[1]
 TINY_PARAMS = ROOT / "tests" / "params_tiny.yaml"
 
 # The longest modules first, each given whole to one worker (pyproject.toml: --dist loadscope, in this order): stage
-# 06's project, which the two recorded runs copy and the chain's report reads (run_once), on one worker while the
-# pipeline chain starts on the other; then the two recorded `dvc repro` runs (a class each).
+# 06's project, which the recorded run copies and the chain's report reads (run_once), on one worker while the
+# pipeline chain starts on the other; then the recorded `dvc repro` run.
 LONGEST_FIRST = ("tests/tracking/test_notebook_06.py", "tests/test_notebooks.py", "tests/recorded/test_dvc_repro.py",
                  "tests/test_stage.py")
 

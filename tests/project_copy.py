@@ -47,7 +47,7 @@ def stage_06_project(folder: Path) -> None:
 
     The marker-tracking study depends on no other stage and on no ``generate`` key, so the tests run it once per
     session (``run_once("stage_06", stage_06_project)``): tests/tracking/test_notebook_06.py checks its outputs, the
-    notebook chain's report reads its metrics, and each recorded `dvc repro` starts from a copy of this project, where
+    notebook chain's report reads its metrics, and the recorded `dvc repro` starts from a copy of this project, where
     DVC finds stage 06 done (its lock entry, outputs and cache) and runs the other six."""
     project_copy(folder)
     run([str(DVC), "repro", "06_marker_tracking"], folder)

@@ -1,18 +1,21 @@
-"""The CPU dispatch pin (poseintegrity.dispatch): every library capped at AVX2 by the package import, whatever the
-user's environment asks, in this process, in the stage runner's kernel and in a shell of the Dask recipe."""
+"""The CPU dispatch pin (poseintegrity.dispatch): every library capped at AVX2 and OpenBLAS on its Haswell kernels by
+the package import, whatever the user's environment asks, in this process, in the stage runner's kernel, in the
+venv's Jupyter kernels and in a shell of the Dask recipe."""
 
 import os
 import subprocess
 import sys
 import textwrap
+from pathlib import Path
 from types import SimpleNamespace
 
 import pytest
 
 from poseintegrity import dispatch
-from poseintegrity.dispatch import dispatch_above_ceiling, pin_dispatch, pinned_environment
+from poseintegrity.dispatch import openblas_cores, pin_dispatch, pinned_environment, unpinned_dispatch
 
-AVX2_CPU = frozenset({"sse4_2", "avx", "avx2", "fma"})
+AVX_CPU = frozenset({"sse4_2", "avx"})
+AVX2_CPU = AVX_CPU | {"avx2", "fma"}
 SKX_CPU = AVX2_CPU | {"avx512f", "avx512cd", "avx512bw", "avx512dq", "avx512vl"}
 
 # SIFT on a fixed blurred-noise image: OpenCV's SIFT kernels are dispatched (sift.simd.hpp), so an AVX build and an
@@ -25,6 +28,12 @@ SIFT_HASH = textwrap.dedent("""
     points = np.array([k.pt + (k.size, k.angle, k.response) for k in keypoints])
     print(hashlib.sha256(points.tobytes() + descriptors.tobytes()).hexdigest())
 """)
+# A matrix product through numpy's OpenBLAS: its kernel sets sum in other orders, with or without fused multiply-adds
+DGEMM_HASH = textwrap.dedent("""
+    import hashlib, poseintegrity, numpy as np
+    a, b = np.random.default_rng(0).standard_normal((2, 300, 300))
+    print(hashlib.sha256((a @ b).tobytes()).hexdigest())
+""")
 
 
 def test_an_avx512_cpu_disables_opencvs_avx512_group_and_an_avx2_cpu_names_none():
@@ -34,27 +43,49 @@ def test_an_avx512_cpu_disables_opencvs_avx512_group_and_an_avx2_cpu_names_none(
         assert env["ATEN_CPU_CAPABILITY"] == "avx2" and env["MKL_CBWR"].startswith("AVX2")
         assert env["NPY_DISABLE_CPU_FEATURES"].split() == ["X86_V4", "AVX512_ICL", "AVX512_SPR"]
         assert env["NUMBA_CPU_NAME"] == "haswell" and env["ONEDNN_MAX_CPU_ISA"] == "AVX2"
+        assert env["OPENBLAS_CORETYPE"] == "Haswell"
+    assert "OPENBLAS_CORETYPE" not in pinned_environment(AVX_CPU)  # Haswell's kernels need AVX2 and FMA
 
 
 def test_the_pin_replaces_a_users_values_unless_switched_to_native():
-    environ = {"OPENCV_CPU_DISABLE": "AVX2", "ATEN_CPU_CAPABILITY": "default"}
-    pinned = pin_dispatch(environ)
+    environ = {"OPENCV_CPU_DISABLE": "AVX2", "ATEN_CPU_CAPABILITY": "default", "NUMBA_CPU_NAME": "haswell",
+               "OPENBLAS_CORETYPE": "Prescott"}
+    replaced = pin_dispatch(environ)
     assert environ["ATEN_CPU_CAPABILITY"] == "avx2" and environ["OPENCV_CPU_DISABLE"] != "AVX2"
-    assert pinned == {key: environ[key] for key in pinned}
+    assert replaced["ATEN_CPU_CAPABILITY"] == ("default", "avx2") and "NUMBA_CPU_NAME" not in replaced  # the same
+    assert environ.items() >= pinned_environment(dispatch.cpu_flags()).items()
+    if dispatch.OPENBLAS_NEEDS <= dispatch.cpu_flags():
+        assert replaced["OPENBLAS_CORETYPE"] == ("Prescott", "Haswell") and environ["OPENBLAS_CORETYPE"] == "Haswell"
     native = {"POSEINTEGRITY_CPU_DISPATCH": "native", "OPENCV_CPU_DISABLE": "AVX2"}
     assert pin_dispatch(native) == {} and native["OPENCV_CPU_DISABLE"] == "AVX2"
+
+
+def test_a_replaced_value_is_named_once_by_the_process_that_replaced_it():
+    """The importing process warns; a child it starts inherits the pinned value and says nothing."""
+    child = "import subprocess, sys; subprocess.run([sys.executable, '-c', 'import poseintegrity'], check=True)"
+    script = f"import poseintegrity; {child}"
+    env = os.environ | {"ATEN_CPU_CAPABILITY": "default"}
+    run = subprocess.run([sys.executable, "-c", script], env=env, capture_output=True, text=True, check=True)
+    assert run.stderr.count("RuntimeWarning") == 1
+    assert "ATEN_CPU_CAPABILITY='avx2' in place of your 'default'" in run.stderr
 
 
 def test_libraries_loaded_above_the_ceiling_are_named():
     cv2 = SimpleNamespace(getCPUFeaturesLine=lambda: "SSE SSE2 *SSE4.1 *AVX *AVX2 *AVX512-SKX")
     numpy_core = SimpleNamespace(__cpu_features__={"X86_V3": True, "X86_V4": True, "AVX512_ICL": False})
     torch = SimpleNamespace(backends=SimpleNamespace(cpu=SimpleNamespace(get_cpu_capability=lambda: "AVX512")))
-    found = dispatch_above_ceiling({"cv2": cv2, "numpy._core._multiarray_umath": numpy_core, "torch": torch})
-    assert found == ["numpy dispatches X86_V4", "OpenCV dispatches AVX512-SKX", "torch dispatches AVX512"]
+    openblas = {"libopenblas.so": "SkylakeX", "libscipy_openblas.so": "Haswell"}
+    found = unpinned_dispatch({"cv2": cv2, "numpy._core._multiarray_umath": numpy_core, "torch": torch}, openblas,
+                              SKX_CPU)
+    assert found == ["OpenBLAS (libopenblas.so) runs its SkylakeX kernels", "numpy dispatches X86_V4",
+                     "OpenCV dispatches AVX512-SKX", "torch dispatches AVX512"]
     capped = SimpleNamespace(getCPUFeaturesLine=lambda: "SSE SSE2 *SSE4.1 *AVX *AVX2 *AVX512-SKX?")
-    assert dispatch_above_ceiling({"cv2": capped}) == []
+    assert unpinned_dispatch({"cv2": capped}, {}, SKX_CPU) == []
+    assert unpinned_dispatch({}, {"libopenblas.so": "Sandybridge"}, AVX_CPU) == []  # no Haswell kernels to pin to
     with pytest.warns(RuntimeWarning, match="OpenCV dispatches AVX512-SKX.*import poseintegrity first"):
-        dispatch.check_dispatch({"cv2": cv2})
+        dispatch.check_dispatch(modules={"cv2": cv2}, openblas={})
+    with pytest.warns(RuntimeWarning, match="OPENBLAS_CORETYPE='Haswell' in place of your 'Prescott'"):
+        dispatch.check_dispatch({"OPENBLAS_CORETYPE": ("Prescott", "Haswell")}, modules={})
 
 
 def test_this_process_is_pinned():
@@ -62,25 +93,60 @@ def test_this_process_is_pinned():
     import numpy as np
     import torch
 
-    assert dispatch_above_ceiling() == []
+    assert unpinned_dispatch() == []
     assert os.environ["NUMBA_CPU_NAME"] == "haswell"
+    if dispatch.OPENBLAS_NEEDS <= dispatch.cpu_flags():
+        assert set(openblas_cores().values()) == {"Haswell"}
     assert not np._core._multiarray_umath.__cpu_features__.get("X86_V4")
     assert torch.backends.cpu.get_cpu_capability() in ("AVX2", "DEFAULT", "NO AVX")
     assert "*AVX512-SKX?" in cv2.getCPUFeaturesLine() or "AVX512-SKX" not in cv2.getCPUFeaturesLine()
 
 
-def _sift_hash(env: dict[str, str]) -> str:
-    run = subprocess.run([sys.executable, "-c", SIFT_HASH], env={**os.environ, **env}, capture_output=True,
-                         text=True, check=True)
+def _hash(script: str, env: dict[str, str]) -> str:
+    run = subprocess.run([sys.executable, "-c", script], env={**os.environ, **env}, capture_output=True, text=True,
+                         check=True)
     return run.stdout.strip()
 
 
 @pytest.mark.skipif("avx2" not in dispatch.cpu_flags(), reason="the AVX2 path needs an AVX2 CPU")
 def test_sift_moves_with_the_dispatch_level_unpinned_and_not_pinned():
     native = {"POSEINTEGRITY_CPU_DISPATCH": "native"}
-    assert _sift_hash(native | {"OPENCV_CPU_DISABLE": ""}) != _sift_hash(native | {"OPENCV_CPU_DISABLE": "AVX2"})
+    avx2, avx = {"OPENCV_CPU_DISABLE": ""}, {"OPENCV_CPU_DISABLE": "AVX2"}
+    assert _hash(SIFT_HASH, native | avx2) != _hash(SIFT_HASH, native | avx)
     pinned = {"POSEINTEGRITY_CPU_DISPATCH": "pinned"}
-    assert _sift_hash(pinned | {"OPENCV_CPU_DISABLE": ""}) == _sift_hash(pinned | {"OPENCV_CPU_DISABLE": "AVX2"})
+    assert _hash(SIFT_HASH, pinned | avx2) == _hash(SIFT_HASH, pinned | avx)
+
+
+@pytest.mark.skipif(not dispatch.OPENBLAS_NEEDS <= dispatch.cpu_flags(), reason="Haswell's kernels need AVX2 + FMA")
+def test_a_matrix_product_moves_with_openblas_kernels_unpinned_and_not_pinned():
+    """Sandybridge's kernels (AVX, no FMA) run on every AVX2 CPU: left to the user's OPENBLAS_CORETYPE, the product
+    changes in its last bits; pinned, it is the Haswell kernels' whatever the user asks."""
+    native, pinned = {"POSEINTEGRITY_CPU_DISPATCH": "native"}, {"POSEINTEGRITY_CPU_DISPATCH": "pinned"}
+    haswell = _hash(DGEMM_HASH, native | {"OPENBLAS_CORETYPE": "Haswell"})
+    assert _hash(DGEMM_HASH, native | {"OPENBLAS_CORETYPE": "Sandybridge"}) != haswell
+    assert _hash(DGEMM_HASH, pinned | {"OPENBLAS_CORETYPE": "Sandybridge"}) == haswell
+
+
+def test_a_jupyter_kernel_of_the_venv_is_pinned_before_its_first_cell(tmp_path):
+    """make install: the venv's kernels import poseintegrity first (IPython's exec_lines), so that a notebook opened in
+    JupyterLab whose first cell imports numpy runs the pinned kernels too."""
+    from jupyter_client.manager import start_new_kernel
+
+    config = Path(sys.prefix) / "etc" / "ipython" / "ipython_kernel_config.py"
+    assert "import poseintegrity" in config.read_text()
+    env = {k: v for k, v in os.environ.items()
+           if k not in dispatch.FIXED and not k.startswith(("OPENCV_", "OPENBLAS_"))}
+    env["JUPYTER_PATH"] = str(Path(sys.prefix) / "share" / "jupyter")
+    manager, client = start_new_kernel(kernel_name="python3", env=env)
+    try:
+        out = []
+        client.execute_interactive("import numpy\nfrom poseintegrity.dispatch import unpinned_dispatch\n"
+                                   "print(unpinned_dispatch())", timeout=60,
+                                   output_hook=lambda m: out.append(m["content"].get("text", "")))
+    finally:
+        client.stop_channels()
+        manager.shutdown_kernel(now=True)
+    assert "".join(out).strip() == "[]"
 
 
 def test_the_dask_workers_recipe_pins_a_shell_that_never_imported_poseintegrity():
@@ -94,3 +160,7 @@ def test_the_dask_workers_recipe_pins_a_shell_that_never_imported_poseintegrity(
     run = subprocess.run(["bash", "-c", script], env=env, capture_output=True, text=True, check=True)
     expected = pinned_environment(dispatch.cpu_flags())
     assert run.stdout.split() == ["avx2", "haswell", repr(expected["OPENCV_CPU_DISABLE"])]
+    assert run.stderr == ""  # runpy's RuntimeWarning ("found in sys.modules") no more
+    exports = subprocess.run([sys.executable, "-m", "poseintegrity.dispatch"], env=env, capture_output=True, text=True,
+                             check=True).stdout
+    assert all(f"export {name}='{value}'" in exports for name, value in expected.items())

@@ -21,7 +21,7 @@ import pytest
 
 from notebook_run import TINY_PARAMS, NotebookServer
 from poseintegrity.artifact_models import FIT_STATUSES
-from poseintegrity.artifact_models.names import distinct_theta_needed
+from poseintegrity.params.model_names import distinct_theta_needed
 from poseintegrity.config import load_params
 from poseintegrity.localization.dataset import recorded_worlds
 from poseintegrity.localization.envelope_causes import CAUSES
@@ -32,7 +32,7 @@ from poseintegrity.report.claims import TITLE
 from project_copy import project_copy, stage_06_project
 from repository import ROOT
 
-pytestmark = pytest.mark.notebook
+pytestmark = pytest.mark.pipeline
 TINY = load_params(TINY_PARAMS)
 ORDER = ["01_generate_datasets", "02_extract_artifacts", "05_pnp_variants", "03_fit_artifact_models",
          "04_predictor_sweeps", "06_marker_tracking", "07_report"]  # dvc.yaml's order: 04 reads 05's tables
@@ -106,7 +106,7 @@ def test_stage_02_flags_the_spoiled_frames_and_writes_tables_metrics_and_figures
                                  "status", "reason"]
     found = metrics(reports, "artifacts.json")
     assert found["flagged_frames"] == {"bad_image": 1, "bad_pose": 1}
-    assert recorded_worlds(data) == set()  # rendered: its realism is judged (the recorded runs': described only)
+    assert recorded_worlds(data) == set()  # rendered: its realism is judged (the recorded run's: described only)
     assert found["status_counts"]["bad_image"] == found["status_counts"]["bad_pose"] == 1
     for key in ("min_abs_spearman", "error_ratio_low_vs_high_inliers", "n_uncensored_4mm10deg",
                 "min_theta_a_2mm3deg", "cv_theta_a_2mm3deg"):

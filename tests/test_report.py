@@ -93,7 +93,8 @@ def test_metrics_file_is_valid_json_with_null_for_nan(tmp_path):
 def test_fit_statuses_have_a_row_per_model_and_predictor():
     """Stages 03 and 04 count flagged fits (artifact_models/fitted.py): the summary shows every status of every model
     of Fig. 2 and of every predictor, beside the RMSE and SPL they qualify."""
-    from poseintegrity.artifact_models import FIT_STATUSES, MODEL_NAMES
+    from poseintegrity.artifact_models import FIT_STATUSES
+    from poseintegrity.params.model_names import MODEL_NAMES
     from poseintegrity.report.headlines import FIT_STATUS_LABELS, MODEL_LABELS
 
     assert list(FIT_STATUS_LABELS) == list(FIT_STATUSES) and set(MODEL_LABELS) == set(MODEL_NAMES)

@@ -45,6 +45,7 @@ def test_one_world_says_nothing_was_held_out_and_the_rendered_summary_is_unchang
                                      "note": "one world only (lab_a): no second world to apply its operating points to"}}
     text = render_summary(one, [])
     assert text.count("one world only (lab_a)") == 2  # in the section on the data and as stage 04's held-out part
+    assert "No straight lines in this world: Fig. 7 has nothing to show." in text  # lab_a: one arc
     rendered = render_summary({"generate": {"disk_gb": 1.4731}}, [])
     assert "Your recorded data" not in rendered and "| disk (GB) | 1.473 | - | <= 3 |" in rendered
 

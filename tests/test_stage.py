@@ -53,7 +53,7 @@ def runner(notebook: Path, root: Path, parallel: str) -> list[str]:
             "--data", str(root / "data"), "--reports", str(root / "reports")]
 
 
-@pytest.mark.notebook
+@pytest.mark.pipeline
 def test_runner_streams_output_while_running_and_writes_notebook_html_and_timing(tmp_path):
     notebook = make_notebook(tmp_path / "demo.ipynb", {"work": WORK, "handshake": HANDSHAKE, "bar": BAR,
                                                         "write": WRITE})
@@ -91,7 +91,7 @@ def test_runner_streams_output_while_running_and_writes_notebook_html_and_timing
     assert not list(reports.rglob("*partial*"))
 
 
-@pytest.mark.notebook
+@pytest.mark.pipeline
 def test_failed_stage_leaves_nothing_that_looks_complete(tmp_path):
     notebook = make_notebook(tmp_path / "demo.ipynb", {"fail": 'raise RuntimeError("boom")'})
     reports = tmp_path / "reports"
@@ -151,23 +151,25 @@ def test_summary_lists_stages_in_name_order_with_their_total(tmp_path):
 PINNED = """\
 import os
 import cv2
-from poseintegrity.dispatch import dispatch_above_ceiling
+from poseintegrity.dispatch import unpinned_dispatch
 with Workers(load_section(params_path, "parallel")) as workers:
-    in_workers = workers.map(os.getenv, ["OPENCV_CPU_DISABLE", "NUMBA_CPU_NAME"])
+    in_workers = workers.map(os.getenv, ["OPENCV_CPU_DISABLE", "NUMBA_CPU_NAME", "OPENBLAS_CORETYPE"])
 (Path(data_dir) / "pinned.txt").write_text(repr([os.getenv("OPENCV_CPU_DISABLE"), cv2.getCPUFeaturesLine(),
-                                                 dispatch_above_ceiling(), in_workers]))"""
+                                                 unpinned_dispatch(), in_workers]))"""
 
 
-@pytest.mark.notebook
+@pytest.mark.pipeline
 def test_the_kernel_and_its_workers_run_pinned_whatever_the_callers_environment(tmp_path):
-    """dispatch.py: the runner imports poseintegrity, which pins the environment its kernel and workers inherit;
-    a caller's OPENCV_CPU_DISABLE=AVX2 (a lower level) does not reach them."""
+    """dispatch: the runner imports poseintegrity, which pins the environment its kernel and workers inherit; a
+    caller's OPENCV_CPU_DISABLE=AVX2 (a lower level) and OPENBLAS_CORETYPE=Sandybridge do not reach them."""
     notebook = make_notebook(tmp_path / "pinned.ipynb", {"work": WORK, "pinned": PINNED})
     command = runner(notebook, tmp_path, "{backend: local, n_jobs: 2}")
-    env = {k: v for k, v in os.environ.items() if k != "POSEINTEGRITY_CPU_DISPATCH"} | {"OPENCV_CPU_DISABLE": "AVX2"}
+    caller = {"OPENCV_CPU_DISABLE": "AVX2", "OPENBLAS_CORETYPE": "Sandybridge"}
+    env = {k: v for k, v in os.environ.items() if k != "POSEINTEGRITY_CPU_DISPATCH"} | caller
     subprocess.run(command, env=env, check=True, capture_output=True)
     disabled, features, above, in_workers = eval((tmp_path / "data" / "pinned.txt").read_text())
-    expected = pinned_environment(cpu_flags())["OPENCV_CPU_DISABLE"]
-    assert disabled == expected and in_workers == [expected, "haswell"] and above == []
+    expected = pinned_environment(cpu_flags())
+    assert disabled == expected["OPENCV_CPU_DISABLE"] and above == []
+    assert in_workers == [expected["OPENCV_CPU_DISABLE"], "haswell", expected.get("OPENBLAS_CORETYPE")]
     if "avx2" in cpu_flags():
         assert "*AVX2 " in features  # enabled: a disabled one reads "*AVX2?"

@@ -48,6 +48,7 @@ def test_the_stage_runner_prefers_the_venvs_kernel_to_the_users(tmp_path, monkey
     assert KernelSpecManager().get_kernel_spec("python3").argv[0] == sys.executable
 
 
+@pytest.mark.pipeline
 def test_dvc_exp_run_gives_its_stage_the_venvs_python(tmp_path):
     """A one-stage project under git: `dvc exp run` (the README's parameter change) runs the cmd's `python` as the
     venv's with a PATH that has none. (Queued runs start their workers with dvc's own interpreter, dvc/daemon.py;
@@ -95,6 +96,7 @@ open("curve.csv", "w").write("theta,n_i\\n" + "".join(f"{k},{100 - k * t}\\n" fo
 """
 
 
+@pytest.mark.pipeline
 def test_the_readmes_experiment_commands_run_as_written(tmp_path):
     """README "Changing a parameter", on a one-stage project that writes the headline from the committed metrics
     (TOY_STAGE) and declares the metrics dvc.yaml declares, with a plot: named runs of three RANSAC thresholds (run

@@ -3,6 +3,7 @@ stage runner that depend on data (never on executed notebooks), params sections 
 README commands."""
 
 import json
+import tomllib
 from pathlib import Path
 
 import pytest
@@ -84,7 +85,7 @@ def _import_closure(notebook: Path) -> set[Path]:
     """The source files of poseintegrity whose code a notebook runs: the modules it imports and theirs (a static
     walk of import statements, function-level ones included). Not followed: a package's ``__init__`` (its
     re-exports load code a stage need not run) and ``config`` (it imports every section's schema; a stage depends
-    on its own section's schema through its subpackage)."""
+    on the schemas of the sections it reads, :func:`test_every_stage_depends_on_the_schema_of_each_section_it_reads`)."""
     cells = json.loads(notebook.read_text())["cells"]
     todo = _imported_modules("\n".join("".join(c["source"]) for c in cells if c["cell_type"] == "code"))
     files: set[Path] = set()
@@ -110,6 +111,16 @@ def test_every_stage_depends_on_every_source_file_its_notebook_runs():
         if lost := sorted(str(f.relative_to(ROOT)) for f in closure if not any(f == d or d in f.parents for d in deps)):
             missing[notebook.stem] = lost
     assert not missing, f"stages run source files they do not depend on in dvc.yaml: {missing}"
+
+
+def test_every_stage_depends_on_the_schema_of_each_section_it_reads():
+    """A change to the rules of a section re-runs the stages that read it, whether or not their code imports it."""
+    schemas = {path.stem for path in (ROOT / "src/poseintegrity/params").glob("*.py")} - {"__init__"}
+    for name, stage in DVC["stages"].items():
+        read = {key.split(".")[0] for key in stage.get("params", [])} & schemas
+        assert read or name == "07_report", name
+        missing = {section for section in read if f"src/poseintegrity/params/{section}.py" not in stage["deps"]}
+        assert not missing, f"{name} reads params sections whose schema it does not depend on: {missing}"
 
 
 def test_no_stage_depends_on_an_executed_notebook():
@@ -155,6 +166,19 @@ def test_declared_metrics_are_stage_outputs_kept_in_git():
                 outs.update(out)
     for metric in DVC["metrics"]:
         assert outs.get(metric) == {"cache": False}, metric
+
+
+def test_the_fast_tier_is_the_suite_without_its_pipeline_runs():
+    """README "Development": `make test-fast` runs pytest on both cores, leaving out the tests marked `pipeline`, a
+    marker pyproject.toml registers."""
+    import subprocess
+
+    dry = subprocess.run(["make", "--no-print-directory", "-n", "test-fast"], cwd=ROOT, capture_output=True, text=True,
+                         check=True).stdout  # the commands it would run (under `make test`, a sub-make's)
+    assert 'pytest -n 2 -m "not pipeline"' in dry.splitlines()[-1]
+    markers = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["pytest"]["ini_options"]["markers"]
+    assert any(marker.startswith("pipeline:") for marker in markers)
+    assert "make test-fast" in (ROOT / "README.md").read_text().split("## Development", 1)[1]
 
 
 def test_readme_and_ci_use_the_two_commands():

@@ -8,8 +8,7 @@ DOI 10.1109/TIM.2024.3398108), as a DVC pipeline of papermill notebooks (docs/re
 
 from poseintegrity.dispatch import check_dispatch, pin_dispatch
 
-pin_dispatch()  # before numpy, OpenCV, torch or numba load: they read it once (dispatch.py)
-check_dispatch()
+check_dispatch(pin_dispatch())  # before numpy, OpenBLAS, OpenCV, torch or numba load: they read it once (dispatch)
 
 from poseintegrity.errors import ArgumentError, PoseIntegrityError  # noqa: E402
 

@@ -1,4 +1,4 @@
-"""Building blocks shared by the params schemas of every section (``poseintegrity.<subpackage>.params``).
+"""Building blocks shared by the params schemas of every section (``poseintegrity.params.<section>``).
 
 Every section model derives from :class:`Section`: unknown keys are refused, values are frozen, every float
 must be finite (NaN and inf are refused wherever a number is expected) and numbers are strict: YAML's ``true``,

@@ -34,6 +34,7 @@ ENVELOPE_COLUMNS = ("world", "dataset", "trajectory", "method", "tolerance", "th
 NOT_MEASURED = "not_measured"  # an envelope row's status when its theta_a could not be read (localization.envelope)
 FIG2_KEYS = ("trajectory", "dataset", "k", "model")
 FIG2_COLUMNS = ("trajectory", "dataset", "k", "model", "rmse", "status", "reason", "n_samples")
+FIT_STATUSES = ("ok", "at_bound", "non_physical", "fallback")  # a fit's status, least to most severe (fitted.py)
 
 
 class TableError(PoseIntegrityError):
@@ -131,8 +132,6 @@ def check_envelopes(table: pd.DataFrame, name: str = "the envelopes table", *,
 def check_fig2_rmse(table: pd.DataFrame, name: str = "the Fig. 2 RMSE table") -> pd.DataFrame:
     """The Fig. 2 table of stage 03 (artifact_models.fig2_rmse), checked: its columns, rows, one row per
     (trajectory, dataset, k, model), k an integer >= 1, rmse >= 0 or NaN, a known fit status. Returns it."""
-    from poseintegrity.artifact_models.fitted import FIT_STATUSES  # noqa: PLC0415 (keep this module light)
-
     _structure(table, name, FIG2_COLUMNS, FIG2_KEYS)
     _numeric(table, name, "k", FIG2_KEYS, integer=True, low=1)
     _numeric(table, name, "rmse", FIG2_KEYS, low=0, nan=True)

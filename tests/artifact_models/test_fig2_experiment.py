@@ -9,7 +9,6 @@ import pytest
 from poseintegrity.artifact_models import (
     EMG,
     FIT_STATUSES,
-    MODEL_NAMES,
     at_sampled_stops,
     dataset_series,
     fig2_rmse,
@@ -18,7 +17,7 @@ from poseintegrity.artifact_models import (
     status_counts,
 )
 from poseintegrity.artifact_models.fitted import OK
-from poseintegrity.artifact_models.names import distinct_theta_needed
+from poseintegrity.params.model_names import MODEL_NAMES, distinct_theta_needed
 
 
 @pytest.fixture(scope="module")

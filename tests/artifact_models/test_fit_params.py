@@ -9,9 +9,9 @@ import pytest
 from pydantic import ValidationError
 
 from params_cases import refusal
-from poseintegrity.artifact_models import BASE_FUNCTIONS, MODEL_NAMES
-from poseintegrity.artifact_models.names import distinct_theta_needed
-from poseintegrity.artifact_models.params import ModelName
+from poseintegrity.artifact_models import BASE_FUNCTIONS
+from poseintegrity.params.model_names import MODEL_NAMES, distinct_theta_needed
+from poseintegrity.params.fit import ModelName
 from poseintegrity.config import load_params
 
 ROOT = Path(__file__).resolve().parents[2]

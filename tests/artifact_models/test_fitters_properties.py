@@ -12,7 +12,8 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from poseintegrity.artifact_models import BASE_FUNCTIONS, FIT_STATUSES, MODEL_NAMES, fit_model
+from poseintegrity.artifact_models import BASE_FUNCTIONS, FIT_STATUSES, fit_model
+from poseintegrity.params.model_names import MODEL_NAMES
 from poseintegrity.artifact_models.fitted import FALLBACK, OK, valid_samples
 
 END = 45.0  # samples are drawn over an arc of 45 deg; the range end passed to every fit

@@ -9,6 +9,7 @@ pixel is an invalid pixel, not an error). Add a public function here when you ad
 from __future__ import annotations
 
 import json
+import shutil
 import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -543,11 +544,18 @@ RECORDED_FILES = ("dataset.yaml", "camera.yaml", "board.yaml", "model.csv", "sto
 
 
 def _recorded_dir(tmp: Path) -> Path:
-    """A recorded dataset folder: the one-image stage-01 dataset of :func:`_dataset_dir` exported."""
+    """A recorded dataset folder: the one-image stage-01 dataset of :func:`_dataset_dir` exported (a copy in ``tmp``
+    of the one exported once per session, as :func:`_dataset_dir`)."""
+    folder = tmp / "recorded" / "ds_arc"
+    shutil.copytree(_recorded_once(str(tmp.parent / "shared")), folder, dirs_exist_ok=True)
+    return folder
+
+
+@cache
+def _recorded_once(shared: str) -> Path:
     from poseintegrity.recorded.export import export_dataset
 
-    index = _dataset_dir(tmp)
-    return export_dataset(index.parents[1], "datasets/ds_arc", tmp / "recorded")
+    return export_dataset(_dataset_once(shared), "datasets/ds_arc", Path(shared) / "recorded")
 
 
 def _bag_dir(tmp: Path) -> Path:
@@ -603,8 +611,6 @@ def _pose_missing(folder: Path) -> bool:
 
 
 def _recording_copy(tmp: Path, name: str) -> Path:
-    import shutil
-
     source = _recording_dir(str(tmp.parent / "shared"))
     folder = tmp / f"copy_{name}"
     if not folder.exists():
@@ -613,12 +619,21 @@ def _recording_copy(tmp: Path, name: str) -> Path:
 
 
 def _dataset_dir(tmp: Path) -> Path:
+    """index.parquet of a one-image stage-01 dataset (loc_synthetic) in ``tmp``: a copy of the one written once per
+    session beside the cases' folders (writing it took 27 ms, a copy takes 2), so that each case spoils its own."""
+    data_dir = tmp / "data"
+    shutil.copytree(_dataset_once(str(tmp.parent / "shared")), data_dir, dirs_exist_ok=True)
+    return data_dir / "datasets" / "index.parquet"
+
+
+@cache
+def _dataset_once(shared: str) -> Path:
     import loc_synthetic as synthetic
 
-    data_dir = tmp / "data"
+    data_dir = Path(shared) / "data"
     rows = [synthetic.write_dataset(data_dir, "ds_arc", np.random.default_rng(0), stops=(10.0,), images_per_stop=1)]
     synthetic.write_index(data_dir, rows)
-    return data_dir / "datasets" / "index.parquet"
+    return data_dir
 
 
 def _series(theta: np.ndarray, n_inliers: np.ndarray, sigma_t: np.ndarray | None = None):

@@ -15,7 +15,7 @@ sys.path.insert(0, str(Path(__file__).parent))  # --import-mode=importlib: make 
 import loc_synthetic as synthetic  # noqa: E402
 
 from poseintegrity.config import load_params  # noqa: E402
-from poseintegrity.localization import ExtractParams  # noqa: E402
+from poseintegrity.params.extract import ExtractParams  # noqa: E402
 from poseintegrity.parallel import Workers  # noqa: E402
 from repository import ROOT  # noqa: E402
 

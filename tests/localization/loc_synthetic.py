@@ -17,7 +17,7 @@ import pandas as pd
 from scipy.spatial.transform import Rotation
 
 from poseintegrity.lens import Camera, write_camera_yaml
-from poseintegrity.localization.params import GroundTruthParams
+from poseintegrity.params.extract import GroundTruthParams
 
 BOARD = dict(dictionary="DICT_4X4_50", markers_x=3, markers_y=2, marker_length_mm=20.0, separation_mm=5.0, first_id=0)
 CANVAS_MM = (-20.0, -30.0, 180.0, 80.0)  # x_min, y_min, x_max, y_max of the scene plane

@@ -13,7 +13,7 @@ from poseintegrity.lens import Camera
 from poseintegrity.localization.ground_truth import (
     board_pose, consistent_fit, predicted_uncertainty, truth_error,
 )
-from poseintegrity.localization.params import GroundTruthParams
+from poseintegrity.params.extract import GroundTruthParams
 from poseintegrity.poses import pose_errors, pose_from_rvec_tvec, pose_matrix
 from scipy.spatial.transform import Rotation
 

@@ -8,6 +8,8 @@ import pytest
 from poseintegrity.localization import extract_all
 from poseintegrity.parallel import ParallelParams, Workers
 
+pytestmark = pytest.mark.pipeline  # stage 02 on two backends
+
 
 @pytest.mark.parametrize("methods", [["usac_magsac"]])
 def test_local_processes_and_a_dask_cluster_write_the_same_bytes(synthetic_data_dir, extract_params, tmp_path,

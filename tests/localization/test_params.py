@@ -7,7 +7,7 @@ import pytest
 
 from params_cases import refusal
 from poseintegrity.config import ParamsError, parse_params
-from poseintegrity.localization.params import ClaheParams, ExtractParams, RealismParams, SiftParams
+from poseintegrity.params.extract import ClaheParams, ExtractParams, RealismParams, SiftParams
 
 
 def test_tiny_section_validates_beside_the_paper_protocol(tiny_params):

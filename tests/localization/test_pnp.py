@@ -11,7 +11,7 @@ from poseintegrity.errors import PoseIntegrityError
 from poseintegrity.localization.pnp import (
     CLASSIC_FLAGS, EPNP_KERNEL, FAILURES, METHODS, reprojection_errors, solve_checked, solve_methods, solve_pnp_ransac,
 )
-from poseintegrity.localization.ransac import minimal_sample_size, ransac_iterations
+from poseintegrity.ransac import minimal_sample_size, ransac_iterations
 from pnp_scenes import K, scene
 
 

@@ -19,6 +19,8 @@ from poseintegrity.scenes import dataset
 from recorded_tools import assert_rows_identical
 from repository import ROOT
 
+pytestmark = pytest.mark.pipeline  # stages 01 and 02 on the tiny parameters
+
 TINY = load_params(ROOT / "tests" / "params_tiny.yaml")
 
 

@@ -7,7 +7,7 @@ import pytest
 
 from poseintegrity.config import load_params
 from poseintegrity.scenes import catalog, mesh
-from poseintegrity.scenes.params import SceneSpec
+from poseintegrity.params.generate import SceneSpec
 
 ROOT = Path(__file__).resolve().parents[2]
 

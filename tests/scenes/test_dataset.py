@@ -3,6 +3,10 @@ count; another generate.seed gives another world), atomic writes."""
 
 import hashlib
 import json
+import os
+import subprocess
+import sys
+import textwrap
 
 import cv2
 import numpy as np
@@ -40,6 +44,7 @@ def tiny_root(tmp_path_factory):
     return params, top / "datasets"
 
 
+@pytest.mark.pipeline  # tiny_root: stage 01 on the tiny parameters
 def test_layout_and_index(tiny_root):
     params, root = tiny_root
     index = pd.read_parquet(root / "index.parquet")
@@ -65,6 +70,7 @@ def test_layout_and_index(tiny_root):
         assert set(np.unique(mask)) <= {0, 255} and (mask > 0).any()
 
 
+@pytest.mark.pipeline  # tiny_root: stage 01 on the tiny parameters
 def test_images_of_a_stop_differ_only_by_noise(tiny_root):
     _, root = tiny_root
     folder = root / "scene_a_arc000"
@@ -87,6 +93,7 @@ def test_png_files_hold_exactly_the_pixels_exposed(tmp_path, flags):
         assert (cv2.imread(str(folder / name), cv2.IMREAD_UNCHANGED) == image).all()
 
 
+@pytest.mark.pipeline  # tiny_root: stage 01 on the tiny parameters
 def test_the_recorded_exact_pose_is_the_one_the_image_shows(tiny_root):
     """frames.parquet's T_cam_board (the robot's actual pose, turned by the image's ring-down) puts the board's
     ChArUco corners, through the *true* lens, where OpenCV detects them in the image: no bias (mean offset), and an
@@ -113,12 +120,44 @@ def test_the_recorded_exact_pose_is_the_one_the_image_shows(tiny_root):
         assert np.sqrt(np.mean(np.sum(offsets**2, axis=1))) < 0.5
 
 
+@pytest.mark.pipeline  # tiny_root: stage 01 on the tiny parameters
 def test_rerun_reproduces_every_file_byte_for_byte_on_two_workers(tiny_root, tmp_path):
     params, root = tiny_root
     run(params, tmp_path, n_jobs=2)
     assert digest(tmp_path) == digest(root.parent)
 
 
+# A world build that frees 200 MB of 1 MB temporaries (below the mmap threshold: heap memory), under the Makefile's
+# malloc settings, which keep freed heap memory for reuse; the resident size before the build, after it, and after
+# giving back by hand what was still resident.
+BUILD_RSS = textwrap.dedent("""
+    import psutil, numpy as np
+    from poseintegrity.scenes import dataset
+    rss = lambda: psutil.Process().memory_info().rss / 1e6
+    def build(*args):
+        temporaries = [np.ones(125_000) for _ in range(200)]
+        del temporaries
+        return "world"
+    dataset._build_world = build
+    before = rss()
+    dataset.world(dataset.GenerateParams.model_construct(), dataset.ProtocolParams.model_construct(), 0, "arc")
+    after = rss()
+    dataset.give_back_freed_memory()
+    print(before, after, rss())
+""")
+
+
+def test_building_a_world_gives_its_temporaries_back_to_the_kernel():
+    """loky restarts a worker whose memory grew by 300 MB past its first task; the temporaries of a world build
+    (~130 MB at paper scale) used to stay resident under the Makefile's malloc settings, and every stage-01 run lost
+    both render workers that way (dataset.give_back_freed_memory)."""
+    env = os.environ | {"MALLOC_MMAP_THRESHOLD_": "33554432", "MALLOC_TRIM_THRESHOLD_": "1073741824"}
+    run = subprocess.run([sys.executable, "-c", BUILD_RSS], env=env, capture_output=True, text=True, check=True)
+    before, after, trimmed = map(float, run.stdout.split())
+    assert after - before < 50 and after - trimmed < 20  # MB: the 200 MB are not resident after the build
+
+
+@pytest.mark.pipeline  # tiny_root: stage 01 on the tiny parameters
 def test_another_seed_lays_out_and_exposes_another_world(tiny_root, tmp_path):
     """Every random draw derives from generate.seed: the scene layouts (board and target poses), the textures,
     the foam and the sensor noise."""
@@ -136,6 +175,7 @@ def test_another_seed_lays_out_and_exposes_another_world(tiny_root, tmp_path):
             assert not np.allclose(*boards)
 
 
+@pytest.mark.pipeline  # tiny_root: stage 01 on the tiny parameters
 def test_interrupted_run_leaves_nothing_that_looks_complete(tiny_root, tmp_path, monkeypatch):
     params, _ = tiny_root
     calls = {"n": 0}

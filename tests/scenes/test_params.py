@@ -4,7 +4,7 @@ import pytest
 
 from params_cases import refusal
 from poseintegrity.scenes import dataset
-from poseintegrity.scenes.params import GenerateParams
+from poseintegrity.params.generate import GenerateParams
 
 NO_LIGHT = {"ambient": 0.0, "ring": 0.0, "room": 0.0, "background": 0.5}
 

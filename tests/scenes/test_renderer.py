@@ -19,8 +19,8 @@ NO_SPECULAR = mesh.Material(specular=0.0)
 LIGHTS = (0.2, 0.7, 0.3, 0.05)  # ambient, ring, room, background
 FLAT = foam.ReliefVolume(np.zeros((8, 8, 8), np.float32), 0.125, 0.2, 0.0, 1.0)  # no relief, no mottling
 # the phantoms' foam with more contrast between pores and bumps, unmottled, on a smaller grid
-RELIEF = GENERATE.bone_foam.model_copy(update={"pore_fraction": 0.05, "bump_slope": 0.1, "albedo_std": 0.0}).relief(
-    0, n=64)
+RELIEF = foam.bone_foam_relief(
+    GENERATE.bone_foam.model_copy(update={"pore_fraction": 0.05, "bump_slope": 0.1, "albedo_std": 0.0}), 0, n=64)
 
 
 def smooth_texture(seed: int, size: int = 256, sigma: float = 3.0) -> np.ndarray:

@@ -9,9 +9,10 @@ from scipy.spatial.transform import Rotation
 
 from params_cases import refusal, with_value
 from poseintegrity.config import ParamsError, load_params, parse_params
+from poseintegrity import kinematics
+from poseintegrity.kinematics import UR5E
 from poseintegrity.poses import pose_errors
-from poseintegrity.scenes import kinematics, ringdown, robot, trajectories
-from poseintegrity.scenes.kinematics import UR5E
+from poseintegrity.scenes import ringdown, robot, trajectories
 from poseintegrity.seeding import keyed_rng
 from repository import ROOT
 

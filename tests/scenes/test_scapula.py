@@ -8,7 +8,7 @@ import trimesh
 
 from poseintegrity.config import ParamsError, load_params, parse_params, read_raw
 from poseintegrity.scenes.dataset import WorldError, check_world
-from poseintegrity.scenes.mesh import MeshError, check_mesh, read_mesh
+from poseintegrity.mesh_file import MeshError, check_mesh, read_mesh
 from poseintegrity.scenes.scapula import scapula_mesh
 
 ROOT = Path(__file__).resolve().parents[2]

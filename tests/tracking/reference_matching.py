@@ -15,7 +15,7 @@ from scipy.optimize import linear_sum_assignment
 
 from poseintegrity.tracking.markers.geometry import pairwise_distances
 from poseintegrity.tracking.markers.kabsch import kabsch_unchecked
-from poseintegrity.tracking.params import MatchingParams
+from poseintegrity.params.track import MatchingParams
 
 
 def kabsch_residuals(points_world: np.ndarray, points_body: np.ndarray) -> np.ndarray:

@@ -16,7 +16,7 @@ from project_copy import DVC, run, stage_06_project
 FIGURES = ["06_errors.png", "06_noise_vs_lag.png", "06_occlusion.png", "06_small_blobs.png", "06_success_rate.png"]
 
 
-@pytest.mark.notebook
+@pytest.mark.pipeline
 def test_stage_06_writes_tracking_metrics_and_figures(run_once):
     reports = run_once("stage_06", stage_06_project) / "reports"
     metrics = json.loads((reports / "metrics" / "tracking.json").read_text())

@@ -3,8 +3,9 @@ of tests/params_tiny.yaml, one process) gives tracking.json as the code before t
 (study_metrics_tiny.json: the stage-06 notebook's output on those parameters, timings left out).
 
 Every experiment draws from its own seeded generator in a fixed order, so the numbers are the same to the bit on one
-machine. Across machines they are not: OpenBLAS (numpy's and scipy's matrix kernels, left to the machine) picks its
-kernels by the CPU, and the filters amplify the last-bit differences of those kernels over hundreds of steps. Measured
+machine, and since OpenBLAS runs its Haswell kernels everywhere (poseintegrity.dispatch), on every x86-64 machine. The
+fixture was written before that, on a CPU with other OpenBLAS kernels, and the filters amplify the last-bit
+differences of those kernels over hundreds of steps, so it is compared within their spread. Measured
 on one AMD EPYC (AVX2) under every kernel set it can run (OPENBLAS_CORETYPE Prescott/Core2 = Katmai, Nehalem,
 Sandybridge, Haswell = Zen = the default), against this fixture (written on a CPU with yet other kernels): the
 filters' metrics (RMS errors, sigma sweeps, occlusion and restart errors) spread by at most 1.7e-5 relative

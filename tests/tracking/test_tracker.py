@@ -6,7 +6,7 @@ from poseintegrity.errors import PoseIntegrityError
 
 from poseintegrity.tracking.markers.geometry import transform_points
 from poseintegrity.tracking.markers.kabsch import pose_from_points
-from poseintegrity.tracking.params import PAPER_SIGMAS
+from poseintegrity.params.track import PAPER_SIGMAS
 from poseintegrity.tracking.filter.tracker import MarkerTracker, innovation_gate
 
 from tracking.track_section import GEOMETRY, TRACK

@@ -1,12 +1,10 @@
 """Artifact models f: theta -> n_inliers (Windsor et al. III-D, Fig. 2), fitted to the first stops of a dataset.
 
-    params.py          the ``fit`` section of params.yaml (FitParams)
     fitted.py          FittedModel: what every fitter returns (status ok / at_bound / non_physical / fallback, reason,
                        fallback line)
     base_functions.py  eq. 1 (scaled EMG) and four other decays, fitted by bounded least squares; beside them (ours)
                        eq. 1 with a free Gaussian width (emg_free_width)
     mlp.py             the 3 x 10 tanh MLP (IV-E), from scratch or EMG-pretrained + fine-tuned (III-D)
-    names.py           MODEL_NAMES, and the fewest stops each model can be fitted to
     models.py          fit_model(name, ...): one entry point for all of them
     series.py          Series: one dataset's samples (theta, n_inliers per image, in stop order)
     fig2.py            the Fig. 2 experiment on the stage-02 artifacts table
@@ -27,8 +25,6 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
         "fitted": ["FIT_STATUSES", "FallbackLine", "FittedModel"],
         "mlp": ["fit_mlp"],
         "models": ["fit_model"],
-        "names": ["MODEL_NAMES", "distinct_theta_needed"],
-        "params": ["FitParams", "MLPParams"],
         "series": ["Series", "dataset_series"],
     },
 )

@@ -40,6 +40,7 @@ from poseintegrity.artifact_models.fitted import (
     too_few_samples,
     valid_samples,
 )
+from poseintegrity.params.model_names import LEAST_SQUARES_PARAMETERS as PARAMETERS
 
 K_MIN = 0.05  # lower bound of the EMG shape K: exponnorm misbehaves as K -> 0 (docs/references.md, "SciPy")
 LONGEST_DECAY = 20.0  # longest decay length (K, tau, s) a fit may choose, in sampled spans
@@ -337,20 +338,20 @@ class FreeWidthEMG(BaseFunction):
         return ([broad, np.clip([*eq1.x, 1.0], lower, upper)] if eq1.success else [broad]), lower, upper
 
 
-EMG = BaseFunction("emg", ("alpha", "K", "mu"), emg, _start_emg, emg_jacobian)
+EMG = BaseFunction("emg", PARAMETERS["emg"], emg, _start_emg, emg_jacobian)
 # The least squares base functions of Fig. 2 (III-D): eq. 1 and the decays it was compared with (stage 02's realism
 # bar R1 compares them, as the paper did)
 BASE_FUNCTIONS: dict[str, BaseFunction] = {
     b.name: b
     for b in (
         EMG,
-        BaseFunction("exponential", ("a", "tau"), exponential, _start_exponential),
-        BaseFunction("gaussian", ("a", "m", "s"), gaussian, _start_gaussian),
-        BaseFunction("logistic", ("a", "t50", "s"), logistic, _start_logistic),
-        BaseFunction("power_law", ("a", "t50", "p"), power_law, _start_power_law),
+        BaseFunction("exponential", PARAMETERS["exponential"], exponential, _start_exponential),
+        BaseFunction("gaussian", PARAMETERS["gaussian"], gaussian, _start_gaussian),
+        BaseFunction("logistic", PARAMETERS["logistic"], logistic, _start_logistic),
+        BaseFunction("power_law", PARAMETERS["power_law"], power_law, _start_power_law),
     )
 }
-EMG_FREE_WIDTH = FreeWidthEMG("emg_free_width", ("alpha", "K", "mu", "sigma"), emg_free_width, _start_emg_free_width,
+EMG_FREE_WIDTH = FreeWidthEMG("emg_free_width", PARAMETERS["emg_free_width"], emg_free_width, _start_emg_free_width,
                               emg_free_width_jacobian)  # fmt: skip
 # Every least squares model fit_model knows: the paper's base functions and ours beside eq. 1
 LEAST_SQUARES: dict[str, BaseFunction] = {**BASE_FUNCTIONS, EMG_FREE_WIDTH.name: EMG_FREE_WIDTH}

@@ -19,8 +19,8 @@ import pandas as pd
 from poseintegrity.seeding import keyed_rng
 from poseintegrity.artifact_models.fitted import FIT_STATUSES, OK, FittedModel
 from poseintegrity.artifact_models.models import fit_model
-from poseintegrity.artifact_models.names import distinct_theta_needed
-from poseintegrity.artifact_models.params import FitParams
+from poseintegrity.params.model_names import distinct_theta_needed
+from poseintegrity.params.fit import FitParams
 from poseintegrity.artifact_models.series import Series, dataset_series
 from poseintegrity.errors import ArgumentError
 from poseintegrity.tables import check_fig2_rmse

@@ -29,9 +29,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from poseintegrity.errors import ArgumentError, check_scalar
+from poseintegrity.tables import FIT_STATUSES  # the fits tables' status column: least to most severe
 
-OK, AT_BOUND, NON_PHYSICAL, FALLBACK = "ok", "at_bound", "non_physical", "fallback"
-FIT_STATUSES = (OK, AT_BOUND, NON_PHYSICAL, FALLBACK)  # least to most severe
+OK, AT_BOUND, NON_PHYSICAL, FALLBACK = FIT_STATUSES
 LARGEST_LEVEL = 10.0  # largest count level a model may predict or a level parameter take, in largest mean counts
 NEGATIVE_COUNT = -0.5  # a prediction below this rounds to a negative inlier count
 ONE_INLIER = 0.5  # a prediction from this on rounds to at least one inlier

@@ -24,8 +24,8 @@ from poseintegrity.artifact_models.base_functions import EMG
 from poseintegrity.artifact_models.fitted import FittedModel, too_few_samples, valid_samples
 from poseintegrity.artifact_models.lbfgs import minimize_mse
 from poseintegrity.artifact_models.mlp_net import forward, mse
-from poseintegrity.artifact_models.names import MLP_DISTINCT_THETA
-from poseintegrity.artifact_models.params import MLPParams
+from poseintegrity.params.model_names import MLP_DISTINCT_THETA
+from poseintegrity.params.fit import MLPParams
 
 PARAM_NAMES = ("loss", "evaluations")  # FittedModel.params of an MLP: final scaled MSE, loss evaluations
 

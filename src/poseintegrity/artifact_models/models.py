@@ -13,8 +13,8 @@ from poseintegrity.errors import ArgumentError, check_scalar
 from poseintegrity.artifact_models.base_functions import LEAST_SQUARES
 from poseintegrity.artifact_models.fitted import MAX_THETA, FittedModel
 from poseintegrity.artifact_models.mlp import fit_mlp
-from poseintegrity.artifact_models.names import MLP_RECIPES, MODEL_NAMES
-from poseintegrity.artifact_models.params import FitParams
+from poseintegrity.params.model_names import MLP_RECIPES, MODEL_NAMES
+from poseintegrity.params.fit import FitParams
 
 
 def fit_model(

@@ -2,7 +2,7 @@
 
 dataset (stage-01 datasets, checked on read) -> features (CLAHE + SIFT, cached) -> matching (ratio test) ->
 target_model (M_t, III-B) -> evidence (a frame's checked image, matches and ArUco pose, cached for stage 05) -> pnp
-(PnP-RANSAC: USAC and classic variants, the classic iteration budget from ransac; frame_pnp runs a frame's methods,
+(PnP-RANSAC: USAC and classic variants, the classic iteration budget from poseintegrity.ransac; frame_pnp runs a frame's methods,
 cached) -> poseintegrity.poses (E_t, E_r)
 against the exact pose and the ground_truth (ArUco board) -> frame_artifacts (n_i and friends), realism checks ->
 envelope (theta_a, IV-E). extract runs it over datasets on the workers of poseintegrity.parallel.
@@ -18,9 +18,7 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
         "dataset": ["DatasetError"],
         "envelope": ["actual_envelope", "envelopes"],
         "extract": ["DATA_FLAGS", "extract_all", "extract_dataset", "usable"],
-        "params": ["ExtractParams"],
         "pnp": ["METHODS", "solve_pnp_ransac"],
-        "ransac": ["minimal_sample_size", "ransac_iterations"],
         "target_model": ["TargetModel", "build_target_model"],
     },
 )

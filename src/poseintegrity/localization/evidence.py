@@ -29,7 +29,7 @@ from poseintegrity.localization.features import (
 )
 from poseintegrity.localization.ground_truth import BoardPose, board_from_dict, board_pose, no_pose
 from poseintegrity.localization.matching import match_ratio_test
-from poseintegrity.localization.params import ExtractParams
+from poseintegrity.params.extract import ExtractParams
 from poseintegrity.localization.target_model import TargetModel
 
 EVIDENCE_VERSION = 4  # bump when the cached content or its layout changes (3: the checked board pose, issue 30;

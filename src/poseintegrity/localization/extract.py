@@ -48,9 +48,9 @@ from poseintegrity.localization.features import cached_features, read_gray, writ
 from poseintegrity.localization.frame_artifacts import frame_artifacts
 from poseintegrity.localization.frame_pnp import frame_pnp
 from poseintegrity.localization.ground_truth import BoardPose, board_from_dict, board_pose, no_pose, truth_error
-from poseintegrity.localization.params import ExtractParams
+from poseintegrity.params.extract import ExtractParams
 from poseintegrity.localization.pnp import PnPResult, failed, solve_checked
-from poseintegrity.localization.ransac import minimal_sample_size, ransac_iterations
+from poseintegrity.ransac import minimal_sample_size, ransac_iterations
 from poseintegrity.poses import NAN_POSE, pose_errors
 from poseintegrity.localization.target_model import TargetModel, build_target_model
 from poseintegrity.parallel import Workers

@@ -20,7 +20,7 @@ import numpy as np
 from poseintegrity.defaults import published
 from poseintegrity.grayscale import as_gray8
 from poseintegrity.localization.dataset import DatasetError
-from poseintegrity.localization.params import ClaheParams, SiftParams
+from poseintegrity.params.extract import ClaheParams, SiftParams
 
 CACHE_VERSION = 1  # bump when the cached content or its layout changes
 

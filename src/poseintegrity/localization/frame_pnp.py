@@ -25,7 +25,7 @@ import cv2
 import numpy as np
 
 from poseintegrity.localization.features import write_npz
-from poseintegrity.localization.params import ExtractParams
+from poseintegrity.params.extract import ExtractParams
 from poseintegrity.localization.pnp import PnPResult, solve_methods
 
 PNP_CACHE_VERSION = 1  # bump when the cached content, its layout or what computes it changes

@@ -36,7 +36,7 @@ from poseintegrity.defaults import published
 from poseintegrity.errors import ArgumentError
 from poseintegrity.grayscale import as_gray8
 from poseintegrity.lens import Camera
-from poseintegrity.localization.params import GroundTruthParams
+from poseintegrity.params.extract import GroundTruthParams
 from poseintegrity.poses import NAN_POSE, inverse, pose_errors, pose_from_rvec_tvec
 
 __all__ = ["BoardPose", "board_from_dict", "board_pose", "detect_board_points", "consistent_fit", "truth_error"]

@@ -17,7 +17,7 @@ Iterations of the classic path: OpenCV stops as soon as the best consensus found
 adaptive RANSAC count), capped by ``iterationsCount``. The cap is sized, per method, for a stated inlier ratio w
 (``extract.ransac_budget_inlier_ratio``): N = log(1 - p) / log(1 - w^s) (Fischler & Bolles 1981; Hartley &
 Zisserman, Multiple View Geometry, 2nd ed., eq. 4.18), s the minimal sample OpenCV draws: 5 points solved by EPnP
-for every flag but P3P/AP3P, which draw 4 (:mod:`~poseintegrity.localization.ransac`; docs/references.md, "RANSAC
+for every flag but P3P/AP3P, which draw 4 (:mod:`~poseintegrity.ransac`; docs/references.md, "RANSAC
 iteration count").
 A frame with a lower inlier ratio may then fail: a budget, not a guarantee.
 
@@ -42,7 +42,7 @@ import cv2
 import numpy as np
 
 from poseintegrity.errors import ArgumentError, check_array, check_intrinsics, check_scalar, check_same_length
-from poseintegrity.localization.ransac import minimal_sample_size
+from poseintegrity.ransac import minimal_sample_size
 from poseintegrity.poses import NAN_POSE, pose_from_rvec_tvec
 
 # names of docs/references.md, "OpenCV 5" (OpenCV 5 renumbered the flags: never use the integers)

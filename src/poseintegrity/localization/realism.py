@@ -15,7 +15,7 @@ from scipy.stats import spearmanr
 
 from poseintegrity.artifact_models.base_functions import BASE_FUNCTIONS
 from poseintegrity.localization.envelope import headline
-from poseintegrity.localization.params import RealismParams
+from poseintegrity.params.extract import RealismParams
 from poseintegrity.localization.truth_accuracy import truth_accuracy
 from poseintegrity.protocol import ProtocolParams, tolerance_name
 

@@ -1,6 +1,5 @@
 """Localization-envelope predictors of Windsor et al. (III-E, III-F, IV-A, IV-E, V) and what goes past them.
 
-    params.py       the ``predict`` section of params.yaml (PredictParams)
     predictors.py   theta_p for all n_t at once; long range, next-step (III-E) and static (IV-A) predictors
     metrics.py      SPL (eq. 3), R_i (eq. 4), SPL vs R_i curves, max mean SPL at zero incursion (Tables I-III)
     sweeps.py       the whole operating-point sweep over datasets, predictors, tolerances, PnP methods (V)
@@ -27,7 +26,6 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "best_operating_point", "incursion", "operating_curves", "relative_improvement", "safe_path_length",
             "with_metrics",
         ],
-        "params": ["PredictorModels", "PredictParams", "UncertaintyParams"],
         "predictors": [
             "NO_FIT", "Boundaries", "boundaries", "envelope_prediction", "long_range", "next_step",
             "next_step_stops", "relative_thresholds", "static_baseline",

@@ -21,12 +21,12 @@ from functools import partial
 import numpy as np
 import pandas as pd
 
-from poseintegrity.artifact_models import FitParams
+from poseintegrity.params.fit import FitParams
 from poseintegrity.artifact_models.series import Series, dataset_series
 from poseintegrity.parallel import Workers
 from poseintegrity.prediction.loso import loso, pooled
 from poseintegrity.prediction.metrics import best_operating_point, operating_curves
-from poseintegrity.prediction.params import PredictParams
+from poseintegrity.params.predict import PredictParams
 from poseintegrity.prediction.predictors import fit_rng, long_range
 from poseintegrity.prediction.sweeps import fit_of, prediction_rows
 from poseintegrity.protocol import ProtocolParams

@@ -34,7 +34,8 @@ import numpy as np
 
 from poseintegrity.errors import ArgumentError, check_array, check_increasing, check_scalar
 from poseintegrity.seeding import keyed_rng
-from poseintegrity.artifact_models import FIT_STATUSES, FitParams, FittedModel, fit_model
+from poseintegrity.artifact_models import FIT_STATUSES, FittedModel, fit_model
+from poseintegrity.params.fit import FitParams
 from poseintegrity.artifact_models.fitted import MAX_THETA, OK
 from poseintegrity.artifact_models.series import Series
 

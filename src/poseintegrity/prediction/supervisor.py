@@ -21,9 +21,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from poseintegrity.errors import ArgumentError, check_array, check_scalar
-from poseintegrity.artifact_models import FitParams, fit_model
+from poseintegrity.artifact_models import fit_model
+from poseintegrity.params.fit import FitParams
 from poseintegrity.artifact_models.fitted import MAX_THETA
-from poseintegrity.prediction.params import PredictParams, UncertaintyParams
+from poseintegrity.params.predict import PredictParams, UncertaintyParams
 from poseintegrity.prediction.predictors import NO_FIT, envelope_prediction, next_step_stops
 from poseintegrity.prediction.uncertainty import prediction_interval
 

@@ -32,14 +32,14 @@ from functools import partial
 import numpy as np
 import pandas as pd
 
-from poseintegrity.artifact_models import FitParams
+from poseintegrity.params.fit import FitParams
 from poseintegrity.artifact_models.fitted import OK
 from poseintegrity.artifact_models.series import REQUIRED_COLUMNS, Series, dataset_series
 from poseintegrity.parallel import Workers
 from poseintegrity.tables import TableError, check_artifacts, check_envelopes
 from poseintegrity.prediction.metrics import with_metrics
 from poseintegrity.prediction.error_predictors import combined, error_long_range, error_next_step
-from poseintegrity.prediction.params import PredictParams
+from poseintegrity.params.predict import PredictParams
 from poseintegrity.prediction.predictors import (
     NO_FIT,
     Boundaries,

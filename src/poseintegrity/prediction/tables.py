@@ -20,7 +20,7 @@ from poseintegrity.prediction.ceiling import ceiling, ceiling_share
 from poseintegrity.prediction.loso import loso_summary
 from poseintegrity.prediction.metrics import (best_operating_point, operating_curves, relative_improvement,
                                                with_metrics)
-from poseintegrity.prediction.params import PredictParams
+from poseintegrity.params.predict import PredictParams
 from poseintegrity.prediction.predictors import NO_FIT
 from poseintegrity.prediction.sweeps import (
     CONSERVATIVE_HIGH, ERROR_PREDICTORS, FITTED_PREDICTORS, FREE_WIDTH_PREDICTORS, OPERATING_POINT_KEY,

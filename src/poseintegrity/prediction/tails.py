@@ -20,9 +20,10 @@ from dataclasses import dataclass
 import pandas as pd
 
 from poseintegrity.errors import ArgumentError
-from poseintegrity.artifact_models import FitParams, FittedModel
+from poseintegrity.artifact_models import FittedModel
+from poseintegrity.params.fit import FitParams
 from poseintegrity.artifact_models.series import Series, dataset_series
-from poseintegrity.prediction.params import PredictParams
+from poseintegrity.params.predict import PredictParams
 from poseintegrity.prediction.predictors import fit_rng, long_range
 from poseintegrity.protocol import ProtocolParams
 

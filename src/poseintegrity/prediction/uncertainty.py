@@ -23,9 +23,10 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.stats import norm
 
-from poseintegrity.artifact_models import FitParams, FittedModel, fit_model
+from poseintegrity.artifact_models import FittedModel, fit_model
+from poseintegrity.params.fit import FitParams
 from poseintegrity.artifact_models.base_functions import BaseCurve
-from poseintegrity.prediction.params import UncertaintyParams
+from poseintegrity.params.predict import UncertaintyParams
 from poseintegrity.prediction.predictors import envelope_prediction
 
 

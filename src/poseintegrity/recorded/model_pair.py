@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from poseintegrity.localization.features import detect_features
-from poseintegrity.localization.params import ExtractParams
+from poseintegrity.params.extract import ExtractParams
 from poseintegrity.localization.target_model import build_target_model
 from poseintegrity.protocol import ProtocolParams
 from poseintegrity.recorded.reader import Recorded, read_image

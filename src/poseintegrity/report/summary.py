@@ -141,10 +141,5 @@ def render_summary(metrics: dict[str, dict], timings: list[StageTiming]) -> str:
 
 
 # What README "Same numbers on any x86-64 machine" measured of the figures above
-MACHINE_NOTE = ("OpenCV, numpy, torch and numba run capped at AVX2 on every x86-64 machine (`poseintegrity/dispatch.py`), "
-                "so SIFT and every figure that follows from it are the same on an AVX-512 machine. OpenBLAS (numpy's "
-                "and scipy's linear algebra) keeps the machine's kernels. Measured between two of its kernel sets "
-                "(README): the long range and EMG figures move by <= 1e-5 relative (2e-4 for the lower-bound "
-                "variant's improvement on the validation world), static and next step not at all; the MLP's SPL by "
-                "~1 % (it trains from the EMG fits) and its fit shares by a few points; the shares of free-width and "
-                "logistic fits at a bound by up to 5 points; the tracking metrics of stage 06 by up to 2e-5.")
+MACHINE_NOTE = ("OpenCV, numpy, torch and numba run capped at AVX2 on every x86-64 machine (`poseintegrity/dispatch`), "
+                "so SIFT and every figure that follows from it are the same on an AVX-512 machine.")

@@ -13,8 +13,8 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from poseintegrity.poses import pose_matrix
-from poseintegrity.scenes.camera_params import CaptureParams
-from poseintegrity.scenes.params import GenerateParams
+from poseintegrity.params.camera import CaptureParams
+from poseintegrity.params.generate import GenerateParams
 from poseintegrity.scenes.ringdown import Exposure, RingDown, ring_down
 from poseintegrity.scenes.robot import PlacedRobot
 from poseintegrity.seeding import keyed_rng

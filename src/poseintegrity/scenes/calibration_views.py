@@ -28,7 +28,7 @@ from poseintegrity.scenes import mesh, optics, renderer
 from poseintegrity.scenes.camera import true_camera
 from poseintegrity.scenes.catalog import measured_scale, print_errors
 from poseintegrity.scenes.foam import ReliefVolume
-from poseintegrity.scenes.params import GenerateParams
+from poseintegrity.params.generate import GenerateParams
 from poseintegrity.scenes.textures import build_atlas, to_u8
 from poseintegrity.seeding import keyed_rng
 

@@ -16,7 +16,7 @@ from poseintegrity.lens import Camera
 from poseintegrity.poses import pose_matrix
 
 if TYPE_CHECKING:
-    from poseintegrity.scenes.camera_params import CameraParams
+    from poseintegrity.params.camera import CameraParams
 
 
 @dataclass(frozen=True)
@@ -32,7 +32,7 @@ class Intrinsics:
 
     @classmethod
     def from_params(cls, camera: "CameraParams") -> "Intrinsics":
-        """The true intrinsics of ``camera`` (:meth:`~.camera_params.CameraParams.intrinsics`)."""
+        """The true intrinsics of ``camera`` (:meth:`poseintegrity.params.camera.CameraParams.intrinsics`)."""
         K, width, height = camera.intrinsics()
         return cls(width, height, K)
 

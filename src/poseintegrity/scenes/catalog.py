@@ -28,7 +28,7 @@ from poseintegrity.scenes import mesh as meshes
 from poseintegrity.scenes import textures as tex
 from poseintegrity.poses import pose_matrix
 from poseintegrity.protocol import ProtocolParams
-from poseintegrity.scenes.params import TEXTURE_NAMES, GenerateParams, SceneSpec
+from poseintegrity.params.generate import TEXTURE_NAMES, BoneFoamParams, GenerateParams, SceneSpec
 from poseintegrity.scenes.camera import Intrinsics
 from poseintegrity.scenes.scapula import scapula_mesh
 
@@ -76,12 +76,17 @@ def _faint_lid(albedo: np.ndarray, rng: np.random.Generator) -> np.ndarray:
     return out
 
 
+def foam_material(bone_foam: BoneFoamParams) -> meshes.Material:
+    """The reflectance of ``generate.bone_foam``: its mean albedo, under its relief (:mod:`.foam`), and its lobe."""
+    return meshes.Material(specular=bone_foam.specular, shininess=bone_foam.shininess, foam_albedo=bone_foam.albedo)
+
+
 def target_mesh(name: str, params: "GenerateParams") -> meshes.Mesh:
     """A target in its own frame: +z the face shown to the model camera (the glenoid for the scapula phantoms,
     whose origin is the glenoid centre; the lid for a box, whose origin is its centre)."""
     if name.startswith("scapula"):
         bone = scapula_mesh(params.scapula, drilled=name == "scapula_drilled")
-        return meshes.from_trimesh(bone, params.bone_foam.material())
+        return meshes.from_trimesh(bone, foam_material(params.bone_foam))
     return meshes.box(BLOCK_SIZE_MM, name, material=meshes.Material(specular=0.08, shininess=30.0))
 
 
@@ -294,7 +299,7 @@ def _clutter(spec: "SceneSpec", params: "GenerateParams", rng: np.random.Generat
     board's paper corners (4, 3) and the scene's poses; no object (as tall as any can be) may cover the board at any
     of them."""
     occupied = [(aim[:2], 90.0 + 130.0 * (len(spec.targets) - 1)), (board_centre, 80.0)]
-    foam = params.bone_foam.material()
+    foam = foam_material(params.bone_foam)
     placed, attempts = [], 0
     while len(placed) < spec.n_clutter and attempts < 500:
         attempts += 1

@@ -26,6 +26,7 @@ backend, the worker count or the order the shots run in.
 
 from __future__ import annotations
 
+import ctypes
 import json
 import shutil
 from collections import OrderedDict
@@ -50,8 +51,8 @@ from poseintegrity.scenes.acquisition import Route, image_motion, image_pose, mo
 from poseintegrity.scenes.board_placement import BoardPlacement, PlacementError
 from poseintegrity.scenes.calibration_views import CalibrationSession, calibration_session, write_calibration
 from poseintegrity.scenes.camera import Intrinsics, true_camera
-from poseintegrity.scenes.foam import ReliefVolume
-from poseintegrity.scenes.params import BoneFoamParams, GenerateParams
+from poseintegrity.scenes.foam import ReliefVolume, bone_foam_relief
+from poseintegrity.params.generate import BoneFoamParams, GenerateParams
 from poseintegrity.scenes.robot import Robot, accuracy, trip_path
 from poseintegrity.scenes.textures import build_atlas
 from poseintegrity.seeding import keyed_rng
@@ -220,14 +221,29 @@ def world(params: GenerateParams, protocol: ProtocolParams, scene_index: int, se
         _WORLDS[key] = _build_world(params, protocol, scene_index, session, placement)
         while len(_WORLDS) > WORLDS_KEPT:
             _WORLDS.popitem(last=False)
+        give_back_freed_memory()
     _WORLDS.move_to_end(key)
     return _WORLDS[key]
+
+
+def give_back_freed_memory() -> None:
+    """Return the heap memory freed so far to the kernel (glibc's ``malloc_trim``; nothing where there is none).
+
+    The Makefile keeps freed memory for reuse (``MALLOC_TRIM_THRESHOLD_`` 1 GB: SIFT's per-frame buffers), so the
+    temporaries of building a world stayed resident in the render worker: at paper scale 130 MB for a world whose foam
+    relief is drawn (its 128^3 FFTs), 66 MB for one that reuses it. loky restarts a worker whose memory grew by
+    300 MB past what it held after its first task (a robot drive, ~350 MB); by the validation world's first shot a
+    render worker held 310-330 MB more and was restarted, in every stage-01 run, with "A worker stopped while some
+    jobs were given to the executor" (and built its worlds again). Given back, they peak ~210 MB above it."""
+    trim = getattr(ctypes.CDLL(None), "malloc_trim", None)  # the C library this process runs on
+    if trim is not None:
+        trim(0)
 
 
 @lru_cache(maxsize=2)
 def _relief(bone_foam: BoneFoamParams, seed: int) -> ReliefVolume:
     """The foam's relief: one material, the same in every scene of a world, drawn once per process."""
-    return bone_foam.relief(seed)
+    return bone_foam_relief(bone_foam, seed)
 
 
 def _build_world(params: GenerateParams, protocol: ProtocolParams, scene_index: int, session: str,

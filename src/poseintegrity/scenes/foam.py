@@ -21,14 +21,19 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import cached_property
+from typing import TYPE_CHECKING
 
 import numba
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from poseintegrity.params.generate import VOXEL_MM
+
+if TYPE_CHECKING:
+    from poseintegrity.params.generate import BoneFoamParams
+
 N_OCTAVES = 3  # pore radii r0, 2 r0, 4 r0
 N_VOXELS = 128  # one period of the relief volume: 128 voxels of VOXEL_MM = 16 mm
-VOXEL_MM = 0.125
 # fixed, well spread rotations decorrelating the octaves (and the albedo octave) from each other
 OCTAVE_ROTATIONS = Rotation.from_rotvec(
     [[0.0, 0.0, 0.0], [0.9, 0.3, -0.4], [-0.5, 1.1, 0.6], [0.7, -0.8, 1.2]]
@@ -75,7 +80,7 @@ def relief_volume(rng: np.random.Generator, *, pore_radius_mm: float, pore_fract
                   bump_slope: float, albedo_std: float, albedo_mottle_mm: float, n: int = N_VOXELS,
                   voxel_mm: float = VOXEL_MM) -> ReliefVolume:
     """The foam's height field over one period (n voxels of ``voxel_mm``); the material's values come from
-    ``generate.bone_foam`` (:meth:`~.params.BoneFoamParams.relief`).
+    ``generate.bone_foam`` (:func:`bone_foam_relief`).
 
     Pores: spherical pits (Gaussian profile, std = radius) at uniformly random centres, depth = pore_depth x radius
     x U(0.5, 1.5), covering about ``pore_fraction`` of a plane section (each pore's cross-section pi r^2);
@@ -97,6 +102,15 @@ def relief_volume(rng: np.random.Generator, *, pore_radius_mm: float, pore_fract
     height = pores + bumps * (bump_slope / slope)
     return ReliefVolume((height - height.mean()).astype(np.float32), voxel_mm, pore_radius_mm, albedo_std,
                         albedo_mottle_mm / pore_radius_mm)
+
+
+def bone_foam_relief(bone_foam: BoneFoamParams, seed: int, **grid) -> ReliefVolume:
+    """The relief of ``generate.bone_foam``, seeded by ``generate.seed`` (one material: the same for every object);
+    ``grid``: ``n`` / ``voxel_mm`` of :func:`relief_volume` (tests shrink it)."""
+    return relief_volume(np.random.default_rng([seed, 7]), pore_radius_mm=bone_foam.pore_radius_mm,
+                         pore_fraction=bone_foam.pore_fraction, pore_depth=bone_foam.pore_depth,
+                         bump_slope=bone_foam.bump_slope, albedo_std=bone_foam.albedo_std,
+                         albedo_mottle_mm=bone_foam.albedo_mottle_mm, **grid)
 
 
 @numba.njit(cache=True, nogil=True, fastmath=True, error_model="numpy")

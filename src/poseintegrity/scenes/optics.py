@@ -16,7 +16,7 @@ import cv2
 import numpy as np
 
 if TYPE_CHECKING:
-    from poseintegrity.scenes.camera_params import CameraParams
+    from poseintegrity.params.camera import CameraParams
 
 LADDER_RATIO = 1.25  # successive blur sigmas of the layered approximation; interpolation error < 3 % of a sigma
 SHARPEST_SIGMA_PX = 0.1  # below this a Gaussian blur changes nothing a sensor can see

@@ -21,7 +21,7 @@ import numpy as np
 from poseintegrity.scenes import foam
 from poseintegrity.scenes.foam import ReliefVolume
 from poseintegrity.scenes.mesh import Mesh
-from poseintegrity.scenes.camera_params import SensorParams
+from poseintegrity.params.camera import SensorParams
 from poseintegrity.scenes.textures import TextureAtlas
 
 NEAR_MM = 20.0

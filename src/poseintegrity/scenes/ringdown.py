@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 if TYPE_CHECKING:
-    from poseintegrity.scenes.robot_params import RingDownParams
+    from poseintegrity.params.robot import RingDownParams
 
 
 @dataclass(frozen=True)

@@ -18,15 +18,15 @@ from typing import TYPE_CHECKING, Protocol
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from poseintegrity import kinematics
 from poseintegrity.errors import PoseIntegrityError
+from poseintegrity.kinematics import DH, UR5E
 from poseintegrity.poses import inverse as inverse_pose
 from poseintegrity.poses import pose_errors, pose_matrix, rotation_angle_deg
-from poseintegrity.scenes import kinematics
-from poseintegrity.scenes.kinematics import DH, UR5E
 from poseintegrity.scenes.trajectories import Stop
 
 if TYPE_CHECKING:
-    from poseintegrity.scenes.robot_params import PlacementParams, RobotParams
+    from poseintegrity.params.robot import PlacementParams, RobotParams
 
 ISO_9283_CYCLES = 30  # visits per pose of the ISO 9283 repeatability test
 

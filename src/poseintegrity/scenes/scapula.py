@@ -19,10 +19,10 @@ from typing import TYPE_CHECKING
 import numpy as np
 import trimesh
 
-from poseintegrity.scenes.mesh import MeshError, read_mesh
+from poseintegrity.mesh_file import MeshError, read_mesh
 
 if TYPE_CHECKING:
-    from poseintegrity.scenes.params import ScapulaParams
+    from poseintegrity.params.generate import ScapulaParams
 
 HOLE_VOLUME_TOLERANCE = 0.3  # the hole must remove at least 70 % of its cylinder's volume from the bone
 

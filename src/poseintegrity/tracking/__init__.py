@@ -29,7 +29,6 @@ Sub-packages (paper section -> module):
                                         :mod:`.experiments.small_blobs` (ours: 8-20 px markers),
                                         :mod:`.experiments.peers` (filterpy, pykalman); :mod:`.experiments.study`
                                         runs them all
-    params        the ``track`` section of params.yaml
     replay        command line: a recording + a tool file -> pose table and summary
 """
 
@@ -52,7 +51,6 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
         "io.hl2_recordings": ["convert_hl2ss", "convert_stream_recorder", "read_hl2ss_ahat", "read_hl2ss_calibration"],
         "io.recording": ["Recording", "RecordingError", "RecordingWriter", "read_recording", "track_recording"],
         "io.tool_files": ["read_tools", "write_tools"],
-        "params": ["TrackParams"],
         "replay": ["replay_summary"],
     },
 )

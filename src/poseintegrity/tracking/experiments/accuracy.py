@@ -7,7 +7,7 @@ import numpy as np
 import pandas as pd
 
 from poseintegrity.tracking.simulation.errors import rms, rms_summary
-from poseintegrity.tracking.params import PAPER_SIGMAS, TrackParams
+from poseintegrity.params.track import PAPER_SIGMAS, TrackParams
 from poseintegrity.tracking.simulation.simulate import Simulation, run_no_filter, simulate
 from poseintegrity.tracking.experiments.filter_runs import (
     experiment_rng, FilterResults, accuracy_runs, agreement_runs, sweep_runs, sigma_runs, filter_agreement,

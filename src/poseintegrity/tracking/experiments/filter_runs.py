@@ -11,7 +11,7 @@ import numpy as np
 import pandas as pd
 
 from poseintegrity.seeding import keyed_rng
-from poseintegrity.tracking.params import PAPER_SIGMAS, FilterParams, TrackParams
+from poseintegrity.params.track import PAPER_SIGMAS, FilterParams, TrackParams
 from poseintegrity.tracking.simulation.simulate import Simulation, run_filter
 from poseintegrity.tracking.filter.srukf import SquareRootUKF
 from poseintegrity.tracking.filter.tracker import MarkerTracker

@@ -29,7 +29,7 @@ from pykalman.sqrt.unscented import Moments, moments2points, unscented_filter_pr
 from poseintegrity.tracking.filter.model import (
     centred, process_model, process_model_reference, process_noise_sqrt, state_dim,
 )
-from poseintegrity.tracking.params import FilterParams
+from poseintegrity.params.track import FilterParams
 from poseintegrity.tracking.filter.srukf import SquareRootUKF
 from poseintegrity.tracking.filter.ukf import UnscentedKalmanFilter
 

@@ -9,7 +9,7 @@ import pandas as pd
 
 from poseintegrity.tracking.simulation.frames import intrinsics, unit_plane_lut
 from poseintegrity.tracking.markers.geometry import transform_points
-from poseintegrity.tracking.params import TrackParams
+from poseintegrity.params.track import TrackParams
 from poseintegrity.tracking.io.recording import RecordingWriter, read_recording, track_recording
 from poseintegrity.tracking.simulation.simulate import Simulation, run_filter, simulate
 from poseintegrity.tracking.filter.tracker import MarkerTracker

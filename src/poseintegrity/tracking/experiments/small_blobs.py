@@ -13,7 +13,7 @@ from scipy.spatial.transform import Rotation
 from poseintegrity.tracking.markers.detection import detect_markers
 from poseintegrity.tracking.simulation.frames import Phantom, intrinsics, render_frame
 from poseintegrity.tracking.markers.geometry import MARKER_DIAMETER_M, pairwise_distances
-from poseintegrity.tracking.params import DetectionParams, TrackParams
+from poseintegrity.params.track import DetectionParams, TrackParams
 
 MEASURES = get_args(DetectionParams.model_fields["shape_measure"].annotation)  # ("contour", "pixel")
 

@@ -22,7 +22,7 @@ import pandas as pd
 from poseintegrity.tracking.experiments.small_blobs import small_blob_sweep, sweep_summary
 from poseintegrity.parallel import Workers
 from poseintegrity.paper_results import BLACK_RESULTS
-from poseintegrity.tracking.params import TrackParams
+from poseintegrity.params.track import TrackParams
 from poseintegrity.tracking.experiments.peers import filter_speed, pykalman_time_update
 from poseintegrity.tracking.experiments.filter_runs import experiment_rng, study_filter_runs, run_filter_task
 from poseintegrity.tracking.experiments.accuracy import (

@@ -14,7 +14,7 @@ from poseintegrity.tracking.simulation.frames import draw_phantoms, intrinsics, 
 from poseintegrity.poses import pose_matrix
 from poseintegrity.tracking.markers.geometry import MARKER_DIAMETER_M, transform_points
 from poseintegrity.tracking.simulation.motion import sample_sensors, simulate_trajectory
-from poseintegrity.tracking.params import TrackParams
+from poseintegrity.params.track import TrackParams
 from poseintegrity.tracking.simulation.simulate import Simulation, T_world_cam, background_seen, run_no_filter, simulate, simulate_hand
 from poseintegrity.tracking.filter.multi_tool import MultiToolTracker
 from poseintegrity.tracking.experiments.filter_runs import experiment_rng

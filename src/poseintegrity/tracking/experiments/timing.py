@@ -12,7 +12,7 @@ from poseintegrity.tracking.markers.detection import detect_markers
 from poseintegrity.tracking.simulation.frames import draw_phantoms, intrinsics, render_frame
 from poseintegrity.tracking.markers.geometry import MARKER_DIAMETER_M, transform_points
 from poseintegrity.tracking.markers.kabsch import kabsch_unchecked, pose_from_points_unchecked
-from poseintegrity.tracking.params import TrackParams
+from poseintegrity.params.track import TrackParams
 from poseintegrity.tracking.simulation.simulate import Simulation, T_world_cam
 from poseintegrity.tracking.filter.tracker import MarkerTracker
 from poseintegrity.tracking.experiments.filter_runs import experiment_rng

@@ -8,7 +8,7 @@ import numpy as np
 from poseintegrity.defaults import published
 from poseintegrity.tracking.filter.tracker import FrameResult, MarkerTracker, check_points, check_rates, check_timestamp
 from poseintegrity.tracking.markers.tools import ToolError, check_tools
-from poseintegrity.tracking.params import FilterParams, MatchingParams
+from poseintegrity.params.track import FilterParams, MatchingParams
 
 
 class MultiToolTracker:

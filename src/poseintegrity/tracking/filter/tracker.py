@@ -40,7 +40,7 @@ from poseintegrity.poses import NAN_POSE
 from poseintegrity.tracking.markers.correspondence import match_markers_unchecked
 from poseintegrity.tracking.markers.geometry import transform_points
 from poseintegrity.tracking.markers.kabsch import pose_from_points_unchecked
-from poseintegrity.tracking.params import FilterParams, MatchingParams
+from poseintegrity.params.track import FilterParams, MatchingParams
 from poseintegrity.tracking.filter.srukf import SquareRootUKF
 from poseintegrity.tracking.filter.unscented import UnscentedMarkerFilter
 

@@ -13,7 +13,7 @@ import numpy as np
 
 from poseintegrity.errors import ArgumentError, check_array
 from poseintegrity.tracking.markers.kabsch import check_kabsch_arguments, pose_from_points_unchecked
-from poseintegrity.tracking.params import FilterParams
+from poseintegrity.params.track import FilterParams
 from poseintegrity.tracking.filter.model import (
     centred,
     measurement_noise_std,

@@ -58,7 +58,7 @@ from scipy.spatial.transform import Rotation
 from poseintegrity.defaults import published
 from poseintegrity.errors import ArgumentError, PoseIntegrityError, check_array, check_increasing, check_same_length, read_text_file
 from poseintegrity.tracking.markers.detection import detect_markers_unchecked, validate_frame
-from poseintegrity.tracking.params import TrackParams
+from poseintegrity.params.track import TrackParams
 from poseintegrity.tracking.filter.multi_tool import MultiToolTracker
 from poseintegrity.tracking.filter.tracker import MAX_ABS_TIME_S, check_timestamp
 

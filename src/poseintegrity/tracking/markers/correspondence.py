@@ -24,7 +24,7 @@ from scipy.optimize import linear_sum_assignment
 from poseintegrity.defaults import published
 from poseintegrity.errors import ArgumentError, check_array
 from poseintegrity.tracking.markers.kabsch import centre_into, fused_multiply_add, kabsch_into, residuals_into
-from poseintegrity.tracking.params import MatchingParams
+from poseintegrity.params.track import MatchingParams
 
 MAX_ABS_M = 1e6  # a measured or body point farther than 1000 km is not a marker
 

@@ -6,7 +6,7 @@ millimetres along each pixel's ray.  The constants of their public code (docs/re
 tracking"): IR clipped at 1000 and scaled to 8 bit, threshold 222, contour area 2-1000 px, circularity >= 0.6
 (area over the area of the minimum enclosing circle), convexity >= 0.75, depth window 100-900 mm.
 
-Two additions of ours, both switchable in :class:`~poseintegrity.tracking.params.DetectionParams`:
+Two additions of ours, both switchable in :class:`~poseintegrity.params.track.DetectionParams`:
 
 - ``shape_measure: pixel`` measures a blob by its pixels instead of by the polygon through its boundary
   pixel centres.  A blob of 8-20 px (an 11 mm sphere at 0.6-0.9 m, focal ~250 px) has a contour polygon
@@ -33,7 +33,7 @@ import numpy as np
 from poseintegrity.defaults import published
 from poseintegrity.errors import ArgumentError, PoseIntegrityError, check_intrinsics, check_pose
 from poseintegrity.tracking.markers.geometry import transform_points
-from poseintegrity.tracking.params import DetectionParams
+from poseintegrity.params.track import DetectionParams
 
 MIN_METRES_DEPTH_MM = 10.0  # a median depth below this is metres, not millimetres (AHAT depth is 100-1000 mm)
 MAX_UNIT_PLANE = 20.0  # |x|, |y| of a pixel ray on the unit plane: 20 is a field of view of 174 deg, beyond any depth camera

@@ -11,7 +11,8 @@ from collections.abc import Mapping
 import numpy as np
 
 from poseintegrity.errors import ArgumentError, PoseIntegrityError, check_array
-from poseintegrity.tracking.markers.geometry import pairwise_distances, tool_geometry_problem
+from poseintegrity.params.track import tool_geometry_problem
+from poseintegrity.tracking.markers.geometry import pairwise_distances
 
 
 class ToolError(PoseIntegrityError):
@@ -21,7 +22,7 @@ class ToolError(PoseIntegrityError):
 def check_distinct_distances(tools: dict[str, np.ndarray], distinct_m: float, source: str = "tools") -> None:
     """Raise :class:`ToolError` saying why the tools (name -> (m, 3) metres) cannot be told apart or posed:
     fewer than 3 markers, markers on one line, or two inter-marker distances (within a tool or across tools)
-    within distinct_m (m) of each other (:func:`~poseintegrity.tracking.markers.geometry.tool_geometry_problem`).
+    within distinct_m (m) of each other (:func:`~poseintegrity.params.track.tool_geometry_problem`).
     source (a file name, or "tools") begins the message."""
     problem = tool_geometry_problem(tools, distinct_m)
     if problem:

@@ -16,7 +16,7 @@ import numba
 import numpy as np
 from scipy.special import ndtri
 
-from poseintegrity.tracking.params import CameraParams, FrameParams
+from poseintegrity.params.track import CameraParams, FrameParams
 
 
 @dataclass(frozen=True)

@@ -19,7 +19,7 @@ import numba
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from poseintegrity.tracking.params import HandMotionParams, MotionParams
+from poseintegrity.params.track import HandMotionParams, MotionParams
 
 
 @dataclass(frozen=True)

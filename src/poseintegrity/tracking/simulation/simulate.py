@@ -12,7 +12,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 import pandas as pd
-from tqdm.auto import tqdm
+from tqdm import tqdm  # text bar: tqdm.auto warns "IProgress not found" in every kernel (no ipywidgets here)
 
 from poseintegrity.tracking.markers.correspondence import match_markers_unchecked
 from poseintegrity.tracking.markers.detection import detect_markers_each, raw_threshold
@@ -30,7 +30,7 @@ from poseintegrity.tracking.simulation.motion import (
     simulate_hand_motion,
     simulate_trajectory,
 )
-from poseintegrity.tracking.params import DetectionParams, FilterParams, TrackParams
+from poseintegrity.params.track import DetectionParams, FilterParams, TrackParams
 from poseintegrity.tracking.filter.srukf import SquareRootUKF
 from poseintegrity.tracking.filter.tracker import MarkerTracker
 from poseintegrity.tracking.filter.unscented import UnscentedMarkerFilter
@@ -137,7 +137,7 @@ def simulate(params: TrackParams, rng: np.random.Generator, markers_body: np.nda
 
 
 def simulate_hand(params: TrackParams, rng: np.random.Generator, markers_body: np.ndarray, duration_s: float, n_frames: int | None = None) -> Simulation:
-    """Motion (a), paper-like (:class:`~poseintegrity.tracking.params.HandMotionParams`): full turns about every
+    """Motion (a), paper-like (:class:`~poseintegrity.params.track.HandMotionParams`): full turns about every
     axis, large translations, brief per-marker occlusions in place of the i.i.d. P_o and the deliberate occlusion.
     n_frames : as in :func:`simulate`."""
     motion = params.motion.model_copy(update={"duration_s": duration_s, "p_occlusion": 0.0, "occlusions": []})

@@ -14,21 +14,20 @@ from pathlib import Path
 from typing import Annotated, Literal
 
 import cv2
-import numpy as np
 from pydantic import Field, ValidationError, ValidationInfo, field_validator, model_validator
 
-from poseintegrity.scenes.camera_params import (
+from poseintegrity.errors import ArgumentError
+from poseintegrity.mesh_file import check_mesh
+from poseintegrity.params.camera import (
     CalibrationParams, CameraParams, CaptureParams, GroundTruthBoardParams, PrintedBoardParams, SensorParams,
 )
-from poseintegrity.scenes.foam import VOXEL_MM, ReliefVolume, relief_volume
-from poseintegrity.scenes.mesh import Material, check_mesh
-from poseintegrity.scenes.robot_params import RobotParams
-from poseintegrity.errors import ArgumentError
+from poseintegrity.params.robot import RobotParams
 from poseintegrity.schema import FromList, KeyRule, ProjectPath, Section, Seed, distinct
 
 NAME_PATTERN = r"^[A-Za-z0-9][A-Za-z0-9_-]*$"  # scene names make folder names (no path, no hidden .partial folder)
 
 TARGET_NAMES = ("scapula", "scapula_drilled", "block_print", "block_mosaic")  # the targets scenes/catalog.py builds
+VOXEL_MM = 0.125  # the voxel of the foam's relief volume (scenes/foam.py): the smallest pore radius it resolves
 TEXTURE_NAMES = ("block_print", "block_mosaic", "table", "clutter_a", "clutter_b", "clutter_c", "clutter_print")
 
 
@@ -102,17 +101,6 @@ class BoneFoamParams(Section):
     albedo_mottle_mm: float = Field(gt=0, le=50, description="size of the mottles")
     specular: float = Field(ge=0, le=1, description="Blinn-Phong k_s: a mild lobe")
     shininess: float = Field(gt=0, le=1000, description="Blinn-Phong exponent")
-
-    def material(self) -> "Material":
-        return Material(specular=self.specular, shininess=self.shininess, foam_albedo=self.albedo)
-
-    def relief(self, seed: int, **grid) -> "ReliefVolume":
-        """The foam's height field, seeded by ``generate.seed`` (one material: the same for every object);
-        ``grid``: ``n`` / ``voxel_mm`` of :func:`~.foam.relief_volume` (tests shrink it)."""
-        return relief_volume(np.random.default_rng([seed, 7]), pore_radius_mm=self.pore_radius_mm,
-                             pore_fraction=self.pore_fraction, pore_depth=self.pore_depth,
-                             bump_slope=self.bump_slope, albedo_std=self.albedo_std,
-                             albedo_mottle_mm=self.albedo_mottle_mm, **grid)
 
 
 Distance = Annotated[float, Field(ge=100, le=2000)]  # camera to target centre, mm
@@ -325,6 +313,6 @@ class GenerateParams(Section):
         return {name: self.world(name) for name in WORLDS if name == "main" or self.validation is not None}
 
     def dataset_ids(self) -> list[str]:
-        """Every dataset, in the order of :func:`~.dataset.plan_datasets`: each scene's arcs, then the lines."""
+        """Every dataset, in the order of scenes/dataset.py plan_datasets: each scene's arcs, then the lines."""
         return ([i for spec in self.scenes for i in self.arcs.dataset_ids(spec.name)]
                 + ([] if self.lines is None else self.lines.dataset_ids()))

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from pydantic import Field, ValidationInfo, model_validator
 
-from poseintegrity.localization.ransac import minimal_sample_size, ransac_iterations
+from poseintegrity.ransac import minimal_sample_size, ransac_iterations
 from poseintegrity.protocol import PnPMethod
 from poseintegrity.schema import KeyRule, Section, Seed, distinct
 

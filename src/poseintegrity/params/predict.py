@@ -1,6 +1,6 @@
 """Schema of the ``predict`` section of ``params.yaml`` (stage 04, localization-envelope predictors).
 
-The artifact models themselves are configured by the ``fit`` section (:class:`poseintegrity.artifact_models.FitParams`:
+The artifact models themselves are configured by the ``fit`` section (:class:`poseintegrity.params.fit.FitParams`:
 least squares budget, MLP recipe); the range ends, the stops sampled before predicting and the tolerances by
 ``protocol``; the workers by ``parallel``. This section says how the predictors of Windsor et al. III-E use the
 models and how the operating points are swept (IV-A, V). Every value is explicit in ``params.yaml`` (no default
@@ -14,9 +14,9 @@ from typing import Annotated, Literal
 import numpy as np
 from pydantic import Field, ValidationInfo, model_validator
 
-from poseintegrity.artifact_models.base_functions import LEAST_SQUARES
-from poseintegrity.artifact_models.names import distinct_theta_needed
-from poseintegrity.artifact_models.params import ModelName
+from poseintegrity.params.fit import ModelName
+from poseintegrity.params.model_names import LEAST_SQUARES_PARAMETERS as LEAST_SQUARES
+from poseintegrity.params.model_names import distinct_theta_needed
 from poseintegrity.schema import KeyRule, Seed, Section, distinct
 
 IntervalMethod = Literal["covariance", "bootstrap"]
@@ -25,7 +25,7 @@ GRID = 100_000  # upper bound of every sweep or scan size: a typo, not a grid, b
 
 
 class PredictorModels(Section):
-    """Artifact model behind each predictor (a name of :data:`poseintegrity.artifact_models.MODEL_NAMES`)."""
+    """Artifact model behind each predictor (a name of :data:`poseintegrity.params.model_names.MODEL_NAMES`)."""
 
     long_range: ModelName = Field(description="long range predictor (paper: eq. 1, the EMG)")
     next_step: ModelName = Field(description="next-step predictor (paper: the EMG)")
@@ -56,9 +56,9 @@ class ErrorPredictorParams(Section):
     k_min: float = Field(gt=0, le=1e3, description="smallest safety factor of the sweep")
     k_max: float = Field(gt=0, le=1e3, description="largest safety factor of the sweep")
     n_k: int = Field(ge=2, le=GRID, description="safety factors swept, k_min .. k_max in geometric steps")
-    live_k: Annotated[float, Field(gt=0, le=1e3)] | None = Field(description="fixed k of the simulated live trials of error_next_step (as live_n_t "
-                                             "of the paper's); null: the k of the main world's Table III at "
-                                             "live_tolerance")
+    live_k: Annotated[float, Field(gt=0, le=1e3)] | None = Field(
+        description="fixed k of the simulated live trials of error_next_step (as live_n_t of the paper's); null: the "
+                    "k of the main world's Table III at live_tolerance")
 
     @model_validator(mode="after")
     def _check(self) -> ErrorPredictorParams:

@@ -1,6 +1,7 @@
 """Schema of ``generate.robot`` (stage 01): the UR5e carrying the camera, how its poses err, where it stands and how
-it rings down after a stop (:mod:`.robot`, :mod:`.kinematics`, :mod:`.ringdown`). Every number bounded with its
-reason; a robot whose expected error reaches the stops' spacing is refused by the ``generate`` section."""
+it rings down after a stop (:mod:`poseintegrity.scenes.robot`, :mod:`poseintegrity.kinematics`,
+:mod:`poseintegrity.scenes.ringdown`). Every number bounded with its reason; a robot whose expected error reaches
+the stops' spacing is refused by the ``generate`` section."""
 
 from __future__ import annotations
 
@@ -9,12 +10,12 @@ from typing import Annotated
 
 from pydantic import Field, field_validator
 
-from poseintegrity.scenes.kinematics import UR5E
+from poseintegrity.kinematics import UR5E
 from poseintegrity.schema import FromList, Section, distinct
 
 
 class DHErrorParams(Section):
-    """How far the physical arm's DH parameters are from the published ones (:mod:`.robot`): each joint's
+    """How far the physical arm's DH parameters are from the published ones (scenes/robot.py): each joint's
     deviation is drawn once per world from N(0, std). A factory-calibrated UR-class arm that its user has not
     calibrated again reaches a commanded pose to about a millimetre (docs/references.md "Robot")."""
 
@@ -29,7 +30,7 @@ Turn = Annotated[float, Field(ge=-360, le=360)]  # deg: a component beyond a ful
 
 
 class MountParams(Section):
-    """The adapter holding the camera on the tool flange: T_flange_cam (:mod:`.robot`)."""
+    """The adapter holding the camera on the tool flange: T_flange_cam (scenes/robot.py)."""
 
     translation_mm: Annotated[tuple[Annotated[float, Field(ge=-300, le=300)], Annotated[float, Field(ge=-300, le=300)],
                                     Annotated[float, Field(ge=-300, le=300)]], FromList] = Field(
@@ -55,7 +56,7 @@ class HandEyeErrorParams(Section):
 
 
 class PlacementParams(Section):
-    """Where the robot's base stands on a scene's table (:meth:`.robot.Robot.placed`): the first candidate whose
+    """Where the robot's base stands on a scene's table (scenes/robot.py Robot.placed): the first candidate whose
     IK reaches every pose of the scene within the margins."""
 
     base_azimuths_deg: distinct(Annotated[float, Field(ge=-180, le=180)]) = Field(
@@ -70,7 +71,7 @@ class PlacementParams(Section):
 
 
 class RingDownParams(Section):
-    """The camera's vibration after a stop (:mod:`.ringdown`): one damped mode of the arm."""
+    """The camera's vibration after a stop (scenes/ringdown.py): one damped mode of the arm."""
 
     natural_frequency_hz: float = Field(ge=1, le=200, description="lowest mode of a lightweight arm: a few to tens "
                                                                   "of Hz")
@@ -80,7 +81,7 @@ class RingDownParams(Section):
 
 
 class RobotParams(Section):
-    """A UR5e carrying the eye-in-hand camera, and how its poses err (:mod:`.robot`, :mod:`.ringdown`):
+    """A UR5e carrying the eye-in-hand camera, and how its poses err (scenes/robot.py, scenes/ringdown.py):
     shared by both worlds, each of which draws its own arm, calibration and placement from its seed."""
 
     dh_errors: DHErrorParams

@@ -1,6 +1,6 @@
 """Schema of the camera side of the ``generate`` section (stage 01): the camera and its lens, the sensor, how a
-stop's images are captured, the calibration session and the printed boards (:mod:`.camera`, :mod:`.optics`,
-:mod:`.calibration_views`, :mod:`poseintegrity.lens`). Every number bounded, its key named when refused."""
+stop's images are captured, the calibration session and the printed boards (scenes/camera.py, scenes/optics.py,
+scenes/calibration_views.py, :mod:`poseintegrity.lens`). Every number bounded, its key named when refused."""
 
 from __future__ import annotations
 
@@ -184,7 +184,7 @@ class GroundTruthBoardParams(Section):
 
 
 class CalibrationParams(Section):
-    """The camera's calibration session before any data (:mod:`.calibration_views`): the board shown in ``n_views``
+    """The camera's calibration session before any data (scenes/calibration_views.py): the board shown in ``n_views``
     poses; the estimate is what the pipeline uses as the camera."""
 
     board: CharucoParams
@@ -209,7 +209,7 @@ class CalibrationParams(Section):
 
 class CaptureParams(Section):
     """How the images of a stop are taken once the robot reports it has stopped (IV-D: "stopping every 2.25 deg to
-    capture 10 images"): a burst of exposures while the arm rings down (:mod:`.ringdown`). Ours: the paper gives no
+    capture 10 images"): a burst of exposures while the arm rings down (scenes/ringdown.py). Ours: the paper gives no
     timing."""
 
     delay_ms: float = Field(ge=0, le=5000, description="from the reported stop to the first exposure's start")

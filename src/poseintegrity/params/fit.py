@@ -11,7 +11,7 @@ from typing import Literal
 
 from pydantic import Field, ValidationInfo, model_validator
 
-from poseintegrity.artifact_models.names import distinct_theta_needed
+from poseintegrity.params.model_names import distinct_theta_needed
 from poseintegrity.schema import KeyRule, Seed, Section, distinct
 
 ModelName = Literal[
@@ -45,7 +45,7 @@ class FitParams(Section):
 
     models: distinct(ModelName) = Field(min_length=1, description="artifact models compared in Fig. 2")
     k_min: int = Field(ge=2, le=100, description="fewest stops (from the start) used for a fit; a model needing more"
-                                                 " (names.distinct_theta_needed) joins Fig. 2 at its own count")
+                                                 " (model_names.distinct_theta_needed) joins Fig. 2 at its own count")
     k_max: int | None = Field(ge=2, le=100, description="most stops used for a fit; null = all stops")
     max_nfev: int = Field(ge=10, le=ITERATIONS, description="least squares evaluation budget per base-function fit")
     seed: Seed = Field(description="seed of every random draw of the stage (MLP initial weights)")

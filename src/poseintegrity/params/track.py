@@ -10,19 +10,47 @@ keys raises :class:`~poseintegrity.schema.KeyRule` naming the key to change.
 from __future__ import annotations
 
 import math
+from itertools import combinations
 from typing import Annotated, Literal
 
 import numpy as np
 from pydantic import AfterValidator, Field, model_validator
 
 from poseintegrity.schema import FromList, KeyRule, Section, Seed, ordered_range
-from poseintegrity.tracking.markers.geometry import tool_geometry_problem
 
 
 def _non_empty(values: list) -> list:
     if not values:
         raise ValueError("needs at least one value")
     return values
+
+
+def tool_geometry_problem(tools: dict[str, np.ndarray], distinct_m: float) -> str:
+    """Why these marker bodies cannot be told apart or posed, or "" if they can.
+
+    tools : name -> (m, 3) marker centres, metres (the first tool is ``markers_body``, the
+    geometry of docs/references.md).  Each tool needs at least 3 markers that do not lie on one line (a line
+    of markers leaves the rotation about it open: Alg. 4 needs 3 non-collinear points), i.e. whose centred
+    points spread more than distinct_m off their best line; and every inter-marker distance, within a tool
+    and across tools, must differ from every other by more than distinct_m (m): Alg. 2 votes by distance, so
+    a shared distance lets one pair vote for another's.
+    """
+    pairs = []
+    for name, markers in tools.items():
+        markers = np.asarray(markers, dtype=float).reshape(-1, 3)
+        if len(markers) < 3:
+            return f"tool {name!r} has {len(markers)} markers; at least 3 are needed for a pose"
+        spread = np.linalg.svd(markers - markers.mean(axis=0), compute_uv=False)
+        if spread[1] <= distinct_m:
+            return f"the markers of tool {name!r} lie on one line (within {distinct_m * 1000:g} mm): the rotation about it is undetermined"
+        D = np.linalg.norm(markers[:, None] - markers[None], axis=-1)
+        pairs += [(D[i, j], f"{name} markers {i + 1}-{j + 1}") for i, j in combinations(range(len(markers)), 2)]
+    pairs.sort()
+    for (d1, a), (d2, b) in zip(pairs, pairs[1:]):
+        if d2 - d1 <= distinct_m:
+            return (f"inter-marker distances are not distinct: {a} = {d1 * 1000:.2f} mm and {b} = {d2 * 1000:.2f} mm "
+                    f"differ by <= {distinct_m * 1000:g} mm (correspondence by distance voting cannot tell them apart)")
+    return ""
 
 
 # Bounds shared by several keys. Each refuses what no setting can mean (a typo such as 1e9), not what is unusual.

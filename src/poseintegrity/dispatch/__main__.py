@@ -1,0 +1,16 @@
+"""``python -m poseintegrity.dispatch``: this machine's pinned environment as shell ``export`` lines, for a process
+that does not start by importing poseintegrity (README, "Running on a Dask cluster")."""
+
+import sys
+
+from poseintegrity.dispatch import cpu_flags, pinned_environment
+
+
+def main() -> int:
+    for name, value in sorted(pinned_environment(cpu_flags()).items()):
+        print(f"export {name}='{value}'")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
