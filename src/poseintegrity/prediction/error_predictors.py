@@ -35,7 +35,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import nnls
 
-from poseintegrity.artifact_models import FitParams, FittedModel
+from poseintegrity.artifact_models import FittedModel
+from poseintegrity.params.fit import FitParams
 from poseintegrity.errors import ArgumentError, check_array
 from poseintegrity.artifact_models.fitted import FALLBACK
 from poseintegrity.artifact_models.series import Series
