@@ -127,6 +127,7 @@ def test_a_matrix_product_moves_with_openblas_kernels_unpinned_and_not_pinned():
     assert _hash(DGEMM_HASH, pinned | {"OPENBLAS_CORETYPE": "Sandybridge"}) == haswell
 
 
+@pytest.mark.pipeline  # a notebook's kernel
 def test_a_jupyter_kernel_of_the_venv_is_pinned_before_its_first_cell(tmp_path):
     """make install: the venv's kernels import poseintegrity first (IPython's exec_lines), so that a notebook opened in
     JupyterLab whose first cell imports numpy runs the pinned kernels too."""

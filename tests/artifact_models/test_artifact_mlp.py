@@ -4,8 +4,6 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-import torch
-from torch import nn
 
 from poseintegrity.artifact_models import EMG, emg, fit_mlp
 from poseintegrity.artifact_models.fitted import FALLBACK, NEGATIVE_COUNT, NON_PHYSICAL, OK
@@ -26,7 +24,11 @@ def fit(tiny_fit, protocol):
 
 
 def torch_network(generator: torch.Generator) -> nn.Sequential:
-    """Reference: the 3 x 10 tanh net of IV-E as torch layers, initialised by nn.init.uniform_ from ``generator``."""
+    """Reference: the 3 x 10 tanh net of IV-E as torch layers, initialised by nn.init.uniform_ from ``generator``.
+    torch is imported where a test uses it, not when the tests are collected (1.2 s of every worker's start)."""
+    import torch
+    from torch import nn
+
     net = nn.Sequential(*[m for i, o in ((1, 10), (10, 10), (10, 10)) for m in (nn.Linear(i, o), nn.Tanh())],
                         nn.Linear(10, 1)).double()  # fmt: skip
     with torch.no_grad():
@@ -39,6 +41,9 @@ def torch_network(generator: torch.Generator) -> nn.Sequential:
 
 
 def test_network_is_three_hidden_layers_of_ten_tanh_neurons_initialised_like_torch_linear_layers():
+    import torch
+    from torch import nn
+
     net = torch_network(torch.Generator().manual_seed(7))
     weights = initial_weights(3, 10, 7)
     assert weights.shape == (n_parameters(3, 10),) == (sum(p.numel() for p in net.parameters()),) == (251,)
@@ -54,6 +59,8 @@ def test_same_seed_same_model_other_seed_other_model(fit, pretrain):
 
 
 def test_global_torch_rng_is_untouched(fit):
+    import torch
+
     state = torch.random.get_rng_state()
     fit()
     assert torch.equal(state, torch.random.get_rng_state())

@@ -4,8 +4,6 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-import torch
-from torch import nn
 
 from artifact_models.test_artifact_mlp import torch_network
 from poseintegrity.artifact_models.lbfgs import HISTORY_SIZE, TOLERANCE_GRAD, cubic_interpolate, minimize_mse
@@ -18,6 +16,9 @@ U_STOPS, INDEX = np.unique(U, return_inverse=True)  # the numba net runs once pe
 
 def torch_reference(seed: int, max_iter: int, y: np.ndarray = Y) -> tuple[np.ndarray, np.ndarray, int]:
     """(initial, trained parameters, closure calls) of torch.optim.LBFGS on the MSE of the torch net at (U, y)."""
+    import torch  # here, not at collection (test_artifact_mlp.torch_network)
+    from torch import nn
+
     net = torch_network(torch.Generator().manual_seed(seed))
     x0 = nn.utils.parameters_to_vector(net.parameters()).detach().numpy().copy()
     u, y = torch.as_tensor(U).reshape(-1, 1), torch.as_tensor(y).reshape(-1, 1)
@@ -40,6 +41,9 @@ def torch_reference(seed: int, max_iter: int, y: np.ndarray = Y) -> tuple[np.nda
 
 @pytest.mark.parametrize("seed", [0, 1, 2])
 def test_forward_loss_and_gradient_equal_torch_autograd(seed):
+    import torch
+    from torch import nn
+
     net = torch_network(torch.Generator().manual_seed(seed))
     x = nn.utils.parameters_to_vector(net.parameters()).detach().numpy().copy()
     u, y = torch.as_tensor(U).reshape(-1, 1), torch.as_tensor(Y).reshape(-1, 1)
