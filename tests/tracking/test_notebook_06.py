@@ -25,7 +25,7 @@ def test_stage_06_writes_tracking_metrics_and_figures(run_once):
     assert json.loads((reports / "metrics" / "timing" / "06_marker_tracking.json").read_text())["wall_time_s"] > 0
 
 
-@pytest.mark.notebook
+@pytest.mark.pipeline
 def test_stage_06_run_in_jupyterlab_rewrites_the_outputs_dvc_repro_wrote(run_once, tmp_path):
     """README, "Reading the results": only the timings and the replayed recording's run id differ from the run of
     `dvc repro`, so `dvc status` lists those two outputs of stage 06 as modified, and nothing is written elsewhere."""
