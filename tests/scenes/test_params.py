@@ -43,6 +43,9 @@ BAD_VALUES = [
     ("board.squares_x", None, "board.squares_x"),  # a ChArUco board without its size
     ("board.squares_x", 30, "board.dictionary"),  # 60 markers on 30 x 4 squares, DICT_4X4_50 has 50
     ("board.placement", "hanging", "board.placement"),
+    ("board.placement", "planned", "board.sizes_mm"),  # a plan without the sizes it chooses from
+    ("board.sizes_mm", [15.0, 18.0], "board.sizes_mm"),  # a key of the plan on a board placed by the old rule
+    ("board.max_boards", 3, "board.max_boards"),
     ("printed_boards.caliper_std_mm", -0.1, "printed_boards.caliper_std_mm"),
     ("capture.model_settle_ms", -5.0, "capture.model_settle_ms"),
     ("calibration.distance_mm", [450.0, 250.0], "calibration.distance_mm"),
@@ -85,10 +88,11 @@ def test_bad_value_names_its_key(tiny_raw, key, value, expected):
 def test_every_key_is_set_by_params_yaml():
     """No field has a default that could disagree with params.yaml: leaving any key out is refused (the optional
     keys are required exactly where they mean something: glenoid_tilt_deg with a scapula, a board's sizes with its
-    type, and refused elsewhere)."""
+    type, the plan's keys with placement planned, and refused elsewhere)."""
     optional = {("SceneSpec", "glenoid_tilt_deg")} | {
         ("GroundTruthBoardParams", key) for key in ("markers_x", "markers_y", "marker_length_mm", "separation_mm",
-                                                    "squares_x", "squares_y", "square_mm", "marker_mm")}
+                                                    "squares_x", "squares_y", "square_mm", "marker_mm", "sizes_mm",
+                                                    "max_boards", "plan_sigma_t_mm")}
 
     def defaults(model):
         for name, field in model.model_fields.items():
