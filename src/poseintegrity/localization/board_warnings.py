@@ -31,9 +31,9 @@ def board_warnings(table: pd.DataFrame, params: GroundTruthParams,
     ``params``: ``extract.ground_truth``; ``tolerances``: ``protocol.tolerances`` (E_t mm, E_r deg).
 
     Each warning: ``dataset``, ``world``, ``trusted_share``, ``sigma_t_mm`` (the median predicted RMS error at the
-    board origin over the frames with a fitted pose; NaN when none), ``max_sigma_t_mm``, ``tightest_tolerance_mm``
-    (the tightest E_t tolerance this board can judge, NaN without a fit) and ``message``, the paragraph stage 02
-    prints."""
+    board origin over the frames it does not judge whose pose was fitted; NaN when none), ``max_sigma_t_mm``,
+    ``tightest_tolerance_mm`` (the tightest E_t tolerance at which the board would judge half of those, NaN without
+    a fit) and ``message``, the paragraph stage 02 prints."""
     frames = table.drop_duplicates(FRAME_KEYS)
     frames = frames[frames["board_status"] != "no_board"]
     tightest, tightest_deg = min(float(t) for t, _ in tolerances), min(float(r) for _, r in tolerances)
@@ -42,7 +42,7 @@ def board_warnings(table: pd.DataFrame, params: GroundTruthParams,
         trusted = float((rows["board_status"] == "ok").mean())
         if trusted >= WARN_BELOW:
             continue
-        fitted = rows[np.isfinite(rows["board_sigma_t_mm"].astype(float))]
+        fitted = rows[(rows["board_status"] != "ok") & np.isfinite(rows["board_sigma_t_mm"].astype(float))]
         sigma_t = float(fitted["board_sigma_t_mm"].median()) if len(fitted) else math.nan
         sigma_r = float(fitted["board_sigma_r_deg"].median()) if len(fitted) else math.nan
         judges = sigma_t / params.max_sigma_t_mm * tightest
@@ -76,8 +76,8 @@ def _message(dataset: str, world: str, rows: pd.DataFrame, trusted: float, sigma
                 f"uncovered at every stop, with larger markers.")
     rotation = f" and max_sigma_r_deg to {sigma_r:.2f}" if sigma_r > params.max_sigma_r_deg else ""
     degrees = sigma_r / params.max_sigma_r_deg * tightest_deg
-    return (f"{head} Its poses are predicted to {sigma_t:.2f} mm / {sigma_r:.2f} deg at the board origin (median), "
-            f"above {limit}. The tightest tolerance this board can judge is about {judges:.1f} mm / "
+    return (f"{head} Its poses there are predicted to {sigma_t:.2f} mm / {sigma_r:.2f} deg at the board origin "
+            f"(median), above {limit}. The tightest tolerance this board can judge is about {judges:.1f} mm / "
             f"{max(degrees, tightest_deg):.1f} deg. To judge "
             f"{tightest:g} mm: a larger board, nearer the camera, with more markers or corners (a ChArUco board: its "
             f"corners are located more precisely), turned away from facing the camera by 20-40 deg; or, for a looser "
