@@ -4,6 +4,7 @@ import pytest
 
 from params_cases import refusal
 from poseintegrity.scenes import dataset
+from poseintegrity.scenes.optics import defocus_sigma_px
 from poseintegrity.scenes.params import GenerateParams
 
 NO_LIGHT = {"ambient": 0.0, "ring": 0.0, "room": 0.0, "background": 0.5}
@@ -58,7 +59,7 @@ BAD_VALUES = [
     ("printed_boards.scale_std", 0.05, "printed_boards.scale_std"),  # 5 %: seen with a ruler
     ("capture.exposure_ms", 50.0, "capture.exposure_ms"),  # longer than the 33.3 ms frame period
     ("validation.scenes.0.name", "scene_a", "validation.scenes"),  # names the main world's datasets
-    ("validation.lines", {"scene": "scene_a", "distance_mm": 240, "offsets_deg": [0], "n_stops": 6},
+    ("validation.lines", {"scene": "scene_a", "distance_mm": 240, "offsets_deg": [0], "n_stops": 6, "focus": "range"},
      "validation.lines.scene"),  # a scene of the other world
     ("validation.images_per_stop", 0, "validation.images_per_stop"),
     ("validation.seed", -1, "validation.seed"),
@@ -109,3 +110,20 @@ def test_dataset_ids_are_the_plan_and_distinct(tiny_params):
     assert ids == [plan.dataset for plan in dataset.plan_datasets(tiny_params.generate)]
     assert len(set(ids)) == len(ids)
 
+
+
+@pytest.mark.parametrize("distance_mm", [220.0, 300.0])
+def test_lines_focused_for_their_range_blur_both_ends_alike(tiny_params, distance_mm):
+    """``lines.focus: range`` puts the focus where the thin lens blurs the lines' near end (the model view) and far
+    end (the 0-deg line's last stop) alike, between the two and nearer the near end (the circle of confusion grows as
+    |d - d_f| / d); ``model_view`` keeps the near end sharp and blurs the far end twice as much."""
+    generate, length = tiny_params.generate, tiny_params.protocol.line_length_mm
+    lines = generate.lines.model_copy(update={"distance_mm": distance_mm, "focus": "range"})
+    near, far = distance_mm, distance_mm + length * (lines.n_stops - 1) / lines.n_stops
+    focus = lines.focus_mm(length)
+    assert near < focus < (near + far) / 2
+    blur = [float(defocus_sigma_px(d, focus, generate.camera)) for d in (near, far)]
+    assert blur[0] == pytest.approx(blur[1], rel=1e-9) and blur[0] > 0
+    at_model = lines.model_copy(update={"focus": "model_view"})
+    assert at_model.focus_mm(length) == near
+    assert float(defocus_sigma_px(far, near, generate.camera)) == pytest.approx(2 * blur[1], rel=0.05)

@@ -12,7 +12,7 @@ their far stop):
    image (its outline, sampled at most OUTLINE_STEP_PX apart, on the other's silhouette hull grown by CLEARANCE_PX,
    or a hull vertex inside it), the nearer of the two covers the other; and the board **never covers a target** or
    another board, at any pose of the session, served or not (a candidate that would is dropped);
-3. **it is in focus**: the lens is focused at the model view and not refocused (:mod:`.optics`), so the blur of the
+3. **it is in focus**: the lens is focused once per session (:mod:`.optics`), so the blur of the
    board's nearest or farthest corner, hypot(the lens' own blur, the defocus), must stay within FOCUS_BLUR_PER_CELL of
    a marker's bit cell where the pattern is smallest in the image (far, foreshortened), and a bit cell must span at
    least MIN_CELL_PX, or its markers are not read (the lines' far stops of issue 30);

@@ -49,7 +49,8 @@ class CameraParams(Section):
     downscale: int = Field(ge=1, le=MAX_SENSOR_PX // MIN_IMAGE_PX,
                            description="images are rendered at sensor size / downscale (the shorter side >= "
                                        "MIN_IMAGE_PX, checked below)")
-    f_number: float = Field(ge=0.5, le=64, description="aperture; sets the depth of field (focus at the model view)")
+    f_number: float = Field(ge=0.5, le=64, description="aperture; sets the depth of field (focus at the model view; "
+                                                       "the lines' session: lines.focus)")
     principal_point_offset_px: Annotated[tuple[Annotated[float, Field(ge=-100, le=100)],
                                                Annotated[float, Field(ge=-100, le=100)]], FromList] = (
         Field(description="where the optical axis meets the sensor, from its centre, full-resolution px (a lens is "

@@ -267,10 +267,10 @@ def _standing_boards(params: "GenerateParams", protocol: "ProtocolParams", spec:
     cam = Intrinsics.from_params(params.camera)
     if session == "line":
         lines = params.lines
-        focus = lines.distance_mm
-        pair, trajectories = board_placement.line_trajectories(aim, view_dir, focus, params.model_baseline_mm,
-                                                               lines.offsets_deg, protocol.line_length_mm,
-                                                               lines.n_stops)
+        focus = lines.focus_mm(protocol.line_length_mm)
+        pair, trajectories = board_placement.line_trajectories(aim, view_dir, lines.distance_mm,
+                                                               params.model_baseline_mm, lines.offsets_deg,
+                                                               protocol.line_length_mm, lines.n_stops)
     else:
         focus = spec.distance_mm
         pair, trajectories = board_placement.arc_trajectories(aim, view_dir, focus, params.model_baseline_mm,

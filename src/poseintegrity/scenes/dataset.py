@@ -95,9 +95,11 @@ def plan_datasets(params: GenerateParams, world: str = "main") -> list[DatasetPl
 @dataclass(frozen=True)
 class Trip:
     """Where the camera of one dataset is commanded to go: its model pair (T_world_cam, the first is where the
-    trajectory starts) at ``distance_mm`` from the aim point, and the stops of its trajectory."""
+    trajectory starts) at ``distance_mm`` from the aim point, and the stops of its trajectory; the lens is focused at
+    ``focus_mm`` for the whole session (arcs: the model view; lines: ``generate.lines.focus``)."""
 
     distance_mm: float
+    focus_mm: float
     model_views: list[np.ndarray]
     stops: list[trajectories.Stop]
 
@@ -113,7 +115,8 @@ def plan_trip(params: GenerateParams, protocol: ProtocolParams, plan: DatasetPla
     else:
         stops = trajectories.line(model_views[0], scene.aim, plan.offset_deg, protocol.line_length_mm,
                                   params.lines.n_stops)
-    return Trip(distance_mm, model_views, stops)
+    focus_mm = distance_mm if plan.trajectory == "arc" else params.lines.focus_mm(protocol.line_length_mm)
+    return Trip(distance_mm, focus_mm, model_views, stops)
 
 
 class WorldError(PoseIntegrityError):
@@ -293,14 +296,14 @@ def plan_shots(params: GenerateParams, plans: list[DatasetPlan], trips: list[Tri
                     for e in shot.exposures))
                 continue
             motion = model_motion(visit, params.capture, f_px)
-            shots[key] = Shot(plan.scene_index, plan.trajectory, visit.T_world_cam, trip.distance_mm, (Exposure(
+            shots[key] = Shot(plan.scene_index, plan.trajectory, visit.T_world_cam, trip.focus_mm, (Exposure(
                 (plan.dataset,), f"model/model_{k}.png", ("model", plan.scene_index, plan.trajectory, k),
                 motion.path, f"model/mask_{k}.png"),), boards[plan.scene_index, plan.trajectory])
         for s, visit in enumerate(route.stops):
             exposures = tuple(Exposure((plan.dataset,), file, (plan.dataset, s, i),
                                        image_motion(visit, params.capture, i, f_px).path)
                               for i, file in enumerate(_image_files(s, params.images_per_stop)))
-            shots[(plan.dataset, s)] = Shot(plan.scene_index, plan.trajectory, visit.T_world_cam, trip.distance_mm,
+            shots[(plan.dataset, s)] = Shot(plan.scene_index, plan.trajectory, visit.T_world_cam, trip.focus_mm,
                                             exposures, boards[plan.scene_index, plan.trajectory])
     # stable: the datasets' order within a session; a worker then builds each session's scene once
     return sorted(shots.values(), key=lambda shot: (shot.scene_index, shot.session))
