@@ -1,9 +1,9 @@
-"""Which ground-truth board, and where (issue 30): the board's own error as it enters E_t and E_r (R11), measured
-on the main world rendered with each option, before one is chosen for params.yaml.
+"""Which ground-truth board, and where (issues 30 and 39): the board's own error as it enters E_t and E_r (R11), and
+the share of frames it can judge, measured on a world rendered with each option, before one is chosen for params.yaml.
 
 For each option (``OPTIONS``: a ``generate.board``, whether the lab measures its printed boards, how flat they are, how
-it calibrates), stage 01's
-world is rendered with one image per stop (every arc and line, the validation world left out), and every frame's
+it calibrates), one world of stage 01 (``--world``: the main one by default, or the validation world, or the world of
+another params file) is rendered with one image per stop (every arc and line), and every frame's
 board pose is found and checked as stage 02 does (:func:`poseintegrity.localization.ground_truth.board_pose`, with
 the world's calibrated camera). Reported per option: the share of frames whose board pose is trusted (status "ok"),
 and over them the median and 99th percentile of what the ground truth adds to E_t (mm) and E_r (deg)
@@ -11,9 +11,11 @@ and over them the median and 99th percentile of what the ground truth adds to E_
 beside the absolute error of model image 0's board pose (the model placement). The R11 bar: p99 <= 0.5 mm and
 0.5 deg. With ``--true-camera`` the renderer's camera replaces the calibration (what the calibration adds).
 
-    .venv/bin/python studies/board_options.py [--options charuco_15 charuco_12 ...] [--out /tmp/board_options]
+    .venv/bin/python studies/board_options.py [--options planned charuco_7x5 ...] [--world validation]
+        [--params held_out.yaml] [--per-dataset] [--out /tmp/board_options]
 
-Prints one table; writes ``<out>/<option>/frames.parquet`` (one row per frame).
+Prints one table (and with ``--per-dataset`` each dataset's board, trusted share and fewest corners); writes
+``<out>/<option>/<world>/frames.parquet`` (one row per frame).
 """
 
 from __future__ import annotations
@@ -38,6 +40,9 @@ from poseintegrity.poses import pose_errors
 from poseintegrity.scenes.dataset import generate
 
 CHARUCO = dict(type="charuco", dictionary="DICT_4X4_50", margin_mm=6.0, px_per_mm=8.0, placement="facing_camera")
+SIZES = [12.0, 15.0, 18.0, 21.0, 24.0]
+PLANNED = CHARUCO | dict(squares_x=7, squares_y=5, square_mm=15.0, marker_mm=11.0, placement="planned",
+                         plan_sigma_t_mm=0.15)  # issue 39: scenes/board_plan.py
 ARUCO = dict(type="aruco_grid", dictionary="DICT_4X4_50", px_per_mm=8.0)
 LAB = dict(printed_boards=dict(caliper_std_mm=0.02, board_sag_std_mm=0.03, calibration_sag_std_mm=0.03),
            calibration=dict(n_views=60, max_tilt_deg=50.0))  # boards on glass, measured; a careful calibration
@@ -52,18 +57,22 @@ OPTIONS = {  # name: (generate.board, overrides of generate's sections)
                                       placement="facing_camera"), LAB),
     "charuco_7x5_card": (CHARUCO | dict(squares_x=7, squares_y=5, square_mm=15.0, marker_mm=11.0), CARD),
     "charuco_5x4": (CHARUCO | dict(squares_x=5, squares_y=4, square_mm=15.0, marker_mm=11.0), LAB),
-    "charuco_7x5": (CHARUCO | dict(squares_x=7, squares_y=5, square_mm=15.0, marker_mm=11.0), LAB),
+    "charuco_7x5": (CHARUCO | dict(squares_x=7, squares_y=5, square_mm=15.0, marker_mm=11.0), LAB),  # issue 30
+    "planned_15_one": (PLANNED | dict(sizes_mm=[15.0], max_boards=1), LAB),  # the rule's placement, one size
+    "planned_one": (PLANNED | dict(sizes_mm=SIZES, max_boards=1), LAB),  # and sized per scene
+    "planned": (PLANNED | dict(sizes_mm=SIZES, max_boards=2), LAB),  # and a second board where one cannot serve
 }
 
 
-def render(option: str, params_path: Path, out: Path) -> Path:
-    """Stage 01's main world with ``option``'s board, one image per stop, under ``out / option``."""
+def render(option: str, params_path: Path, out: Path, world: str) -> Path:
+    """Stage 01's world ``world`` with ``option``'s board, one image per stop, under ``out / option / world``."""
     board, overrides = OPTIONS[option]
     params = load_params(params_path)
-    sections = {name: getattr(params.generate, name).model_copy(update=values) for name, values in overrides.items()}
-    generate_params = params.generate.model_copy(update=sections | {
-        "board": type(params.generate.board).model_validate(board), "images_per_stop": 1, "validation": None})
-    data = out / option
+    world_params = params.generate.world(world)
+    sections = {name: getattr(world_params, name).model_copy(update=values) for name, values in overrides.items()}
+    generate_params = world_params.model_copy(update=sections | {
+        "board": type(params.generate.board).model_validate(board), "images_per_stop": 1})
+    data = out / option / world
     if not (data / "datasets" / "index.parquet").exists():
         with Workers(params.parallel) as workers:
             generate(generate_params, params.protocol, data / "datasets", workers, calibration_dir=data / "calibration")
@@ -92,6 +101,8 @@ def measure(data: Path, params_path: Path, true_camera: bool) -> pd.DataFrame:
             E_t_abs, E_r_abs = pose_errors(found.T_cam_board, exact)
             E_t, E_r = truth_error(found.T_cam_board, exact, anchor.T_cam_board, exact_0)
             rows.append(dict(dataset=dataset.name, trajectory=dataset.meta["trajectory"], stop=frame.stop,
+                             board_first_id=dataset.meta["board"].get("first_id", 0),
+                             square_mm=dataset.meta["board"].get("square_mm", np.nan),
                              status=found.status, reason=found.reason, n_points=found.n_points,
                              n_dropped=found.n_dropped, rms_px=found.rms_px, sigma_t_mm=found.sigma_t_mm,
                              sigma_r_deg=found.sigma_r_deg, E_t_abs_mm=float(E_t_abs), E_r_abs_deg=float(E_r_abs),
@@ -116,17 +127,29 @@ def summary(frames: pd.DataFrame) -> dict[str, float]:
             "dropped_share": float((frames["n_dropped"] > 0).mean())}
 
 
+def per_dataset(frames: pd.DataFrame) -> pd.DataFrame:
+    """Per dataset: its board (square size, first marker id), the share of its frames trusted, and the fewest board
+    corners (or marker corners) of a pose at any stop (0 where the board was not found)."""
+    return frames.groupby("dataset").agg(
+        square_mm=("square_mm", "first"), first_id=("board_first_id", "first"),
+        trusted=("status", lambda status: float((status == "ok").mean())),
+        min_corners=("n_points", "min"), median_sigma_t_mm=("sigma_t_mm", "median"),
+        max_sigma_t_mm=("sigma_t_mm", "max"))
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--options", nargs="+", default=list(OPTIONS), choices=list(OPTIONS))
     parser.add_argument("--params", default="params.yaml", type=Path)
     parser.add_argument("--out", default=Path("/tmp/board_options"), type=Path)
     parser.add_argument("--true-camera", action="store_true")
+    parser.add_argument("--world", default="main", help="the world of --params to render (main, validation)")
+    parser.add_argument("--per-dataset", action="store_true", help="print each dataset's trusted share too")
     args = parser.parse_args()
     results = {}
     for option in args.options:
         try:
-            data = render(option, args.params, args.out)
+            data = render(option, args.params, args.out, args.world)
         except PoseIntegrityError as error:  # e.g. no place for the board in some scene
             print(option, f"cannot be rendered: {error}", flush=True)
             continue
@@ -134,6 +157,8 @@ def main() -> int:
         frames.to_parquet(data / f"frames{'_true_camera' if args.true_camera else ''}.parquet", index=False)
         results[option] = summary(frames)
         print(option, json.dumps({k: round(v, 4) for k, v in results[option].items()}), flush=True)
+        if args.per_dataset:
+            print(per_dataset(frames).round(3).to_string(), flush=True)
     print(pd.DataFrame(results).T.round(3).to_string())
     return 0
 

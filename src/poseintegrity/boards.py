@@ -77,13 +77,15 @@ class ArucoGrid:
 @dataclass(frozen=True)
 class Charuco:
     """A ChArUco board: squares_x x squares_y chessboard squares of ``square_mm`` with ArUco markers of ``marker_mm``
-    in the white ones (ids from 0); its points are the inner chessboard corners, each a group of its own."""
+    in the white ones (ids from ``first_id``: a second board in the same view has ids of its own); its points are the
+    inner chessboard corners, each a group of its own."""
 
     dictionary: str
     squares_x: int
     squares_y: int
     square_mm: float
     marker_mm: float
+    first_id: int = 0
     scale: tuple[float, float] = (1.0, 1.0)
     type: str = field(default="charuco", init=False)
 
@@ -94,7 +96,8 @@ class Charuco:
 
     def cv_board(self) -> "cv2.aruco.CharucoBoard":
         return cv2.aruco.CharucoBoard((self.squares_x, self.squares_y), self.square_mm, self.marker_mm,
-                                      cv2.aruco.getPredefinedDictionary(aruco_dictionary(self.dictionary)))
+                                      cv2.aruco.getPredefinedDictionary(aruco_dictionary(self.dictionary)),
+                                      np.arange(self.first_id, self.first_id + self.n_markers))
 
     @property
     def size_mm(self) -> tuple[float, float]:
@@ -103,7 +106,7 @@ class Charuco:
     def as_dict(self) -> dict[str, Any]:
         return {"type": self.type, "dictionary": self.dictionary, "squares_x": self.squares_x,
                 "squares_y": self.squares_y, "square_mm": self.square_mm, "marker_mm": self.marker_mm,
-                "scale": list(self.scale)}
+                "first_id": self.first_id, "scale": list(self.scale)}
 
 
 Board = ArucoGrid | Charuco
@@ -113,8 +116,9 @@ _FIELDS = {"aruco_grid": ("dictionary", "markers_x", "markers_y", "marker_length
 
 def board_from_dict(spec: dict[str, Any], where: str = "board") -> Board:
     """The board a dataset describes (meta.json's ``board``, a board.yaml): ``type`` ``aruco_grid`` (the default,
-    the paper's board) or ``charuco``, the fields of that type, and optionally ``scale`` [x, y] (measured printed size
-    over drawn size). A missing field, an unknown type or dictionary, or a value that is not a positive number (an
+    the paper's board) or ``charuco``, the fields of that type, and optionally ``first_id`` (the first marker's id,
+    default 0) and ``scale`` [x, y] (measured printed size over drawn size). A missing field, an unknown type or
+    dictionary, or a value that is not a positive number (an
     integer for counts) raises :class:`ArgumentError` naming ``where`` and the key."""
     if not isinstance(spec, dict):
         raise ArgumentError(f"{where}: expected a mapping of the board's fields, got {type(spec).__name__}")
@@ -132,10 +136,9 @@ def board_from_dict(spec: dict[str, Any], where: str = "board") -> Board:
     if not isinstance(scale, (list, tuple)) or len(scale) != 2:
         raise ArgumentError(f"{where}.scale: expected [x, y], the printed over the drawn size, got {scale!r}")
     scale = tuple(_checked(s, f"{where}.scale", integer=False) for s in scale)
-    if kind == "aruco_grid":
-        values["first_id"] = _checked(spec.get("first_id", 0), f"{where}.first_id", integer=True, allow_zero=True)
+    values["first_id"] = _checked(spec.get("first_id", 0), f"{where}.first_id", integer=True, allow_zero=True)
     board = Charuco(**values, scale=scale) if kind == "charuco" else ArucoGrid(**values, scale=scale)
-    first, size = getattr(board, "first_id", 0), dictionary_size(board.dictionary)
+    first, size = board.first_id, dictionary_size(board.dictionary)
     if first + board.n_markers > size:
         raise ArgumentError(f"{where}: markers {first} .. {first + board.n_markers - 1} do not fit {board.dictionary} "
                             f"({size} markers)")
@@ -163,5 +166,7 @@ def board_description(spec: dict[str, Any]) -> str:
     5 squares"."""
     board = board_from_dict(spec)
     if isinstance(board, Charuco):
-        return f"{board.dictionary}, ChArUco {board.squares_x} x {board.squares_y} squares of {board.square_mm:g} mm"
+        ids = f", markers from id {board.first_id}" if board.first_id else ""
+        return (f"{board.dictionary}, ChArUco {board.squares_x} x {board.squares_y} squares of {board.square_mm:g} mm"
+                f"{ids}")
     return f"{board.dictionary}, {board.markers_x} x {board.markers_y} markers from id {board.first_id}"

@@ -11,7 +11,7 @@ from poseintegrity.boards import ArucoGrid, Charuco, board_from_dict
 from poseintegrity.errors import ArgumentError
 from poseintegrity.lens import Camera
 from poseintegrity.localization.ground_truth import (
-    board_pose, consistent_fit, predicted_uncertainty, truth_error,
+    board_pose, consistent_fit, detect_board_points, predicted_uncertainty, truth_error,
 )
 from poseintegrity.params.extract import GroundTruthParams
 from poseintegrity.poses import pose_errors, pose_from_rvec_tvec, pose_matrix
@@ -49,6 +49,22 @@ def test_a_charuco_board_image_gives_the_known_pose_from_its_corners():
     assert result.status == "ok" and result.n_points == 24
     E_t_mm, E_r_deg = pose_errors(result.T_cam_board, T)
     assert E_t_mm < 0.3 and E_r_deg < 0.2
+
+
+def test_two_charuco_boards_in_one_image_each_find_their_own_corners():
+    """A scene's second board has marker ids of its own (first_id, issue 39): side by side in one image, each board
+    finds its 24 corners on its own side and none of the other's, and a board.yaml / meta.json of it round-trips."""
+    first, second = Charuco("DICT_4X4_50", 7, 5, 15.0, 11.0), Charuco("DICT_4X4_50", 7, 5, 15.0, 11.0, first_id=17)
+    tiles = [board.cv_board().generateImage((420 + 60, 300 + 60), marginSize=30) for board in (first, second)]
+    image = np.full((360, 1000), 255, np.uint8)
+    image[:, 10:490], image[:, 510:990] = tiles
+    for board, side in ((first, slice(0, 500)), (second, slice(500, 1000))):
+        object_points, image_points, _ = detect_board_points(image, board)
+        assert len(object_points) == 24
+        assert np.all((image_points[:, 0] >= side.start) & (image_points[:, 0] < side.stop))
+    assert board_from_dict(second.as_dict()) == second and second.as_dict()["first_id"] == 17
+    with pytest.raises(ArgumentError, match="board: markers 40 .. 56 do not fit DICT_4X4_50"):
+        board_from_dict(second.as_dict() | {"first_id": 40})
 
 
 def test_board_corners_are_undistorted_by_the_camera_before_the_pose():

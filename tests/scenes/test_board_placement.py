@@ -29,7 +29,8 @@ def project(points, T_world_cam):
 
 
 def poses():
-    return placement.arc_poses(AIM, VIEW, 350.0, 20.0, [0.0, 90.0, 270.0], 45.0, 20)
+    pair, arcs = placement.arc_trajectories(AIM, VIEW, 350.0, 20.0, [0.0, 90.0, 270.0], 45.0, 20)
+    return [*pair] + [T for arc in arcs for T in arc]
 
 
 def test_the_board_stays_in_view_and_clear_of_the_target_at_every_pose():

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from poseintegrity.config import load_params
-from poseintegrity.scenes import catalog, mesh
+from poseintegrity.scenes import board_placement, catalog, mesh
 from poseintegrity.params.generate import SceneSpec
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -18,8 +18,17 @@ def params():
 
 
 @pytest.fixture(scope="module")
-def generate(params):
+def planned(params):
+    """params.yaml's world, its boards planned (scenes/board_plan.py: seconds a scene)."""
     return params.generate
+
+
+@pytest.fixture(scope="module")
+def generate(planned):
+    """The same world with issue 30's board placement (fast): the layout tests that are not about the boards."""
+    board = planned.board.model_dump() | dict(placement="facing_camera", sizes_mm=None, max_boards=None,
+                                              plan_sigma_t_mm=None)
+    return planned.model_copy(update={"board": type(planned.board).model_validate(board)})
 
 
 @pytest.fixture(scope="module")
@@ -33,27 +42,36 @@ def spec(targets, **extra):
     return SceneSpec(name="s", targets=targets, distance_mm=350, elevation_deg=50, n_clutter=6, **extra)
 
 
-@pytest.mark.parametrize("targets", [["scapula"], ["block_print"], ["scapula", "block_mosaic"]])
-def test_the_board_faces_the_model_camera_its_origin_the_corner_nearest_the_target(generate, protocol, targets):
-    """E_t is measured at the board origin (the model origin, IV-C): the board is turned so that its origin is nearer
+@pytest.mark.parametrize("targets", [["scapula"], ["scapula", "block_mosaic"]])
+def test_the_boards_face_the_model_camera_their_origin_the_corner_nearest_the_target(planned, protocol, targets):
+    """E_t is measured at the board origin (the model origin, IV-C): each board is turned so that its origin is nearer
     the target than the corner a half turn would put there (and than its centre); its printed side faces the model
-    camera (board z = the camera's forward axis) and it stands on its post."""
-    scene = catalog.build_scene(spec(targets), 3, generate, protocol)
-    bw, bh = scene.board.size_mm
-    corners = np.array([[x, y, 0.0, 1.0] for x in (0, bw) for y in (0, bh)]) @ scene.T_world_board.T
-    distances = np.linalg.norm(corners[:, :3] - dict(scene.placed)[targets[0]].vertices.mean(axis=0), axis=1)
-    centre = scene.T_world_board @ [bw / 2, bh / 2, 0.0, 1.0]
-    assert distances[0] <= distances[3] and distances[0] < np.linalg.norm(
-        centre[:3] - dict(scene.placed)[targets[0]].vertices.mean(axis=0))
-    np.testing.assert_allclose(scene.T_world_board[:3, 2], -scene.view_dir, atol=1e-9)
-    post = dict(scene.placed)["board_post"].vertices
-    assert post[:, 2].min() == pytest.approx(0.0) and post[:, 2].max() >= corners[:, 2].min()
+    camera, tilted from facing it by at most 40 deg (board z against the camera's forward axis), and it stands on its
+    post, whose top is behind its centre (never through the paper)."""
+    scene = catalog.build_scene(spec(targets), 3, planned, protocol)
+    target = dict(scene.placed)[targets[0]].vertices.mean(axis=0)
+    for k, board in enumerate(scene.boards):
+        bw, bh = board.drawing.size_mm
+        T = board.T_world_board
+        corners = np.array([[x, y, 0.0, 1.0] for x in (0, bw) for y in (0, bh)]) @ T.T
+        distances = np.linalg.norm(corners[:, :3] - target, axis=1)
+        centre = T @ [bw / 2, bh / 2, 0.0, 1.0]
+        assert distances[0] <= distances[3] and distances[0] < np.linalg.norm(centre[:3] - target)
+        assert np.degrees(np.arccos(np.clip(T[:3, 2] @ -scene.view_dir, -1.0, 1.0))) <= 40.0 + 1e-6
+        post = dict(scene.placed)["board_post" + ("" if k == 0 else f"_{k + 1}")].vertices
+        axis = post[:, :2].mean(axis=0)
+        top = np.append(axis, post[:, 2].max())
+        assert post[:, 2].min() == pytest.approx(0.0)
+        # its top behind the board's centre by more than its radius: it holds the board and never pierces the paper
+        behind = top - centre[:3]
+        assert np.linalg.norm(np.cross(behind, T[:3, 2])) == pytest.approx(0.0, abs=0.5)  # the mesh's facets
+        assert behind @ T[:3, 2] > board_placement.POST_RADIUS_MM
 
 
 def test_the_flat_placement_lays_the_board_beside_the_target_on_its_pedestal(generate, protocol):
     flat = generate.model_copy(update={"board": generate.board.model_copy(update={"placement": "flat"})})
     scene = catalog.build_scene(spec(["scapula"]), 3, flat, protocol)
-    np.testing.assert_allclose(scene.T_world_board[:3, 2], [0.0, 0.0, -1.0])  # printed side up
+    np.testing.assert_allclose(scene.boards[0].T_world_board[:3, 2], [0.0, 0.0, -1.0])  # printed side up
     assert "board_pedestal" in dict(scene.placed)
 
 
@@ -61,12 +79,14 @@ def test_the_lab_measures_the_printed_board_with_calipers(generate, protocol):
     """meta.json's board is the drawing scaled by what the lab measured: within a caliper error of the printed
     scale; without calipers (null) the drawing itself."""
     scene = catalog.build_scene(spec(["block_print"]), 0, generate, protocol)
-    printed, _ = catalog.print_errors(generate, "aruco", generate.printed_boards.board_sag_std_mm)
-    width, height = generate.board.drawing().size_mm
     caliper = generate.printed_boards.caliper_std_mm
-    assert abs(scene.board.scale[0] - printed[0]) * width < 5 * caliper
-    assert abs(scene.board.scale[1] - printed[1]) * height < 5 * caliper
-    assert scene.board.scale != (1.0, 1.0)
+    for board in scene.boards:  # each printed board its own print and measurement
+        printed, _ = catalog.print_errors(generate, catalog.printed_name(generate, board.drawing),
+                                          generate.printed_boards.board_sag_std_mm)
+        width, height = board.drawing.size_mm
+        assert abs(board.board.scale[0] - printed[0]) * width < 5 * caliper
+        assert abs(board.board.scale[1] - printed[1]) * height < 5 * caliper
+        assert board.board.scale != (1.0, 1.0) and board.board.first_id == board.drawing.first_id
     unmeasured = generate.model_copy(update={"printed_boards": generate.printed_boards.model_copy(
         update={"caliper_std_mm": None})})
     assert catalog.measured_board(unmeasured).scale == (1.0, 1.0)

@@ -4,6 +4,7 @@ import pytest
 
 from params_cases import refusal
 from poseintegrity.scenes import dataset
+from poseintegrity.scenes.optics import defocus_sigma_px
 from poseintegrity.params.generate import GenerateParams
 
 NO_LIGHT = {"ambient": 0.0, "ring": 0.0, "room": 0.0, "background": 0.5}
@@ -43,6 +44,9 @@ BAD_VALUES = [
     ("board.squares_x", None, "board.squares_x"),  # a ChArUco board without its size
     ("board.squares_x", 30, "board.dictionary"),  # 60 markers on 30 x 4 squares, DICT_4X4_50 has 50
     ("board.placement", "hanging", "board.placement"),
+    ("board.placement", "planned", "board.sizes_mm"),  # a plan without the sizes it chooses from
+    ("board.sizes_mm", [15.0, 18.0], "board.sizes_mm"),  # a key of the plan on a board placed by the old rule
+    ("board.max_boards", 3, "board.max_boards"),
     ("printed_boards.caliper_std_mm", -0.1, "printed_boards.caliper_std_mm"),
     ("capture.model_settle_ms", -5.0, "capture.model_settle_ms"),
     ("calibration.distance_mm", [450.0, 250.0], "calibration.distance_mm"),
@@ -55,7 +59,7 @@ BAD_VALUES = [
     ("printed_boards.scale_std", 0.05, "printed_boards.scale_std"),  # 5 %: seen with a ruler
     ("capture.exposure_ms", 50.0, "capture.exposure_ms"),  # longer than the 33.3 ms frame period
     ("validation.scenes.0.name", "scene_a", "validation.scenes"),  # names the main world's datasets
-    ("validation.lines", {"scene": "scene_a", "distance_mm": 240, "offsets_deg": [0], "n_stops": 6},
+    ("validation.lines", {"scene": "scene_a", "distance_mm": 240, "offsets_deg": [0], "n_stops": 6, "focus": "range"},
      "validation.lines.scene"),  # a scene of the other world
     ("validation.images_per_stop", 0, "validation.images_per_stop"),
     ("validation.seed", -1, "validation.seed"),
@@ -85,10 +89,11 @@ def test_bad_value_names_its_key(tiny_raw, key, value, expected):
 def test_every_key_is_set_by_params_yaml():
     """No field has a default that could disagree with params.yaml: leaving any key out is refused (the optional
     keys are required exactly where they mean something: glenoid_tilt_deg with a scapula, a board's sizes with its
-    type, and refused elsewhere)."""
+    type, the plan's keys with placement planned, and refused elsewhere)."""
     optional = {("SceneSpec", "glenoid_tilt_deg")} | {
         ("GroundTruthBoardParams", key) for key in ("markers_x", "markers_y", "marker_length_mm", "separation_mm",
-                                                    "squares_x", "squares_y", "square_mm", "marker_mm")}
+                                                    "squares_x", "squares_y", "square_mm", "marker_mm", "sizes_mm",
+                                                    "max_boards", "plan_sigma_t_mm")}
 
     def defaults(model):
         for name, field in model.model_fields.items():
@@ -105,3 +110,20 @@ def test_dataset_ids_are_the_plan_and_distinct(tiny_params):
     assert ids == [plan.dataset for plan in dataset.plan_datasets(tiny_params.generate)]
     assert len(set(ids)) == len(ids)
 
+
+
+@pytest.mark.parametrize("distance_mm", [220.0, 300.0])
+def test_lines_focused_for_their_range_blur_both_ends_alike(tiny_params, distance_mm):
+    """``lines.focus: range`` puts the focus where the thin lens blurs the lines' near end (the model view) and far
+    end (the 0-deg line's last stop) alike, between the two and nearer the near end (the circle of confusion grows as
+    |d - d_f| / d); ``model_view`` keeps the near end sharp and blurs the far end twice as much."""
+    generate, length = tiny_params.generate, tiny_params.protocol.line_length_mm
+    lines = generate.lines.model_copy(update={"distance_mm": distance_mm, "focus": "range"})
+    near, far = distance_mm, distance_mm + length * (lines.n_stops - 1) / lines.n_stops
+    focus = lines.focus_mm(length)
+    assert near < focus < (near + far) / 2
+    blur = [float(defocus_sigma_px(d, focus, generate.camera)) for d in (near, far)]
+    assert blur[0] == pytest.approx(blur[1], rel=1e-9) and blur[0] > 0
+    at_model = lines.model_copy(update={"focus": "model_view"})
+    assert at_model.focus_mm(length) == near
+    assert float(defocus_sigma_px(far, near, generate.camera)) == pytest.approx(2 * blur[1], rel=0.05)

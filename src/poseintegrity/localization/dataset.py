@@ -81,9 +81,9 @@ class _Read(BaseModel):
 
 class BoardMeta(_Read):
     """The ground-truth board (IV-C; :mod:`poseintegrity.boards`), lengths in mm: ``type`` ``aruco_grid`` (the
-    default, the paper's "ArUco marker board": markers_x, markers_y, marker_length_mm, separation_mm, first_id) or
-    ``charuco`` (squares_x, squares_y, square_mm, marker_mm); ``scale`` [x, y]: the printed size over the drawn size,
-    as measured with calipers (default [1, 1]: the drawing)."""
+    default, the paper's "ArUco marker board": markers_x, markers_y, marker_length_mm, separation_mm) or
+    ``charuco`` (squares_x, squares_y, square_mm, marker_mm), its markers' ids from ``first_id`` (default 0);
+    ``scale`` [x, y]: the printed size over the drawn size, as measured with calipers (default [1, 1]: the drawing)."""
 
     type: Literal["aruco_grid", "charuco"] = "aruco_grid"
     dictionary: str = Field(pattern=r"^DICT_\w+$")
@@ -114,7 +114,7 @@ class BoardMeta(_Read):
         if self.type == "charuco":
             if self.marker_mm >= self.square_mm:
                 raise ValueError(f"marker_mm ({self.marker_mm:g}) must be below square_mm ({self.square_mm:g})")
-            first, last = 0, self.squares_x * self.squares_y // 2
+            first, last = self.first_id, self.first_id + self.squares_x * self.squares_y // 2
         else:
             first, last = self.first_id, self.first_id + self.markers_x * self.markers_y
         size = dictionary_size(self.dictionary)

@@ -57,17 +57,25 @@ def envelope_rule_summary(envelope_table: pd.DataFrame, table: pd.DataFrame, met
 
 def dataset_summary(table: pd.DataFrame, envelope_table: pd.DataFrame, method: str) -> pd.DataFrame:
     """What was measured on each dataset, for ``method`` (the paper's PnP path): world, trajectory, frames, stops,
-    the last stop's position (deg for arcs, mm for lines), the share of frames localized (status ok), the mean n_i
-    at the first stop, and per tolerance theta_a (deg or mm) and whether it is censored (the envelope reaches the
-    end of the range, IV-E). ``table``: usable rows (the data flags left out); ``envelope_table``: one rule's rows
+    the last stop's position (deg for arcs, mm for lines), the share of frames localized (status ok), the share of
+    frames whose ground truth judges them (``trusted_share``: a trusted board pose, or a recorded pose), the fewest
+    board points (ChArUco corners, or marker corners of a grid) of the pose at any stop (``min_corners_in_view``: the
+    median over the stop's images; 0 where the board was not found; NaN with pose ground truth), the mean n_i at the
+    first stop, and per tolerance theta_a (deg or mm) and whether it is censored (the envelope reaches the end of the
+    range, IV-E). ``table``: usable rows (the data flags left out); ``envelope_table``: one rule's rows
     (:func:`poseintegrity.localization.envelope.headline`). One row per dataset, by world and name."""
     rows = table[table["method"] == method]
     rows = rows.assign(position=rows["theta_deg"].where(rows["trajectory"] == "arc", rows["x_mm"]))
     first = rows[rows["stop"] == rows.groupby("dataset")["stop"].transform("min")]
-    summary = rows.groupby(["world", "trajectory", "dataset"]).agg(
+    keys = ["world", "trajectory", "dataset"]
+    summary = rows.groupby(keys).agg(
         n_frames=("status", "size"), n_stops=("stop", "nunique"), last_stop=("position", "max"),
-        localized_share=("status", lambda status: float((status == "ok").mean())))
-    summary["first_stop_mean_n_inliers"] = first.groupby(["world", "trajectory", "dataset"])["n_inliers"].mean()
+        localized_share=("status", lambda status: float((status == "ok").mean())),
+        trusted_share=("board_status", lambda status: float(status.isin(["ok", "no_board"]).mean())))
+    board = rows[rows["board_status"] != "no_board"]
+    summary["min_corners_in_view"] = (board.groupby([*keys, "stop"])["board_n_points"].median()
+                                      .groupby(level=keys).min()).astype(float)
+    summary["first_stop_mean_n_inliers"] = first.groupby(keys)["n_inliers"].mean()
     envelopes = envelope_table[envelope_table["method"] == method]
     for column in ("theta_a", "censored"):
         wide = envelopes.pivot_table(index=["world", "trajectory", "dataset"], columns="tolerance", values=column,

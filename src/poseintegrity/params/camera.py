@@ -12,7 +12,7 @@ from pydantic import AfterValidator, Field, field_validator, model_validator
 
 from poseintegrity.boards import ArucoGrid, Board, Charuco, dictionary_size
 from poseintegrity.lens import LensError, check_folding
-from poseintegrity.schema import FromList, KeyRule, Section, ordered_range
+from poseintegrity.schema import FromList, KeyRule, Section, distinct, ordered_range
 
 MIN_IMAGE_PX = 64  # the rendered image's shorter side: below it no target keeps enough pixels to be localized
 # Zhang's method takes the focal length from how the board's plane turns between views (views of parallel planes add
@@ -49,7 +49,8 @@ class CameraParams(Section):
     downscale: int = Field(ge=1, le=MAX_SENSOR_PX // MIN_IMAGE_PX,
                            description="images are rendered at sensor size / downscale (the shorter side >= "
                                        "MIN_IMAGE_PX, checked below)")
-    f_number: float = Field(ge=0.5, le=64, description="aperture; sets the depth of field (focus at the model view)")
+    f_number: float = Field(ge=0.5, le=64, description="aperture; sets the depth of field (focus at the model view; "
+                                                       "the lines' session: lines.focus)")
     principal_point_offset_px: Annotated[tuple[Annotated[float, Field(ge=-100, le=100)],
                                                Annotated[float, Field(ge=-100, le=100)]], FromList] = (
         Field(description="where the optical axis meets the sensor, from its centre, full-resolution px (a lens is "
@@ -139,9 +140,11 @@ class GroundTruthBoardParams(Section):
     """The scenes' ground-truth board (IV-C: "an ArUco marker board [35]"; its size and layout are unpublished, ours
     are chosen by measurement: docs/references.md, "Ground-truth boards"). ``aruco_grid`` needs markers_x, markers_y,
     marker_length_mm and separation_mm; ``charuco`` squares_x, squares_y, square_mm and marker_mm (the other kind's
-    keys are refused). ``placement``: ``facing_camera`` (on a post, facing the model camera, where along every
-    trajectory of its scene no target covers it and it covers none: scenes/board_placement.py) or ``flat`` (lying on
-    a pedestal beside the target, the layout before issue 30)."""
+    keys are refused). ``placement``: ``planned`` (per scene, a ChArUco board of one of ``sizes_mm`` on a post facing
+    the model camera, wholly in view, in focus and predicted within ``plan_sigma_t_mm`` at every stop of the
+    trajectories it serves, and up to ``max_boards`` of them: scenes/board_placement.py, issue 39),
+    ``facing_camera`` (one board of square_mm, most of it in view along every trajectory: the layout of issue 30) or
+    ``flat`` (lying on a pedestal beside the target, the layout before issue 30)."""
 
     type: Literal["aruco_grid", "charuco"]
     dictionary: Dictionary
@@ -155,7 +158,16 @@ class GroundTruthBoardParams(Section):
     marker_mm: float | None = Field(None, gt=0, le=200)
     margin_mm: float = Field(ge=0, le=100, description="white paper around the pattern")
     px_per_mm: float = Field(ge=2, le=32, description="texels per mm of the printed board's texture")
-    placement: Literal["facing_camera", "flat"]
+    placement: Literal["planned", "facing_camera", "flat"]
+    sizes_mm: distinct(Annotated[float, Field(gt=0, le=200)]) | None = Field(
+        None, min_length=1, description="planned: the square sizes the lab may print the board at (marker_mm scales "
+                                        "with square_mm); the plan picks one per board")
+    max_boards: int | None = Field(
+        None, ge=1, le=2, description="planned: boards per scene at most (a second one where no place keeps one in "
+                                      "view on every trajectory)")
+    plan_sigma_t_mm: float | None = Field(
+        None, gt=0, le=100, description="planned: a board serves a trajectory when its pose is predicted within this "
+        "(RMS at the board origin, mm) at every stop; extract.ground_truth.max_sigma_t_mm is what stage 02 then trusts")
 
     @model_validator(mode="after")
     def _fields_of_its_type(self) -> "GroundTruthBoardParams":
@@ -170,15 +182,27 @@ class GroundTruthBoardParams(Section):
                     raise KeyRule(key, f"a key of a {kind} board; this board is {self.type}")
         if self.type == "charuco" and self.marker_mm >= self.square_mm:
             raise KeyRule("marker_mm", f"a marker lies inside its square: must be < square_mm ({self.square_mm:g})")
-        n_markers, size = self.drawing().n_markers, dictionary_size(self.dictionary)
+        planned = ("sizes_mm", "max_boards", "plan_sigma_t_mm")
+        for key in planned:
+            if (getattr(self, key) is None) == (self.placement == "planned"):
+                raise KeyRule(key, "required by placement planned" if self.placement == "planned" else
+                              f"a key of placement planned; this board's placement is {self.placement}")
+        if self.placement == "planned" and self.type != "charuco":
+            raise KeyRule("type", "placement planned plans ChArUco boards (their corners stay sharp under blur)")
+        n_markers, size = self.drawing().n_markers * (self.max_boards or 1), dictionary_size(self.dictionary)
         if n_markers > size:
-            raise KeyRule("dictionary", f"the board holds {n_markers} markers, {self.dictionary} has {size}")
+            raise KeyRule("dictionary", f"the board(s) hold {n_markers} markers, {self.dictionary} has {size}")
         return self
 
-    def drawing(self, scale: tuple[float, float] = (1.0, 1.0)) -> Board:
-        """The board as drawn (:mod:`poseintegrity.boards`), or as measured with ``scale`` (printed / drawn)."""
+    def drawing(self, scale: tuple[float, float] = (1.0, 1.0), square_mm: float | None = None,
+                first_id: int = 0) -> Board:
+        """The board as drawn (:mod:`poseintegrity.boards`), or as measured with ``scale`` (printed / drawn); a
+        ChArUco board printed with squares of ``square_mm`` (default: ``square_mm``; its markers scaled alike) and
+        ids from ``first_id``."""
         if self.type == "charuco":
-            return Charuco(self.dictionary, self.squares_x, self.squares_y, self.square_mm, self.marker_mm, scale)
+            square = self.square_mm if square_mm is None else square_mm
+            return Charuco(self.dictionary, self.squares_x, self.squares_y, square,
+                           self.marker_mm * square / self.square_mm, first_id, scale)
         return ArucoGrid(self.dictionary, self.markers_x, self.markers_y, self.marker_length_mm, self.separation_mm,
                          0, scale)
 

@@ -161,10 +161,27 @@ class LineParams(Section):
     distance_mm: Distance = Field(description="camera to target centre at the lines' own model pair")
     offsets_deg: distinct(Annotated[float, Field(ge=0, le=90)]) = Field(min_length=1)
     n_stops: Stops
+    focus: Literal["model_view", "range"] = Field(
+        description="where the lab focuses the lens for the lines' session: model_view, at distance_mm (the far stops, "
+        "up to 140 mm beyond, are then blurred by sigma 2.9 px at f/4 and 220 mm, and no board beside the target is "
+        "read there); range, at the distance that blurs the near and the far end of the lines alike (focus_mm)")
 
     def dataset_ids(self) -> list[str]:
         """The datasets of the lines, one per start offset (the id names its folder)."""
         return [f"{self.scene}_line{offset:02.0f}" for offset in self.offsets_deg]
+
+    def focus_mm(self, line_length_mm: float) -> float:
+        """Where the lens is focused for the lines (``focus``): at their model view, or for the range they image, the
+        target from distance_mm (model pair, first stop) to d_far = distance_mm + the last stop's x (the 0-deg line;
+        the offset lines end nearer). The thin lens' circle of confusion grows as |d - d_f| / d
+        (:func:`~poseintegrity.scenes.optics.defocus_sigma_px`), equal at both ends when
+        d_f = 2 d_near d_far / (d_near + d_far), the harmonic mean (the usual depth-of-field split of a near and a far
+        limit). At f/4 with the 12 mm lens and lines from 220 to 360 mm: 273 mm, and the target blurred by sigma
+        1.4 px at both ends (model_view: 0 px near, 2.9 px far)."""
+        if self.focus == "model_view":
+            return float(self.distance_mm)
+        near, far = float(self.distance_mm), self.distance_mm + line_length_mm * (self.n_stops - 1) / self.n_stops
+        return 2 * near * far / (near + far)
 
 
 WORLDS = ("main", "validation")  # the main world, calibrated to the paper; a second one nothing was tuned on

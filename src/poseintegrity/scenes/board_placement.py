@@ -1,4 +1,6 @@
-"""Where a lab stands the ground-truth board (``generate.board.placement: facing_camera``; issue 30): on a post beside
+"""Where a lab stood the ground-truth board before issue 39's plan (``generate.board.placement: facing_camera``,
+:mod:`.board_plan` for ``planned``), and the image geometry both share (projections, the targets' grown silhouettes,
+whether clutter covers a board). Issue 30's rule: the board stands on a post beside
 the target, facing the model camera, where along every trajectory of its scene no target covers the board, the board
 and its post cover no target, and most of the board stays in the image. A target's edge over a marker is what put the
 ArUco ground truth millimetres off (a partly hidden marker is still decoded, one corner pixels off); a board seen
@@ -38,6 +40,7 @@ MIN_IN_VIEW = 0.25  # share of the board's area inside the image at every pose, 
 CLEARANCE_PX = 6.0  # between the board (or its post) and a target's silhouette hull, in the image
 TABLE_CLEARANCE_MM = 5.0  # the board's lowest corner above the table
 POST_RADIUS_MM = 8.0
+POST_BEHIND_MM = 3.0  # the post's top behind the paper beyond its own radius (at 3 mm its top poked through the board)
 NEAR_MM = 20.0
 BOUNDING = 1.3  # a clutter box of 2 r x up to 1.5 r lies within a cylinder of 1.25 r about its centre
 
@@ -58,31 +61,33 @@ class BoardPlacement:
     in_view: float
 
 
-def arc_poses(aim: np.ndarray, view_dir: np.ndarray, distance_mm: float, baseline_mm: float,
-              azimuths_deg: list[float], span_deg: float, n_stops: int) -> list[np.ndarray]:
-    """Every commanded T_world_cam (4, 4) of a scene's arcs session: its model pair and the arcs' stops
-    (:mod:`.trajectories`)."""
+def arc_trajectories(aim: np.ndarray, view_dir: np.ndarray, distance_mm: float, baseline_mm: float,
+                     azimuths_deg: list[float], span_deg: float, n_stops: int
+                     ) -> tuple[list[np.ndarray], list[list[np.ndarray]]]:
+    """A scene's arcs session: its model pair (T_world_cam (4, 4) each) and per arc (one per azimuth) the commanded
+    T_world_cam of its stops (:mod:`.trajectories`; the first is model image 0's)."""
     pair = trajectories.model_pair(aim, view_dir, distance_mm, baseline_mm)
-    return [*pair] + [stop.T_world_cam for az in azimuths_deg
-                      for stop in trajectories.arc(pair[0], aim, az, span_deg, n_stops)]
+    return pair, [[stop.T_world_cam for stop in trajectories.arc(pair[0], aim, az, span_deg, n_stops)]
+                  for az in azimuths_deg]
 
 
-def line_poses(aim: np.ndarray, view_dir: np.ndarray, distance_mm: float, baseline_mm: float,
-               offsets_deg: list[float], length_mm: float, n_stops: int) -> list[np.ndarray]:
-    """Every commanded T_world_cam (4, 4) of the lines session: its model pair and the lines' stops."""
+def line_trajectories(aim: np.ndarray, view_dir: np.ndarray, distance_mm: float, baseline_mm: float,
+                      offsets_deg: list[float], length_mm: float, n_stops: int
+                      ) -> tuple[list[np.ndarray], list[list[np.ndarray]]]:
+    """The lines session: its model pair and per line (one per offset) the commanded T_world_cam of its stops."""
     pair = trajectories.model_pair(aim, view_dir, distance_mm, baseline_mm)
-    return [*pair] + [stop.T_world_cam for offset in offsets_deg
-                      for stop in trajectories.line(pair[0], aim, offset, length_mm, n_stops)]
+    return pair, [[stop.T_world_cam for stop in trajectories.line(pair[0], aim, offset, length_mm, n_stops)]
+                  for offset in offsets_deg]
 
 
-def _project(points: np.ndarray, T_cam_world: np.ndarray, K: np.ndarray) -> np.ndarray:
+def project(points: np.ndarray, T_cam_world: np.ndarray, K: np.ndarray) -> np.ndarray:
     """(n, 2) pixels of world points (n, 3) in front of the camera (those nearer than NEAR_MM are left out)."""
     cam = points @ T_cam_world[:3, :3].T + T_cam_world[:3, 3]
     cam = cam[cam[:, 2] > NEAR_MM]
     return (cam[:, :2] / cam[:, 2:3]) @ K[:2, :2].T + K[:2, 2]
 
 
-def _near_targets(hulls: list[np.ndarray], width: int, height: int, clearance_px: float) -> np.ndarray:
+def near_targets(hulls: list[np.ndarray], width: int, height: int, clearance_px: float) -> np.ndarray:
     """(height, width) bool: the pixels within ``clearance_px`` of the targets' silhouette hulls (their hulls grown by
     a square of that half-width: a disc would do, the square errs on the side of clearance and is 20 x faster)."""
     mask = np.zeros((height, width), np.uint8)
@@ -92,7 +97,7 @@ def _near_targets(hulls: list[np.ndarray], width: int, height: int, clearance_px
     return cv2.dilate(mask, cv2.getStructuringElement(cv2.MORPH_RECT, (size, size))).astype(bool)
 
 
-def _pixels(points: np.ndarray, T_cam_world: np.ndarray, K: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def pixels(points: np.ndarray, T_cam_world: np.ndarray, K: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Pixels (..., 2) of world points (..., 3) and whether each lies in front of the camera (...)."""
     cam = points @ T_cam_world[:3, :3].T + T_cam_world[:3, 3]
     front = cam[..., 2] > NEAR_MM
@@ -100,18 +105,18 @@ def _pixels(points: np.ndarray, T_cam_world: np.ndarray, K: np.ndarray) -> tuple
     return np.stack([K[0, 0] * cam[..., 0] / z + K[0, 2], K[1, 1] * cam[..., 1] / z + K[1, 2]], axis=-1), front
 
 
-def _hits(pixels: np.ndarray, front: np.ndarray, near: np.ndarray) -> np.ndarray:
+def hits(points: np.ndarray, front: np.ndarray, near: np.ndarray) -> np.ndarray:
     """(n,) whether any of each candidate's points (n, k, 2) in front of the camera and inside the image falls on
-    ``near`` (:func:`_near_targets`)."""
+    ``near`` (:func:`near_targets`)."""
     height, width = near.shape
-    u, v = np.round(pixels[..., 0]).astype(np.int64), np.round(pixels[..., 1]).astype(np.int64)
+    u, v = np.round(points[..., 0]).astype(np.int64), np.round(points[..., 1]).astype(np.int64)
     inside = front & (u >= 0) & (u < width) & (v >= 0) & (v < height)
     hit = np.zeros(u.shape, bool)
     hit[inside] = near[v[inside], u[inside]]
     return hit.any(axis=1)
 
 
-def _vertices_inside(quads: np.ndarray, points: np.ndarray) -> np.ndarray:
+def vertices_inside(quads: np.ndarray, points: np.ndarray) -> np.ndarray:
     """(n,) whether any of ``points`` (m, 2) lies inside each convex quad (n, 4, 2) (either winding)."""
     edges = np.roll(quads, -1, axis=1) - quads  # (n, 4, 2)
     rel = points[None, None, :, :] - quads[:, :, None, :]  # (n, 4, m, 2)
@@ -159,7 +164,7 @@ def place_board(size_mm: tuple[float, float], margin_mm: float, targets: list[np
         return (centres[keep, None, :] + local[None, :, 0, None] * x_b[keep, None, :]
                 + local[None, :, 1, None] * y_b[keep, None, :])
 
-    tops = centres + 3.0 * forward  # the post holds the board from behind
+    tops = centres + (POST_RADIUS_MM + POST_BEHIND_MM) * forward  # the post holds the board from behind
     feet = tops * np.array([1.0, 1.0, 0.0])
     post = feet[:, None, :] + np.linspace(0.0, 1.0, 12)[None, :, None] * (tops - feet)[:, None, :]  # (n, 12, 3)
     keep = on_paper(corners, np.ones(len(centres), bool))[..., 2].min(axis=1) >= TABLE_CLEARANCE_MM
@@ -169,19 +174,19 @@ def place_board(size_mm: tuple[float, float], margin_mm: float, targets: list[np
         if not keep.any():
             break
         view = inverse(poses[k])
-        hulls = [cv2.convexHull(_project(v, view, K).astype(np.float32)).reshape(-1, 2) for v in targets]
+        hulls = [cv2.convexHull(project(v, view, K).astype(np.float32)).reshape(-1, 2) for v in targets]
         distance = np.linalg.norm(poses[k][:3, 3] - aim)
-        near_board = _near_targets(hulls, width, height, CLEARANCE_PX)
-        near_post = _near_targets(hulls, width, height, CLEARANCE_PX + POST_RADIUS_MM * K[0, 0] / distance)
+        near_board = near_targets(hulls, width, height, CLEARANCE_PX)
+        near_post = near_targets(hulls, width, height, CLEARANCE_PX + POST_RADIUS_MM * K[0, 0] / distance)
         idx = np.flatnonzero(keep)
-        quad, front = _pixels(on_paper(corners, keep), view, K)
-        pixels, _ = _pixels(on_paper(grid, keep), view, K)
-        in_view = ((pixels[..., 0] >= 0) & (pixels[..., 0] <= width - 1) & (pixels[..., 1] >= 0)
-                   & (pixels[..., 1] <= height - 1)).mean(axis=1)
+        quad, front = pixels(on_paper(corners, keep), view, K)
+        grid_px, _ = pixels(on_paper(grid, keep), view, K)
+        in_view = ((grid_px[..., 0] >= 0) & (grid_px[..., 0] <= width - 1) & (grid_px[..., 1] >= 0)
+                   & (grid_px[..., 1] <= height - 1)).mean(axis=1)
         bad = ~front.all(axis=1) | (in_view < MIN_IN_VIEW)
-        bad |= _hits(*_pixels(on_paper(outline, keep), view, K), near_board)
-        bad |= _hits(*_pixels(post[keep], view, K), near_post)
-        bad |= _vertices_inside(quad, np.vstack(hulls))
+        bad |= hits(*pixels(on_paper(outline, keep), view, K), near_board)
+        bad |= hits(*pixels(post[keep], view, K), near_post)
+        bad |= vertices_inside(quad, np.vstack(hulls))
         worst[idx] = np.minimum(worst[idx], in_view)
         keep[idx[bad]] = False
     if not keep.any():
@@ -209,8 +214,11 @@ def covers(xy: np.ndarray, radius: float, height: float, paper: np.ndarray, pose
         view = inverse(T)
         if (view[2, :3] @ centre + view[2, 3]) >= (view[2, :3] @ paper.mean(axis=0) + view[2, 3]):
             continue  # behind the board
-        hull = cv2.convexHull(_project(solid, view, K).astype(np.float32)).reshape(-1, 2)
-        area, _ = cv2.intersectConvexConvex(_project(paper, view, K).astype(np.float32), hull)
+        seen = project(solid, view, K)
+        if len(seen) < 3:
+            continue  # behind the camera
+        hull = cv2.convexHull(seen.astype(np.float32)).reshape(-1, 2)
+        area, _ = cv2.intersectConvexConvex(project(paper, view, K).astype(np.float32), hull)
         if area > 0:
             return True
     return False

@@ -54,7 +54,7 @@ def charuco_spec(params: GenerateParams, measured: bool = True) -> Charuco:
     board = params.calibration.board
     drawing = Charuco(board.dictionary, board.squares_x, board.squares_y, board.square_mm, board.marker_mm)
     return drawing if not measured else Charuco(board.dictionary, board.squares_x, board.squares_y, board.square_mm,
-                                                board.marker_mm, measured_scale(params, "charuco", drawing))
+                                                board.marker_mm, scale=measured_scale(params, "charuco", drawing))
 
 
 @lru_cache(maxsize=2)

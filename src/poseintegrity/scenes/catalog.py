@@ -15,7 +15,7 @@ z up, millimetres.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import lru_cache
 
 import numpy as np
@@ -23,7 +23,7 @@ from scipy.spatial.transform import Rotation
 
 from poseintegrity.boards import Board
 from poseintegrity.seeding import keyed_rng
-from poseintegrity.scenes import board_placement
+from poseintegrity.scenes import board_placement, board_plan
 from poseintegrity.scenes import mesh as meshes
 from poseintegrity.scenes import textures as tex
 from poseintegrity.poses import pose_matrix
@@ -90,26 +90,48 @@ def target_mesh(name: str, params: "GenerateParams") -> meshes.Mesh:
     return meshes.box(BLOCK_SIZE_MM, name, material=meshes.Material(specular=0.08, shininess=30.0))
 
 
+@dataclass(frozen=True)
+class SceneBoard:
+    """One ground-truth board of a scene: as printed from its drawing (``drawing``, :mod:`poseintegrity.boards`) and
+    as the lab measured it (``board``, :func:`measured_board`), its frame T_world_board (4, 4, mm), where it stands
+    (``placement``; None when it lies flat) and its worst predicted sigma_t (mm) over the stops it serves (planned
+    boards; NaN otherwise)."""
+
+    drawing: Board
+    board: Board
+    T_world_board: np.ndarray
+    placement: board_placement.BoardPlacement | None = None
+    sigma_t_mm: float = float("nan")
+
+
 @dataclass
 class Scene:
-    """A laid-out scene: placed meshes, which of them are targets, the board, the model-view direction (the
+    """A laid-out scene: placed meshes, which of them are targets, the boards, the model-view direction (the
     textures of its meshes: :func:`scene_textures`).
 
-    T_world_target is the frame of the first target; ``board`` the ground-truth board as the lab measured it
-    (:func:`measured_board`), T_world_board its frame; ``aim`` is the point the camera looks at and the arcs turn
-    about (the glenoid centre of a single scapula: the paper's robot keeps its guide wire in the drill hole).
+    T_world_target is the frame of the first target; ``boards`` the ground-truth boards (one, or two where one
+    cannot serve every trajectory), ``board_of`` per trajectory of the session (``arcs.azimuths_deg`` or
+    ``lines.offsets_deg``, in order) the index of the board that is its ground truth (:meth:`board_for`); ``aim``
+    is the point the camera looks at and the arcs turn about (the glenoid centre of a single scapula: the paper's
+    robot keeps its guide wire in the drill hole); ``plan``: the boards' plan (standing boards), which rebuilds the
+    scene without planning again.
     """
 
     name: str
     placed: list[tuple[str, meshes.Mesh]]
     target_objects: tuple[str, ...]
     T_world_target: np.ndarray
-    T_world_board: np.ndarray
-    board: Board
+    boards: tuple[SceneBoard, ...]
+    board_of: tuple[int, ...]
     aim: np.ndarray
     view_dir: np.ndarray
     light_dir: np.ndarray
-    placement: board_placement.BoardPlacement | None = None  # a standing board's place (None: lying flat)
+    plan: board_plan.BoardPlan | None = None
+
+    def board_for(self, trajectory: int) -> SceneBoard:
+        """The board of the session's trajectory ``trajectory`` (its index in ``arcs.azimuths_deg`` or
+        ``lines.offsets_deg``): the dataset's ground truth and model origin."""
+        return self.boards[self.board_of[trajectory]]
 
 
 def _model_view_frame(view_dir: np.ndarray) -> np.ndarray:
@@ -141,14 +163,13 @@ def _held_phantom(name: str, params: "GenerateParams", spec: "SceneSpec", view_d
 
 
 def build_scene(spec: "SceneSpec", index: int, params: "GenerateParams", protocol: "ProtocolParams",
-                session: str = "arc", placement: board_placement.BoardPlacement | None = None) -> Scene:
+                session: str = "arc", plan: board_plan.BoardPlan | None = None) -> Scene:
     """Lay out scene ``spec`` (index = its position in params, seeds the arrangement with ``params.seed``) for one
     session: its arcs (``"arc"``) or, on the lines' scene, its lines (``"line"``). Each session has its own model pair
-    (IV-D), and the lab stands the ground-truth board where that session's trajectories (``protocol``) keep it in view;
-    targets, their stands and the table are the same in both, the clutter keeps clear of the board's sight lines. A
-    board that fits nowhere raises :class:`~.board_placement.PlacementError`; ``placement``: the board's place found
-    by an earlier call for the same session (the search is skipped: workers rebuild a scene the main process laid
-    out)."""
+    (IV-D), and the lab stands the ground-truth boards where that session's trajectories (``protocol``) keep them in
+    view; targets, their stands and the table are the same in both, the clutter keeps clear of the boards' sight lines.
+    A board that fits nowhere raises :class:`~.board_placement.PlacementError`; ``plan``: the boards' plan found by an
+    earlier call for the same session (the search is skipped: workers rebuild a scene the main process laid out)."""
     rng = keyed_rng(params.seed, "scene", index)
     yaw = np.deg2rad(rng.uniform(-20, 20))  # direction of the model camera around the target
     elev = np.deg2rad(spec.elevation_deg)
@@ -169,37 +190,52 @@ def build_scene(spec: "SceneSpec", index: int, params: "GenerateParams", protoco
         target_poses.append(T)
     aim = np.mean([T[:3, 3] for T in target_poses], axis=0)
 
-    board = params.board.drawing()
     board_yaw = yaw + np.pi + rng.uniform(-0.3, 0.3)  # drawn for either placement: the clutter after it lies alike
+    n_trajectories = len(params.arcs.azimuths_deg) if session == "arc" else len(params.lines.offsets_deg)
     if params.board.placement == "flat":
-        T_world_board, board_objects, board_centre = _flat_board(params, board, board_yaw, target_poses[0], yaw, aim,
+        drawing = params.board.drawing()
+        T_world_board, board_objects, board_centre = _flat_board(params, drawing, board_yaw, target_poses[0], yaw, aim,
                                                                  view_dir)
-        sight, placement = None, None
+        boards, board_of, sight = (SceneBoard(drawing, measured_board(params, drawing), T_world_board),), None, None
+        feet = [board_centre]
     else:
-        placement, board_objects, sight = _standing_board(params, protocol, spec, session, board, placed, aim,
-                                                          view_dir, placement)
-        T_world_board, board_centre = placement.T_world_board, placement.post_foot[:2]
+        plan, board_objects, sight = _standing_boards(params, protocol, spec, session, placed, aim, view_dir, plan)
+        boards = tuple(SceneBoard(drawing, measured_board(params, drawing), b.placement.T_world_board, b.placement,
+                                  b.sigma_t_mm) for b, drawing in zip(plan.boards, _drawings(params, plan)))
+        board_of, feet = plan.board_of, [b.placement.post_foot[:2] for b in plan.boards]
     placed += board_objects
-    placed += _clutter(spec, params, rng, aim, view_dir[:2] / np.linalg.norm(view_dir[:2]), board_centre, sight)
+    placed += _clutter(spec, params, rng, aim, view_dir[:2] / np.linalg.norm(view_dir[:2]), feet, sight)
 
     light_dir = np.array([rng.uniform(-0.5, 0.5), rng.uniform(-0.5, 0.3), 1.0])
-    return Scene(spec.name, placed, tuple(spec.targets), target_poses[0], T_world_board, measured_board(params), aim,
-                 view_dir, light_dir, placement)
+    return Scene(spec.name, placed, tuple(spec.targets), target_poses[0], boards, board_of or (0,) * n_trajectories,
+                 aim, view_dir, light_dir, plan if params.board.placement != "flat" else None)
 
 
-def _board_sheet(params: "GenerateParams", board: Board) -> meshes.Mesh:
-    """The printed board in its own frame (x right, y down, facing -z, origin at the pattern's top-left corner), as
-    printed: scaled and bowed (:func:`print_errors`). The plane spans the texture's texel centres (the renderer maps
-    texture coordinates 0 and 1 onto its edges): a plane of the print's full size would stretch the board by
-    n / (n - 1) texels (calibration_views.py)."""
+def _drawings(params: "GenerateParams", plan: board_plan.BoardPlan) -> list[Board]:
+    """The drawing of each board of a plan: the params' board printed at its square size, ids from its first."""
+    return [params.board.drawing(square_mm=b.square_mm, first_id=b.first_id) for b in plan.boards]
+
+
+def board_texture_name(k: int) -> str:
+    """The texture of a scene's k-th board (the first: ``board``)."""
+    return "board" if k == 0 else f"board_{k + 1}"
+
+
+def _board_sheet(params: "GenerateParams", board: Board, k: int = 0) -> meshes.Mesh:
+    """The printed board (its drawing) in its own frame (x right, y down, facing -z, origin at the pattern's top-left
+    corner), as printed: scaled and bowed (:func:`print_errors`), textured with the scene's k-th board texture
+    (:func:`board_texture_name`). The plane spans the texture's texel centres (the renderer maps texture coordinates
+    0 and 1 onto its edges): a plane of the print's full size would stretch the board by n / (n - 1) texels
+    (calibration_views.py)."""
     bw, bh = board.size_mm
     n_x, n_y = tex.board_texture(board, params.board.px_per_mm, params.board.margin_mm).shape[::-1]
-    sheet = meshes.plane((n_x - 1) / params.board.px_per_mm, (n_y - 1) / params.board.px_per_mm, 12, 9, "board",
-                         material=meshes.Material(0.02, 10.0))
+    sheet = meshes.plane((n_x - 1) / params.board.px_per_mm, (n_y - 1) / params.board.px_per_mm, 12, 9,
+                         board_texture_name(k), material=meshes.Material(0.02, 10.0))
     # plane() faces +z with texture v along -y; flip about x so it faces -z (the printed side) with v along +y
     sheet = sheet.transformed(pose_matrix(np.diag([1.0, -1.0, -1.0]), [bw / 2, bh / 2, 0.0]))
     return meshes.printed_sheet(sheet, np.array([bw / 2, bh / 2]), (n_x - 1) / params.board.px_per_mm / 2,
-                                *print_errors(params, "aruco", params.printed_boards.board_sag_std_mm))
+                                *print_errors(params, printed_name(params, board),
+                                              params.printed_boards.board_sag_std_mm))
 
 
 def _flat_board(params: "GenerateParams", board: Board, board_yaw: float, T_world_target: np.ndarray, yaw: float,
@@ -226,39 +262,82 @@ def _flat_board(params: "GenerateParams", board: Board, board_yaw: float, T_worl
     return T_world_board, objects, board_centre
 
 
-def _standing_board(params: "GenerateParams", protocol: "ProtocolParams", spec: "SceneSpec", session: str,
-                    board: Board, placed: list[tuple[str, meshes.Mesh]], aim: np.ndarray, view_dir: np.ndarray,
-                    placement: board_placement.BoardPlacement | None):
-    """Placement ``facing_camera`` (:mod:`.board_placement`): the board on a post, facing the session's model camera,
-    clear of the targets along every trajectory of the session (``placement``, when given, is where it was found).
-    Returns the placement, the meshes (board, post) and what clutter must keep clear of: the board's paper corners
-    (4, 3) and the session's poses."""
+def _standing_boards(params: "GenerateParams", protocol: "ProtocolParams", spec: "SceneSpec", session: str,
+                     placed: list[tuple[str, meshes.Mesh]], aim: np.ndarray, view_dir: np.ndarray,
+                     plan: board_plan.BoardPlan | None):
+    """Placements ``planned`` (:mod:`.board_plan`) and ``facing_camera`` (:mod:`.board_placement`): boards on posts,
+    facing the session's model camera, clear of the targets along every trajectory of the session (``plan``, when
+    given, is where they were found). Returns the plan, the meshes (boards, posts) and what clutter must keep clear
+    of: each board's paper corners (4, 3) and the session's poses."""
     cam = Intrinsics.from_params(params.camera)
     if session == "line":
         lines = params.lines
-        poses = board_placement.line_poses(aim, view_dir, lines.distance_mm, params.model_baseline_mm,
-                                           lines.offsets_deg, protocol.line_length_mm, lines.n_stops)
+        focus = lines.focus_mm(protocol.line_length_mm)
+        pair, trajectories = board_placement.line_trajectories(aim, view_dir, lines.distance_mm,
+                                                               params.model_baseline_mm, lines.offsets_deg,
+                                                               protocol.line_length_mm, lines.n_stops)
     else:
-        poses = board_placement.arc_poses(aim, view_dir, spec.distance_mm, params.model_baseline_mm,
-                                          params.arcs.azimuths_deg, protocol.arc_span_deg, params.arcs.n_stops)
+        focus = spec.distance_mm
+        pair, trajectories = board_placement.arc_trajectories(aim, view_dir, focus, params.model_baseline_mm,
+                                                              params.arcs.azimuths_deg, protocol.arc_span_deg,
+                                                              params.arcs.n_stops)
+    if plan is None:
+        plan = _plan(params, spec, placed, aim, pair, trajectories, cam, focus)
+    objects, papers = [], []
+    m = params.board.margin_mm
+    for k, (planned, drawing) in enumerate(zip(plan.boards, _drawings(params, plan))):
+        T, where = planned.placement.T_world_board, planned.placement
+        post = meshes.cylinder(board_placement.POST_RADIUS_MM, float(where.post_top[2]), "clutter_c")
+        suffix = "" if k == 0 else f"_{k + 1}"
+        objects += [(f"board{suffix}", _board_sheet(params, drawing, k).transformed(T)),
+                    (f"board_post{suffix}", post.transformed(pose_matrix(np.eye(3), where.post_foot)))]
+        bw, bh = drawing.size_mm
+        papers.append((T[:3, :3] @ np.array([[-m, -m, 0], [bw + m, -m, 0], [bw + m, bh + m, 0], [-m, bh + m, 0]]).T
+                       ).T + T[:3, 3])
+    poses = [*pair] + [T for trajectory in trajectories for T in trajectory]
+    return plan, objects, (papers, poses)
+
+
+def _plan(params: "GenerateParams", spec: "SceneSpec", placed: list[tuple[str, meshes.Mesh]], aim: np.ndarray,
+          pair: list[np.ndarray], trajectories: list[list[np.ndarray]], cam: Intrinsics,
+          focus_mm: float) -> board_plan.BoardPlan:
+    """Where the session's boards stand: :func:`.board_plan.plan_boards` (``planned``) or one board of the params'
+    size where most of it stays in view (``facing_camera``, :func:`.board_placement.place_board`)."""
     targets = [mesh.vertices for name, mesh in placed if name in spec.targets]
-    if placement is None:
-        placement = board_placement.place_board(board.size_mm, params.board.margin_mm, targets, aim, poses[0], poses,
-                                                cam.K, cam.width, cam.height, f"scene {spec.name}")
-    T = placement.T_world_board
-    post = meshes.cylinder(board_placement.POST_RADIUS_MM, float(placement.post_top[2]), "clutter_c")
-    objects = [("board", _board_sheet(params, board).transformed(T)),
-               ("board_post", post.transformed(pose_matrix(np.eye(3), placement.post_foot)))]
-    bw, bh, m = *board.size_mm, params.board.margin_mm
-    paper = (T[:3, :3] @ np.array([[-m, -m, 0], [bw + m, -m, 0], [bw + m, bh + m, 0], [-m, bh + m, 0]]).T).T + T[:3, 3]
-    return placement, objects, (paper, poses)
+    where = f"scene {spec.name}"
+    board = params.board
+    if board.placement == "facing_camera":
+        poses = [*pair] + [T for trajectory in trajectories for T in trajectory]
+        placement = board_placement.place_board(board.drawing().size_mm, board.margin_mm, targets, aim, poses[0],
+                                                poses, cam.K, cam.width, cam.height, where)
+        return board_plan.BoardPlan((board_plan.PlannedBoard(board.square_mm, 0, placement, float("nan")),),
+                                    (0,) * len(trajectories), (0,) * len(trajectories))
+    obstacles = [board_plan.Obstacle(v, True) for v in targets] + [
+        board_plan.Obstacle(mesh.vertices, False) for name, mesh in placed
+        if name.endswith("_stand") and name.removesuffix("_stand") in spec.targets]
+    cells = board.drawing().cv_board().getDictionary().markerSize + 2  # its bits and the black border
+    return board_plan.plan_boards(board.sizes_mm, (board.squares_x, board.squares_y), board.marker_mm / board.square_mm,
+                                  cells, board.margin_mm, board.max_boards, board.plan_sigma_t_mm, obstacles,
+                                  targets[0].mean(axis=0), aim, pair, trajectories, cam.K, cam.width, cam.height,
+                                  focus_mm,
+                                  params.camera, params.sensor.blur_sigma_px, where)
 
 
-def measured_board(params: "GenerateParams") -> Board:
-    """The ground-truth board as the lab knows it: the drawing scaled by the printed size the lab measured
-    (:func:`measured_scale`)."""
-    drawing = params.board.drawing()
-    return params.board.drawing(measured_scale(params, "aruco", drawing))
+def measured_board(params: "GenerateParams", drawing: Board | None = None) -> Board:
+    """A ground-truth board as the lab knows it: its drawing (default: ``generate.board``'s) scaled by the printed
+    size the lab measured (:func:`measured_scale`)."""
+    drawing = params.board.drawing() if drawing is None else drawing
+    scale = measured_scale(params, printed_name(params, drawing), drawing)
+    return replace(drawing, scale=scale)
+
+
+def printed_name(params: "GenerateParams", drawing: Board) -> str:
+    """The key of a printed ground-truth board's draws (:func:`print_errors`, :func:`measured_scale`): "aruco" for
+    the params' own drawing (the board of every scene before issue 39), else one of its size and first id: each
+    board the lab prints is one physical board in every scene that uses it."""
+    if drawing == params.board.drawing():
+        return "aruco"
+    return f"aruco_{drawing.size_mm[0]:g}x{drawing.size_mm[1]:g}_{getattr(drawing, 'first_id', 0)}"
 
 
 def measured_scale(params: "GenerateParams", board: str, drawing: Board) -> tuple[float, float]:
@@ -283,22 +362,24 @@ def print_errors(params: "GenerateParams", board: str, sag_std_mm: float) -> tup
 
 def scene_textures(scene: Scene, params: "GenerateParams") -> dict[str, np.ndarray]:
     """The albedo map of every texture the scene's meshes use: an image file of ``generate.textures`` or the
-    procedural texture of that name, and the printed ground-truth board."""
+    procedural texture of that name, and the printed ground-truth boards."""
     used = {m.texture for _, m in scene.placed if m.texture is not None}
+    boards = {board_texture_name(k): b.drawing for k, b in enumerate(scene.boards)}
     textures = {name: (tex.load_texture(params.textures[name]) if name in params.textures
-                       else procedural_texture(name, params.seed)) for name in used if name != "board"}
-    textures["board"] = tex.board_texture(params.board.drawing(), params.board.px_per_mm, params.board.margin_mm)
+                       else procedural_texture(name, params.seed)) for name in used if name not in boards}
+    textures |= {name: tex.board_texture(drawing, params.board.px_per_mm, params.board.margin_mm)
+                 for name, drawing in boards.items()}
     return textures
 
 
 def _clutter(spec: "SceneSpec", params: "GenerateParams", rng: np.random.Generator, aim: np.ndarray,
-             toward_cam: np.ndarray, board_centre: np.ndarray,
-             sight: tuple[np.ndarray, list[np.ndarray]] | None) -> list[tuple[str, meshes.Mesh]]:
-    """``spec.n_clutter`` objects around the target, off the line of sight of the model view and off the board:
-    printed boxes and cylinders, and (one in three) bone-foam offcuts, a block or a shaft. ``sight``: a standing
-    board's paper corners (4, 3) and the scene's poses; no object (as tall as any can be) may cover the board at any
-    of them."""
-    occupied = [(aim[:2], 90.0 + 130.0 * (len(spec.targets) - 1)), (board_centre, 80.0)]
+             toward_cam: np.ndarray, board_feet: list[np.ndarray],
+             sight: tuple[list[np.ndarray], list[np.ndarray]] | None) -> list[tuple[str, meshes.Mesh]]:
+    """``spec.n_clutter`` objects around the target, off the line of sight of the model view and off the boards
+    (``board_feet``: where each stands on the table, (2,)): printed boxes and cylinders, and (one in three) bone-foam
+    offcuts, a block or a shaft. ``sight``: the standing boards' paper corners (4, 3 each) and the scene's poses; no
+    object (as tall as any can be) may cover a board at any of them."""
+    occupied = [(aim[:2], 90.0 + 130.0 * (len(spec.targets) - 1))] + [(foot, 80.0) for foot in board_feet]
     foam = foam_material(params.bone_foam)
     placed, attempts = [], 0
     while len(placed) < spec.n_clutter and attempts < 500:
@@ -311,8 +392,9 @@ def _clutter(spec: "SceneSpec", params: "GenerateParams", rng: np.random.Generat
             continue
         if any(np.linalg.norm(xy - c) < radius + rc for c, rc in occupied):
             continue
-        if sight is not None and board_placement.covers(xy, radius, CLUTTER_MAX_HEIGHT_MM, *sight,
-                                                        Intrinsics.from_params(params.camera).K):
+        if sight is not None and any(board_placement.covers(xy, radius, CLUTTER_MAX_HEIGHT_MM, paper, sight[1],
+                                                            Intrinsics.from_params(params.camera).K)
+                                     for paper in sight[0]):
             continue
         occupied.append((xy, radius))
         kind = rng.random()

@@ -48,7 +48,8 @@ from poseintegrity.protocol import ProtocolParams
 from poseintegrity.staging import partial_folder
 from poseintegrity.scenes import catalog, optics, renderer, trajectories
 from poseintegrity.scenes.acquisition import Route, image_motion, image_pose, model_motion, rotation_maps, visits
-from poseintegrity.scenes.board_placement import BoardPlacement, PlacementError
+from poseintegrity.scenes.board_placement import PlacementError
+from poseintegrity.scenes.board_plan import BoardPlan
 from poseintegrity.scenes.calibration_views import CalibrationSession, calibration_session, write_calibration
 from poseintegrity.scenes.camera import Intrinsics, true_camera
 from poseintegrity.scenes.foam import ReliefVolume, bone_foam_relief
@@ -95,9 +96,11 @@ def plan_datasets(params: GenerateParams, world: str = "main") -> list[DatasetPl
 @dataclass(frozen=True)
 class Trip:
     """Where the camera of one dataset is commanded to go: its model pair (T_world_cam, the first is where the
-    trajectory starts) at ``distance_mm`` from the aim point, and the stops of its trajectory."""
+    trajectory starts) at ``distance_mm`` from the aim point, and the stops of its trajectory; the lens is focused at
+    ``focus_mm`` for the whole session (arcs: the model view; lines: ``generate.lines.focus``)."""
 
     distance_mm: float
+    focus_mm: float
     model_views: list[np.ndarray]
     stops: list[trajectories.Stop]
 
@@ -113,7 +116,8 @@ def plan_trip(params: GenerateParams, protocol: ProtocolParams, plan: DatasetPla
     else:
         stops = trajectories.line(model_views[0], scene.aim, plan.offset_deg, protocol.line_length_mm,
                                   params.lines.n_stops)
-    return Trip(distance_mm, model_views, stops)
+    focus_mm = distance_mm if plan.trajectory == "arc" else params.lines.focus_mm(protocol.line_length_mm)
+    return Trip(distance_mm, focus_mm, model_views, stops)
 
 
 class WorldError(PoseIntegrityError):
@@ -134,19 +138,29 @@ def sessions(params: GenerateParams) -> list[tuple[int, str]]:
     return [(index, "arc") for index in range(len(names))] + lines
 
 
-def check_world(params: GenerateParams, protocol: ProtocolParams, world: str = "main") -> dict[tuple[int, str], catalog.Scene]:
+def laid_out(params: GenerateParams, protocol: ProtocolParams, world: str, index: int, session: str) -> catalog.Scene:
+    """Scene ``index``'s ``session`` laid out (:func:`~.catalog.build_scene`, its boards planned); a board with no
+    place raises :class:`WorldError` naming the scene's key."""
+    try:
+        return catalog.build_scene(params.scenes[index], index, params, protocol, session)
+    except PlacementError as error:
+        raise WorldError(f"{scenes_key(world)}.{index} ({session}s): {error}") from None
+
+
+def check_world(params: GenerateParams, protocol: ProtocolParams, world: str = "main",
+                workers: Workers | None = None, progress: bool = True) -> dict[tuple[int, str], catalog.Scene]:
     """Lay out every scene's sessions before any rendering, naming the key, when one cannot be rendered as the
     protocol needs; returns the scenes by (index, session). Every scene is built (an unreadable mesh or a hole outside
-    the bone raises :class:`~.mesh.MeshError` here, a board with no place a :class:`WorldError`); each target must lie
-    mostly inside both model views of its session (a mesh scaled far too large or too small, or a distance that puts
-    the target out of the picture). The robot's reach is checked by :func:`drive`."""
+    the bone raises :class:`~.mesh.MeshError` here, a board with no place a :class:`WorldError`), on ``workers`` when
+    given (planning a scene's boards takes seconds); each target must lie mostly inside both model views of its
+    session (a mesh scaled far too large or too small, or a distance that puts the target out of the picture). The
+    robot's reach is checked by :func:`drive`."""
     cam = Intrinsics.from_params(params.camera)
-    scenes = {}
-    for index, session in sessions(params):
-        try:
-            scene = scenes[index, session] = catalog.build_scene(params.scenes[index], index, params, protocol, session)
-        except PlacementError as error:
-            raise WorldError(f"{scenes_key(world)}.{index} ({session}s): {error}") from None
+    layouts = [partial(laid_out, params, protocol, world, index, session) for index, session in sessions(params)]
+    built = (workers.map(_call, layouts, desc=f"layouts and boards of {len(layouts)} sessions ({world} world)",
+                         progress=progress) if workers is not None else [layout() for layout in layouts])
+    scenes = dict(zip(sessions(params), built))
+    for (index, session), scene in scenes.items():
         distance = params.scenes[index].distance_mm if session == "arc" else params.lines.distance_mm
         for T_world_cam in trajectories.model_pair(scene.aim, scene.view_dir, distance, params.model_baseline_mm):
             T_cam_world = inverse(T_world_cam)
@@ -212,13 +226,13 @@ WORLDS_KEPT = 2  # per process: the shots of one session run together, a worker 
 
 
 def world(params: GenerateParams, protocol: ProtocolParams, scene_index: int, session: str,
-          placement: BoardPlacement | None = None) -> World:
+          plan: BoardPlan | None = None) -> World:
     """The scene of one session and its renderable geometry, built once per process (the last WORLDS_KEPT kept);
-    ``placement``: its board's place, found when the world was planned (:func:`~.catalog.build_scene`)."""
+    ``plan``: its boards' plan, found when the world was planned (:func:`~.catalog.build_scene`)."""
     key = (params.model_dump_json(), protocol.model_dump_json(), scene_index, session,
-           None if placement is None else placement.T_world_board.tobytes())
+           None if plan is None else tuple(b.placement.T_world_board.tobytes() for b in plan.boards))
     if key not in _WORLDS:
-        _WORLDS[key] = _build_world(params, protocol, scene_index, session, placement)
+        _WORLDS[key] = _build_world(params, protocol, scene_index, session, plan)
         while len(_WORLDS) > WORLDS_KEPT:
             _WORLDS.popitem(last=False)
         give_back_freed_memory()
@@ -247,8 +261,8 @@ def _relief(bone_foam: BoneFoamParams, seed: int) -> ReliefVolume:
 
 
 def _build_world(params: GenerateParams, protocol: ProtocolParams, scene_index: int, session: str,
-                 placement: BoardPlacement | None) -> World:
-    scene = catalog.build_scene(params.scenes[scene_index], scene_index, params, protocol, session, placement)
+                 plan: BoardPlan | None) -> World:
+    scene = catalog.build_scene(params.scenes[scene_index], scene_index, params, protocol, session, plan)
     atlas = build_atlas(catalog.scene_textures(scene, params))
     geometry = renderer.SceneGeometry.from_meshes(scene.placed, atlas, scene.light_dir, params.lights.intensities(),
                                                   _relief(params.bone_foam, params.seed))
@@ -279,13 +293,13 @@ class Shot:
     T_world_cam: np.ndarray
     focus_mm: float
     exposures: tuple[Exposure, ...]
-    placement: BoardPlacement | None = None  # the session's board (found when the world was planned)
+    plan: BoardPlan | None = None  # the session's boards (found when the world was planned)
 
 
 def plan_shots(params: GenerateParams, plans: list[DatasetPlan], trips: list[Trip], routes: list[Route],
-               placements: dict[tuple[int, str], BoardPlacement | None]) -> list[Shot]:
+               boards: dict[tuple[int, str], BoardPlan | None]) -> list[Shot]:
     """Every image of every dataset, one shot per visit (a scene's model pair once for all datasets sharing it), the
-    shots of a scene together (a worker then builds each scene once); ``placements``: each session's board."""
+    shots of a scene together (a worker then builds each scene once); ``boards``: each session's boards' plan."""
     f_px = Intrinsics.from_params(params.camera).K[0, 0]
     shots: dict[tuple, Shot] = {}
     for plan, trip, route in zip(plans, trips, routes):
@@ -298,15 +312,15 @@ def plan_shots(params: GenerateParams, plans: list[DatasetPlan], trips: list[Tri
                     for e in shot.exposures))
                 continue
             motion = model_motion(visit, params.capture, f_px)
-            shots[key] = Shot(plan.scene_index, plan.trajectory, visit.T_world_cam, trip.distance_mm, (Exposure(
+            shots[key] = Shot(plan.scene_index, plan.trajectory, visit.T_world_cam, trip.focus_mm, (Exposure(
                 (plan.dataset,), f"model/model_{k}.png", ("model", plan.scene_index, plan.trajectory, k),
-                motion.path, f"model/mask_{k}.png"),), placements[plan.scene_index, plan.trajectory])
+                motion.path, f"model/mask_{k}.png"),), boards[plan.scene_index, plan.trajectory])
         for s, visit in enumerate(route.stops):
             exposures = tuple(Exposure((plan.dataset,), file, (plan.dataset, s, i),
                                        image_motion(visit, params.capture, i, f_px).path)
                               for i, file in enumerate(_image_files(s, params.images_per_stop)))
-            shots[(plan.dataset, s)] = Shot(plan.scene_index, plan.trajectory, visit.T_world_cam, trip.distance_mm,
-                                            exposures, placements[plan.scene_index, plan.trajectory])
+            shots[(plan.dataset, s)] = Shot(plan.scene_index, plan.trajectory, visit.T_world_cam, trip.focus_mm,
+                                            exposures, boards[plan.scene_index, plan.trajectory])
     # stable: the datasets' order within a session; a worker then builds each session's scene once
     return sorted(shots.values(), key=lambda shot: (shot.scene_index, shot.session))
 
@@ -325,7 +339,7 @@ def take_shot(params: GenerateParams, protocol: ProtocolParams, root: Path, shot
     """Render ``shot`` on the lens' ideal canvas, blur it by the lens and the depth of field, and for every image
     turn it by the image's ring-down path, distort it onto the sensor and expose it; write the images (and masks)
     into the datasets' partial folders under ``root``."""
-    scene_world = world(params, protocol, shot.scene_index, shot.session, shot.placement)
+    scene_world = world(params, protocol, shot.scene_index, shot.session, shot.plan)
     lens = true_camera(params.camera)  # its canvas and sensor maps are computed once per process
     K_canvas, width, height = lens.canvas
     frame = renderer.render(scene_world.geometry, K_canvas, width, height, inverse(shot.T_world_cam))
@@ -370,11 +384,21 @@ def check_meta(meta: dict, dataset: str) -> None:
         raise DatasetError(f"dataset {dataset}: its meta.json would have invalid values:\n" + "\n".join(lines)) from None
 
 
+def trajectory_index(params: GenerateParams, plan: DatasetPlan) -> int:
+    """The index of a dataset's trajectory in its session (``arcs.azimuths_deg`` or ``lines.offsets_deg``), which
+    names its board (:meth:`~.catalog.Scene.board_for`)."""
+    if plan.trajectory == "arc":
+        return params.arcs.azimuths_deg.index(plan.azimuth_deg)
+    return params.lines.offsets_deg.index(plan.offset_deg)
+
+
 def finish_dataset(params: GenerateParams, root: Path, plan: DatasetPlan, trip: Trip, route: Route,
                    scene: catalog.Scene, camera: Camera) -> dict:
     """Once its images are written: the dataset's frames.parquet, meta.json and camera.yaml (``camera``: the world's
-    calibration estimate), then its partial folder renamed to ``root / plan.dataset``; returns its row of the index."""
+    calibration estimate), then its partial folder renamed to ``root / plan.dataset``; returns its row of the index.
+    The dataset's ground truth is its trajectory's board (:meth:`~.catalog.Scene.board_for`)."""
     spec = params.scenes[plan.scene_index]
+    board = scene.board_for(trajectory_index(params, plan))
     truth = true_camera(params.camera)
     f_px = truth.K[0, 0]
     tmp, final = _partial(root, plan.dataset), root / plan.dataset
@@ -384,21 +408,21 @@ def finish_dataset(params: GenerateParams, root: Path, plan: DatasetPlan, trip: 
         "images": [f"model/model_{k}.png" for k in range(len(route.model))],
         "masks": [f"model/mask_{k}.png" for k in range(len(route.model))],
         "T_cam1_cam0": T_cam1_cam0.tolist(),
-        "exact_T_cam_board": [(inverse(T) @ scene.T_world_board).tolist() for T in model_poses],
+        "exact_T_cam_board": [(inverse(T) @ board.T_world_board).tolist() for T in model_poses],
     }
     rows = []
     for s, (stop, visit) in enumerate(zip(trip.stops, route.stops)):
         for i, file in enumerate(_image_files(s, params.images_per_stop)):
             T_cam_world = inverse(image_pose(visit, image_motion(visit, params.capture, i, f_px)))
             rows.append({"dataset": plan.dataset, "stop": s, "image": i, "theta_deg": stop.theta_deg,
-                         "x_mm": stop.x_mm, "file": file, "T_cam_board": _flat(T_cam_world @ scene.T_world_board),
+                         "x_mm": stop.x_mm, "file": file, "T_cam_board": _flat(T_cam_world @ board.T_world_board),
                          "T_cam_target": _flat(T_cam_world @ scene.T_world_target)})
     pd.DataFrame(rows).to_parquet(tmp / "frames.parquet", index=False)
     meta = {
         "dataset": plan.dataset, "world": plan.world, "scene": spec.name, "targets": list(spec.targets),
         "trajectory": plan.trajectory, "azimuth_deg": plan.azimuth_deg, "offset_deg": plan.offset_deg,
         "n_stops": len(trip.stops), "images_per_stop": params.images_per_stop,
-        "board": scene.board.as_dict(), "model": model, "model_baseline_mm": params.model_baseline_mm,
+        "board": board.board.as_dict(), "model": model, "model_baseline_mm": params.model_baseline_mm,
         "distance_mm": trip.distance_mm,
         "true_camera": {"K": truth.K.tolist(), "dist": truth.dist.tolist()},  # a diagnostic: stage 02 never reads it
     }
@@ -438,7 +462,8 @@ def plan_worlds(params: GenerateParams, protocol: ProtocolParams, workers: Worke
     in each scene (:func:`drive_scene`): every error comes here, before any dataset is rendered. The results do not
     depend on where the tasks run (keyed draws): the same as one after the other, world by world."""
     worlds = params.worlds()
-    scenes = {name: check_world(world_params, protocol, name) for name, world_params in worlds.items()}
+    scenes = {name: check_world(world_params, protocol, name, workers, progress)
+              for name, world_params in worlds.items()}
     plans = {name: plan_datasets(world_params, name) for name, world_params in worlds.items()}
     trips = {name: [plan_trip(worlds[name], protocol, plan, scenes[name][plan.scene_index, plan.trajectory])
                     for plan in plans[name]]
@@ -483,7 +508,7 @@ def generate(params: GenerateParams, protocol: ProtocolParams, root: Path, worke
             shutil.rmtree(tmp, ignore_errors=True)
             (tmp / "model").mkdir(parents=True)
             (tmp / "images").mkdir()
-        shots = plan_shots(w.params, w.plans, w.trips, w.routes, {key: s.placement for key, s in w.scenes.items()})
+        shots = plan_shots(w.params, w.plans, w.trips, w.routes, {key: s.plan for key, s in w.scenes.items()})
         workers.map(partial(take_shot, w.params, protocol, root), shots,
                     desc=f"camera poses of {len(w.plans)} datasets ({w.name} world)", progress=progress)
         rows += [finish_dataset(w.params, root, plan, trip, route, w.scenes[plan.scene_index, plan.trajectory],

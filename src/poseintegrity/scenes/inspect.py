@@ -63,17 +63,25 @@ def folder_size_bytes(root: Path) -> int:
 
 
 def board_layout(worlds: dict) -> pd.DataFrame:
-    """Per world, scene and session (``dataset.generate``'s plans): where the ground-truth board stands. Columns:
+    """Per world, scene, session and board (``dataset.generate``'s plans): where each ground-truth board stands.
+    Columns: ``board_index`` (0, or 1 for a second board), ``square_mm``, ``first_id``, ``trajectories`` (the
+    trajectories it is the ground truth of, by index in ``arcs.azimuths_deg`` / ``lines.offsets_deg``),
     ``lever_arm_mm``, the distance from the board origin (where E_t is measured, IV-C) to the aim point the arcs turn
     about (the target); ``in_view``, the share of the board inside the image at its worst commanded pose (standing
-    boards; NaN when it lies flat); ``scale_x``, ``scale_y``, the printed size over the drawn size as the lab
-    measured it."""
+    boards; NaN when it lies flat); ``predicted_sigma_t_mm``, its pose's predicted RMS error at its origin at the
+    worst stop it serves (planned boards, :mod:`.board_plan`; else NaN); ``scale_x``, ``scale_y``, the printed size
+    over the drawn size as the lab measured it."""
     rows = []
     for name, w in worlds.items():
         for (index, session), scene in w.scenes.items():
-            rows.append({"world": name, "scene": scene.name, "session": session,
-                         "placement": w.params.board.placement, "board": w.params.board.type,
-                         "lever_arm_mm": float(np.linalg.norm(scene.T_world_board[:3, 3] - scene.aim)),
-                         "in_view": scene.placement.in_view if scene.placement is not None else np.nan,
-                         "scale_x": scene.board.scale[0], "scale_y": scene.board.scale[1]})
+            for k, board in enumerate(scene.boards):
+                rows.append({"world": name, "scene": scene.name, "session": session, "board_index": k,
+                             "placement": w.params.board.placement, "board": w.params.board.type,
+                             "square_mm": getattr(board.drawing, "square_mm", np.nan),
+                             "first_id": board.drawing.first_id,
+                             "trajectories": [t for t, b in enumerate(scene.board_of) if b == k],
+                             "lever_arm_mm": float(np.linalg.norm(board.T_world_board[:3, 3] - scene.aim)),
+                             "in_view": board.placement.in_view if board.placement is not None else np.nan,
+                             "predicted_sigma_t_mm": board.sigma_t_mm,
+                             "scale_x": board.board.scale[0], "scale_y": board.board.scale[1]})
     return pd.DataFrame(rows)

@@ -1,9 +1,10 @@
 """The lens between the rendered radiance and the sensor: depth of field and the lens' own blur.
 
-The camera is focused once, at the model view's aim point (IV-D: the robot then moves; a fixed-focus machine-vision
-lens is not refocused), so every point is blurred by its own circle of confusion, which grows with its distance
-from the focus plane: the far clutter of a view, the far side of a target seen obliquely, the whole target once the
-robot has backed away along a line. The blur of a pixel is a Gaussian of sigma = hypot(lens blur, defocus(depth)),
+The camera is focused once per session (IV-D: the robot then moves; a fixed-focus machine-vision lens is not
+refocused): an arc's at the model view's aim point, the lines' where ``generate.lines.focus`` says (the model view,
+or the range the lines image), so every point is blurred by its own circle of confusion, which grows with its
+distance from the focus plane: the far clutter of a view, the far side of a target seen obliquely, the target at the
+ends of a line. The blur of a pixel is a Gaussian of sigma = hypot(lens blur, defocus(depth)),
 applied as a layered depth-of-field approximation (the radiance blurred at a ladder of sigmas, each pixel
 interpolated between the two rungs around its own sigma): exact inside a surface, approximate at depth edges.
 """

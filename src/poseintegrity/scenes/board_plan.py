@@ -1,0 +1,419 @@
+"""How a lab places and sizes the ground-truth boards of a scene (``generate.board.placement: planned``; issue 39).
+
+The lab looks at its camera's live image at every commanded pose of the scene's session (the robot's program is
+known before any data is taken) and stands ChArUco boards on posts beside the target. A board *serves* a trajectory
+when at model image 0 (whose board pose places M_t, IV-C) and at every stop of it (arcs to their last stop, lines to
+their far stop):
+
+1. **the whole board is in view**: the corners of its paper (pattern and white margin) lie inside the image, in
+   front of the camera. Part of a board gives a pose, but a weaker one (fewer corners, all to one side): issue 30's
+   board stood at the image's edge in scenes 5 and 7 and was trusted in 0-1 of 200 frames;
+2. **no target covers it**: where the board and a target (or a target's stand, or another board) overlap in the
+   image (its outline, sampled at most OUTLINE_STEP_PX apart, on the other's silhouette hull grown by CLEARANCE_PX,
+   or a hull vertex inside it), the nearer of the two covers the other; and the board **never covers a target** or
+   another board, at any pose of the session, served or not (a candidate that would is dropped);
+3. **it is in focus**: the lens is focused once per session (:mod:`.optics`), so the blur of the
+   board's nearest or farthest corner, hypot(the lens' own blur, the defocus), must stay within FOCUS_BLUR_PER_CELL of
+   a marker's bit cell where the pattern is smallest in the image (far, foreshortened), and a bit cell must span at
+   least MIN_CELL_PX, or its markers are not read (the lines' far stops of issue 30);
+4. **its pose is predicted within ``plan_sigma_t_mm``**: the covariance s^2 (J^T J)^-1 of the board pose from its
+   inner corners (the same prediction as stage 02's trust rule, :mod:`poseintegrity.localization.ground_truth`), J
+   the Jacobian of the corners' projections at the commanded pose, s the corner noise CORNER_NOISE_PX grown by the
+   blur; sigma_t is its RMS at the board origin, where E_t is measured (IV-C).
+
+The candidates: every size of ``generate.board.sizes_mm`` (squares_x x squares_y squares, the markers scaled alike),
+at board centres on a grid in the model camera's frame about the aim point (GRID_RIGHT_MM, GRID_UP_MM in the image,
+PLAN_TOWARDS_MM towards the camera), long side across the image or upright, facing the model camera or turned from it
+by PLAN_TILTS_DEG (a planar target seen face on is its worst-conditioned pose: its tilt trades for its distance), the
+origin at the corner nearest the first target. A candidate that fails 1-3 in model image 0 is dropped. Chosen, by the
+trajectories served, then the fewest poses not served, then the worst predicted sigma_t over what it serves (to
+SIGMA_STEP_MM), then the shortest lever arm from its origin to the target:
+
+- the best single board; and, where it does not serve every trajectory and ``max_boards`` is 2,
+- the best pair of boards that stand apart in the image at every pose (neither paper overlaps the other's paper or
+  post), among the PAIR_POOL best single boards and, for each trajectory, the PAIR_POOL boards best for it, when the
+  pair is better. The second board's marker ids follow the first's: the detector never mixes them.
+
+Each trajectory (dataset) takes one board for all its frames, the one that serves it best (the first on a tie): its
+origin is the dataset's model origin, M_t is placed by that board's pose in model image 0, and E_t and R11 are
+measured at that origin, as with one board. A trajectory no board serves wholly takes the one that fails the fewest of
+its poses (``BoardPlan.unserved`` counts them); stage 02 then says which frames are not judged. Deterministic: no
+random draw.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+from scipy.spatial import ConvexHull
+
+from poseintegrity.poses import inverse, pose_matrix
+from poseintegrity.scenes.board_placement import (
+    CLEARANCE_PX, GRID_RIGHT_MM, GRID_UP_MM, NEAR_MM, POST_BEHIND_MM, POST_RADIUS_MM, TABLE_CLEARANCE_MM,
+    BoardPlacement, PlacementError, hits, near_targets, pixels, project, vertices_inside,
+)
+from poseintegrity.scenes.optics import defocus_sigma_px
+
+# Measured on the renders of studies/board_options.py (ChArUco boards, 960 frames of issue 30's and this plan's
+# boards): the corner noise the trust rule sees, s = sqrt(SSR / (2n - 6)), is 0.055-0.065 px (median) on sharp boards
+# and grows with the blur to 0.10-0.13 px at a blur sigma of 2-2.7 px, as hypot(a, b x blur sigma). With
+# (0.068, 0.038) px the predicted sigma_t is at least the measured one in 95 % of the 506 frames whose board was
+# wholly in view, in focus and found with 20 or more corners (the measured one is 0.51-1.21 x, median 0.76 x, the
+# predicted one). Boards whose bit cells are 3 px or more and blurred by at most 0.35 of a cell were found with 20 or
+# more corners in 92-100 % of frames; beyond 0.5 of a cell in none.
+CORNER_NOISE_PX = (0.068, 0.038)
+PLAN_TOWARDS_MM = (-60.0, -30.0, 0.0, 30.0, 60.0)  # board centres from the aim point towards the camera
+# the board turned from facing the model camera by (about the image's x axis: 0, about its y axis: 1, deg): a board
+# seen face on is the worst-conditioned planar pose (its tilt trades for its distance, Schweighofer and Pinz 2006); a
+# lab tilts it
+PLAN_TILTS_DEG = ((0, 0.0), (0, 25.0), (0, -25.0), (0, 40.0), (0, -40.0), (1, 25.0), (1, -25.0), (1, 40.0), (1, -40.0))
+FOCUS_BLUR_PER_CELL = 0.35
+MIN_CELL_PX = 3.0  # below 3 px bit cells a quarter to a half of the boards lost their markers
+SIGMA_STEP_MM = 0.01  # predicted sigma_t closer than this count as equal: the lever arm decides
+PAIR_POOL = 25  # pairs of boards are sought among the 25 best single boards and the 25 best for each trajectory
+OUTLINE_STEP_PX = 10.0  # outline samples at most this far apart: less than 2 CLEARANCE_PX, so a crossing is caught
+
+
+@dataclass(frozen=True)
+class PlannedBoard:
+    """One board of a scene's plan: squares of ``square_mm``, marker ids from ``first_id``, where it stands, and its
+    worst predicted sigma_t (mm, at the board origin) over the stops of the trajectories it serves."""
+
+    square_mm: float
+    first_id: int
+    placement: BoardPlacement
+    sigma_t_mm: float
+
+
+@dataclass(frozen=True)
+class BoardPlan:
+    """The boards of one scene and session, per trajectory (in the order given) the index of its board, and how many
+    of the trajectory's poses (model image 0 and its stops) that board does not serve (0: every one)."""
+
+    boards: tuple[PlannedBoard, ...]
+    board_of: tuple[int, ...]
+    unserved: tuple[int, ...]
+
+
+@dataclass
+class _Candidates:
+    """Board candidates (n of them): centre (n, 3), board axes x_b, y_b, z_b (n, 3; z_b into the board, away from
+    the printed side), pattern size (n, 2), square (n,), paper size with its margin (n, 2); derived: ``origin`` (n, 3),
+    the pattern's corner x = y = 0, and ``post_top`` (n, 3), behind the centre."""
+
+    centre: np.ndarray
+    x_b: np.ndarray
+    y_b: np.ndarray
+    z_b: np.ndarray
+    pattern: np.ndarray
+    square: np.ndarray
+    paper: np.ndarray
+
+    def subset(self, keep: np.ndarray) -> _Candidates:
+        """The candidates ``keep`` (a mask or indices) alone."""
+        return _Candidates(self.centre[keep], self.x_b[keep], self.y_b[keep], self.z_b[keep], self.pattern[keep],
+                           self.square[keep], self.paper[keep])
+
+    def __post_init__(self) -> None:
+        self.origin = self.centre - self.pattern[:, :1] / 2 * self.x_b - self.pattern[:, 1:] / 2 * self.y_b
+        self.post_top = self.centre + (POST_RADIUS_MM + POST_BEHIND_MM) * self.z_b
+
+    def on_board(self, fractions: np.ndarray, of: np.ndarray, keep: np.ndarray) -> np.ndarray:
+        """World points (k, m, 3) of board-plane points given as fractions (m, 2) of the size ``of`` (n, 2) about
+        the centre, of the candidates ``keep`` (k of n: a mask or their indices)."""
+        offsets = fractions[None, :, :] * of[keep, None, :]  # (k, m, 2)
+        return (self.centre[keep, None, :] + offsets[..., :1] * self.x_b[keep, None, :]
+                + offsets[..., 1:] * self.y_b[keep, None, :])
+
+    def post(self, keep: np.ndarray, n: int = 24) -> np.ndarray:
+        """(k, n, 3): points along the post's axis from the table to its top."""
+        top = self.post_top[keep]
+        foot = top * np.array([1.0, 1.0, 0.0])
+        return foot[:, None, :] + np.linspace(0.0, 1.0, n)[None, :, None] * (top - foot)[:, None, :]
+
+
+def _candidates(sizes_mm: list[float], squares: tuple[int, int], margin_mm: float, aim: np.ndarray,
+                T_world_model: np.ndarray, target_centre: np.ndarray) -> _Candidates:
+    right, down, forward = T_world_model[:3, 0], T_world_model[:3, 1], T_world_model[:3, 2]
+    S, R_, U_, T_, L_, A_ = np.meshgrid(sizes_mm, GRID_RIGHT_MM, GRID_UP_MM, PLAN_TOWARDS_MM, (0, 1),
+                                        np.arange(len(PLAN_TILTS_DEG)), indexing="ij")
+    square = S.ravel()
+    centre = aim + R_.reshape(-1, 1) * right - U_.reshape(-1, 1) * down - T_.reshape(-1, 1) * forward
+    pattern = square[:, None] * np.array(squares, float)
+    # printed side towards the camera (board z = camera forward), its long side across the image (L_ 0) or upright
+    # (1), turned by 180 deg or not so that the origin is the corner nearest the target
+    turns = np.radians([0.0, 180.0, 90.0, 270.0]).reshape(2, 2)[L_.ravel()]  # (n, 2)
+    x_turn = np.cos(turns)[..., None] * right + np.sin(turns)[..., None] * down  # (n, 2, 3)
+    y_turn = -np.sin(turns)[..., None] * right + np.cos(turns)[..., None] * down
+    origins = centre[:, None, :] - pattern[:, None, :1] / 2 * x_turn - pattern[:, None, 1:] / 2 * y_turn  # (n, 2, 3)
+    turn = np.argmin(np.linalg.norm(origins - target_centre, axis=2), axis=1)
+    pick = np.arange(len(square))
+    x_b, y_b = x_turn[pick, turn], y_turn[pick, turn]
+    # then tilted from facing the model camera about the image's horizontal or vertical axis (Rodrigues' formula)
+    tilts = np.array(PLAN_TILTS_DEG)[A_.ravel()]
+    axis = np.where((tilts[:, :1] == 0), right, down)  # about "down": turns left-right; about "right": up-down
+    angle = np.radians(tilts[:, 1])[:, None]
+
+    def tilted(v: np.ndarray) -> np.ndarray:
+        return (v * np.cos(angle) + np.cross(axis, v) * np.sin(angle)
+                + axis * np.sum(axis * v, axis=1, keepdims=True) * (1 - np.cos(angle)))
+
+    x_b, y_b = tilted(x_b), tilted(y_b)
+    return _Candidates(centre, x_b, y_b, np.cross(x_b, y_b), pattern, square, pattern + 2 * margin_mm)
+
+
+@dataclass
+class _Judged:
+    """Per candidate (n) and pose (p): ``alive`` (n,): whole, in focus and uncovered in model image 0 and covering
+    nothing at any pose; ``served`` (n, p): criteria 1-3 hold; ``sigma_t`` (n, p) predicted (inf where not served)."""
+
+    alive: np.ndarray
+    served: np.ndarray
+    sigma_t: np.ndarray
+
+
+PAPER = np.array([[-0.5, -0.5], [0.5, -0.5], [0.5, 0.5], [-0.5, 0.5]])
+
+
+@dataclass(frozen=True)
+class Obstacle:
+    """An object near the board: its vertices (k, 3, world mm), and whether the board may never stand in front of
+    it (a target) or only must not stand behind it where it serves (a target's stand)."""
+
+    vertices: np.ndarray
+    hidden_matters: bool
+
+
+def _judge(c: _Candidates, poses: list[np.ndarray], obstacles: list[Obstacle], squares: tuple[int, int],
+           marker_cells: float, marker_share: float, K: np.ndarray, width: int, height: int, focus_mm: float,
+           camera, blur_sigma_px: float) -> _Judged:
+    """Criteria 1-4 of the module docstring for every candidate at every pose. Criterion 2 in two parts: where a
+    board and an obstacle overlap in the image (the board's outline, sampled at most OUTLINE_STEP_PX apart, on the
+    obstacle's hull grown by CLEARANCE_PX, or a hull vertex inside the board; its post likewise), the nearer one
+    covers the other (their centres' depths): a board covering a target is dropped, one covered does not serve that
+    pose. A candidate failing 1-3 at pose 0 (model image 0) is dropped too (``alive`` False)."""
+    n, p = len(c.centre), len(poses)
+    alive = c.on_board(PAPER, c.paper, np.ones(n, bool))[..., 2].min(axis=1) >= TABLE_CLEARANCE_MM
+    served = np.zeros((n, p), bool)
+    sigma_t = np.full((n, p), np.inf)
+    sx, sy = squares
+    inner = np.array([[(i + 1) / sx - 0.5, (j + 1) / sy - 0.5] for j in range(sy - 1) for i in range(sx - 1)])
+    for k, T_world_cam in enumerate(poses):
+        if not alive.any():
+            break
+        view = inverse(T_world_cam)
+        # 1 and 3 first, on the paper's and the pattern's corners: in model image 0 they drop most candidates
+        corners = c.on_board(PAPER, c.paper, alive)
+        quad, front = pixels(corners, view, K)
+        inside = (front & (quad[..., 0] >= 0) & (quad[..., 0] <= width - 1) & (quad[..., 1] >= 0)
+                  & (quad[..., 1] <= height - 1)).all(axis=1)
+        # the blur at the board's nearest and farthest corners against a marker's bit cell where the pattern's
+        # outline is shortest in the image (far and foreshortened)
+        depth = corners @ view[2, :3] + view[2, 3]  # (k, 4)
+        blur = np.hypot(blur_sigma_px, defocus_sigma_px(np.clip(depth, NEAR_MM, None), focus_mm, camera)).max(axis=1)
+        pattern, _ = pixels(c.on_board(PAPER, c.pattern, alive), view, K)
+        sides = np.linalg.norm(np.roll(pattern, -1, axis=1) - pattern, axis=2) / np.array(squares * 2, float)
+        cell = sides.min(axis=1) * marker_share / marker_cells
+        ok = inside & (cell >= MIN_CELL_PX) & (blur <= FOCUS_BLUR_PER_CELL * cell)
+        if k == 0:
+            alive[np.flatnonzero(alive)[~ok]] = False
+            quad, front, corners, blur, ok = quad[ok], front[ok], corners[ok], blur[ok], ok[ok]
+        idx = np.flatnonzero(alive)
+        # 2: who covers whom
+        edge_px = np.nanmax(np.linalg.norm(np.roll(quad, -1, axis=1) - quad, axis=2)[front.all(axis=1)], initial=0.0)
+        s = np.linspace(-0.5, 0.5, int(np.ceil(min(edge_px, 4 * width) / OUTLINE_STEP_PX)) + 2)
+        outline = np.vstack([np.column_stack([s, np.full_like(s, e)]) for e in (-0.5, 0.5)]
+                            + [np.column_stack([np.full_like(s, e), s]) for e in (-0.5, 0.5)])
+        outline_px = pixels(c.on_board(outline, c.paper, alive), view, K)
+        post_px = pixels(c.post(alive), view, K)
+        board_depth = c.centre[alive] @ view[2, :3] + view[2, 3]
+        covers, covered = np.zeros(len(idx), bool), np.zeros(len(idx), bool)
+        for obstacle in obstacles:
+            hull = _hull(project(obstacle.vertices, view, K))
+            if len(hull) == 0:
+                continue
+            distance = obstacle.vertices.mean(axis=0) @ view[2, :3] + view[2, 3]
+            overlap = hits(*outline_px, near_targets([hull], width, height, CLEARANCE_PX)) | vertices_inside(quad, hull)
+            nearer = board_depth < distance
+            covers |= overlap & nearer & obstacle.hidden_matters
+            covered |= overlap & ~nearer
+            if obstacle.hidden_matters:  # the post in front of it
+                covers |= nearer & hits(*post_px, near_targets(
+                    [hull], width, height, CLEARANCE_PX + POST_RADIUS_MM * K[0, 0] / max(distance, NEAR_MM)))
+        ok &= ~covered
+        # 4: the board pose's predicted sigma_t at its origin from its inner corners, at the corner noise of this blur
+        noise = np.hypot(CORNER_NOISE_PX[0], CORNER_NOISE_PX[1] * blur[ok])
+        served[idx, k] = ok
+        sigma_t[idx[ok], k] = noise * _unit_sigma_t(c.on_board(inner, c.pattern, idx[ok]), c.origin[idx[ok]], view, K)
+        alive[idx] = ~covers & (ok if k == 0 else True)
+    return _Judged(alive, served, sigma_t)
+
+
+def _hull(points: np.ndarray) -> np.ndarray:
+    """The convex hull (m, 2) of image points (k, 2) (those behind the camera already left out; a post seen end on
+    is a line)."""
+    return cv2.convexHull(points.astype(np.float32)).reshape(-1, 2) if len(points) else points
+
+
+def _unit_sigma_t(corners: np.ndarray, origin: np.ndarray, view: np.ndarray, K: np.ndarray) -> np.ndarray:
+    """(k,) RMS error (mm) of the board origin predicted from the corners (k, m, 3, world) at unit pixel noise:
+    sqrt(trace of the translation block of (J^T J)^-1), J (2m, 6) the Jacobian of the corners' pixels with respect to
+    a small rotation about the camera origin and the translation of the board (the translation block does not
+    depend on how the rotation is parametrized: OpenCV's rvec gives the same)."""
+    if len(corners) == 0:
+        return np.empty(0)
+    P = corners @ view[:3, :3].T + view[:3, 3]  # (k, m, 3) camera frame
+    t = origin @ view[:3, :3].T + view[:3, 3]  # (k, 3)
+    X, Y, Z = P[..., 0], P[..., 1], np.clip(P[..., 2], NEAR_MM, None)
+    zeros = np.zeros_like(Z)
+    d_point = np.stack([np.stack([K[0, 0] / Z, zeros, -K[0, 0] * X / Z**2], -1),
+                        np.stack([zeros, K[1, 1] / Z, -K[1, 1] * Y / Z**2], -1)], -2)  # (k, m, 2, 3)
+    r = P - t[:, None, :]  # rotation moves r: d P = omega x r = -[r]_x omega
+    skew = np.zeros((*r.shape, 3))
+    skew[..., 0, 1], skew[..., 0, 2], skew[..., 1, 2] = -r[..., 2], r[..., 1], -r[..., 0]
+    skew[..., 1, 0], skew[..., 2, 0], skew[..., 2, 1] = r[..., 2], -r[..., 1], r[..., 0]
+    J = np.concatenate([d_point @ -skew, d_point], axis=-1).reshape(len(P), -1, 6)  # (k, 2m, 6)
+    information = np.einsum("kai,kaj->kij", J, J)
+    singular = np.linalg.cond(information) > 1e12
+    information[singular] = np.eye(6)
+    covariance = np.linalg.inv(information)
+    return np.where(singular, np.inf, np.sqrt(np.clip(np.trace(covariance[:, 3:, 3:], axis1=1, axis2=2), 0.0, None)))
+
+
+def _placement(c: _Candidates, i: int, in_view: float) -> BoardPlacement:
+    top = c.post_top[i]
+    return BoardPlacement(pose_matrix(np.column_stack([c.x_b[i], c.y_b[i], c.z_b[i]]), c.origin[i]),
+                          top * np.array([1.0, 1.0, 0.0]), top, in_view)
+
+
+def _apart(c: _Candidates, boards: np.ndarray, poses: list[np.ndarray], K: np.ndarray) -> np.ndarray:
+    """(m, m) whether each two of the boards ``boards`` (m,) stay apart in the image at every pose: neither paper
+    overlaps the other's, nor the other's post (a segment from its foot to its top), with CLEARANCE_PX to spare, so
+    that neither covers the other wherever it serves."""
+    apart = np.ones((len(boards), len(boards)), bool)
+    ends = np.array([0, -1])
+    for T_world_cam in poses:
+        view = inverse(T_world_cam)
+        papers, front = pixels(c.on_board(PAPER, c.paper, boards), view, K)
+        posts, post_front = pixels(c.post(boards)[:, ends], view, K)
+        seen = front.all(axis=1) & post_front.all(axis=1)  # a board partly behind the camera is not in the image
+        overlap = _overlap(papers, papers) | _overlap(papers, posts) | _overlap(posts, papers)
+        apart &= ~(seen[:, None] & seen[None, :] & overlap)
+    return apart
+
+
+def _overlap(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """(m, n): whether the convex polygons a[i] (m, p, 2) and b[j] (n, q, 2) (a segment when 2 points) come within
+    CLEARANCE_PX of each other: no separating axis among their edges' normals (the separating axis theorem)."""
+    def normals(polygon: np.ndarray) -> np.ndarray:
+        edges = np.roll(polygon, -1, axis=1) - polygon
+        n = np.stack([-edges[..., 1], edges[..., 0]], axis=-1)
+        return n / np.maximum(np.linalg.norm(n, axis=-1, keepdims=True), 1e-9)
+
+    na, nb = normals(a), normals(b)
+    own_a, a_on_b = np.einsum("ikd,ipd->ikp", na, a), np.einsum("jkd,ipd->ijkp", nb, a)
+    own_b, b_on_a = np.einsum("jkd,jpd->jkp", nb, b), np.einsum("ikd,jpd->ijkp", na, b)
+    gap_a = np.maximum(b_on_a.min(axis=-1) - own_a.max(axis=-1)[:, None], own_a.min(axis=-1)[:, None]
+                       - b_on_a.max(axis=-1))  # (m, n, k) along a's axes
+    gap_b = np.maximum(a_on_b.min(axis=-1) - own_b.max(axis=-1)[None], own_b.min(axis=-1)[None]
+                       - a_on_b.max(axis=-1))  # along b's axes
+    return ~((gap_a > CLEARANCE_PX).any(axis=-1) | (gap_b > CLEARANCE_PX).any(axis=-1))
+
+
+def plan_boards(sizes_mm: list[float], squares: tuple[int, int], marker_share: float, marker_cells: float,
+                margin_mm: float, max_boards: int, plan_sigma_t_mm: float, obstacles: list[Obstacle],
+                target_centre: np.ndarray, aim: np.ndarray, model_pair: list[np.ndarray],
+                trajectories: list[list[np.ndarray]], K: np.ndarray, width: int, height: int, focus_mm: float,
+                camera, blur_sigma_px: float, where: str) -> BoardPlan:
+    """The boards of one scene and session (module docstring).
+
+    sizes_mm : square sizes to choose from; squares : (squares_x, squares_y); marker_share : marker / square;
+    marker_cells : a marker's bit cells across (its bits and the black border); margin_mm : white paper around the
+    pattern; obstacles : the targets and their stands, what the boards must not cover or be covered by;
+    target_centre (3,) : where the lever arm is measured to; model_pair : the session's model images' T_world_cam
+    (4, 4) (the first orients the boards; in the second a board only must cover no target); trajectories : per
+    trajectory the commanded T_world_cam of its stops; K (3, 3), width, height : the camera (pinhole of its true
+    intrinsics); focus_mm : where the lens is focused; camera : ``generate.camera`` (its depth of field);
+    blur_sigma_px : the lens' own blur. Raises :class:`~.board_placement.PlacementError` naming ``where`` when no
+    candidate stands clear of the targets and whole in model image 0."""
+    obstacles = [Obstacle(o.vertices[ConvexHull(o.vertices).vertices], o.hidden_matters)  # the same image hulls
+                 for o in obstacles]
+    poses, index = _unique_poses([model_pair[:1], *[model_pair[:1] + t for t in trajectories], model_pair[1:]])
+    index = index[1:-1]  # a trajectory's: model image 0 (its board pose places M_t) and its stops
+    judge = (obstacles, squares, marker_cells, marker_share, K, width, height, focus_mm, camera, blur_sigma_px)
+    c = _candidates(sizes_mm, squares, margin_mm, aim, model_pair[0], target_centre)
+    c = c.subset(_judge(c, poses[:1], *judge).alive)  # model image 0 drops most, cheaply: the rest judged alone
+    judged = _judge(c, poses, *judge)
+    alive = np.flatnonzero(judged.alive)
+    if not len(alive):
+        raise PlacementError(
+            f"{where}: no place beside the target keeps a board of {min(sizes_mm):g}-{max(sizes_mm):g} mm squares "
+            f"wholly in model image 0 and clear of the targets along every trajectory; smaller "
+            f"generate.board.sizes_mm, a larger distance_mm, fewer or smaller targets (generate.scapula.length_mm) "
+            f"would leave room")
+    failing = np.stack([((~judged.served[alive][:, i]) | (judged.sigma_t[alive][:, i] > plan_sigma_t_mm)).sum(axis=1)
+                        for i in index], axis=1)  # (alive, trajectories): the poses it does not serve
+    worst = np.stack([judged.sigma_t[alive][:, i].max(axis=1) for i in index], axis=1)
+    lever = np.linalg.norm(c.origin[alive] - target_centre, axis=1)
+
+    def rank(boards: tuple[int, ...]) -> tuple:
+        """Boards (indices into alive) are better the more trajectories they serve, the fewer poses they fail, the
+        smaller their worst predicted sigma_t (to SIGMA_STEP_MM) and the shorter their lever arms."""
+        fails = failing[list(boards)].min(axis=0)
+        served = [worst[boards[int(np.argmin(failing[list(boards), t]))], t] for t in range(len(index)) if not fails[t]]
+        return (-int((fails == 0).sum()), int(fails.sum()), np.round(max(served, default=0.0) / SIGMA_STEP_MM),
+                float(lever[list(boards)].sum()), boards)
+
+    chosen = min(((k,) for k in range(len(alive))), key=rank)
+    if max_boards > 1 and failing[chosen[0]].any():
+        # a pair: the best boards alone, each with the boards that serve some trajectory best, apart from each other
+        pool = sorted(range(len(alive)), key=lambda k: rank((k,)))[:PAIR_POOL]
+        seconds = np.unique(np.concatenate([np.lexsort((lever, worst[:, t], failing[:, t]))[:PAIR_POOL]
+                                            for t in range(len(index))]))
+        members = np.union1d(pool, seconds)
+        apart = _apart(c, alive[members], poses, K)
+        position = {k: n for n, k in enumerate(members)}
+        for a in pool:
+            for b in seconds[(seconds != a) & apart[position[a], [position[k] for k in seconds]]]:
+                if rank((a, b)) < rank(chosen):
+                    chosen = (a, b)
+    board_of = tuple(int(np.argmin(failing[list(chosen), t])) for t in range(len(index)))
+    planned = []
+    for b, k in enumerate(chosen):
+        served = [t for t in range(len(index)) if board_of[t] == b]
+        sigma = max((worst[k, t] for t in served if not failing[k, t]), default=float("nan"))
+        in_view = _worst_in_view(c, alive[k], [poses[p] for t in served for p in index[t]], K, width, height)
+        planned.append(PlannedBoard(float(c.square[alive[k]]), b * (squares[0] * squares[1] // 2),
+                                    _placement(c, alive[k], in_view), float(sigma)))
+    return BoardPlan(tuple(planned), board_of, tuple(int(failing[chosen[b], t]) for t, b in enumerate(board_of)))
+
+
+def _unique_poses(trajectories: list[list[np.ndarray]]) -> tuple[list[np.ndarray], list[np.ndarray]]:
+    """The distinct poses of the trajectories (model image 0 first, then the poses furthest from it first: there
+    candidates fail most) and per trajectory the indices (into them) of its poses."""
+    keys, poses = {}, []
+    for trajectory in trajectories:
+        for T in trajectory:
+            if T.tobytes() not in keys:
+                keys[T.tobytes()] = len(poses)
+                poses.append(T)
+    far = np.argsort([-np.linalg.norm(T[:3, 3] - poses[0][:3, 3]) for T in poses], kind="stable")
+    order = np.concatenate([[0], far[far != 0]])
+    rank = np.empty(len(order), int)
+    rank[order] = np.arange(len(order))
+    return [poses[k] for k in order], [np.array([rank[keys[T.tobytes()]] for T in t]) for t in trajectories]
+
+
+def _worst_in_view(c: _Candidates, i: int, poses: list[np.ndarray], K: np.ndarray, width: int, height: int) -> float:
+    """The share of board ``i``'s paper inside the image at the worst of ``poses`` (a 10 x 8 grid on it)."""
+    gx, gy = np.meshgrid(np.linspace(-0.45, 0.45, 10), np.linspace(-0.45, 0.45, 8))
+    keep = np.arange(len(c.centre)) == i
+    grid = c.on_board(np.column_stack([gx.ravel(), gy.ravel()]), c.paper, keep)
+    shares = []
+    for T in poses:
+        uv, front = pixels(grid, inverse(T), K)
+        shares.append(float((front & (uv[..., 0] >= 0) & (uv[..., 0] <= width - 1) & (uv[..., 1] >= 0)
+                             & (uv[..., 1] <= height - 1)).mean()))
+    return min(shares, default=1.0)
