@@ -61,6 +61,7 @@ OPTIONS = {  # name: (generate.board, overrides of generate's sections)
     "planned_15_one": (PLANNED | dict(sizes_mm=[15.0], max_boards=1), LAB),  # the rule's placement, one size
     "planned_one": (PLANNED | dict(sizes_mm=SIZES, max_boards=1), LAB),  # and sized per scene
     "planned": (PLANNED | dict(sizes_mm=SIZES, max_boards=2), LAB),  # and a second board where one cannot serve
+    "planned_from_15": (PLANNED | dict(sizes_mm=[s for s in SIZES if s >= 15.0], max_boards=2), LAB),  # no 12 mm
 }
 
 

@@ -7,7 +7,7 @@ import pandas as pd
 import pytest
 
 from poseintegrity.localization.board_warnings import board_warnings
-from poseintegrity.localization.params import GroundTruthParams
+from poseintegrity.params.extract import GroundTruthParams
 
 TRUTH = GroundTruthParams(consistency_factor=4.0, noise_floor_px=0.05, min_markers=3, min_corners=6,
                           max_sigma_t_mm=0.15, max_sigma_r_deg=0.15)

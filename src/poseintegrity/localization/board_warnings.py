@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from poseintegrity.localization.params import GroundTruthParams
+from poseintegrity.params.extract import GroundTruthParams
 
 WARN_BELOW = 0.5  # a dataset whose board is trusted in fewer than this share of its frames is warned about
 FRAME_KEYS = ["dataset", "stop", "image"]
