@@ -223,7 +223,7 @@ def _ours_row(read: Reader, worlds: list[World], predictor: str, links: dict[str
             cells.append(absent(read.metrics, world.stage))
             continue
         cells.append(" · ".join(f"{read.text(world.stage, f'{predictor}.{t}.max_mean_spl_zero_incursion')}, k "
-                                f"{read.text(world.stage, f'{predictor}.{t}.best_k', '{:g}')}, "
+                                f"{read.text(world.stage, f'{predictor}.{t}.best_k', '{:.3g}')}, "
                                 f"{read.share(world.stage, f'{predictor}.{t}')}" for t in paper.TOLERANCES))
     return Row(f"ours: {NAMES[predictor]}, 2 mm/3 deg · 4 mm/10 deg (issue 38)", "-", cells, "-",
                f"its operating point is the safety factor k, chosen on {worlds[0].name}", links["predictors"])
