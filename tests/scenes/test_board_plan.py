@@ -34,6 +34,8 @@ def world(params, scene_index: int, placement: str, azimuths: list[float]):
     board = generate.board.model_dump()
     if placement == "facing_camera":
         board |= dict(placement=placement, sizes_mm=None, max_boards=None, plan_sigma_t_mm=None)
+    else:  # the rule on every size a lab may print, 12 mm too (params.yaml prints from 15 mm: R11, docs/references.md)
+        board |= dict(sizes_mm=[12.0, 15.0, 18.0, 21.0, 24.0])
     generate = generate.model_copy(update={"board": type(generate.board).model_validate(board),
                                            "arcs": generate.arcs.model_copy(update={"azimuths_deg": azimuths})})
     return generate, dataset.world(generate, params.protocol, scene_index, "arc")
