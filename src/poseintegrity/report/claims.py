@@ -16,6 +16,8 @@ weakest world decides. The paper's margins are read from :mod:`poseintegrity.pap
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import re
 from dataclasses import dataclass
 
@@ -193,20 +195,31 @@ def _over_static_row(read: Reader, worlds: list[World], predictor: str, toleranc
                links["envelopes"])
 
 
-def _mlp_row(read: Reader, worlds: list[World], links: dict[str, str]) -> Row:
-    """Table I: the MLP's max mean SPL and ceiling share per tolerance; the claim is long range's gain over it."""
-    margin = paper.WINDSOR_IMPROVEMENTS["long_range_vs_mlp"]
+def _graded_gain(read: Reader, worlds: list[World], key: str, margin: float,
+                 cell: Callable[[str], str]) -> tuple[list[str], dict[int, int]]:
+    """(cells, grades) of a claim judged on one relative gain ``key`` per world against the paper's ``margin``: a
+    world without the key shows why (``absent``) and is not graded; the others show ``cell(stage)``."""
     cells, grades = [], {}
     for i, world in enumerate(worlds):
-        gain = read.value(world.stage, "long_range.relative_improvement_vs_mlp")
+        gain = read.value(world.stage, key)
         if gain is MISSING:
             cells.append(absent(read.metrics, world.stage))
             continue
         grades[i] = gain_grade(gain, margin)
-        spl = " · ".join(read.text(world.stage, f"mlp.{t}.max_mean_spl_zero_incursion") for t in paper.TOLERANCES)
-        shares = read.share(world.stage, *(f"mlp.{t}" for t in paper.TOLERANCES))
-        cells.append(f"{spl} ({shares}); long range "
-                     f"{read.text(world.stage, 'long_range.relative_improvement_vs_mlp', '{:+.1%}')}")
+        cells.append(cell(world.stage))
+    return cells, grades
+
+
+def _mlp_row(read: Reader, worlds: list[World], links: dict[str, str]) -> Row:
+    """Table I: the MLP's max mean SPL and ceiling share per tolerance; the claim is long range's gain over it."""
+    margin = paper.WINDSOR_IMPROVEMENTS["long_range_vs_mlp"]
+
+    def cell(stage: str) -> str:
+        spl = " · ".join(read.text(stage, f"mlp.{t}.max_mean_spl_zero_incursion") for t in paper.TOLERANCES)
+        shares = read.share(stage, *(f"mlp.{t}" for t in paper.TOLERANCES))
+        return f"{spl} ({shares}); long range {read.text(stage, 'long_range.relative_improvement_vs_mlp', '{:+.1%}')}"
+
+    cells, grades = _graded_gain(read, worlds, "long_range.relative_improvement_vs_mlp", margin, cell)
     world = worlds[_weakest(grades)] if grades else None
     why = (f"{world.name}: the MLP's fits are non-physical in "
            f"{read.text(world.stage, 'fit_status.mlp.non_physical', SHARE)} of its rows" if world else UNMEASURED)
@@ -232,16 +245,13 @@ def _ours_row(read: Reader, worlds: list[World], predictor: str, links: dict[str
 def _lines_row(read: Reader, worlds: list[World], links: dict[str, str]) -> Row:
     """Fig. 7: long range over static on the straight lines (V-A)."""
     margin = paper.WINDSOR_IMPROVEMENTS["straight_line_vs_static"]
-    cells, grades = [], {}
-    for i, world in enumerate(worlds):
-        gain = read.value(world.stage, "straight_line.relative_improvement")
-        if gain is MISSING:
-            cells.append(absent(read.metrics, world.stage))
-            continue
-        grades[i] = gain_grade(gain, margin)
-        cells.append(f"{read.text(world.stage, 'straight_line.relative_improvement', '{:+.1%}')} ("
-                     f"{read.text(world.stage, 'straight_line.long_range_max_mean_spl_zero_incursion')} vs "
-                     f"{read.text(world.stage, 'straight_line.static_max_mean_spl_zero_incursion')} mm)")
+
+    def cell(stage: str) -> str:
+        return (f"{read.text(stage, 'straight_line.relative_improvement', '{:+.1%}')} ("
+                f"{read.text(stage, 'straight_line.long_range_max_mean_spl_zero_incursion')} vs "
+                f"{read.text(stage, 'straight_line.static_max_mean_spl_zero_incursion')} mm)")
+
+    cells, grades = _graded_gain(read, worlds, "straight_line.relative_improvement", margin, cell)
     world = worlds[_weakest(grades)] if grades else None
     why = (f"{world.name}: R8, lines' mean / smallest x_a, is "
            f"{read.text('artifacts', f'{world.prefix}realism.line_x_a_mean_over_min_2mm3deg', '{:.2f}')}"
