@@ -121,6 +121,8 @@ def test_stage_02_flags_the_spoiled_frames_and_writes_tables_metrics_and_figures
     calibration = found["error_prediction"]["main"][TINY.protocol.tolerance_names[0]]
     assert 0 <= calibration["within_1sigma_t"] <= calibration["within_2sigma_t"] <= 1
     assert calibration["n_frames"] > 0 and calibration["pixel_noise_px"] > 0
+    assert table.loc[table.status == "ok", "E_t_kinematic_mm"].notna().all()  # stage 01 writes the robot's log
+    assert calibration["kinematic"]["spearman_t"] > 0.5 and calibration["kinematic"]["median_first_stop_mm"] < 1.0
     exact = pd.read_parquet(data / "artifacts" / "envelopes_exact.parquet")  # the diagnostic against the exact pose
     assert list(exact.columns) == list(env.columns) and set(exact["dataset"]) == set(env["dataset"])
     causes = pd.DataFrame(found["envelope_causes"])  # one row per dataset of the main world and tolerance
@@ -192,6 +194,8 @@ def test_stage_04_scores_every_predictor_on_both_worlds_and_draws_every_figure(p
             gap = limit["mean_theta_a"] - limit["static_spl"]
             assert share == pytest.approx((spl - limit["static_spl"]) / gap if gap > 0 else np.nan, nan_ok=True)
     assert {"k", "incursions", "envelope_share"} <= set(found["live"]["error_next_step"])
+    made = pd.read_parquet(data / "predictions" / "predictions.parquet").predictor
+    assert (made == "error_next_step_observed").any()  # the robot's log reached stage 04
     assert {"straight_line", "pnp", "loso", "live", "fit_status", "tails", "envelope_rules",
             "model_choice"} <= set(found)
     assert set(found["model_choice"]["main"]) == set(TINY.predict.model_choice)  # every candidate, scored

@@ -110,13 +110,18 @@ def shifted(T_cam_board: np.ndarray, offset_cam_mm: np.ndarray) -> np.ndarray:
     return T
 
 
+T_BASE_BOARD = np.array([[0.0, -1.0, 0.0, 350.0], [1.0, 0.0, 0.0, -120.0], [0.0, 0.0, 1.0, 40.0],
+                         [0.0, 0.0, 0.0, 1.0]])  # where the board stands in the (exact) robot's base frame, mm
+
+
 def write_dataset(
     data_dir: Path, name: str, rng: np.random.Generator, trajectory: str = "arc", azimuth_deg: float = 0.0,
     stops: tuple[float, ...] = (10.0, 25.0, 40.0, 55.0), images_per_stop: int = 2, noise: float = 2.0,
 ) -> dict:
     """Write one dataset in the stage-01 format under data_dir/datasets/<name>; returns its index row.
 
-    ``stops`` are theta (deg) for arcs and x (mm, backwards along the optical axis) for lines.
+    ``stops`` are theta (deg) for arcs and x (mm, backwards along the optical axis) for lines. The robot that
+    carries the camera is exact: its reported poses (T_base_cam_robot) put the board at T_BASE_BOARD.
     """
     folder = data_dir / "datasets" / name
     (folder / "images").mkdir(parents=True, exist_ok=True)
@@ -125,7 +130,8 @@ def write_dataset(
     T_model = arc_pose(0.0, azimuth_deg)
     model_poses = [T_model, shifted(T_model, np.array([20.0, 0.0, 0.0]))]  # IV-D: 2 cm along camera x
     model = dict(images=[], masks=[], T_cam1_cam0=(model_poses[1] @ np.linalg.inv(model_poses[0])).tolist(),
-                 exact_T_cam_board=[T.tolist() for T in model_poses])
+                 exact_T_cam_board=[T.tolist() for T in model_poses],
+                 T_base_cam_robot=[(T_BASE_BOARD @ np.linalg.inv(T)).tolist() for T in model_poses])
     for index, T in enumerate(model_poses):
         cv2.imwrite(str(folder / f"model/image_{index}.png"), render(plane, T))
         cv2.imwrite(str(folder / f"model/mask_{index}.png"), render(target, T, cv2.INTER_NEAREST))
@@ -142,7 +148,8 @@ def write_dataset(
             file = f"images/s{stop:02d}_i{image:02d}.png"
             cv2.imwrite(str(folder / file), np.clip(picture, 0, 255).astype(np.uint8))
             rows.append(dict(dataset=name, stop=stop, image=image, theta_deg=theta_deg, x_mm=x_mm, file=file,
-                             T_cam_board=T.ravel().tolist(), T_cam_target=T.ravel().tolist()))
+                             T_cam_board=T.ravel().tolist(), T_cam_target=T.ravel().tolist(),
+                             T_base_cam_robot=(T_BASE_BOARD @ np.linalg.inv(T)).ravel().tolist()))
     pd.DataFrame(rows).to_parquet(folder / "frames.parquet")
     meta = dict(
         dataset=name, world="main", scene="synthetic", targets=["texture"], trajectory=trajectory,

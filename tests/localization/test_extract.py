@@ -6,7 +6,8 @@ import pytest
 from scipy.stats import spearmanr
 
 from poseintegrity.localization import extract as E
-from poseintegrity.localization.dataset import DatasetError
+from poseintegrity.localization.dataset import DatasetError, load_dataset
+from poseintegrity.poses import pose_errors
 from poseintegrity.localization.envelope import envelopes
 from poseintegrity.protocol import FAILED_FRAME_RULES
 
@@ -44,6 +45,24 @@ def test_accurate_near_the_model_view_and_inliers_fall_with_theta(table):
     assert first.E_t_exact_mm.max() < 1.5 and first.E_t_board_exact_mm.max() < 1.5  # it is close to the exact pose
     per_stop = arc.groupby("stop").agg(theta=("theta_deg", "mean"), n_i=("n_inliers", "mean"))
     assert spearmanr(per_stop.theta, per_stop.n_i).statistic < -0.9
+
+
+def test_an_exact_robot_observes_the_error_against_the_placed_board(table, synthetic_data_dir, extract_params):
+    """The synthetic robot reports where the camera was: the kinematic disagreement is then exactly the estimate's
+    error against the true pose carried by M_t's placement (model image 0's board pose), T_true T_true0^-1 T_anchor
+    (no robot in that formula: the frames' true poses instead)."""
+    rows = table[(table.dataset == "arc_a") & (table.method == "usac_magsac") & (table.status == "ok")]
+    assert len(rows) == 8
+    dataset = load_dataset(synthetic_data_dir, "datasets/arc_a")
+    _, anchor = E.dataset_model(dataset, extract_params, synthetic_data_dir / extract_params.features_dir / "arc_a")
+    T_true0 = np.asarray(dataset.meta["model"]["exact_T_cam_board"][0])
+    truth = dataset.frames.set_index(["stop", "image"]).T_cam_board
+    placed = np.stack([np.reshape(truth[(row.stop, row.image)], (4, 4)) @ np.linalg.inv(T_true0) @ anchor.T_cam_board
+                       for row in rows.itertuples()])
+    E_t, E_r = pose_errors(np.stack([np.reshape(T, (4, 4)) for T in rows.T_cam_board_est]), placed)
+    np.testing.assert_allclose(rows.E_t_kinematic_mm, E_t, rtol=1e-6, atol=1e-9)
+    np.testing.assert_allclose(rows.E_r_kinematic_deg, E_r, rtol=1e-5, atol=1e-6)
+    assert rows.E_t_kinematic_mm.max() > 1.0  # the far stops' errors are seen
 
 
 def test_features_evidence_and_model_are_cached_per_image(table, synthetic_data_dir, extract_params):

@@ -3,6 +3,8 @@ variant, the per-tolerance scoring, and the ceiling with its share, against know
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -14,7 +16,7 @@ from poseintegrity.artifact_models.series import Series
 from poseintegrity.errors import ArgumentError
 from poseintegrity.prediction.ceiling import ceiling, ceiling_share
 from poseintegrity.prediction.error_predictors import (
-    error_long_range, error_next_step, fit_growth, growth_regressor,
+    error_long_range, error_next_step, fit_growth, growth_regressor, observed_scale,
 )
 from poseintegrity.prediction.predictors import next_step
 from poseintegrity.prediction.sweeps import COLUMNS, attach_envelopes, combined_rows
@@ -73,6 +75,42 @@ def test_error_next_step_follows_iii_e_rule(tiny_fit):
             assert theta_p < crossing + 1e-6 and crossing - theta_p <= 2.25 + 1e-6
         elif status == "stopped":
             assert theta_p == THETA_STOPS[3]
+
+
+def observed(series: Series, times_t, times_r=None) -> Series:
+    """``series`` with observed errors ``times_t`` (and ``times_r``, default the same) x its predicted ones."""
+    times_r = times_t if times_r is None else times_r
+    return replace(series, observed_t=series.sigma_t * times_t, observed_r=series.sigma_r * times_r)
+
+
+def test_observed_scale_is_the_median_excess_after_the_first_stop():
+    series = error_series()
+    assert observed_scale(observed(series, 3.0, 1.5), np.arange(6)) == pytest.approx((3.0, 1.5))
+    assert observed_scale(observed(series, 0.5), np.arange(6)) == (1.0, 1.0)  # never lowers the prediction
+    first = np.where(series.stop == 0, 100.0, 2.0)  # the model view's disagreement is not the estimate's
+    assert observed_scale(observed(series, first), np.arange(6)) == pytest.approx((2.0, 2.0))
+    assert observed_scale(observed(series, first), np.arange(1)) == (1.0, 1.0)  # nothing after the first stop yet
+    gaps = np.where(series.stop % 2 == 1, np.nan, 4.0)  # images without a pose or a robot pose are no sample
+    assert observed_scale(observed(series, gaps), np.arange(6)) == pytest.approx((4.0, 4.0))
+    rising = 1.0 + series.stop  # the scale uses the stops seen so far only
+    assert observed_scale(observed(series, rising), np.arange(3))[0] == pytest.approx(np.sqrt(2.0 * 3.0))  # log median
+
+
+def test_error_next_step_observed_is_the_plain_one_on_the_scaled_error(tiny_fit):
+    """With observed errors 3 x (t) and 2 x (r) the predicted ones at every stop, the observed variant stops where the
+    plain one stops on errors scaled so; with observed errors below the predicted, where the plain one stops."""
+    series = error_series()
+    args = (4, "emg", FACTORS, TOLERANCE, tiny_fit, 0, "usac_magsac", 256)
+    scaled = error_next_step(replace(series, sigma_t=3.0 * series.sigma_t, sigma_r=2.0 * series.sigma_r), *args)
+    ours = error_next_step(observed(series, 3.0, 2.0), *args, observed=True)
+    np.testing.assert_array_equal(ours.prediction.theta_p, scaled.prediction.theta_p)
+    assert (ours.prediction.status == "stopped").sum() > 20
+    plain = error_next_step(series, *args)
+    np.testing.assert_array_equal(error_next_step(observed(series, 0.5), *args, observed=True).prediction.theta_p,
+                                  plain.prediction.theta_p)
+    assert np.nanmean(ours.prediction.theta_p) < np.nanmean(plain.prediction.theta_p)
+    with pytest.raises(ArgumentError, match="no observed error"):
+        error_next_step(series, *args, observed=True)
 
 
 def test_no_predicted_error_is_a_flagged_fit_not_an_error(tiny_fit):

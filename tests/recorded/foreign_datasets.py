@@ -43,6 +43,10 @@ computed from its poses (model.csv's T_cam_ref)."""
     baseline_mm: float = 20.0  # the model pair's, along camera 0's x axis
     seed: int = 0
     extra: dict = field(default_factory=dict)  # more dataset.yaml fields
+    robot: bool = False  # T_base_cam columns: the camera poses an (exact) robot logged, the reference at T_BASE_REF
+
+
+T_BASE_REF = np.array([[1.0, 0.0, 0.0, -300.0], [0.0, 0.0, -1.0, 80.0], [0.0, 1.0, 0.0, 250.0], [0.0, 0.0, 0.0, 1.0]])
 
 
 def _K(size: tuple[int, int]) -> np.ndarray:
@@ -85,16 +89,19 @@ def write_folder(root: Path, spec: Folder) -> Path:
         clean = scene.render(plane, T, K=K, size=spec.size).astype(np.float64)
         return np.clip(clean + rng.normal(0.0, 2.0, clean.shape), 0, 255).astype(np.uint8)
 
+    def robot(T: np.ndarray) -> list[str]:  # the robot's log: where it put the camera, in its base frame
+        return [_pose_cell(T_BASE_REF @ np.linalg.inv(T))] if spec.robot else []
+
     model_rows = []
     for k, T in enumerate(model_poses):
         _store(folder / f"model/pair_{k}.png", picture(T), spec)
         mask = scene.render(target, T, cv2.INTER_NEAREST, K=K, size=spec.size)
         cv2.imwrite(str(folder / f"model/pair_{k}_mask.png"), mask)
-        model_rows.append([f"model/pair_{k}.png", f"model/pair_{k}_mask.png", _pose_cell(T)])
-    _write_csv(folder / "model.csv", ["file", "mask", "T_cam_ref"], model_rows)
+        model_rows.append([f"model/pair_{k}.png", f"model/pair_{k}_mask.png", _pose_cell(T)] + robot(T))
+    _write_csv(folder / "model.csv", ["file", "mask", "T_cam_ref"] + ["T_base_cam"] * spec.robot, model_rows)
 
     header = ["file", "stop"] + (["theta_deg" if spec.trajectory == "arc" else "x_mm"] if spec.positions else []) \
-        + ["T_cam_ref"]
+        + ["T_cam_ref"] + ["T_base_cam"] * spec.robot
     rows = []
     for stop, position in enumerate(spec.stops):
         T = scene.arc_pose(position, spec.azimuth_deg) if spec.trajectory == "arc" else \
@@ -102,7 +109,8 @@ def write_folder(root: Path, spec: Folder) -> Path:
         for image in range(spec.images_per_stop):
             file = f"frames/stop{stop}_{image}{spec.suffix}"
             _store(folder / file, picture(T), spec)
-            rows.append([file, stop] + ([repr(float(position))] if spec.positions else []) + [_pose_cell(T)])
+            rows.append([file, stop] + ([repr(float(position))] if spec.positions else []) + [_pose_cell(T)]
+                        + robot(T))
     _write_csv(folder / "stops.csv", header, rows)
 
     settings = {"trajectory": spec.trajectory, "ground_truth": spec.ground_truth, **spec.extra}

@@ -24,6 +24,7 @@ import json
 import shutil
 
 import cv2
+import numpy as np
 import pandas as pd
 import pytest
 import yaml
@@ -37,9 +38,10 @@ from repository import ROOT
 FOLDERS = [
     Folder("line_a", trajectory="line", stops=(0.0, 30.0, 60.0, 90.0, 120.0), world="lab_a", seed=2),
     Folder("arc_b", stops=(5.0, 15.0, 25.0, 35.0, 44.0), world="lab_b", ground_truth="board", colour=True, bits=16,
-           suffix=".tif", seed=3),
+           suffix=".tif", seed=3, robot=True),
     Folder("line_b", trajectory="line", stops=(0.0, 40.0, 80.0, 120.0, 140.0), world="lab_b", size=(400, 250), seed=4),
-    Folder("arc_poses_jpeg", stops=(5.0, 30.0, 60.0, 120.0, 175.0), colour=True, suffix=".jpg", size=(360, 240)),
+    Folder("arc_poses_jpeg", stops=(5.0, 30.0, 60.0, 120.0, 175.0), colour=True, suffix=".jpg", size=(360, 240),
+           robot=True),
     Folder("arc_board_16", ground_truth="board", bits=16, images_per_stop=2, positions=False, seed=1),
 ]
 OVERLAY = {"protocol": {"arc_span_deg": 180.0}}  # arc_poses_jpeg's last stop; the others end within it
@@ -131,3 +133,18 @@ def test_both_kinds_of_ground_truth_are_measured_and_nothing_is_judged_as_a_worl
     realism = json.loads((copy / "reports" / "metrics" / "artifacts.json").read_text())["realism"]
     assert "passed" not in realism and "recorded data" in realism["description_only"]  # described, not judged
     assert "Realism bars: recorded data" in (copy / "reports" / "summary.md").read_text()
+
+
+def test_a_robot_log_is_what_the_robot_observes_and_calibrates_the_error_predictor(recorded_project):
+    """The robot's poses of arc_b (board) and arc_poses_jpeg (poses) reach stage 02 as each estimate's disagreement
+    with the (exact) robot, which is then its error against the truth as placed by model image 0 (the recorded poses,
+    exact here: E_t itself), and stage 04 runs error_next_step_observed on them; the other datasets have none."""
+    copy = recorded_project
+    rows = pd.read_parquet(copy / "data" / "artifacts" / "artifacts.parquet")
+    posed = rows[rows.status == "ok"]
+    logged = posed.dataset.isin(["arc_b", "arc_poses_jpeg"])
+    assert posed.loc[logged, "E_t_kinematic_mm"].notna().all() and posed.loc[~logged, "E_t_kinematic_mm"].isna().all()
+    jpeg = posed[posed.dataset == "arc_poses_jpeg"]
+    np.testing.assert_allclose(jpeg.E_t_kinematic_mm, jpeg.E_t_mm, rtol=1e-6, atol=1e-6)
+    made = pd.read_parquet(copy / "data" / "predictions" / "predictions.parquet")
+    assert set(made.loc[made.predictor == "error_next_step_observed", "dataset"]) == {"arc_b", "arc_poses_jpeg"}

@@ -120,8 +120,9 @@ def test_board_truth_without_recorded_poses(rendered_dir, exported, extract_para
     errors are NaN and the board-truth errors are the original's."""
     folder = copy(exported, tmp_path, "arc_r")
     for table in ("stops.csv", "model.csv"):
-        lines = (folder / table).read_text().splitlines()
-        (folder / table).write_text("\n".join(line.rsplit(",", 1)[0] for line in lines) + "\n")
+        lines = [line.split(",") for line in (folder / table).read_text().splitlines()]
+        drop = lines[0].index("T_cam_ref")
+        (folder / table).write_text("\n".join(",".join(cells[:drop] + cells[drop + 1:]) for cells in lines) + "\n")
     materialize([folder], tmp_path / "data")
     rows = extract(tmp_path / "data", "arc_r", extract_params, workers)
     original = extract(rendered_dir, "arc_r", extract_params, workers)

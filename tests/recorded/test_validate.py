@@ -74,6 +74,13 @@ def test_positions_computed_from_poses_are_the_scenes(exported, tmp_path, name, 
     assert np.allclose([frame.x_mm for frame in frames], x, atol=1e-9)
 
 
+def empty_cell(lines: list[str], row: int, column: str) -> list[str]:
+    """``lines`` of a table (no quoted commas) with the cell of ``column`` on line index ``row`` emptied."""
+    index = lines[0].split(",").index(column)
+    cells = lines[row].split(",")
+    return [*lines[:row], ",".join(cells[:index] + [""] + cells[index + 1:]), *lines[row + 1:]]
+
+
 def problems_of(folder: Path) -> list[str]:
     status, out, err = run(["validate", str(folder)])
     assert status == 2 and out == "" and "Traceback" not in err
@@ -159,7 +166,7 @@ def test_every_problem_is_listed_at_once(folder):
 def test_pose_ground_truth_needs_poses_on_every_row(folder):
     edit(folder / "dataset.yaml", "ground_truth: board", "ground_truth: poses")
     (folder / "board.yaml").unlink()
-    rewrite_csv(folder / "stops.csv", lambda lines: [*lines[:2], lines[2].rsplit(",", 1)[0] + ",", *lines[3:]])
+    rewrite_csv(folder / "stops.csv", lambda lines: empty_cell(lines, 2, "T_cam_ref"))
     [line] = problems_of(folder)
     assert "stops.csv, line 3: field T_cam_ref is empty" in line
 
@@ -196,3 +203,21 @@ def test_export_command(rendered_dir, tmp_path):
 def test_not_a_folder(tmp_path):
     [line] = problems_of(tmp_path / "nothing")
     assert "nothing: not a folder" in line
+
+
+def test_the_robots_poses_go_in_both_tables_or_in_neither(folder):
+    """The export of a rendered dataset carries the robot's log (T_base_cam); without model.csv's, model image 0
+    cannot place the target in the robot's base frame; a damaged cell is named by line and field."""
+    assert "T_base_cam" in (folder / "model.csv").read_text().splitlines()[0]
+    rewrite_csv(folder / "model.csv", lambda lines: drop_column(lines, "T_base_cam"))
+    [line] = problems_of(folder)
+    assert "model.csv: column T_base_cam is needed too" in line
+    rewrite_csv(folder / "stops.csv", lambda lines: drop_column(lines, "T_base_cam"))
+    assert read_recorded(folder).model_T_base_cam is None  # neither: a recording without the robot's poses
+
+
+def test_a_damaged_robot_pose_is_named(folder):
+    rewrite_csv(folder / "stops.csv", lambda lines: [*lines[:3], lines[3].rsplit(",", 1)[0] + ",1 2 3", *lines[4:]])
+    assert (folder / "stops.csv").read_text().splitlines()[0].endswith(",T_base_cam")  # the cell replaced is its
+    [line] = problems_of(folder)
+    assert "stops.csv, line 4: field T_base_cam" in line

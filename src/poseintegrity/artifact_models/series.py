@@ -28,6 +28,9 @@ class Series:
     theta_p ends and the MLP's artificial point (theta_end, 0) lies (III-D, III-E)
     sigma_t, sigma_r : (m,) float or None, each image's predicted RMS E_t (mm) and E_r (deg) (stage 02's
     ``sigma_t_pred_mm``, ``sigma_r_pred_deg``; NaN without a pose), the error predictors' input (ours, issue 38)
+    observed_t, observed_r : (m,) float or None, each image's disagreement with the robot's kinematics (mm, deg;
+    stage 02's ``E_t_kinematic_mm``, ``E_r_kinematic_deg``, localization/kinematic_consistency.py; None when the
+    dataset holds no robot poses), what ``error_next_step_observed`` calibrates the predicted error with
     """
 
     dataset: str
@@ -38,6 +41,8 @@ class Series:
     theta_end: float
     sigma_t: np.ndarray | None = None
     sigma_r: np.ndarray | None = None
+    observed_t: np.ndarray | None = None
+    observed_r: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         """Checked once when made (every predictor takes a Series): theta and n_inliers (m,) numbers (NaN / inf are
@@ -47,12 +52,12 @@ class Series:
         n_inliers = check_array("Series.n_inliers", self.n_inliers, shape=(None,), finite=False)
         stop = check_array("Series.stop", self.stop, shape=(None,), dtype="int")
         check_same_length(**{"Series.theta": theta, "Series.n_inliers": n_inliers, "Series.stop": stop})
-        for name in ("sigma_t", "sigma_r"):
+        for name in ("sigma_t", "sigma_r", "observed_t", "observed_r"):
             if getattr(self, name) is not None:
-                sigma = check_array(f"Series.{name}", getattr(self, name), shape=(len(theta),), finite=False)
-                if (sigma[np.isfinite(sigma)] < 0).any():
-                    raise ArgumentError(f"Series.{name}: a predicted RMS error is >= 0 (NaN: none)")
-                object.__setattr__(self, name, sigma)
+                error = check_array(f"Series.{name}", getattr(self, name), shape=(len(theta),), finite=False)
+                if (error[np.isfinite(error)] < 0).any():
+                    raise ArgumentError(f"Series.{name}: an error is >= 0 (NaN: none)")
+                object.__setattr__(self, name, error)
         if (stop < 0).any() or (np.diff(stop) < 0).any():
             raise ArgumentError("Series.stop: expected stop indices >= 0 in stop order")
         if (np.abs(theta[np.isfinite(theta)]) > MAX_THETA).any():
@@ -73,6 +78,7 @@ class Series:
 
 REQUIRED_COLUMNS = ("dataset", "trajectory", "stop", "image", "theta_deg", "x_mm", "method", "n_inliers")
 PREDICTED_ERROR_COLUMNS = ("sigma_t_pred_mm", "sigma_r_pred_deg")  # read into Series.sigma_t / sigma_r when present
+OBSERVED_ERROR_COLUMNS = ("E_t_kinematic_mm", "E_r_kinematic_deg")  # Series.observed_t / _r when any is known
 
 
 def dataset_series(artifacts: pd.DataFrame, pnp_method: str, protocol: ProtocolParams) -> list[Series]:
@@ -102,6 +108,8 @@ def dataset_series(artifacts: pd.DataFrame, pnp_method: str, protocol: ProtocolP
             theta_end=protocol.range_end(trajectory),
             **{name: group[column].to_numpy(dtype=float) if column in group else None
                for name, column in zip(("sigma_t", "sigma_r"), PREDICTED_ERROR_COLUMNS)},
+            **{name: group[column].to_numpy(dtype=float) if column in group and group[column].notna().any() else None
+               for name, column in zip(("observed_t", "observed_r"), OBSERVED_ERROR_COLUMNS)},
         )
         _check(one)
         series.append(one)

@@ -136,6 +136,9 @@ class ModelMeta(_Read):
     exact_T_cam_board: list[list[list[float]]] | None = Field(
         default=None, description="the model images' exact board poses (rendered data: a diagnostic, the reference "
                                   "of the ground truth's own accuracy, R11)")
+    T_base_cam_robot: tuple[list[list[float]], list[list[float]]] | None = Field(
+        default=None, description="the model images' camera poses as the robot reports them, in a frame fixed to "
+                                  "its base (mm; with frames.parquet's T_base_cam_robot: kinematic_consistency.py)")
 
     @field_validator("T_cam1_cam0", mode="before")
     @classmethod
@@ -151,6 +154,12 @@ class ModelMeta(_Read):
     @classmethod
     def _rigid_exact(cls, poses: Any) -> Any:
         return None if poses is None else [_pose(pose, f"model image {k}'s exact board pose")
+                                           for k, pose in enumerate(poses)]
+
+    @field_validator("T_base_cam_robot", mode="before")
+    @classmethod
+    def _rigid_robot(cls, poses: Any) -> Any:
+        return None if poses is None else [_pose(pose, f"model image {k}'s robot pose")
                                            for k, pose in enumerate(poses)]
 
 

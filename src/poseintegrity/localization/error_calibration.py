@@ -13,7 +13,11 @@ not a wrong consensus), that have a prediction and a measured error:
   E_t (how well the inlier count alone orders the errors);
 - ``pixel_noise_px``: the median over datasets of the model pair's measured keypoint noise;
 - ``unconditioned``: ``within_1sigma_t``, ``within_2sigma_t`` and ``median_ratio_t`` of the plain first-order
-  prediction, without the inlier test's conditioning (pose_covariance.py, (c)).
+  prediction, without the inlier test's conditioning (pose_covariance.py, (c));
+- ``kinematic``: what the robot observes of the same frames (kinematic_consistency.py): ``spearman_t``, the rank
+  correlation of E_t_kinematic_mm with E_t; ``median_abs_difference_mm``, the median |E_t_kinematic - E_t|;
+  ``median_first_stop_mm``, its median at the first stop (the model view: the robot's and the placement's own
+  disagreement); NaN for datasets without the robot's poses.
 """
 
 from __future__ import annotations
@@ -21,11 +25,6 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 from scipy.stats import spearmanr
-
-CALIBRATION_COLUMNS = ("world", "dataset", "trajectory", "stop", "theta_deg", "x_mm", "method", "status",
-                       "n_inliers", "E_t_mm", "E_r_deg", "E_t_exact_mm", "sigma_t_pred_mm", "sigma_r_pred_deg",
-                       "sigma_t_unconditioned_mm", "covariance_status", "model_pixel_noise_px")
-
 
 def calibration_frames(artifacts: pd.DataFrame, envelopes: pd.DataFrame, method: str) -> pd.DataFrame:
     """The frames a calibration is read on, one row per frame and tolerance: those of ``method`` with a predicted
@@ -48,6 +47,14 @@ def _spearman(a: pd.Series, b: pd.Series) -> float:
     if known.sum() < 3 or a[known].nunique() < 2 or b[known].nunique() < 2:
         return float("nan")
     return float(spearmanr(a[known], b[known]).statistic)
+
+
+def _kinematic(judged: pd.DataFrame) -> dict:
+    """The ``kinematic`` block of one world and tolerance (module docstring)."""
+    observed = judged["E_t_kinematic_mm"] if "E_t_kinematic_mm" in judged else pd.Series(np.nan, index=judged.index)
+    return {"spearman_t": _spearman(observed, judged["E_t_mm"]),
+            "median_abs_difference_mm": float((observed - judged["E_t_mm"]).abs().median()),
+            "median_first_stop_mm": float(observed[judged["stop"] == 0].median())}
 
 
 def calibration_metrics(frames: pd.DataFrame) -> dict:
@@ -74,5 +81,6 @@ def calibration_metrics(frames: pd.DataFrame) -> dict:
                 "within_2sigma_t": _share_within(judged["E_t_mm"], judged["sigma_t_unconditioned_mm"], 2.0),
                 "median_ratio_t": float((judged["E_t_mm"] / judged["sigma_t_unconditioned_mm"]).median()),
             },
+            "kinematic": _kinematic(judged),
         }
     return metrics

@@ -47,6 +47,7 @@ from poseintegrity.localization.evidence import FrameEvidence, frame_evidence, m
 from poseintegrity.localization.features import cached_features, read_gray, write_npz
 from poseintegrity.localization.frame_artifacts import frame_artifacts
 from poseintegrity.localization.frame_pnp import frame_pnp
+from poseintegrity.localization.kinematic_consistency import kinematic_errors, reported_pose
 from poseintegrity.localization.ground_truth import BoardPose, board_from_dict, board_pose, no_pose, truth_error
 from poseintegrity.params.extract import ExtractParams
 from poseintegrity.localization.pnp import PnPResult, failed, solve_checked
@@ -150,6 +151,7 @@ class FrameTask:
     params: ExtractParams
     ground_truth: str = "board"  # meta.json's ground_truth: "board" (IV-C) or "poses" (frames.parquet's)
     T_cam0_board_exact: np.ndarray | None = None  # model image 0's exact board pose (rendered data: R11)
+    T_base_board_robot: np.ndarray | None = None  # where the model view placed the board, in the robot's base frame
 
     @property
     def pnp_path(self) -> Path:
@@ -238,6 +240,8 @@ def frame_rows(task: FrameTask) -> list[dict[str, Any]]:
     E_t_truth_mm, E_r_truth_deg = truth_error(board.T_cam_board, T_cam_board, model.anchor.T_cam_board, exact_0)
     E_t_placement_mm, E_r_placement_deg = map(float, pose_errors(model.anchor.T_cam_board, exact_0))
     seed = frame_seed(task.params.seed, frame["dataset"], int(frame["stop"]), int(frame["image"]))
+    T_base_cam = reported_pose(frame.get("T_base_cam_robot"))
+    T_base_board = NAN_POSE if task.T_base_board_robot is None else task.T_base_board_robot
     caps = {method: iteration_cap(method, task.params) for method in task.methods}
     results = {} if evidence.image_problem else frame_pnp(  # cached per frame; the classic RANSAC shared
         task.pnp_path, evidence.object_points, evidence.image_points, task.camera.K, model.digest, task.methods, caps,
@@ -256,6 +260,7 @@ def frame_rows(task: FrameTask) -> list[dict[str, Any]]:
             )
         E_t_mm, E_r_deg = map(float, pose_errors(T_est, truth))  # IV-C: the board is the truth (or the poses)
         E_t_exact_mm, E_r_exact_deg = map(float, pose_errors(T_est, T_cam_board))
+        E_t_kinematic_mm, E_r_kinematic_deg = map(float, kinematic_errors(T_base_cam, T_est, T_base_board))
         if status in DATA_FLAGS:  # a flagged frame is no evidence: no error is reported for it
             E_t_mm = E_r_deg = np.nan
         rows.append(
@@ -265,6 +270,7 @@ def frame_rows(task: FrameTask) -> list[dict[str, Any]]:
             | artifacts
             | dict(
                 E_t_mm=E_t_mm, E_r_deg=E_r_deg, E_t_exact_mm=E_t_exact_mm, E_r_exact_deg=E_r_exact_deg,
+                E_t_kinematic_mm=E_t_kinematic_mm, E_r_kinematic_deg=E_r_kinematic_deg,
                 board_status=board.status, board_reason=board.reason, board_n_points=board.n_points,
                 board_n_dropped=board.n_dropped, board_rms_px=board.rms_px, board_sigma_t_mm=board.sigma_t_mm,
                 board_sigma_r_deg=board.sigma_r_deg,
@@ -290,6 +296,7 @@ def extract_datasets(
             frame, dataset.path(frame["file"]), cache_dir / Path(frame["file"]).with_suffix(".npz"),
             cache_dir / Path(frame["file"]).with_suffix(".evidence.npz"), model, dataset.meta.get("board"),
             dataset.camera, tuple(methods), params, dataset.meta.get("ground_truth", "board"), exact_model_pose(dataset),
+            robot_board_pose(dataset, model),
         )
         for dataset, cache_dir, model in zip(datasets, cache_dirs, models)
         for frame in dataset.frames.assign(world=dataset.meta["world"], trajectory=dataset.meta["trajectory"])
@@ -297,6 +304,18 @@ def extract_datasets(
     ]
     results = workers.map(frame_rows, tasks, desc=f"frames of {len(datasets)} dataset(s)", progress=progress)
     return pd.DataFrame([row for rows in results for row in rows])
+
+
+def robot_board_pose(dataset: Dataset, model: StoredModel) -> np.ndarray | None:
+    """T_base_board (4, 4, mm) of :mod:`kinematic_consistency`: the pose that placed M_t (the board's in model image
+    0, or meta.json's T_cam0_ref with recorded poses) carried into the robot's base frame by the model view's robot
+    pose; None when the dataset holds no robot poses."""
+    robot = dataset.meta["model"].get("T_base_cam_robot")
+    if robot is None:
+        return None
+    placed = (dataset.meta["model"]["T_cam0_ref"] if dataset.meta.get("ground_truth", "board") == "poses"
+              else model.anchor.T_cam_board)
+    return np.asarray(robot[0], dtype=np.float64) @ np.asarray(placed, dtype=np.float64)
 
 
 def exact_model_pose(dataset: Dataset) -> np.ndarray | None:

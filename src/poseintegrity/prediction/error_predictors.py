@@ -23,6 +23,19 @@ turns). Where the fitted count reaches zero the predicted error is infinite.
                        k x sigma(theta) first reaches the tolerance (III-E's search, :func:`envelope_prediction`)
     error_next_step    refit at every stop from the k-th on and stop where the robot stands once theta_p is less
                        than one step ahead: III-E's rule (:func:`~poseintegrity.prediction.predictors.supervise`)
+    error_next_step_observed
+                       the same, with the predicted error of every stop so far scaled by how much the estimates
+                       have disagreed with the robot's kinematics beyond it (:func:`observed_scale`): the
+                       propagation is calibrated on each arc itself, where the robot observes its error
+
+Why the observed variant: the propagation's measured / predicted E_t is 1.0 in the median over the arcs of a world,
+but it spreads by a factor of exp(0.4) between arcs (std of the log of each arc's median ratio), and on one deciding
+arc (val_2_arc270) it is 3-4.5 from 6.75 deg on: RANSAC's consensus bias (docs/references.md). A static target and a
+robot that reports where it is observe each estimate's error (localization/kinematic_consistency.py, Spearman 0.95
+with E_t), but only once it happened: a failure that comes within one stop is no more visible in it than in the
+propagation, so it calibrates the prediction rather than replacing it. The scale only raises the prediction: the
+observation carries the robot's own error (0.1-0.3 mm across an arc), and a lower observed error at the first stops
+is one draw of M_t's errors, which the propagation already describes.
 
 The search runs on the safety margin m(theta) = min(tol_t / sigma_t, tol_r / sigma_r), which falls as the error
 grows: theta_p(k) is where m falls to k, for every k at once.
@@ -30,7 +43,7 @@ grows: theta_p(k) is where m falls to k, for every k at once.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy.optimize import nnls
@@ -131,16 +144,40 @@ def error_long_range(series: Series, k: int, model: str, factors: np.ndarray, to
     return found, status, reason
 
 
+def observed_scale(series: Series, stops: np.ndarray) -> tuple[float, float]:
+    """(c_t, c_r) >= 1: how many times the observed error (Series.observed_t / _r) has exceeded the predicted one
+    (sigma_t / sigma_r) over the images of ``stops`` after the first (at the first the view is the model view's: the
+    disagreement there is the robot's and the placement's own), the exp of the median log ratio over the images with
+    both, floored at 1 (module docstring); 1 without such images."""
+    keep = np.isin(series.stop, stops[1:])
+    scales = []
+    for observed, predicted in ((series.observed_t, series.sigma_t), (series.observed_r, series.sigma_r)):
+        with np.errstate(divide="ignore", invalid="ignore"):
+            log_ratio = np.log(observed[keep] / predicted[keep])
+        log_ratio = log_ratio[np.isfinite(log_ratio)]
+        scales.append(max(1.0, float(np.exp(np.median(log_ratio)))) if log_ratio.size else 1.0)
+    return scales[0], scales[1]
+
+
 def error_next_step(series: Series, k0: int, model: str, factors: np.ndarray, tolerance: tuple[float, float],
-                    fit: FitParams, seed: int, method: str, n_grid: int) -> NextStep:
+                    fit: FitParams, seed: int, method: str, n_grid: int, observed: bool = False) -> NextStep:
     """The next-step predictor of III-E on the predicted error: from the k0-th stop on, the growth is refitted on
     all stops so far and the robot stops where it stands for every safety factor whose theta_p < theta_i + theta_b
-    (:func:`~poseintegrity.prediction.predictors.supervise`)."""
+    (:func:`~poseintegrity.prediction.predictors.supervise`). ``observed``: each refit on the predicted errors
+    scaled by :func:`observed_scale` of the stops so far (``error_next_step_observed``; a series without observed
+    errors is refused, ArgumentError naming it)."""
     factors = _checked(series, factors)
+    if observed and (series.observed_t is None or series.observed_r is None):
+        raise ArgumentError(f"series: dataset {series.dataset}: the series carries no observed error (stage 02's "
+                            f"E_t_kinematic_mm, E_r_kinematic_deg: the robot's poses, T_base_cam_robot)")
     _, theta_stops = stop_positions(series)
 
     def boundary(stops: np.ndarray, moving: np.ndarray) -> tuple[np.ndarray, str, str]:
-        growth, status, reason = fit_growth(series, stops, model, fit, fit_rng(seed, method, series, stops.size))
+        seen = series
+        if observed:
+            c_t, c_r = observed_scale(series, stops)
+            seen = replace(series, sigma_t=series.sigma_t * c_t, sigma_r=series.sigma_r * c_r)
+        growth, status, reason = fit_growth(seen, stops, model, fit, fit_rng(seed, method, series, stops.size))
         found = envelope_prediction(lambda theta: growth.margin(theta, tolerance), moving, theta_stops[0],
                                     series.theta_end, n_grid)
         return found.theta_p, status, reason

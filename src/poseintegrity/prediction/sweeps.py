@@ -12,7 +12,9 @@ prediction interval, :mod:`.uncertainty`), "mlp", "next_step", "static", and bey
 at the first stop (the same fits as "long_range" / "next_step"), and "long_range_free_width" /
 "next_step_free_width", the same predictors on a second artifact model (``predict.models``: the free-width EMG).
 Ours beside them (issue 38, :mod:`.error_predictors`): "error_long_range" and "error_next_step", which stop where
-k x the predicted localization error reaches the tolerance (operating point: the safety factor k). Their theta_p
+k x the predicted localization error reaches the tolerance (operating point: the safety factor k), and
+"error_next_step_observed", the latter calibrated on each arc by the robot's kinematics (datasets with the robot's
+poses only). Their theta_p
 depends on the tolerance, so their rows name it (column ``tolerance``; empty for every other predictor, whose
 theta_p serves every tolerance). "error_combined", the earlier stop of the error predictor and the paper's at its
 chosen n_t, is made from both after the operating points are chosen (:func:`combined_rows`).
@@ -60,7 +62,8 @@ COLUMNS = [
 PAPER_PREDICTORS = ("static", "long_range", "mlp", "next_step")  # the keys of predictors.json
 RELATIVE_PREDICTORS = ("long_range_relative", "next_step_relative")  # beyond the paper
 FREE_WIDTH_PREDICTORS = ("long_range_free_width", "next_step_free_width")  # ours: on the free-width EMG
-ERROR_PREDICTORS = ("error_long_range", "error_next_step", "error_combined")  # ours: on the predicted error
+ERROR_PREDICTORS = ("error_long_range", "error_next_step", "error_next_step_observed",
+                    "error_combined")  # ours: on the predicted error
 FITTED_PREDICTORS = ("long_range", "long_range_lower", "mlp", "next_step", *RELATIVE_PREDICTORS,
                      *FREE_WIDTH_PREDICTORS, *ERROR_PREDICTORS)  # fmt: skip
 PAPER_COUNTERPART = {"long_range_free_width": "long_range", "next_step_free_width": "next_step"}  # same predictor
@@ -163,6 +166,11 @@ def error_rows(series: Series, method: str, predict: PredictParams, fit: FitPara
                                    predict.n_grid)
             rows.append(prediction_rows("error_next_step", models.next_step, method, series, factors,
                                         step.prediction, step.fit_status, step.fit_reason, name))
+            if series.observed_t is not None and series.observed_r is not None:
+                step = error_next_step(series, k, models.next_step, factors, tolerance, fit, predict.seed, method,
+                                       predict.n_grid, observed=True)
+                rows.append(prediction_rows("error_next_step_observed", models.next_step, method, series, factors,
+                                            step.prediction, step.fit_status, step.fit_reason, name))
     return rows
 
 

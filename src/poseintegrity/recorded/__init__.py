@@ -10,8 +10,8 @@ A recorded dataset is one folder (its name is the dataset's name) holding::
     board.yaml     (ground_truth: board) the ArUco GridBoard in view (IV-C): dictionary, markers_x, markers_y,
                    marker_length_mm, separation_mm, first_id
     model.csv      two rows, the model pair (III-B): file, mask (optional column or empty cell: the whole image is
-                   target), T_cam_ref (optional column; required with ground_truth: poses)
-    stops.csv      one row per image: file, stop, theta_deg, x_mm, T_cam_ref (the last three optional, below)
+                   target), T_cam_ref (optional column; required with ground_truth: poses), T_base_cam (optional)
+    stops.csv      one row per image: file, stop, theta_deg, x_mm, T_cam_ref, T_base_cam (the last four optional)
     images         anywhere in the folder, named by their path relative to it (PNG, JPEG or TIFF; 8 or 16 bit;
                    mono, BGR or BGRA colour); every image file in the folder must be listed in a table
 
@@ -27,7 +27,10 @@ first position (V-A; the first stop's mean camera centre). The position a trajec
 table, else as stage 01 records it: x_mm 0 for arcs, and for lines theta_deg the viewing angle of the first stop
 (the line's offset from the model view, IV-D), 0 without poses. A
 stop's mean position must increase strictly with its index. Without T_cam1_cam0 in dataset.yaml the model pair's
-relative pose is T_cam1_ref inv(T_cam0_ref).
+relative pose is T_cam1_ref inv(T_cam0_ref). ``T_base_cam`` (in both tables or in neither): the camera's pose as
+the robot reported it, 16 row-major numbers mapping camera points into a frame fixed to the robot's base (mm; its
+flange pose times the hand-eye calibration); with a static target it observes each estimate's error
+(localization/kinematic_consistency.py).
 
 Ground truth: ``board`` (IV-C): the ArUco board is detected in every image and is the truth; it must be detected in
 model image 0, which places the target model in the board frame. ``poses``: the tables' T_cam_ref are the truth

@@ -4,7 +4,8 @@ What a rendered dataset knows becomes what a recording would hold: its images an
 relative paths), camera.yaml as it is, board.yaml from meta.json, ``ground_truth: board``, the model pair's relative
 pose as the robot reported it (dataset.yaml's T_cam1_cam0), the robot's theta_deg / x_mm per stop, and the exact
 renderer pose of every frame and model image (meta.json's ``model.exact_T_cam_board``, when there) as T_cam_ref
-(the board frame is the reference). Numbers are written with Python's
+(the board frame is the reference), and the robot's reported camera poses (``T_base_cam_robot``, when there) as
+T_base_cam. Numbers are written with Python's
 shortest round-tripping repr, so materializing the export gives back the same numbers (the round trip of the tests).
 """
 
@@ -41,12 +42,17 @@ def export_dataset(data_dir: str | Path, folder: str | Path, out: str | Path) ->
         (tmp / "dataset.yaml").write_text(yaml.safe_dump(settings, sort_keys=False))
         (tmp / "board.yaml").write_text(yaml.safe_dump(dict(meta["board"]), sort_keys=False))
         exact = meta["model"].get("exact_T_cam_board")
-        write_table(tmp / "model.csv", ["file", "mask"] + (["T_cam_ref"] if exact else []),
-                    [[image, mask] + ([_pose_text(exact[k])] if exact else [])
+        robot = meta["model"].get("T_base_cam_robot")  # the robot's poses, when the dataset has them
+        write_table(tmp / "model.csv", ["file", "mask"] + (["T_cam_ref"] if exact else []) + (["T_base_cam"] if robot
+                                                                                                 else []),
+                    [[image, mask] + ([_pose_text(exact[k])] if exact else []) + ([_pose_text(robot[k])] if robot
+                                                                                   else [])
                      for k, (image, mask) in enumerate(zip(meta["model"]["images"], meta["model"]["masks"]))])
-        write_table(tmp / "stops.csv", ["file", "stop", "theta_deg", "x_mm", "T_cam_ref"],
+        write_table(tmp / "stops.csv", ["file", "stop", "theta_deg", "x_mm", "T_cam_ref"] + (["T_base_cam"] if robot
+                                                                                               else []),
                     [[frame.file, int(frame.stop), repr(float(frame.theta_deg)), repr(float(frame.x_mm)),
-                      _pose_text(frame.T_cam_board)] for frame in dataset.frames.itertuples()])
+                      _pose_text(frame.T_cam_board)] + ([_pose_text(frame.T_base_cam_robot)] if robot else [])
+                     for frame in dataset.frames.itertuples()])
     return Path(out) / dataset.name
 
 

@@ -47,6 +47,8 @@ def write_dataset(recorded: Recorded, root: Path) -> dict:
             model["T_cam0_ref"] = recorded.T_cam0_ref.tolist()
         elif recorded.T_cam0_ref is not None:  # a board, and model image 0's recorded pose in its frame: the
             model["exact_T_cam_board"] = [recorded.T_cam0_ref.tolist()]  # reference of the board's own accuracy (R11)
+        if recorded.model_T_base_cam is not None:  # the robot's poses: kinematic_consistency.py
+            model["T_base_cam_robot"] = [T.tolist() for T in recorded.model_T_base_cam]
         for k, (image, mask) in enumerate(zip(recorded.model_images, recorded.model_masks)):
             _write_image(recorded.folder / image, tmp / model["images"][k])
             if mask is None:  # no mask: the whole image is target
@@ -60,7 +62,8 @@ def write_dataset(recorded: Recorded, root: Path) -> dict:
             _write_image(recorded.folder / frame.file, tmp / file)
             rows.append({"dataset": recorded.name, "stop": frame.stop, "image": frame.image,
                          "theta_deg": frame.theta_deg, "x_mm": frame.x_mm, "file": file,
-                         "T_cam_board": None if frame.T_cam_ref is None else frame.T_cam_ref.ravel().tolist()})
+                         "T_cam_board": None if frame.T_cam_ref is None else frame.T_cam_ref.ravel().tolist()}
+                        | ({} if frame.T_base_cam is None else {"T_base_cam_robot": frame.T_base_cam.ravel().tolist()}))
         pd.DataFrame(rows).to_parquet(tmp / "frames.parquet", index=False)
         meta = {"dataset": recorded.name, "world": recorded.world, "trajectory": recorded.trajectory,
                 "source": "recorded", "ground_truth": recorded.ground_truth, "model": model}

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import csv
 import io
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -50,7 +50,8 @@ class RecordedFormatError(PoseIntegrityError):
 @dataclass(frozen=True)
 class Frame:
     """One row of stops.csv, resolved: file relative to the folder, stop, image (order within the stop),
-    theta_deg, x_mm, T_cam_ref (4, 4) mm or None."""
+    theta_deg, x_mm, T_cam_ref (4, 4) mm or None, T_base_cam (4, 4) mm: the camera's pose as the robot reported it,
+    or None."""
 
     file: str
     stop: int
@@ -58,13 +59,15 @@ class Frame:
     theta_deg: float
     x_mm: float
     T_cam_ref: np.ndarray | None
+    T_base_cam: np.ndarray | None = None
 
 
 @dataclass(frozen=True)
 class Recorded:
     """A checked recorded dataset. model_images / model_masks: files relative to the folder (mask None: the whole
     image); T_cam1_cam0 (4, 4) mm; T_cam0_ref: model image 0's pose (None without poses); board: board.yaml as a
-    dict (None with ground_truth poses)."""
+    dict (None with ground_truth poses); model_T_base_cam: the model images' camera poses as the robot reported them
+    ((4, 4) mm each; None without the robot's poses)."""
 
     folder: Path
     name: str
@@ -78,6 +81,7 @@ class Recorded:
     T_cam1_cam0: np.ndarray
     T_cam0_ref: np.ndarray | None
     frames: tuple[Frame, ...]
+    model_T_base_cam: tuple[np.ndarray, np.ndarray] | None = None
 
 
 def read_image(path: Path) -> tuple[np.ndarray, bool]:
@@ -230,20 +234,21 @@ def _image_problem(folder: Path, relative: str, where: str, camera: Camera | Non
     return None
 
 
-def _poses(rows: list[tuple[int, dict[str, str]]], path: Path, required: bool, problems: _Problems) -> list | None:
-    """Each row's T_cam_ref (or None for all rows when the column is absent / empty everywhere)."""
-    cells = [row.get("T_cam_ref", "") for _, row in rows]
+def _poses(rows: list[tuple[int, dict[str, str]]], path: Path, required: bool, problems: _Problems,
+           column: str = "T_cam_ref") -> list | None:
+    """Each row's pose in ``column`` (or None for all rows when the column is absent / empty everywhere)."""
+    cells = [row.get(column, "") for _, row in rows]
     if not any(cells):
         if required:
-            problems.add(f"{path}: column T_cam_ref is required with ground_truth: poses")
+            problems.add(f"{path}: column {column} is required with ground_truth: poses")
         return None
     poses = []
     for (line, row), cell in zip(rows, cells):
         if not cell:
-            problems.add(f"{path}, line {line}: field T_cam_ref is empty (give a pose on every row or on none)")
+            problems.add(f"{path}, line {line}: field {column} is empty (give a pose on every row or on none)")
             poses.append(None)
         else:
-            poses.append(problems.check(_pose, cell, f"{path}, line {line}: field T_cam_ref"))
+            poses.append(problems.check(_pose, cell, f"{path}, line {line}: field {column}"))
     return poses
 
 
@@ -302,10 +307,11 @@ def read_recorded(folder: str | Path) -> Recorded:
         found.add(f"{folder / 'board.yaml'}: a board with ground_truth: poses (say ground_truth: board to use it)")
 
     model_path, stops_path = folder / "model.csv", folder / "stops.csv"
-    model_rows = found.check(read_table, model_path, ("file",), ("mask", "T_cam_ref")) or []
+    model_rows = found.check(read_table, model_path, ("file",), ("mask", "T_cam_ref", "T_base_cam")) or []
     if model_rows and len(model_rows) != 2:
         found.add(f"{model_path}: expected 2 rows (the model pair, III-B), got {len(model_rows)}")
-    stop_rows = found.check(read_table, stops_path, ("file", "stop"), ("theta_deg", "x_mm", "T_cam_ref")) or []
+    stop_rows = found.check(read_table, stops_path, ("file", "stop"), ("theta_deg", "x_mm", "T_cam_ref", "T_base_cam")
+                            ) or []
 
     listed: set[Path] = set()
     board_image = None
@@ -351,13 +357,21 @@ def read_recorded(folder: str | Path) -> Recorded:
         found.add(f"{folder / 'dataset.yaml'}: field T_cam1_cam0 is needed: model.csv gives no poses to compute "
                   f"the model pair's relative pose from")
 
+    model_robot = _poses(model_rows, model_path, False, found, "T_base_cam") if model_rows else None
+    stop_robot = _poses(stop_rows, stops_path, False, found, "T_base_cam") if stop_rows else None
+    if model_rows and stop_rows and (model_robot is None) != (stop_robot is None):
+        found.add(f"{model_path if model_robot is None else stops_path}: column T_base_cam is needed too: the "
+                  f"robot's poses go in both tables (model image 0's places the target in the robot's base frame) "
+                  f"or in neither")
     frames = _frames(stop_rows, stop_poses, T_cam0_ref, settings, stops_path, found) if settings else ()
     if found.lines:
         raise RecordedFormatError(found.lines)
+    if stop_robot is not None:
+        frames = tuple(replace(frame, T_base_cam=pose) for frame, pose in zip(frames, stop_robot))
     return Recorded(folder, folder.resolve().name, settings["world"], settings["trajectory"], ground_truth, camera,
                     board, (model_rows[0][1]["file"], model_rows[1][1]["file"]),
                     (model_rows[0][1].get("mask") or None, model_rows[1][1].get("mask") or None), T_cam1_cam0,
-                    T_cam0_ref, frames)
+                    T_cam0_ref, frames, None if model_robot is None else tuple(model_robot))
 
 
 def _computed(rows: list[tuple[int, dict[str, str]]], poses: list | None, T_cam0_ref: np.ndarray | None,

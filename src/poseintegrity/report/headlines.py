@@ -183,6 +183,8 @@ def _ceiling_rows(stage: str) -> list[Headline]:
 
 ERROR_NAMES = {"error_long_range": "ours: long range on the predicted error",
                "error_next_step": "ours: next step on the predicted error",
+               "error_next_step_observed": "ours: next step on the predicted error, calibrated on each arc by the "
+                                           "robot's kinematics",
                "error_combined": "ours: next step, the earlier of n_i's (Table III n_t) and the predicted error's"}
 
 

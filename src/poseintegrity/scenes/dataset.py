@@ -409,6 +409,9 @@ def finish_dataset(params: GenerateParams, root: Path, plan: DatasetPlan, trip: 
         "masks": [f"model/mask_{k}.png" for k in range(len(route.model))],
         "T_cam1_cam0": T_cam1_cam0.tolist(),
         "exact_T_cam_board": [(inverse(T) @ board.T_world_board).tolist() for T in model_poses],
+        # the robot's log: the commanded poses its controller reports (its encoders would add the joints'
+        # repeatability, ~0.01 mm here; the world frame stands for its base frame: only relative poses are used)
+        "T_base_cam_robot": [T.tolist() for T in trip.model_views],
     }
     rows = []
     for s, (stop, visit) in enumerate(zip(trip.stops, route.stops)):
@@ -416,6 +419,7 @@ def finish_dataset(params: GenerateParams, root: Path, plan: DatasetPlan, trip: 
             T_cam_world = inverse(image_pose(visit, image_motion(visit, params.capture, i, f_px)))
             rows.append({"dataset": plan.dataset, "stop": s, "image": i, "theta_deg": stop.theta_deg,
                          "x_mm": stop.x_mm, "file": file, "T_cam_board": _flat(T_cam_world @ board.T_world_board),
+                         "T_base_cam_robot": _flat(stop.T_world_cam),
                          "T_cam_target": _flat(T_cam_world @ scene.T_world_target)})
     pd.DataFrame(rows).to_parquet(tmp / "frames.parquet", index=False)
     meta = {
