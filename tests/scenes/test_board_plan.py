@@ -1,6 +1,7 @@
 """How the lab plans a scene's ground-truth boards (scenes/board_plan.py, issue 39), checked against geometry and
-detection of our own: the board issue 30's rule stands leaves the image late in an arc, the plan's stays wholly in
-view at every stop of the trajectories it serves, and rendered at the arc's last stop it is found whole and trusted;
+detection of our own: the board issue 30's rule stands leaves the image late in an arc, the plan's printed pattern
+stays wholly in view at every stop of the trajectories it serves (its white margin may leave it: OpenCV's detector
+finds every corner of a board whose margin the image cuts off), and rendered at the arc's last stop it is found whole and trusted;
 where one board cannot serve every trajectory the plan adds a second with marker ids of its own, apart from the
 first; the predicted uncertainty is OpenCV's."""
 
@@ -13,9 +14,9 @@ from scipy.spatial.transform import Rotation
 
 from poseintegrity.config import load_params
 from poseintegrity.lens import Camera
-from poseintegrity.localization.ground_truth import board_pose
+from poseintegrity.localization.ground_truth import board_pose, detect_board_points
 from poseintegrity.poses import inverse, pose_matrix
-from poseintegrity.scenes import board_placement, board_plan, catalog, dataset, optics, renderer
+from poseintegrity.scenes import board_placement, board_plan, catalog, dataset, optics, renderer, textures
 from poseintegrity.scenes.camera import true_camera
 from poseintegrity.seeding import keyed_rng
 from repository import ROOT
@@ -50,7 +51,7 @@ def stops(generate, protocol, scene, index):
 
 
 def paper(board: catalog.SceneBoard, margin: float) -> np.ndarray:
-    """The board's paper corners (4, 3), world mm."""
+    """The board's paper corners (4, 3), world mm (``margin`` 0: its printed pattern's)."""
     w, h = board.drawing.size_mm
     local = np.array([[-margin, -margin, 0], [w + margin, -margin, 0], [w + margin, h + margin, 0],
                       [-margin, h + margin, 0]], float)
@@ -96,7 +97,7 @@ def test_a_board_that_would_leave_the_view_late_is_placed_wholly_in_view_and_fou
     assert new.scene.plan.unserved == (0,) * len(AZIMUTHS)  # every stop served
     new_stops = stops(after, params.protocol, new.scene, index)
     for poses, b in zip(new_stops, new.scene.board_of):
-        assert min(share_in_view(paper(new.scene.boards[b], 6.0), T, after) for T in poses) == pytest.approx(1.0)
+        assert min(share_in_view(paper(new.scene.boards[b], 0.0), T, after) for T in poses) == pytest.approx(1.0)
     missed = rendered_board(before, old, stops(before, params.protocol, old.scene, index)[arc][stop], focus, old_board)
     found = rendered_board(after, new, new_stops[arc][stop], focus, new.scene.board_for(arc))
     assert missed.n_points + missed.n_dropped < 24
@@ -113,7 +114,7 @@ def test_where_one_board_cannot_serve_every_arc_a_second_one_with_its_own_ids_st
     arcs = stops(generate, params.protocol, scene, index)
     for arc, b, unserved in zip(arcs, scene.board_of, plan.unserved):
         if b == 1:  # the second board serves an arc the first would not
-            assert unserved == 0 and min(share_in_view(paper(scene.boards[1], 6.0), T, generate) for T in arc) == \
+            assert unserved == 0 and min(share_in_view(paper(scene.boards[1], 0.0), T, generate) for T in arc) == \
                 pytest.approx(1.0)
     camera = true_camera(generate.camera)
     for T in [T for arc in arcs for T in arc]:  # the two boards never overlap in the image
@@ -135,3 +136,38 @@ def test_the_predicted_uncertainty_is_opencvs_at_any_point_of_the_board():
         world = corners @ T[:3, :3].T + T[:3, 3]
         got = board_plan._unit_sigma_t(world[None], (T[:3, :3] @ point + T[:3, 3])[None], np.eye(4), K)[0]
         assert got == pytest.approx(expected, rel=1e-9)
+
+
+def test_a_board_whose_white_margin_leaves_the_image_serves_and_is_found_whole(params):
+    """A 7 x 5 board facing a camera 300 mm away (K of f = 1024 px): with its pattern's left edge 10 px inside the image
+    and its 6 mm white margin (20 px) beyond the edge, the plan serves the pose and OpenCV's ChArUco detector finds all
+    24 corners in a synthetic image of it; with the pattern's edge 10 px outside, the plan does not serve it."""
+    generate = params.generate.world("main")
+    drawing = generate.board.drawing()
+    K, width, height, depth = np.array([[1024.0, 0.0, 484.0], [0.0, 1024.0, 304.0], [0.0, 0.0, 1.0]]), 968, 608, 300.0
+    pattern = np.array(drawing.size_mm, float)
+    margin = generate.board.margin_mm
+    served = []
+    for left_px in (10.0, -10.0):
+        left_mm = (left_px - K[0, 2]) * depth / K[0, 0]
+        centre = np.array([[left_mm + pattern[0] / 2, 0.0, depth]])
+        axes = [np.array([v]) for v in np.eye(3)]  # x right, y down, z into the board: its print faces the camera
+        c = board_plan._Candidates(centre, *axes, pattern[None], np.array([drawing.square_mm]),
+                                   pattern[None] + 2 * margin)
+        cells = drawing.cv_board().getDictionary().markerSize + 2
+        judged = board_plan._judge(c, [np.eye(4)], [], (drawing.squares_x, drawing.squares_y), cells,
+                                   drawing.marker_mm / drawing.square_mm, K, width, height, depth, generate.camera,
+                                   generate.sensor.blur_sigma_px)
+        served.append(bool(judged.served[0, 0]))
+    assert served == [True, False]
+    # the image of the first pose: the printed board (with its margin) scaled to the camera's px per mm, cut by the
+    # image's left edge
+    px_per_mm = 8.0
+    texture = textures.board_texture(drawing, px_per_mm, margin)
+    scale = K[0, 0] / depth / px_per_mm
+    top = K[1, 2] - pattern[1] / 2 * K[1, 1] / depth
+    shift = np.array([[scale, 0.0, 10.0 - margin * px_per_mm * scale], [0.0, scale, top - margin * px_per_mm * scale]])
+    image = cv2.warpAffine(texture, shift, (width, height), flags=cv2.INTER_AREA, borderValue=255)
+    assert image[:, 0].min() > 150  # the image's edge cuts the white margin
+    object_points, _, _ = detect_board_points(image, drawing)
+    assert len(object_points) == (drawing.squares_x - 1) * (drawing.squares_y - 1)

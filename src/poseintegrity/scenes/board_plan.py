@@ -5,9 +5,13 @@ known before any data is taken) and stands ChArUco boards on posts beside the ta
 when at model image 0 (whose board pose places M_t, IV-C) and at every stop of it (arcs to their last stop, lines to
 their far stop):
 
-1. **the whole board is in view**: the corners of its paper (pattern and white margin) lie inside the image, in
-   front of the camera. Part of a board gives a pose, but a weaker one (fewer corners, all to one side): issue 30's
-   board stood at the image's edge in scenes 5 and 7 and was trusted in 0-1 of 200 frames;
+1. **the whole pattern is in view**: the corners of its printed pattern (its squares) lie inside the image, in front
+   of the camera. Part of a board gives a pose, but a weaker one (fewer corners, all to one side): issue 30's board
+   stood at the image's edge in scenes 5 and 7 and was trusted in 0-1 of 200 frames. The white margin around the
+   pattern may leave the image: the detector reads the markers and the chessboard corners inside the pattern, never
+   the margin (a board whose margin the image cuts off is found whole, tests/scenes/test_board_plan.py), and a
+   plan that asked for the margin too left trajectories unserved that its boards served (main scene_7's arc090: the
+   margin 1-13 px beyond the image's bottom edge from stop 1, the board trusted to stop 17);
 2. **no target covers it**: where the board and a target (or a target's stand, or another board) overlap in the
    image (its outline, sampled at most OUTLINE_STEP_PX apart, on the other's silhouette hull grown by CLEARANCE_PX,
    or a hull vertex inside it), the nearer of the two covers the other; and the board **never covers a target** or
@@ -204,16 +208,16 @@ def _judge(c: _Candidates, poses: list[np.ndarray], obstacles: list[Obstacle], s
         if not alive.any():
             break
         view = inverse(T_world_cam)
-        # 1 and 3 first, on the paper's and the pattern's corners: in model image 0 they drop most candidates
+        # 1 and 3 first, on the pattern's and the paper's corners: in model image 0 they drop most candidates
         corners = c.on_board(PAPER, c.paper, alive)
         quad, front = pixels(corners, view, K)
-        inside = (front & (quad[..., 0] >= 0) & (quad[..., 0] <= width - 1) & (quad[..., 1] >= 0)
-                  & (quad[..., 1] <= height - 1)).all(axis=1)
+        pattern, pattern_front = pixels(c.on_board(PAPER, c.pattern, alive), view, K)
+        inside = (pattern_front & (pattern[..., 0] >= 0) & (pattern[..., 0] <= width - 1) & (pattern[..., 1] >= 0)
+                  & (pattern[..., 1] <= height - 1)).all(axis=1)
         # the blur at the board's nearest and farthest corners against a marker's bit cell where the pattern's
         # outline is shortest in the image (far and foreshortened)
         depth = corners @ view[2, :3] + view[2, 3]  # (k, 4)
         blur = np.hypot(blur_sigma_px, defocus_sigma_px(np.clip(depth, NEAR_MM, None), focus_mm, camera)).max(axis=1)
-        pattern, _ = pixels(c.on_board(PAPER, c.pattern, alive), view, K)
         sides = np.linalg.norm(np.roll(pattern, -1, axis=1) - pattern, axis=2) / np.array(squares * 2, float)
         cell = sides.min(axis=1) * marker_share / marker_cells
         ok = inside & (cell >= MIN_CELL_PX) & (blur <= FOCUS_BLUR_PER_CELL * cell)
