@@ -171,3 +171,22 @@ def test_a_board_whose_white_margin_leaves_the_image_serves_and_is_found_whole(p
     assert image[:, 0].min() > 150  # the image's edge cuts the white margin
     object_points, _, _ = detect_board_points(image, drawing)
     assert len(object_points) == (drawing.squares_x - 1) * (drawing.squares_y - 1)
+
+
+def test_the_plans_margin_on_sigma_t_is_how_far_stage_02s_estimate_scatters():
+    """Stage 02 trusts a pose by its own sigma_t, s (J^T J)^-1 with s^2 = SSR / (2n - 6): over 4000 draws of Gaussian
+    noise on the 24 corners of a 7 x 5 board at 350 mm, fitted by OpenCV (IPPE, then LM as stage 02 does), the 95th
+    percentile of s / sigma is the plan's margin (the chi-square quantile) to within the draws' scatter."""
+    K = np.array([[1024.0, 0.0, 484.0], [0.0, 1024.0, 304.0], [0.0, 0.0, 1.0]])
+    T = pose_matrix(Rotation.from_euler("xyz", [25.0, -20.0, 5.0], degrees=True).as_matrix(), [-40.0, 10.0, 350.0])
+    corners = np.array([[15.0 * (i + 1), 15.0 * (j + 1), 0.0] for j in range(4) for i in range(6)])
+    exact, _ = cv2.projectPoints(corners, *_rvec_tvec(T), K, None)
+    rng, sigma_px, ratios = np.random.default_rng(39), 0.1, []
+    for _ in range(4000):
+        seen = exact.reshape(-1, 2) + sigma_px * rng.standard_normal((len(corners), 2))
+        _, rvec, tvec = cv2.solvePnP(corners, seen, K, None, flags=cv2.SOLVEPNP_IPPE)
+        rvec, tvec = cv2.solvePnPRefineLM(corners, seen, K, None, rvec, tvec)
+        residual = cv2.projectPoints(corners, rvec, tvec, K, None)[0].reshape(-1, 2) - seen
+        ratios.append(np.sqrt(np.sum(residual**2) / (2 * len(corners) - 6)) / sigma_px)
+    assert np.quantile(ratios, 0.95) == pytest.approx(board_plan.estimate_spread(len(corners)), abs=0.015)
+    assert board_plan.estimate_spread(len(corners)) == pytest.approx(1.176, abs=0.001)
