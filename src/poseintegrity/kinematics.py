@@ -12,6 +12,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.optimize import least_squares
 from scipy.spatial.transform import Rotation
 
 N_JOINTS = 6
@@ -149,9 +150,6 @@ def inverse(dh: DH, T_base_flange: np.ndarray, q_seed: np.ndarray) -> np.ndarray
 
     def residual_jacobian(q):
         return scale[:, None] * jacobian(dh, q)  # exact for position, first order for the rotation error
-
-    from scipy.optimize import least_squares  # only when solved: params.robot reads UR5E, and every process that
-    # loads params.yaml (stage CLIs, workers, kernels) imported scipy.optimize for it (70 ms of 0.83 s of the stage's)
 
     fit = least_squares(residual, np.asarray(q_seed, dtype=np.float64), jac=residual_jacobian, method="lm",
                         xtol=1e-15, ftol=1e-15, gtol=1e-15, max_nfev=IK_MAX_EVALUATIONS)
