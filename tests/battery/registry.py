@@ -71,18 +71,26 @@ def inlier_series() -> tuple[np.ndarray, np.ndarray]:
     return theta, np.round(emg(theta, 3000.0, 8.0, -3.0)) + np.tile([0.0, 3.0, 2.0], len(theta) // 3)
 
 
+HL2_SIZE = 512  # px: the HoloLens 2 formats' depth camera (AHaT), 512 x 512 by their layout
+
+
 @cache
-def tracking_frame() -> dict[str, Any]:
+def tracking_frame(size: int = 128) -> dict[str, Any]:
+    """One rendered frame of the marker body at 0.45 m: IR, depth, K and unit-plane table of the centre ``size`` x
+    ``size`` px of the tiny parameters' camera (the body is seen at u 59..93, v 50..75 px of 128). The recordings the
+    battery writes for its ~130 cases took 1 GB per run at the full 512 x 512 px, most of it the unit-plane table; no
+    check depends on the size, except the HoloLens 2 formats' (HL2_SIZE)."""
     from poseintegrity.tracking.simulation.frames import intrinsics, render_frame, unit_plane_lut
     from poseintegrity.tracking.markers.geometry import MARKER_DIAMETER_M
 
     track = params().track
+    camera = track.camera.model_copy(update={"width": size, "height": size})
     geometry = np.array(track.markers_body)
     markers = geometry @ Rotation.from_rotvec([0.3, 0.2, 0.1]).as_matrix().T + [0.02, -0.01, 0.45]
-    ir, depth = render_frame(markers, [], track.camera, track.frames, MARKER_DIAMETER_M / 2, np.random.default_rng(0))
-    K = intrinsics(track.camera)
-    return dict(ir=ir, depth=depth, lut=unit_plane_lut(K, track.camera.width, track.camera.height), K=K,
-                markers=markers, geometry=geometry)
+    ir, depth = render_frame(markers, [], camera, track.frames, MARKER_DIAMETER_M / 2, np.random.default_rng(0))
+    K = intrinsics(camera)
+    return dict(ir=ir, depth=depth, lut=unit_plane_lut(K, camera.width, camera.height), K=K, markers=markers,
+                geometry=geometry)
 
 
 def _tracker():
@@ -576,14 +584,14 @@ def _tools_json(tmp: Path) -> Path:
 
 
 def _hl2_frames() -> list:
-    frame = tracking_frame()
+    frame = tracking_frame(HL2_SIZE)
     return [(1000 + 460_000 * k, frame["ir"], frame["depth"]) for k in range(3)]  # 46 ms apart, in 100 ns ticks
 
 
 def _stream_recorder_capture(tmp: Path) -> Path:
     from tracking.hl2_writers import write_stream_recorder
 
-    return write_stream_recorder(tmp / "capture", tracking_frame()["lut"], _hl2_frames(), rig_to_cam=np.eye(4),
+    return write_stream_recorder(tmp / "capture", tracking_frame(HL2_SIZE)["lut"], _hl2_frames(), rig_to_cam=np.eye(4),
                                  rig_to_world=[np.eye(4)] * 3)
 
 
@@ -595,7 +603,7 @@ def _hl2ss_recording(tmp: Path) -> Path:
     from tracking.hl2_writers import write_hl2ss
 
     (tmp / "hl2ss").mkdir(parents=True, exist_ok=True)
-    write_hl2ss(tmp / "hl2ss" / "rm_depth_ahat.bin", tmp / "hl2ss" / "calibration", tracking_frame()["lut"], _hl2_frames(),
+    write_hl2ss(tmp / "hl2ss" / "rm_depth_ahat.bin", tmp / "hl2ss" / "calibration", tracking_frame(HL2_SIZE)["lut"], _hl2_frames(),
                 np.eye(4), [np.eye(4)] * 3)
     return tmp / "hl2ss"
 

@@ -14,16 +14,30 @@ import yaml
 import loc_synthetic as synthetic
 from poseintegrity.localization import extract as E
 from poseintegrity.localization.dataset import DatasetError
+from sift_cache import copy_sift_features
 
 METHODS = ["usac_magsac"]
 DATASET = "line_a"  # 2 stops x 2 images: quick to localize
 
 
+@pytest.fixture(scope="module")
+def sift_done(synthetic_data_dir, extract_params, workers, tmp_path_factory):
+    """A copy of the line dataset, extracted once for the module: its SIFT features serve every case (SIFT on every
+    image took three quarters of a case)."""
+    once = tmp_path_factory.mktemp("sift_done")
+    shutil.copytree(synthetic_data_dir / "datasets" / DATASET, once / "datasets" / DATASET)
+    synthetic.write_index(once, [index_row(DATASET)])
+    E.extract_all(once, extract_params, METHODS, workers, progress=False)
+    return once
+
+
 @pytest.fixture
-def data_dir(synthetic_data_dir, tmp_path):
-    """A copy of the line dataset and of the features it needs (its own index)."""
+def data_dir(synthetic_data_dir, sift_done, extract_params, tmp_path):
+    """A copy of the line dataset and of the features it needs (its own index), with the SIFT features of its images
+    as a re-run of stage 02 finds them (a damaged image's are computed anew; every frame is localized again)."""
     shutil.copytree(synthetic_data_dir / "datasets" / DATASET, tmp_path / "datasets" / DATASET)
     synthetic.write_index(tmp_path, [index_row(DATASET)])
+    copy_sift_features(sift_done, tmp_path, DATASET, extract_params)
     return tmp_path
 
 

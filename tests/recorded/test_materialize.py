@@ -20,6 +20,7 @@ from poseintegrity.recorded import materialize as materialize_module
 from poseintegrity.recorded.materialize import materialize
 from poseintegrity.recorded.reader import RecordedFormatError
 from recorded_tools import assert_rows_identical
+from sift_cache import copy_sift_features
 
 METHODS = ["epnp", "sqpnp"]
 
@@ -104,8 +105,9 @@ def test_pose_ground_truth_replaces_the_board(rendered_dir, exported, extract_pa
                                                                                        "ground_truth: poses"))
     (folder / "board.yaml").unlink()
     materialize([folder], tmp_path / "data")
-    rows = extract(tmp_path / "data", "arc_r", extract_params, workers)
     original = extract(rendered_dir, "arc_r", extract_params, workers)
+    copy_sift_features(rendered_dir, tmp_path / "data", "arc_r", extract_params)  # the same images
+    rows = extract(tmp_path / "data", "arc_r", extract_params, workers)
     assert set(rows["board_status"]) == {"no_board"}
     ok = rows["status"] == "ok"
     assert ok.sum() >= len(rows) // 2
@@ -124,8 +126,9 @@ def test_board_truth_without_recorded_poses(rendered_dir, exported, extract_para
         drop = lines[0].index("T_cam_ref")
         (folder / table).write_text("\n".join(",".join(cells[:drop] + cells[drop + 1:]) for cells in lines) + "\n")
     materialize([folder], tmp_path / "data")
-    rows = extract(tmp_path / "data", "arc_r", extract_params, workers)
     original = extract(rendered_dir, "arc_r", extract_params, workers)
+    copy_sift_features(rendered_dir, tmp_path / "data", "arc_r", extract_params)  # the same images
+    rows = extract(tmp_path / "data", "arc_r", extract_params, workers)
     assert not rows["status"].isin(["bad_pose"]).any() and rows["E_t_exact_mm"].isna().all()
     pd.testing.assert_series_equal(rows["E_t_mm"], original["E_t_mm"], check_exact=True)
 
