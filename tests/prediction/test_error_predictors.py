@@ -14,6 +14,7 @@ from poseintegrity.artifact_models.base_functions import emg
 from poseintegrity.artifact_models.fitted import FALLBACK, OK
 from poseintegrity.artifact_models.series import Series
 from poseintegrity.errors import ArgumentError
+from poseintegrity.localization.pnp import MIN_CORRESPONDENCES
 from poseintegrity.prediction.ceiling import ceiling, ceiling_share
 from poseintegrity.prediction.error_predictors import (
     error_long_range, error_next_step, fit_growth, growth_regressor, observed_scale,
@@ -29,7 +30,9 @@ FACTORS = np.geomspace(0.2, 10.0, 41)
 
 
 def exact_sigma(theta, a, b):
-    return np.sqrt((a + b * np.sin(np.radians(theta)) ** 2) / emg(theta, ALPHA, K, MU))
+    """The law's sigma; no pose (inf) where the count is below the 4 correspondences a pose needs (past 38 deg)."""
+    n = emg(theta, ALPHA, K, MU)
+    return np.where(n >= MIN_CORRESPONDENCES, np.sqrt((a + b * np.sin(np.radians(theta)) ** 2) / n), np.inf)
 
 
 def error_series(images: int = 3, n_stops: int = 20, sigma_t=None) -> Series:
@@ -52,6 +55,17 @@ def test_growth_recovers_the_law_from_the_first_stops(tiny_fit):
     np.testing.assert_allclose(growth.coefficients_r, (A_R, B_R), rtol=1e-6)
     theta = np.linspace(0.0, 45.0, 10)
     np.testing.assert_allclose(growth.sigma(theta)[0], exact_sigma(theta, A_T, B_T), rtol=1e-3)
+
+
+def test_no_pose_is_predicted_where_the_count_falls_below_four(tiny_fit):
+    growth, _, _ = fit_growth(error_series(), np.arange(20), "emg", tiny_fit, np.random.default_rng(0))
+    theta = np.linspace(0.0, 45.0, 181)
+    n = growth.inliers.predict(theta)
+    assert (n < 4).any() and (n >= 4).any()
+    sigma_t, sigma_r = growth.sigma(theta)
+    assert np.isinf(sigma_t[n < 4]).all() and np.isinf(sigma_r[n < 4]).all()
+    assert np.isfinite(sigma_t[n >= 4]).all() and np.isfinite(sigma_r[n >= 4]).all()
+    assert (growth.margin(theta, TOLERANCE)[n < 4] == 0).all()  # no safety factor lets the robot go there
 
 
 def test_error_long_range_stops_where_k_sigma_reaches_the_tolerance(tiny_fit):

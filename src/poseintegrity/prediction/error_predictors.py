@@ -17,7 +17,8 @@ is fitted by non-negative least squares to the sampled images with a pose, for E
 n_i(theta) comes from the paper's own artifact model (eq. 1) fitted to the same stops: sigma(theta) =
 sqrt((a + b h(theta)) / n(theta)). The eq. 1 curve carries what n_i says (a falling count raises the error as
 1 / sqrt(n_i)); the propagation adds what it cannot see (the model points' errors entering the image as the view
-turns). Where the fitted count reaches zero the predicted error is infinite.
+turns). Where the fitted count falls below the 4 correspondences a pose needs (pnp.MIN_CORRESPONDENCES) there is
+no pose to have an error: the predicted error is infinite (a frame without a pose fails every tolerance, IV-C).
 
     error_long_range   fit the first k stops (4 on arcs, 5 on lines, as the long range predictor); theta_p where
                        k x sigma(theta) first reaches the tolerance (III-E's search, :func:`envelope_prediction`)
@@ -53,6 +54,7 @@ from poseintegrity.params.fit import FitParams
 from poseintegrity.errors import ArgumentError, check_array
 from poseintegrity.artifact_models.fitted import FALLBACK
 from poseintegrity.artifact_models.series import Series
+from poseintegrity.localization.pnp import MIN_CORRESPONDENCES
 from poseintegrity.prediction.predictors import (
     Boundaries, NextStep, envelope_prediction, fit_rng, fit_stops, flagged, stop_positions, supervise,
 )
@@ -76,11 +78,13 @@ class ErrorGrowth:
     inliers: FittedModel
 
     def sigma(self, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(sigma_t (m,) mm, sigma_r (m,) deg) predicted at theta (m,); inf where the fitted count is <= 0."""
+        """(sigma_t (m,) mm, sigma_r (m,) deg) predicted at theta (m,); inf where the fitted count is below the
+        MIN_CORRESPONDENCES a pose needs (module docstring)."""
         h = growth_regressor(self.trajectory, theta)
         n = np.asarray(self.inliers.predict(theta), dtype=float)
+        posed = n >= MIN_CORRESPONDENCES
         with np.errstate(divide="ignore", invalid="ignore"):
-            return tuple(np.where(n > 0, np.sqrt((a + b * h) / np.where(n > 0, n, 1.0)), np.inf)
+            return tuple(np.where(posed, np.sqrt((a + b * h) / np.where(posed, n, 1.0)), np.inf)
                          for a, b in (self.coefficients_t, self.coefficients_r))
 
     def margin(self, theta: np.ndarray, tolerance: tuple[float, float]) -> np.ndarray:
