@@ -38,7 +38,7 @@ RULE = ("**Verdict**, one per claim, the weakest world deciding: *reproduced*: o
 SPL, SHARE, RATE = "{:.1f}", "{:.0%}", "{:.2%}"
 NAMES = {"static": "static", "long_range": "long range", "next_step": "next step", "mlp": "MLP",
          "error_long_range": "error long range", "error_next_step": "error next step",
-         "error_next_step_observed": "error next step, observed", "error_combined": "error combined"}
+         "error_next_step_observed": "observed error next step", "error_combined": "error combined"}
 TABLES = {"long_range": "Tables I, III", "next_step": "Tables II, III"}
 OURS = ("error_long_range", "error_next_step", "error_next_step_observed", "error_combined")  # issue 38: k, not n_t
 PNP_VARIANTS = {"epnp": "EPnP", "p3p": "P3P", "ap3p": "AP3P"}  # the paper's three (V-A, Fig. 6)
