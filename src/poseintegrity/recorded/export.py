@@ -43,15 +43,14 @@ def export_dataset(data_dir: str | Path, folder: str | Path, out: str | Path) ->
         (tmp / "board.yaml").write_text(yaml.safe_dump(dict(meta["board"]), sort_keys=False))
         exact = meta["model"].get("exact_T_cam_board")
         robot = meta["model"].get("T_base_cam_robot")  # the robot's poses, when the dataset has them
-        write_table(tmp / "model.csv", ["file", "mask"] + (["T_cam_ref"] if exact else []) + (["T_base_cam"] if robot
-                                                                                                 else []),
-                    [[image, mask] + ([_pose_text(exact[k])] if exact else []) + ([_pose_text(robot[k])] if robot
-                                                                                   else [])
+        model_columns = ["T_cam_ref"] * bool(exact) + ["T_base_cam"] * bool(robot)
+        write_table(tmp / "model.csv", ["file", "mask", *model_columns],
+                    [[image, mask, *(_pose_text(poses[k]) for poses in (exact, robot) if poses)]
                      for k, (image, mask) in enumerate(zip(meta["model"]["images"], meta["model"]["masks"]))])
-        write_table(tmp / "stops.csv", ["file", "stop", "theta_deg", "x_mm", "T_cam_ref"] + (["T_base_cam"] if robot
-                                                                                               else []),
+        stop_columns = ["file", "stop", "theta_deg", "x_mm", "T_cam_ref"] + ["T_base_cam"] * bool(robot)
+        write_table(tmp / "stops.csv", stop_columns,
                     [[frame.file, int(frame.stop), repr(float(frame.theta_deg)), repr(float(frame.x_mm)),
-                      _pose_text(frame.T_cam_board)] + ([_pose_text(frame.T_base_cam_robot)] if robot else [])
+                      _pose_text(frame.T_cam_board)] + [_pose_text(frame.T_base_cam_robot)] * bool(robot)
                      for frame in dataset.frames.itertuples()])
     return Path(out) / dataset.name
 
