@@ -25,6 +25,7 @@ import json
 import sys
 from pathlib import Path
 
+import poseintegrity  # noqa: F401  (first: it pins the CPU dispatch before numpy loads)
 import numpy as np
 import pandas as pd
 from tqdm import tqdm
