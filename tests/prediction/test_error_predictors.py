@@ -17,9 +17,9 @@ from poseintegrity.errors import ArgumentError
 from poseintegrity.localization.pnp import MIN_CORRESPONDENCES
 from poseintegrity.prediction.ceiling import ceiling, ceiling_share
 from poseintegrity.prediction.error_predictors import (
-    error_long_range, error_next_step, fit_growth, growth_regressor, observed_scale,
+    CountTrend, error_long_range, error_next_step, fit_growth, growth_regressor, observed_scale,
 )
-from poseintegrity.prediction.predictors import next_step
+from poseintegrity.prediction.predictors import fit_stops, next_step
 from poseintegrity.prediction.sweeps import COLUMNS, attach_envelopes, combined_rows
 
 ALPHA, K, MU = 3000.0, 8.0, -1.0  # exact eq. 1, as tests/prediction/test_predictors.py
@@ -48,8 +48,14 @@ def true_crossing(k: float) -> float:
     return brentq(margin, 0.0, 45.0) if margin(45.0) < 0 < margin(0.0) else np.nan
 
 
+def eq1_growth(series: Series, stops: np.ndarray, fit) -> tuple:
+    """fit_growth with the eq. 1 count fitted to ``stops``, as error_long_range fits it."""
+    fitted, _, _ = fit_stops(series, stops, "emg", fit, np.random.default_rng(0))
+    return fit_growth(series, stops, fitted, fitted.status, fitted.reason)
+
+
 def test_growth_recovers_the_law_from_the_first_stops(tiny_fit):
-    growth, status, _ = fit_growth(error_series(), np.arange(4), "emg", tiny_fit, np.random.default_rng(0))
+    growth, status, _ = eq1_growth(error_series(), np.arange(4), tiny_fit)
     assert status == OK
     np.testing.assert_allclose(growth.coefficients_t, (A_T, B_T), rtol=1e-6)
     np.testing.assert_allclose(growth.coefficients_r, (A_R, B_R), rtol=1e-6)
@@ -58,7 +64,7 @@ def test_growth_recovers_the_law_from_the_first_stops(tiny_fit):
 
 
 def test_no_pose_is_predicted_where_the_count_falls_below_four(tiny_fit):
-    growth, _, _ = fit_growth(error_series(), np.arange(20), "emg", tiny_fit, np.random.default_rng(0))
+    growth, _, _ = eq1_growth(error_series(), np.arange(20), tiny_fit)
     theta = np.linspace(0.0, 45.0, 181)
     n = growth.inliers.predict(theta)
     assert (n < 4).any() and (n >= 4).any()
@@ -78,15 +84,58 @@ def test_error_long_range_stops_where_k_sigma_reaches_the_tolerance(tiny_fit):
     assert np.all(np.diff(found.theta_p) <= 1e-9)  # a larger safety factor never lets the robot go further
 
 
-def test_error_next_step_follows_iii_e_rule(tiny_fit):
+DECAY = -0.12  # per deg: the count of decaying_series, exactly log-linear in (n + 1)
+
+
+def decaying_series(images: int = 3) -> Series:
+    """error_series' law with the count (n + 1) = 300 exp(DECAY theta): the count trend of any three stops is exact."""
+    theta = np.repeat(THETA_STOPS, images)
+    n = 300.0 * np.exp(DECAY * theta) - 1.0
+    sigma = [np.where(n >= MIN_CORRESPONDENCES, np.sqrt((a + b * np.sin(np.radians(theta)) ** 2) / n), np.inf)
+             for a, b in ((A_T, B_T), (A_R, B_R))]
+    return Series("scene_1_arc000", "arc", np.repeat(np.arange(20), images), theta, n, 45.0, *sigma)
+
+
+def test_count_trend_continues_the_last_stops_and_never_rises():
+    series = decaying_series()
+    trend = CountTrend.of(series, np.arange(6))
+    assert trend.slope == pytest.approx(DECAY) and trend.theta_last == pytest.approx(THETA_STOPS[5])
+    theta = np.linspace(0.0, 45.0, 50)
+    np.testing.assert_allclose(trend.predict(theta), np.maximum(300.0 * np.exp(DECAY * theta) - 1.0, 0.0), rtol=1e-9)
+    # only the last three stops count: a different start changes nothing
+    early = replace(series, n_inliers=np.where(series.stop < 3, 1000.0, series.n_inliers))
+    assert CountTrend.of(early, np.arange(6)) == trend
+    rising = replace(series, n_inliers=series.n_inliers[::-1].copy())
+    flat = CountTrend.of(rising, np.arange(6))
+    assert flat.slope == 0.0 and flat.predict(np.array([45.0]))[0] == pytest.approx(flat.n_last)
+    # a failed frame (0 inliers) is a count: the mean of a stop falls with it; NaN is no count
+    holes = replace(series, n_inliers=np.where((series.stop == 5) & (np.arange(60) % 3 == 0), np.nan, series.n_inliers))
+    assert CountTrend.of(holes, np.arange(6)).n_last == pytest.approx(trend.n_last)
+    assert CountTrend.of(series, np.arange(1)).slope == 0.0  # one stop: no trend yet
+
+
+def test_error_next_step_follows_iii_e_rule():
     """At every stop from the 4th on, the robot stops once the predicted crossing is less than a step ahead: with
-    an exact law, at the last stop before the true crossing (at the 4th, where it decides first, if that is later)."""
-    step = error_next_step(error_series(), 4, "emg", FACTORS, TOLERANCE, tiny_fit, 0, "usac_magsac", 256)
+    an exact law (and a count whose trend is exact), at the last stop before the true crossing (at the 4th, where
+    it decides first, if that is later)."""
+    series = decaying_series()
+
+    def crossing(k: float) -> float:
+        theta = np.linspace(0.0, 45.0, 4501)
+        n = 300.0 * np.exp(DECAY * theta) - 1.0
+        h = np.sin(np.radians(theta)) ** 2
+        with np.errstate(divide="ignore", invalid="ignore"):
+            margin = np.where(n >= MIN_CORRESPONDENCES, np.minimum(TOLERANCE[0] / np.sqrt((A_T + B_T * h) / n),
+                                                                   TOLERANCE[1] / np.sqrt((A_R + B_R * h) / n)), 0.0)
+        below = np.flatnonzero(margin < k)
+        return theta[below[0]] if below.size else np.nan
+
+    step = error_next_step(series, 4, FACTORS, TOLERANCE, 256)
     assert (step.prediction.status == "stopped").sum() > 20
     for k, theta_p, status in zip(FACTORS, step.prediction.theta_p, step.prediction.status):
-        crossing = true_crossing(k)
-        if status == "stopped" and crossing > THETA_STOPS[3]:
-            assert theta_p < crossing + 1e-6 and crossing - theta_p <= 2.25 + 1e-6
+        true = crossing(k)
+        if status == "stopped" and true > THETA_STOPS[3]:
+            assert theta_p < true + 0.01 and true - theta_p <= 2.25 + 0.01
         elif status == "stopped":
             assert theta_p == THETA_STOPS[3]
 
@@ -106,15 +155,18 @@ def test_observed_scale_is_the_median_excess_after_the_first_stop():
     assert observed_scale(observed(series, first), np.arange(1)) == (1.0, 1.0)  # nothing after the first stop yet
     gaps = np.where(series.stop % 2 == 1, np.nan, 4.0)  # images without a pose or a robot pose are no sample
     assert observed_scale(observed(series, gaps), np.arange(6)) == pytest.approx((4.0, 4.0))
+    recent = np.where(series.stop < 4, 10.0, 2.0)  # the last SCALE_STOPS (3) stops only: an arc's latest state
+    assert observed_scale(observed(series, recent), np.arange(6)) == pytest.approx((2.0, 2.0))
+    assert observed_scale(observed(series, recent), np.arange(6), window=None) == pytest.approx((10.0, 10.0))
     rising = 1.0 + series.stop  # the scale uses the stops seen so far only
     assert observed_scale(observed(series, rising), np.arange(3))[0] == pytest.approx(np.sqrt(2.0 * 3.0))  # log median
 
 
-def test_error_next_step_observed_is_the_plain_one_on_the_scaled_error(tiny_fit):
+def test_error_next_step_observed_is_the_plain_one_on_the_scaled_error():
     """With observed errors 3 x (t) and 2 x (r) the predicted ones at every stop, the observed variant stops where the
     plain one stops on errors scaled so; with observed errors below the predicted, where the plain one stops."""
     series = error_series()
-    args = (4, "emg", FACTORS, TOLERANCE, tiny_fit, 0, "usac_magsac", 256)
+    args = (4, FACTORS, TOLERANCE, 256)
     scaled = error_next_step(replace(series, sigma_t=3.0 * series.sigma_t, sigma_r=2.0 * series.sigma_r), *args)
     ours = error_next_step(observed(series, 3.0, 2.0), *args, observed=True)
     np.testing.assert_array_equal(ours.prediction.theta_p, scaled.prediction.theta_p)
@@ -129,7 +181,7 @@ def test_error_next_step_observed_is_the_plain_one_on_the_scaled_error(tiny_fit)
 
 def test_no_predicted_error_is_a_flagged_fit_not_an_error(tiny_fit):
     series = error_series(sigma_t=np.full(60, np.nan))
-    growth, status, reason = fit_growth(series, np.arange(4), "emg", tiny_fit, np.random.default_rng(0))
+    growth, status, reason = eq1_growth(series, np.arange(4), tiny_fit)
     assert status == FALLBACK and "no predicted error" in reason
     found, _, _ = error_long_range(series, 4, "emg", FACTORS, TOLERANCE, tiny_fit, np.random.default_rng(0), 256)
     assert np.all(found.theta_p == 0.0)  # an unknown error is no licence to move

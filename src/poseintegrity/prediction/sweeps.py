@@ -40,7 +40,7 @@ from poseintegrity.artifact_models.series import REQUIRED_COLUMNS, Series, datas
 from poseintegrity.parallel import Workers
 from poseintegrity.tables import TableError, check_artifacts, check_envelopes
 from poseintegrity.prediction.metrics import with_metrics
-from poseintegrity.prediction.error_predictors import combined, error_long_range, error_next_step
+from poseintegrity.prediction.error_predictors import COUNT_TREND, combined, error_long_range, error_next_step
 from poseintegrity.params.predict import PredictParams
 from poseintegrity.prediction.predictors import (
     NO_FIT,
@@ -162,14 +162,12 @@ def error_rows(series: Series, method: str, predict: PredictParams, fit: FitPara
         rows.append(prediction_rows("error_long_range", models.long_range, method, series, factors, found, status,
                                     reason, name))
         if with_next_step:
-            step = error_next_step(series, k, models.next_step, factors, tolerance, fit, predict.seed, method,
-                                   predict.n_grid)
-            rows.append(prediction_rows("error_next_step", models.next_step, method, series, factors,
+            step = error_next_step(series, k, factors, tolerance, predict.n_grid)
+            rows.append(prediction_rows("error_next_step", COUNT_TREND, method, series, factors,
                                         step.prediction, step.fit_status, step.fit_reason, name))
             if series.observed_t is not None and series.observed_r is not None:
-                step = error_next_step(series, k, models.next_step, factors, tolerance, fit, predict.seed, method,
-                                       predict.n_grid, observed=True)
-                rows.append(prediction_rows("error_next_step_observed", models.next_step, method, series, factors,
+                step = error_next_step(series, k, factors, tolerance, predict.n_grid, observed=True)
+                rows.append(prediction_rows("error_next_step_observed", COUNT_TREND, method, series, factors,
                                             step.prediction, step.fit_status, step.fit_reason, name))
     return rows
 
