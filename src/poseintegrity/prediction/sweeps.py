@@ -174,6 +174,12 @@ def error_rows(series: Series, method: str, predict: PredictParams, fit: FitPara
 
 def _predict_task(task: tuple[Series, str], predict: PredictParams, fit: FitParams, protocol: ProtocolParams
                   ) -> pd.DataFrame:  # fmt: skip
+    # loky restarts a worker whose memory grows 300 MB past what it held after its first task, and warns "A worker
+    # stopped while some jobs were given to the executor" (docs/references.md). The MLP's torch (225 MB resident)
+    # loads with the first task of protocol.pnp_method, which comes after the other PnP methods' tasks: loaded by
+    # every worker's first task, it is part of what the worker holds from the start.
+    import torch  # noqa: F401, PLC0415
+
     series, method = task
     return predict_dataset(series, method, predict, fit, protocol)
 
