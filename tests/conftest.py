@@ -30,9 +30,11 @@ TINY_PARAMS = ROOT / "tests" / "params_tiny.yaml"
 
 # The longest modules first, each given whole to one worker (pyproject.toml: --dist loadscope, in this order): stage
 # 06's project, which the recorded run copies and the chain's report reads (run_once), on one worker while the
-# pipeline chain starts on the other; then the recorded `dvc repro` run.
+# pipeline chain starts on the other; then the recorded `dvc repro` run. The predictor sweep (run_once) next: made at
+# the start, it is ready when test_model_choice.py asks for it, where the worker that asked second sat idle for
+# 2.5 s of the fast tier while the other made it.
 LONGEST_FIRST = ("tests/tracking/test_notebook_06.py", "tests/test_notebooks.py", "tests/recorded/test_dvc_repro.py",
-                 "tests/test_stage.py")
+                 "tests/test_stage.py", "tests/prediction/test_sweeps.py")
 
 
 def pytest_collection_modifyitems(config, items):
