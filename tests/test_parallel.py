@@ -7,7 +7,6 @@ import sys
 from pathlib import Path
 
 import cloudpickle
-import distributed
 import numpy as np
 import pytest
 
@@ -23,6 +22,8 @@ cloudpickle.register_pickle_by_value(sys.modules[__name__])
 @pytest.fixture(scope="module")
 def cluster():
     """Two single-threaded worker processes on loopback, as `dask scheduler` + `dask worker` would give."""
+    import distributed  # here, not at collection: every test process imported it, one uses it
+
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
                                   dashboard_address=":0") as local_cluster:
         yield local_cluster
