@@ -11,6 +11,12 @@ from pathlib import Path
 import pytest
 from hypothesis import settings
 
+import poseintegrity.stage  # noqa: F401 (first: pins the kernel dispatch before any numpy import, dispatch; and before
+# any papermill or nbformat import: without jsonschema's IRI grammars, 2.7 s of every xdist worker's collection;
+# stage.py. Here, at the top of the first conftest: a test module or folder given on the command line loads its
+# folder's conftest before collection starts, and tests/prediction/conftest.py imports pandas first)
+from poseintegrity.config import parse_params, read_raw
+
 # Property tests explore new random examples on every local run; on CI (CI=true) they replay a fixed set, so a
 # submission never fails on a case nobody has seen. Run locally to find new counterexamples.
 settings.register_profile("ci", derandomize=True)
@@ -31,13 +37,6 @@ TINY_PARAMS = ROOT / "tests" / "params_tiny.yaml"
 # 2.5 s of the fast tier while the other made it.
 LONGEST_FIRST = ("tests/tracking/test_notebook_06.py", "tests/test_notebooks.py", "tests/recorded/test_dvc_repro.py",
                  "tests/test_stage.py", "tests/prediction/test_sweeps.py")
-
-
-def pytest_collectstart(collector):
-    """Before the first test module is imported: poseintegrity.stage, so that a later papermill or nbformat import
-    leaves out jsonschema's IRI grammars (2.7 s of every xdist worker's collection; stage.py). Here and not at the
-    top: the xdist controller, which collects nothing, started its workers 0.7 s later for it."""
-    import poseintegrity.stage  # noqa: F401
 
 
 def pytest_collection_modifyitems(config, items):
@@ -73,8 +72,6 @@ def run_once(tmp_path_factory) -> Callable[[str, Callable[[Path], object]], Path
 
 @pytest.fixture(scope="session")
 def _tiny_raw_once() -> dict:
-    from poseintegrity.config import read_raw
-
     return read_raw(TINY_PARAMS)[0]
 
 
@@ -87,6 +84,4 @@ def tiny_raw(_tiny_raw_once) -> dict:
 
 @pytest.fixture
 def tiny_params(tiny_raw):
-    from poseintegrity.config import parse_params
-
     return parse_params(tiny_raw, base_dir=ROOT)
