@@ -13,11 +13,9 @@ from pathlib import Path
 import pytest
 from hypothesis import settings
 
-import poseintegrity.stage  # noqa: F401 (first: pins the kernel dispatch before any numpy import, dispatch; and before
-# any papermill or nbformat import: without jsonschema's IRI grammars, 2.7 s of every xdist worker's collection;
-# stage.py. Here, at the top of the first conftest: a test module or folder given on the command line loads its
-# folder's conftest before collection starts, and tests/prediction/conftest.py imports pandas first)
-from poseintegrity.config import parse_params, read_raw
+import poseintegrity  # noqa: F401 (first: pins the kernel dispatch before any numpy import, dispatch. Here, at the top
+# of the first conftest: a test module or folder given on the command line loads its folder's conftest before
+# collection starts, and tests/prediction/conftest.py imports pandas first)
 
 # Property tests explore new random examples on every local run; on CI (CI=true) they replay a fixed set, so a
 # submission never fails on a case nobody has seen. Run locally to find new counterexamples.
@@ -54,6 +52,13 @@ LONGEST_FIRST = ("tests/tracking/test_notebook_06.py", "tests/test_notebooks.py"
                  "tests/test_stage.py", "tests/prediction/test_sweeps.py")
 
 
+def pytest_collectstart(collector):
+    """Before any test module is imported: poseintegrity.stage, so that the papermill and nbformat imports of the
+    notebook tests leave out jsonschema's IRI grammars (2.7 s of every xdist worker's collection; stage.py). Not at
+    the top: the xdist controller collects nothing, and it started the workers 0.5 s later for it."""
+    import poseintegrity.stage  # noqa: F401
+
+
 def pytest_collection_modifyitems(config, items):
     rank = {name: i for i, name in enumerate(LONGEST_FIRST)}
     items.sort(key=lambda item: rank.get(Path(item.path).relative_to(ROOT).as_posix(), len(rank)))  # stable
@@ -87,6 +92,8 @@ def run_once(tmp_path_factory) -> Callable[[str, Callable[[Path], object]], Path
 
 @pytest.fixture(scope="session")
 def _tiny_raw_once() -> dict:
+    from poseintegrity.config import read_raw
+
     return read_raw(TINY_PARAMS)[0]
 
 
@@ -99,4 +106,6 @@ def tiny_raw(_tiny_raw_once) -> dict:
 
 @pytest.fixture
 def tiny_params(tiny_raw):
+    from poseintegrity.config import parse_params
+
     return parse_params(tiny_raw, base_dir=ROOT)
