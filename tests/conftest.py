@@ -1,25 +1,40 @@
 """Shared fixtures: the repository root, the tiny parameters every notebook test runs with, and work done once per
 test session whichever xdist worker asks for it first; the order in which the workers take the test modules."""
 
+import atexit
 import copy
 import fcntl
 import os
 import shutil
+import sys
 from collections.abc import Callable
 from pathlib import Path
 
 import pytest
 from hypothesis import settings
 
-import poseintegrity.stage  # noqa: F401 (before any papermill or nbformat import: without jsonschema's IRI grammars,
-# 2.7 s of every xdist worker's collection; stage.py)
-from poseintegrity.config import parse_params, read_raw
+import poseintegrity  # noqa: F401 (first: pins the kernel dispatch before any numpy import, dispatch. Here, at the top
+# of the first conftest: a test module or folder given on the command line loads its folder's conftest before
+# collection starts, and tests/prediction/conftest.py imports pandas first)
 
 # Property tests explore new random examples on every local run; on CI (CI=true) they replay a fixed set, so a
 # submission never fails on a case nobody has seen. Run locally to find new counterexamples.
 settings.register_profile("ci", derandomize=True)
 if os.environ.get("CI"):
     settings.load_profile("ci")
+
+
+def _exit_without_finalization() -> None:
+    """An xdist worker's last act: its results are with the controller, its other exit handlers have run (registered
+    after this one, they run before it); Python's finalization, the teardown of the ~4 000 modules a worker has
+    imported (torch, numba, pandas, Dask), took each worker 2 s more, and every run waited for it at its end."""
+    sys.stdout.flush()
+    sys.stderr.flush()
+    os._exit(0)
+
+
+if os.environ.get("PYTEST_XDIST_WORKER"):
+    atexit.register(_exit_without_finalization)
 
 # The notebooks the tests execute save every figure as the pipeline does, without also rendering each one into the
 # notebook (the inline backend's second drawing of every figure: a fifth of stage 04's time on the tiny parameters).
@@ -30,9 +45,18 @@ TINY_PARAMS = ROOT / "tests" / "params_tiny.yaml"
 
 # The longest modules first, each given whole to one worker (pyproject.toml: --dist loadscope, in this order): stage
 # 06's project, which the recorded run copies and the chain's report reads (run_once), on one worker while the
-# pipeline chain starts on the other; then the recorded `dvc repro` run.
+# pipeline chain starts on the other; then the recorded `dvc repro` run. The predictor sweep (run_once) next: made at
+# the start, it is ready when test_model_choice.py asks for it, where the worker that asked second sat idle for
+# 2.5 s of the fast tier while the other made it.
 LONGEST_FIRST = ("tests/tracking/test_notebook_06.py", "tests/test_notebooks.py", "tests/recorded/test_dvc_repro.py",
-                 "tests/test_stage.py")
+                 "tests/test_stage.py", "tests/prediction/test_sweeps.py")
+
+
+def pytest_collectstart(collector):
+    """Before any test module is imported: poseintegrity.stage, so that the papermill and nbformat imports of the
+    notebook tests leave out jsonschema's IRI grammars (2.7 s of every xdist worker's collection; stage.py). Not at
+    the top: the xdist controller collects nothing, and it started the workers 0.5 s later for it."""
+    import poseintegrity.stage  # noqa: F401
 
 
 def pytest_collection_modifyitems(config, items):
@@ -68,6 +92,8 @@ def run_once(tmp_path_factory) -> Callable[[str, Callable[[Path], object]], Path
 
 @pytest.fixture(scope="session")
 def _tiny_raw_once() -> dict:
+    from poseintegrity.config import read_raw
+
     return read_raw(TINY_PARAMS)[0]
 
 
@@ -80,4 +106,6 @@ def tiny_raw(_tiny_raw_once) -> dict:
 
 @pytest.fixture
 def tiny_params(tiny_raw):
+    from poseintegrity.config import parse_params
+
     return parse_params(tiny_raw, base_dir=ROOT)

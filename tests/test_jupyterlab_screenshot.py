@@ -8,10 +8,6 @@ import sys
 from pathlib import Path
 
 import pytest
-from jupyter_server.auth.identity import IdentityProvider
-from jupyter_server.serverapp import ServerApp
-from jupyterlab.labapp import LabApp
-from jupyterlab_server.settings_utils import get_settings
 
 from repository import ROOT
 
@@ -22,6 +18,11 @@ LAB = Path(sys.prefix) / "share" / "jupyter" / "lab"  # JupyterLab's application
 
 
 def test_every_option_given_to_jupyterlab_is_a_trait_it_has(tmp_path):
+    # JupyterLab imported here, not at collection: 0.8 s of every test process, most of which never run this module
+    from jupyter_server.auth.identity import IdentityProvider
+    from jupyter_server.serverapp import ServerApp
+    from jupyterlab.labapp import LabApp
+
     command = screenshot.lab_command(tmp_path, "t0ken")
     assert command[:3] == [str(Path(sys.executable).parent / "jupyter"), "lab", "--no-browser"]
     classes = {"ServerApp": ServerApp, "IdentityProvider": IdentityProvider, "LabApp": LabApp}
@@ -34,6 +35,8 @@ def test_every_option_given_to_jupyterlab_is_a_trait_it_has(tmp_path):
 
 
 def test_the_settings_written_are_the_ones_jupyterlab_reads(tmp_path):
+    from jupyterlab_server.settings_utils import get_settings
+
     folder = screenshot.write_lab_settings(tmp_path)
     for plugin, values in screenshot.LAB_SETTINGS.items():
         found, problems = get_settings(str(LAB / "settings"), str(LAB / "schemas"), str(folder), schema_name=plugin)

@@ -7,7 +7,6 @@ import sys
 from pathlib import Path
 
 import cloudpickle
-import distributed
 import numpy as np
 import pytest
 
@@ -23,6 +22,8 @@ cloudpickle.register_pickle_by_value(sys.modules[__name__])
 @pytest.fixture(scope="module")
 def cluster():
     """Two single-threaded worker processes on loopback, as `dask scheduler` + `dask worker` would give."""
+    import distributed  # here, not at collection: every test process imported it, one uses it
+
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
                                   dashboard_address=":0") as local_cluster:
         yield local_cluster
@@ -71,24 +72,11 @@ def test_without_address_dask_starts_its_own_local_cluster_of_n_jobs_workers(tmp
         workers.map(abs, [-3])
 
 
-def explode_on_three(value: int) -> int:
-    if value == 3:
-        raise ValueError("task 3 failed")
-    return value
-
-
 def two_workers(request, backend: str) -> ParallelParams:
     """Two worker processes: local, or the module's Dask cluster (started only by the tests that ask for it)."""
     if backend == "dask":
         return ParallelParams(backend="dask", address=request.getfixturevalue("cluster").scheduler_address)
     return ParallelParams(n_jobs=2)
-
-
-@pytest.mark.parametrize("backend", ["local", "dask"])
-def test_a_failing_task_raises_its_exception_in_the_caller(request, backend):
-    params = two_workers(request, backend)
-    with Workers(params) as workers, pytest.raises(ValueError, match="task 3 failed"):
-        workers.map(explode_on_three, range(6), progress=False)
 
 
 def opencv_threads(_: int) -> int:
@@ -123,6 +111,20 @@ def test_tasks_know_whether_they_run_in_a_worker_process(request, backend):
     with Workers(ParallelParams(n_jobs=1)) as workers:
         assert workers.map(task_location, range(2), progress=False) == [False, False]
     assert not parallel.in_worker_task()
+
+
+def explode_on_three(value: int) -> int:
+    if value == 3:
+        raise ValueError("task 3 failed")
+    return value
+
+
+# After the other tests on two local processes: joblib stops them on a failing task, and they would start anew
+@pytest.mark.parametrize("backend", ["local", "dask"])
+def test_a_failing_task_raises_its_exception_in_the_caller(request, backend):
+    params = two_workers(request, backend)
+    with Workers(params) as workers, pytest.raises(ValueError, match="task 3 failed"):
+        workers.map(explode_on_three, range(6), progress=False)
 
 
 def test_empty_task_list_returns_without_starting_anything():

@@ -30,11 +30,10 @@ from pathlib import Path
 # schema uses (python-jsonschema/jsonschema#1428). Marked absent, jsonschema skips those two format checkers.
 sys.modules.setdefault("rfc3987_syntax", None)
 
-import papermill  # noqa: E402
+# papermill and nbconvert (0.5 s) are imported by run_stage once the arguments and `parallel` are checked: a command
+# refused before any work answers without them.
 import psutil  # noqa: E402
-from nbconvert import HTMLExporter  # noqa: E402
 from tqdm import tqdm  # noqa: E402
-from traitlets.config import Config  # noqa: E402
 
 from poseintegrity.config import ParamsError, load_section  # noqa: E402
 from poseintegrity.parallel import worker_count  # noqa: E402
@@ -55,11 +54,14 @@ def kernel_search_path() -> None:
         os.environ["JUPYTER_PATH"] = os.pathsep.join(filter(None, (ours, paths)))
 
 
-def kernel_config() -> Config:
+def kernel_config():
     """jupyter_client's KernelManager by default starts the kernel over TCP without CurveZMQ keys, and the
     kernel (ipykernel's IPKernelApp.init_sockets) then warns "Kernel is running over TCP without encryption" on
     every start. Our kernelspec declares ``supported_encryption: [curve]`` (ipykernel >= 7), so asking the manager
-    to provision keys when the kernel supports them encrypts the sockets, and the warning has no cause left."""
+    to provision keys when the kernel supports them encrypts the sockets, and the warning has no cause left.
+    Returns a traitlets ``Config``."""
+    from traitlets.config import Config
+
     config = Config()
     config.KernelManager.transport_encryption = "auto"
     return config
@@ -114,6 +116,9 @@ def run_stage(notebook: Path, params_path: Path, data_dir: Path, reports_dir: Pa
     kernel_search_path()
     parallel = load_section(params_path, "parallel")
     n_jobs = worker_count(parallel)
+    import papermill
+    from nbconvert import HTMLExporter
+
     outputs = StageOutputs(reports_dir, name)
     for path in (outputs.notebook, outputs.html, outputs.timing):
         path.unlink(missing_ok=True)
@@ -158,6 +163,13 @@ def process_start_epoch() -> float:
         return psutil.Process().create_time()
 
 
+def _execution_error() -> type[Exception]:
+    """papermill's error for a failing cell."""
+    from papermill import PapermillExecutionError
+
+    return PapermillExecutionError
+
+
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("notebook", type=Path, help="source notebook, e.g. notebooks/02_extract_artifacts.ipynb")
@@ -177,7 +189,7 @@ def main(argv: list[str] | None = None) -> None:
                            started=process_start_epoch())
     except (ParamsError, ConnectionError) as error:
         sys.exit(usage_error(f"{name}: {error}"))
-    except papermill.PapermillExecutionError as error:
+    except _execution_error() as error:  # run_stage imported papermill before any cell ran
         sys.exit(f"{error}\n{name} failed; the notebook as far as it ran: {partial}")
     except KeyboardInterrupt:
         sys.exit(f"{name} interrupted; the notebook as far as it ran: {partial}")

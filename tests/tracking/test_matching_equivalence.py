@@ -91,9 +91,13 @@ def differences(n_cases: int, seed: int) -> list[int]:
     return differ
 
 
+# 500 cases a seed: of 23 mutants of correspondence.py's compiled matchers (a comparison flipped, a tie broken the other
+# way, a uniqueness check, a fallback or the outlier filter dropped), the 15 that change an assignment in 3000 cases
+# (1500 a seed, as before) change 4 or more of these 1000, the rarest (outliers left to brute force) 15 of the 3000;
+# the other 8 change none of the 3000. The 2000 more cases cost 4.3 s of every run; the larger draw by hand goes on.
 @pytest.mark.parametrize("seed", [0, 1])
 def test_compiled_matchers_equal_the_numpy_reference(seed):
-    assert differences(1500, seed) == []
+    assert differences(500, seed) == []
 
 
 def test_gated_ties_and_crowded_gates_go_to_scipy_as_before():
