@@ -173,3 +173,35 @@ def test_the_kernel_and_its_workers_run_pinned_whatever_the_callers_environment(
     assert in_workers == [expected["OPENCV_CPU_DISABLE"], "haswell", expected.get("OPENBLAS_CORETYPE")]
     if "avx2" in cpu_flags():
         assert "*AVX2 " in features  # enabled: a disabled one reads "*AVX2?"
+
+
+@pytest.mark.parametrize("ours", [True, False])
+def test_the_kernel_is_shut_down_without_an_interrupt(ours):
+    """jupyter_client interrupts (SIGINT) a kernel before every shutdown; the runner's manager does not (a kernel still
+    sending its last message logged "KeyboardInterrupt caught in kernel" into a stage's output). The other case
+    checks the premise: jupyter_client's own manager does send it."""
+    import asyncio
+    import signal
+
+    from jupyter_client.manager import AsyncKernelManager
+
+    from poseintegrity.stage import KERNEL, kernel_config, kernel_manager_class, kernel_search_path
+
+    kernel_search_path()
+    manager = (kernel_manager_class() if ours else AsyncKernelManager)(kernel_name=KERNEL, config=kernel_config())
+    sent = []
+
+    async def run() -> None:
+        await manager.start_kernel()
+        signal_kernel = manager._async_signal_kernel
+
+        async def spy(signum: int) -> None:
+            sent.append(signum)
+            await signal_kernel(signum)
+
+        manager._async_signal_kernel = spy
+        await manager.shutdown_kernel()
+
+    asyncio.run(run())
+    assert (signal.SIGINT in sent) is not ours
+    assert not manager.has_kernel

@@ -67,6 +67,23 @@ def kernel_config():
     return config
 
 
+def kernel_manager_class() -> type:
+    """jupyter_client's KernelManager sends the kernel an interrupt (SIGINT) before every shutdown request, so that
+    a busy kernel can take the request. The notebook has run to its end by then: a kernel still sending its last
+    message catches the interrupt and logs "[IPKernelApp] ERROR | KeyboardInterrupt caught in kernel." into the
+    stage's output (seen once at the end of stage 04, under load). This manager does not interrupt a kernel it is
+    shutting down; a kernel that does not answer the request is still terminated, then killed
+    (``shutdown_wait_time``). Interrupts at any other time are jupyter_client's own."""
+    from jupyter_client.manager import AsyncKernelManager
+
+    class ShutdownWithoutInterrupt(AsyncKernelManager):
+        async def _async_interrupt_kernel(self) -> None:
+            if not self.shutting_down:
+                await super()._async_interrupt_kernel()
+
+    return ShutdownWithoutInterrupt
+
+
 @dataclass(frozen=True)
 class StageOutputs:
     """The files the runner writes for notebook ``name`` under ``reports_dir``."""
@@ -134,7 +151,7 @@ def run_stage(notebook: Path, params_path: Path, data_dir: Path, reports_dir: Pa
         parameters={"params_path": notebook_parameter(params_path), "data_dir": notebook_parameter(data_dir),
                     "reports_dir": notebook_parameter(reports_dir)},
         stdout_file=sys.stdout, stderr_file=sys.stderr,  # the kernel's output, forwarded as it arrives
-        config=kernel_config(), on_cell_execute=announce_cell,
+        config=kernel_config(), kernel_manager_class=kernel_manager_class(), on_cell_execute=announce_cell,
         coalesce_streams=True,  # the saved notebook keeps a tqdm bar's last state, not every redraw
     )
     body, _ = HTMLExporter().from_notebook_node(nb, resources={"metadata": {"name": name}})
