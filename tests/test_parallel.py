@@ -65,8 +65,10 @@ def test_dask_cluster_gives_byte_identical_results_and_files_to_local_processes(
 
 
 def test_without_address_dask_starts_its_own_local_cluster_of_n_jobs_workers(tmp_path):
-    with Workers(ParallelParams(backend="dask", n_jobs=2)) as workers:
-        assert workers.describe() == "dask LocalCluster, n_jobs 2"
+    # one worker, not two: a cluster that ignored n_jobs would have as many as the cores (two here, and on CI), and
+    # each worker process costs a second to start
+    with Workers(ParallelParams(backend="dask", n_jobs=1)) as workers:
+        assert workers.describe() == "dask LocalCluster, n_jobs 1"
         assert workers.map(abs, [-3, 2, -1], progress=False) == [3, 2, 1]
     with pytest.raises(RuntimeError, match="closed"):  # never a silent fall-back to local processes
         workers.map(abs, [-3])
