@@ -48,31 +48,43 @@ def texture(rng: np.random.Generator, shape: tuple[int, int]) -> np.ndarray:
     return np.clip(field, 0, 255).astype(np.uint8)
 
 
-def make_board() -> cv2.aruco.GridBoard:
-    dictionary = cv2.aruco.getPredefinedDictionary(getattr(cv2.aruco, BOARD["dictionary"]))
-    ids = np.arange(BOARD["first_id"], BOARD["first_id"] + BOARD["markers_x"] * BOARD["markers_y"])
+SECOND_BOARD = BOARD | dict(first_id=6)  # a handover board: the same layout, ids of its own
+SECOND_AT_MM = (98.0, -28.0)  # where its origin lies in the plane (over the target's top edge)
+
+
+def make_board(board: dict = BOARD) -> cv2.aruco.GridBoard:
+    dictionary = cv2.aruco.getPredefinedDictionary(getattr(cv2.aruco, board["dictionary"]))
+    ids = np.arange(board["first_id"], board["first_id"] + board["markers_x"] * board["markers_y"])
     return cv2.aruco.GridBoard(
-        (BOARD["markers_x"], BOARD["markers_y"]), BOARD["marker_length_mm"], BOARD["separation_mm"], dictionary, ids
+        (board["markers_x"], board["markers_y"]), board["marker_length_mm"], board["separation_mm"], dictionary, ids
     )
 
 
-def canvas(rng: np.random.Generator, with_board: bool = True) -> tuple[np.ndarray, np.ndarray]:
-    """The scene plane as (image, target mask), both (h, w) uint8 at PX_PER_MM (X = x_min + (u + 0.5) / s)."""
+def canvas(rng: np.random.Generator, with_board: bool = True, second_board: bool = False
+           ) -> tuple[np.ndarray, np.ndarray]:
+    """The scene plane as (image, target mask), both (h, w) uint8 at PX_PER_MM (X = x_min + (u + 0.5) / s); with
+    ``second_board`` SECOND_BOARD at SECOND_AT_MM too (drawn over the target)."""
     x_min, y_min, x_max, y_max = CANVAS_MM
     w, h = int((x_max - x_min) * PX_PER_MM), int((y_max - y_min) * PX_PER_MM)
     image = np.clip(rng.normal(200, 4, (h, w)), 0, 255).astype(np.uint8)  # faint paper texture
     mask = np.zeros((h, w), np.uint8)
-    if with_board:
-        board = make_board()
-        width_mm, height_mm, _ = board.getRightBottomCorner()
+
+    def draw(board: dict, at_mm: tuple[float, float]) -> None:
+        grid = make_board(board)
+        width_mm, height_mm, _ = grid.getRightBottomCorner()
         margin = 8
         size = (int(width_mm * PX_PER_MM) + 2 * margin, int(height_mm * PX_PER_MM) + 2 * margin)
-        board_image = board.generateImage(size, marginSize=margin)  # board pixel = margin + X * s
-        u0, v0 = int(-x_min * PX_PER_MM) - margin, int(-y_min * PX_PER_MM) - margin
+        board_image = grid.generateImage(size, marginSize=margin)  # board pixel = margin + X * s
+        u0, v0 = int((at_mm[0] - x_min) * PX_PER_MM) - margin, int((at_mm[1] - y_min) * PX_PER_MM) - margin
         image[v0 : v0 + size[1], u0 : u0 + size[0]] = board_image
+
+    if with_board:
+        draw(BOARD, (0.0, 0.0))
     tx0, ty0, tx1, ty1 = ((np.array(TARGET_MM) - [x_min, y_min, x_min, y_min]) * PX_PER_MM).astype(int)
     image[ty0:ty1, tx0:tx1] = texture(rng, (ty1 - ty0, tx1 - tx0))
     mask[ty0:ty1, tx0:tx1] = 255
+    if second_board:
+        draw(SECOND_BOARD, SECOND_AT_MM)
     return image, mask
 
 
@@ -117,16 +129,25 @@ T_BASE_BOARD = np.array([[0.0, -1.0, 0.0, 350.0], [1.0, 0.0, 0.0, -120.0], [0.0,
 def write_dataset(
     data_dir: Path, name: str, rng: np.random.Generator, trajectory: str = "arc", azimuth_deg: float = 0.0,
     stops: tuple[float, ...] = (10.0, 25.0, 40.0, 55.0), images_per_stop: int = 2, noise: float = 2.0,
+    second_board: bool = False, hidden_from_stop: int | None = None,
 ) -> dict:
     """Write one dataset in the stage-01 format under data_dir/datasets/<name>; returns its index row.
 
     ``stops`` are theta (deg) for arcs and x (mm, backwards along the optical axis) for lines. The robot that
-    carries the camera is exact: its reported poses (T_base_cam_robot) put the board at T_BASE_BOARD.
+    carries the camera is exact: its reported poses (T_base_cam_robot) put the board at T_BASE_BOARD. With
+    ``second_board``, SECOND_BOARD stands in the plane too (meta.json's handover_boards); from stop
+    ``hidden_from_stop`` on, the dataset's own board is not in the images (a target in front of it).
     """
     folder = data_dir / "datasets" / name
     (folder / "images").mkdir(parents=True, exist_ok=True)
     (folder / "model").mkdir(exist_ok=True)
-    plane, target = canvas(rng)
+    state = rng.bit_generator.state
+    plane, target = canvas(rng, second_board=second_board)
+    if hidden_from_stop is not None:  # the same plane (the same draws) without the own board
+        after = rng.bit_generator.state
+        rng.bit_generator.state = state
+        hidden, _ = canvas(rng, with_board=False, second_board=second_board)
+        rng.bit_generator.state = after
     T_model = arc_pose(0.0, azimuth_deg)
     model_poses = [T_model, shifted(T_model, np.array([20.0, 0.0, 0.0]))]  # IV-D: 2 cm along camera x
     model = dict(images=[], masks=[], T_cam1_cam0=(model_poses[1] @ np.linalg.inv(model_poses[0])).tolist(),
@@ -143,8 +164,9 @@ def write_dataset(
             T, theta_deg, x_mm = arc_pose(position, azimuth_deg), position, 0.0
         else:
             T, theta_deg, x_mm = shifted(T_model, np.array([0.0, 0.0, -position])), 0.0, position
+        seen = hidden if hidden_from_stop is not None and stop >= hidden_from_stop else plane
         for image in range(images_per_stop):
-            picture = render(plane, T).astype(np.float64) + rng.normal(0, noise, IMAGE_SIZE[::-1])
+            picture = render(seen, T).astype(np.float64) + rng.normal(0, noise, IMAGE_SIZE[::-1])
             file = f"images/s{stop:02d}_i{image:02d}.png"
             cv2.imwrite(str(folder / file), np.clip(picture, 0, 255).astype(np.uint8))
             rows.append(dict(dataset=name, stop=stop, image=image, theta_deg=theta_deg, x_mm=x_mm, file=file,
@@ -154,7 +176,7 @@ def write_dataset(
     meta = dict(
         dataset=name, world="main", scene="synthetic", targets=["texture"], trajectory=trajectory,
         azimuth_deg=azimuth_deg, offset_deg=0.0, n_stops=len(stops), images_per_stop=images_per_stop, board=BOARD,
-        model=model,
+        handover_boards=[SECOND_BOARD] if second_board else [], model=model,
     )
     (folder / "meta.json").write_text(json.dumps(meta))
     write_camera_yaml(folder / "camera.yaml", CAMERA, "synthetic")

@@ -197,7 +197,7 @@ def test_a_bad_dataset_stops_before_any_work_naming_it(data_dir, extract_params,
     damage, expected = STOPS[case]
     damage(data_dir)
     localized = []
-    monkeypatch.setattr(E, "frame_rows", lambda task: localized.append(task) or [])
+    monkeypatch.setattr(E, "frame_rows", lambda task: localized.append(task) or ([], ()))
     with pytest.raises(DatasetError) as error:  # a DatasetError, not a raw pandas / json / OpenCV error
         E.extract_all(data_dir, extract_params, METHODS, workers, progress=False)
     for text in expected:

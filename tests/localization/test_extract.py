@@ -127,3 +127,31 @@ def test_bad_frames_give_flagged_rows_not_crashes(synthetic_data_dir, extract_pa
 def test_unknown_dataset_in_params_is_named(synthetic_data_dir, extract_params, workers):
     with pytest.raises(DatasetError, match="nope"):
         E.extract_all(synthetic_data_dir, extract_params.model_copy(update=dict(datasets=["nope"])), METHODS, workers)
+
+
+def test_a_frame_whose_board_is_hidden_is_judged_by_the_handover_board(tmp_path, extract_params, workers):
+    """Two boards in the plane; from stop 2 on the dataset's own board is out of the images. Those frames are judged
+    by the handover board (truth_board 1, trusted): what it adds to E_t (against the exact motion since model image 0,
+    carried to where M_t was placed) is within 3 x its predicted sigma_t; the frames where the own board is seen keep it (truth_board 0). Without handover_boards in
+    meta.json the hidden frames are not judged."""
+    import json
+
+    import loc_synthetic as synthetic
+
+    row = synthetic.write_dataset(tmp_path, "two", np.random.default_rng(21), stops=(5.0, 15.0, 25.0, 35.0),
+                                  second_board=True, hidden_from_stop=2)
+    synthetic.write_index(tmp_path, [row])
+    rows = E.extract_all(tmp_path, extract_params, ["usac_magsac"], workers, progress=False)
+    seen, hidden = rows[rows.stop < 2], rows[rows.stop >= 2]
+    assert (seen.truth_board == 0).all() and (seen.board_status == "ok").all()
+    assert (hidden.truth_board == 1).all() and (hidden.board_status == "ok").all()
+    assert (hidden.E_t_truth_mm < 3 * hidden.board_sigma_t_mm).all() and hidden.E_t_mm.notna().all()
+
+    meta_path = tmp_path / "datasets" / "two" / "meta.json"
+    meta = json.loads(meta_path.read_text())
+    meta_path.write_text(json.dumps(meta | dict(handover_boards=[])))
+    alone = E.extract_all(tmp_path, extract_params, ["usac_magsac"], workers, progress=False)
+    assert (alone[alone.stop >= 2].board_status != "ok").all() and alone[alone.stop >= 2].E_t_mm.isna().all()
+    meta_path.write_text(json.dumps(meta | dict(handover_boards=[synthetic.BOARD])))
+    with pytest.raises(DatasetError, match=r"handover_boards\[0\].*overlap"):
+        E.extract_all(tmp_path, extract_params, ["usac_magsac"], workers, progress=False)

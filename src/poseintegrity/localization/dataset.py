@@ -13,7 +13,7 @@ What is checked before any work, each failure a :class:`DatasetError` naming the
 - ``meta.json`` readable and holding what stages 02 and 05 read (:class:`Meta`): the dataset's name as in the
   index, its world and trajectory, its ground-truth source (``ground_truth``: ``board``, the default, or ``poses``
   for recorded data whose frames' poses come from an external system), the board (a dictionary OpenCV knows, its
-  marker ids inside it; needed with ``board``), two model images, masks and a rigid finite relative pose (and with
+  marker ids inside it; needed with ``board``; optional handover boards, whose ids must differ), two model images, masks and a rigid finite relative pose (and with
   ``poses`` model image 0's pose ``T_cam0_ref``);
 - ``camera.yaml`` readable, every field valid (positive focal lengths, the plumb_bob model, a lens that does not
   fold the image);
@@ -98,6 +98,12 @@ class BoardMeta(_Read):
     marker_mm: float | None = Field(None, gt=0)
     scale: tuple[Annotated[float, Field(ge=0.9, le=1.1)], Annotated[float, Field(ge=0.9, le=1.1)]] = (1.0, 1.0)
 
+    @property
+    def ids(self) -> set[int]:
+        """The ids of the board's markers."""
+        count = (self.squares_x * self.squares_y // 2 if self.type == "charuco" else self.markers_x * self.markers_y)
+        return set(range(self.first_id, self.first_id + count))
+
     @field_validator("dictionary")
     @classmethod
     def _known(cls, name: str) -> str:
@@ -176,12 +182,24 @@ class Meta(_Read):
         default="board", description="board: the ArUco board detected per frame (IV-C, rendered data); poses: "
                                      "frames.parquet's T_cam_board, from an external system (recorded data)")
     board: BoardMeta | None = None
+    handover_boards: list[BoardMeta] = Field(
+        default_factory=list, description="other boards of the scene, each judging a frame the board cannot "
+                                          "(localization/ground_truth.py, \"Handover boards\"); their marker ids "
+                                          "must not overlap the board's")
     model: ModelMeta
 
     @model_validator(mode="after")
     def _truth_source(self) -> "Meta":
         if self.ground_truth == "board" and self.board is None:
             raise ValueError("board: needed with ground_truth board")
+        if self.handover_boards and self.board is None:
+            raise ValueError("handover_boards: only with a board (ground_truth board)")
+        boards = [self.board, *self.handover_boards] if self.board is not None else []
+        for k, other in enumerate(boards[1:]):
+            for earlier in boards[:k + 1]:
+                if earlier.dictionary == other.dictionary and earlier.ids & other.ids:
+                    raise ValueError(f"handover_boards[{k}]: its marker ids {min(other.ids)}-{max(other.ids)} overlap "
+                                     f"an earlier board's ({min(earlier.ids)}-{max(earlier.ids)}): set its first_id")
         if self.ground_truth == "poses" and self.model.T_cam0_ref is None:
             raise ValueError("model.T_cam0_ref: needed with ground_truth poses (it places M_t in the reference frame)")
         return self

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import hashlib
 import json
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -32,8 +32,9 @@ from poseintegrity.localization.matching import match_ratio_test
 from poseintegrity.params.extract import ExtractParams
 from poseintegrity.localization.target_model import TargetModel
 
-EVIDENCE_VERSION = 4  # bump when the cached content or its layout changes (3: the checked board pose, issue 30;
-# 4: the matched model points' indices, whose covariances the predicted error needs, issue 38)
+EVIDENCE_VERSION = 5  # bump when the cached content or its layout changes (3: the checked board pose, issue 30;
+# 4: the matched model points' indices, whose covariances the predicted error needs, issue 38; 5: the board poses'
+# covariances and the handover boards' poses, issue 39)
 
 
 @dataclass(frozen=True)
@@ -46,6 +47,7 @@ class FrameEvidence:
     image_points : (k, 2) float64, the frame's keypoints of those matches, undistorted (ideal pinhole px of K)
     n_keypoints : SIFT keypoints in the frame
     board : the board's checked pose (the ground truth, :mod:`~poseintegrity.localization.ground_truth`)
+    handover : the checked poses of the dataset's handover boards, in meta.json's order (their ``board`` 1, 2, ...)
     """
 
     image_problem: str
@@ -54,6 +56,7 @@ class FrameEvidence:
     image_points: np.ndarray
     n_keypoints: int
     board: BoardPose
+    handover: tuple[BoardPose, ...] = ()
 
 
 def bad_image(problem: str) -> FrameEvidence:
@@ -67,10 +70,11 @@ def model_digest(model: TargetModel) -> str:
     return hashlib.sha1(model.points.tobytes() + model.descriptors.tobytes()).hexdigest()
 
 
-def evidence_key(features_key_: str, digest: str, params: ExtractParams, board: dict[str, Any], camera: Camera) -> str:
-    """Hash of what a frame's evidence depends on beyond its features: M_t, the ratio, the board and its checks, the
-    camera."""
-    settings = json.dumps([EVIDENCE_VERSION, features_key_, digest, params.ratio_test, board,
+def evidence_key(features_key_: str, digest: str, params: ExtractParams, board: dict[str, Any], camera: Camera,
+                 handover_boards: list[dict[str, Any]] = ()) -> str:
+    """Hash of what a frame's evidence depends on beyond its features: M_t, the ratio, the boards and their checks,
+    the camera."""
+    settings = json.dumps([EVIDENCE_VERSION, features_key_, digest, params.ratio_test, board, list(handover_boards),
                            params.ground_truth.model_dump(),
                            np.asarray(camera.K, np.float64).tolist(), np.asarray(camera.dist, np.float64).tolist(),
                            [camera.width, camera.height]], sort_keys=True)
@@ -92,26 +96,43 @@ def _load(path: Path, key: str) -> FrameEvidence | None:
         with np.load(path) as stored:
             if str(stored["key"]) != key:
                 return None
-            board = BoardPose(stored["board_T_cam_board"], str(stored["board_status"]), str(stored["board_reason"]),
-                              *(int(stored[k]) for k in ("board_n_points", "board_n_dropped")),
-                              *(float(stored[k]) for k in ("board_rms_px", "board_sigma_t_mm", "board_sigma_r_deg")))
             return FrameEvidence("", stored["object_points"], stored["model_index"].astype(np.intp),
-                                 stored["image_points"], int(stored["n_keypoints"]), board)
+                                 stored["image_points"], int(stored["n_keypoints"]), _stored_pose(stored, "board"),
+                                 tuple(_stored_pose(stored, f"handover{k}", k + 1)
+                                       for k in range(int(stored["n_handover"]))))
     except (OSError, ValueError, KeyError):
         return None  # missing, truncated or foreign: recomputed
+
+
+def _pose_arrays(prefix: str, pose: BoardPose) -> dict[str, Any]:
+    """A checked board pose as the arrays of an evidence file (``prefix``_...)."""
+    return {f"{prefix}_T_cam_board": pose.T_cam_board, f"{prefix}_status": pose.status,
+            f"{prefix}_reason": pose.reason, f"{prefix}_n_points": pose.n_points, f"{prefix}_n_dropped": pose.n_dropped,
+            f"{prefix}_rms_px": pose.rms_px, f"{prefix}_sigma_t_mm": pose.sigma_t_mm,
+            f"{prefix}_sigma_r_deg": pose.sigma_r_deg, f"{prefix}_covariance": pose.covariance}
+
+
+def _stored_pose(stored, prefix: str, board: int = 0) -> BoardPose:
+    """The board pose :func:`_pose_arrays` stored."""
+    return BoardPose(stored[f"{prefix}_T_cam_board"], str(stored[f"{prefix}_status"]), str(stored[f"{prefix}_reason"]),
+                     *(int(stored[f"{prefix}_{k}"]) for k in ("n_points", "n_dropped")),
+                     *(float(stored[f"{prefix}_{k}"]) for k in ("rms_px", "sigma_t_mm", "sigma_r_deg")),
+                     stored[f"{prefix}_covariance"], board)
 
 
 def frame_evidence(
     image_path: Path, features_path: Path, evidence_path: Path, model: TargetModel, digest: str,
     board: dict[str, Any], camera: Camera, params: ExtractParams, name: str,
+    handover_boards: list[dict[str, Any]] = (),
 ) -> FrameEvidence:
     """The evidence of one frame: from ``evidence_path`` when its key matches, else computed (the SIFT features
     from ``features_path``, the SIFT cache) and stored. A missing file raises :class:`ImageReadError`; an image that
     cannot be decoded or is not 8-bit gray of the camera's size gives :func:`bad_image` evidence,
-    naming the file by ``name`` (as frames.parquet does: the table is the same whichever folder holds the data)."""
+    naming the file by ``name`` (as frames.parquet does: the table is the same whichever folder holds the data).
+    ``handover_boards``: meta.json's, each board's pose found and checked too."""
     data = read_image_bytes(image_path)
     features_key_ = features_key(data, params.clahe, params.sift)
-    key = evidence_key(features_key_, digest, params, board, camera)
+    key = evidence_key(features_key_, digest, params, board, camera, handover_boards)
     if evidence_path.exists() and (cached := _load(evidence_path, key)) is not None:
         return cached
     try:
@@ -123,8 +144,9 @@ def frame_evidence(
     object_points = model.points[model_index]
     truth = (board_pose(image, board_from_dict(board), camera, params.ground_truth) if board is not None
              else no_pose("no_board", "recorded poses are the ground truth"))  # no board: recorded poses instead
+    handover = tuple(replace(board_pose(image, board_from_dict(other), camera, params.ground_truth), board=k + 1)
+                     for k, other in enumerate(handover_boards))
     write_npz(evidence_path, key=key, object_points=object_points, model_index=model_index, image_points=image_points,
-              n_keypoints=features.n_keypoints, board_T_cam_board=truth.T_cam_board, board_status=truth.status,
-              board_reason=truth.reason, board_n_points=truth.n_points, board_n_dropped=truth.n_dropped,
-              board_rms_px=truth.rms_px, board_sigma_t_mm=truth.sigma_t_mm, board_sigma_r_deg=truth.sigma_r_deg)
-    return FrameEvidence("", object_points, model_index, image_points, features.n_keypoints, truth)
+              n_keypoints=features.n_keypoints, n_handover=len(handover), **_pose_arrays("board", truth),
+              **{k: v for n, pose in enumerate(handover) for k, v in _pose_arrays(f"handover{n}", pose).items()})
+    return FrameEvidence("", object_points, model_index, image_points, features.n_keypoints, truth, handover)

@@ -32,7 +32,7 @@ envelopes and summaries.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import lru_cache
 from pathlib import Path
 from typing import Any
@@ -48,7 +48,9 @@ from poseintegrity.localization.features import cached_features, read_gray, writ
 from poseintegrity.localization.frame_artifacts import frame_artifacts
 from poseintegrity.localization.frame_pnp import frame_pnp
 from poseintegrity.localization.kinematic_consistency import kinematic_errors, reported_pose
-from poseintegrity.localization.ground_truth import BoardPose, board_from_dict, board_pose, no_pose, truth_error
+from poseintegrity.localization.ground_truth import (
+    BoardPose, board_from_dict, board_pose, handed_over, handover, no_pose, truth_error,
+)
 from poseintegrity.params.extract import ExtractParams
 from poseintegrity.localization.pnp import PnPResult, failed, solve_checked
 from poseintegrity.ransac import minimal_sample_size, ransac_iterations
@@ -128,13 +130,14 @@ class ModelTask:
 class StoredModel:
     """Where a dataset's M_t is stored, its digest (part of every evidence key), size and the model pair's measured
     pixel noise; ``anchor``: the board's checked pose in model image 0 that placed M_t in the board frame (status
-    ``no_board`` with recorded poses)."""
+    ``no_board`` with recorded poses); ``handover_anchors``: the handover boards' checked poses there."""
 
     path: Path
     digest: str
     size: int
     anchor: BoardPose
     pixel_noise_px: float
+    handover_anchors: tuple[BoardPose, ...] = ()
 
 @dataclass(frozen=True)
 class FrameTask:
@@ -152,6 +155,7 @@ class FrameTask:
     ground_truth: str = "board"  # meta.json's ground_truth: "board" (IV-C) or "poses" (frames.parquet's)
     T_cam0_board_exact: np.ndarray | None = None  # model image 0's exact board pose (rendered data: R11)
     T_base_board_robot: np.ndarray | None = None  # where the model view placed the board, in the robot's base frame
+    handover_boards: tuple[dict[str, Any], ...] = ()  # meta.json's: boards that judge a frame its own board cannot
 
     @property
     def pnp_path(self) -> Path:
@@ -189,6 +193,17 @@ def dataset_model(dataset: Dataset, params: ExtractParams, cache_dir: Path) -> t
                               params.ratio_test, params.model_max_reprojection_px), anchor
 
 
+def handover_anchors(dataset: Dataset, params: ExtractParams) -> tuple[BoardPose, ...]:
+    """The checked poses of meta.json's handover boards in model image 0 (``board`` 1, 2, ...; ground_truth.py)."""
+    others = dataset.meta.get("handover_boards") or []
+    if not others:
+        return ()
+    image = read_gray(dataset.path(dataset.meta["model"]["images"][0]), dataset.image_size)
+    return tuple(replace(board_pose(image, board_from_dict(other, f"dataset {dataset.name}: meta.json handover_boards["
+                                                                  f"{k}]"), dataset.camera, params.ground_truth),
+                         board=k + 1) for k, other in enumerate(others))
+
+
 def store_model(task: ModelTask) -> StoredModel:
     """Build M_t of a dataset (a worker task) and store it for the frame tasks (unless stored already)."""
     model, anchor = dataset_model(task.dataset, task.params, task.cache_dir)
@@ -201,7 +216,8 @@ def store_model(task: ModelTask) -> StoredModel:
     if not current:
         write_npz(task.path, digest=digest, points=model.points, descriptors=model.descriptors,
                   covariances=model.covariances, pixel_noise_px=model.pixel_noise_px)
-    return StoredModel(task.path, digest, model.size, anchor, model.pixel_noise_px)
+    return StoredModel(task.path, digest, model.size, anchor, model.pixel_noise_px,
+                       handover_anchors(task.dataset, task.params))
 
 
 @lru_cache(maxsize=4)
@@ -214,31 +230,25 @@ def load_model(path: Path, digest: str) -> TargetModel:
                            float(stored["pixel_noise_px"]))
 
 
-def frame_rows(task: FrameTask) -> list[dict[str, Any]]:
-    """All rows (one per method) of one frame; runs in a worker."""
+def frame_rows(task: FrameTask) -> tuple[list[dict[str, Any]], tuple[BoardPose, ...]]:
+    """All rows (one per method) of one frame, judged by the dataset's own board, and the frame's checked board
+    poses (its own, then its handover boards'); runs in a worker."""
     frame, model = task.frame, task.model
     M_t = load_model(model.path, model.digest)
     evidence: FrameEvidence = frame_evidence(
         task.image_path, task.features_path, task.evidence_path, M_t, model.digest, task.board, task.camera,
-        task.params, frame["file"],
+        task.params, frame["file"], task.handover_boards,
     )
     point_covariances = M_t.covariances[evidence.model_index]
     known = frame["T_cam_board"] is not None  # None: a recorded frame without a pose (board ground truth)
     truth_problem = pose_problem(frame["T_cam_board"]) if known else None
-    T_cam_board = NAN_POSE if truth_problem or not known else np.asarray(frame["T_cam_board"],
-                                                                          dtype=np.float64).reshape(4, 4)
-    board = evidence.board  # the checked board pose: ground truth only when trusted (ground_truth.py)
-    truth = T_cam_board if task.ground_truth == "poses" else (board.T_cam_board if board.trusted else NAN_POSE)
+    T_cam_board = exact_pose(frame)
     if evidence.image_problem:
         status, reason = "bad_image", evidence.image_problem
     elif truth_problem:
         status, reason = "bad_pose", f"ground truth T_cam_board of frames.parquet {truth_problem}"
     else:
         status, reason = None, ""
-    E_t_board_exact_mm, E_r_board_exact_deg = map(float, pose_errors(board.T_cam_board, T_cam_board))
-    exact_0 = NAN_POSE if task.T_cam0_board_exact is None else task.T_cam0_board_exact
-    E_t_truth_mm, E_r_truth_deg = truth_error(board.T_cam_board, T_cam_board, model.anchor.T_cam_board, exact_0)
-    E_t_placement_mm, E_r_placement_deg = map(float, pose_errors(model.anchor.T_cam_board, exact_0))
     seed = frame_seed(task.params.seed, frame["dataset"], int(frame["stop"]), int(frame["image"]))
     T_base_cam = reported_pose(frame.get("T_base_cam_robot"))
     T_base_board = NAN_POSE if task.T_base_board_robot is None else task.T_base_board_robot
@@ -258,29 +268,70 @@ def frame_rows(task: FrameTask) -> list[dict[str, Any]]:
                 results[method], evidence.object_points, evidence.image_points, point_covariances,
                 evidence.n_keypoints, model.size, task.camera.K, task.params.reprojection_threshold_px,
             )
-        E_t_mm, E_r_deg = map(float, pose_errors(T_est, truth))  # IV-C: the board is the truth (or the poses)
         E_t_exact_mm, E_r_exact_deg = map(float, pose_errors(T_est, T_cam_board))
         E_t_kinematic_mm, E_r_kinematic_deg = map(float, kinematic_errors(T_base_cam, T_est, T_base_board))
-        if status in DATA_FLAGS:  # a flagged frame is no evidence: no error is reported for it
-            E_t_mm = E_r_deg = np.nan
-        rows.append(
-            {key: frame[key] for key in FRAME_COLUMNS}
-            | dict(method=method, status=status or pnp_status, reason=reason or pnp_reason, model_size=model.size,
-                   model_pixel_noise_px=model.pixel_noise_px)
-            | artifacts
-            | dict(
-                E_t_mm=E_t_mm, E_r_deg=E_r_deg, E_t_exact_mm=E_t_exact_mm, E_r_exact_deg=E_r_exact_deg,
-                E_t_kinematic_mm=E_t_kinematic_mm, E_r_kinematic_deg=E_r_kinematic_deg,
-                board_status=board.status, board_reason=board.reason, board_n_points=board.n_points,
-                board_n_dropped=board.n_dropped, board_rms_px=board.rms_px, board_sigma_t_mm=board.sigma_t_mm,
-                board_sigma_r_deg=board.sigma_r_deg,
+        row = ({key: frame[key] for key in FRAME_COLUMNS}
+               | dict(method=method, status=status or pnp_status, reason=reason or pnp_reason, model_size=model.size,
+                      model_pixel_noise_px=model.pixel_noise_px)
+               | artifacts
+               | dict(E_t_exact_mm=E_t_exact_mm, E_r_exact_deg=E_r_exact_deg, E_t_kinematic_mm=E_t_kinematic_mm,
+                      E_r_kinematic_deg=E_r_kinematic_deg, T_cam_board_est=T_est.ravel().tolist()))
+        rows.append(row | judged(row, evidence.board, task))
+    return rows, (evidence.board, *evidence.handover)
+
+
+def exact_pose(frame: dict[str, Any]) -> np.ndarray:
+    """(4, 4) mm: the frame's pose of frames.parquet (exact when rendered, the external system's when recorded);
+    NaN when it is None or not a finite rigid transform."""
+    pose = frame["T_cam_board"]
+    if pose is None or pose_problem(pose):
+        return NAN_POSE
+    return np.asarray(pose, dtype=np.float64).reshape(4, 4)
+
+
+def judged(row: dict[str, Any], board: BoardPose, task: FrameTask) -> dict[str, Any]:
+    """The columns of a row that its ground truth decides, the checked board pose ``board`` (IV-C; the frame's poses
+    of frames.parquet with ``ground_truth: poses``): E_t and E_r (NaN without a trusted pose, and on a flagged row),
+    the board's columns, and what the board pose adds to E_t and E_r (R11)."""
+    T_cam_board = exact_pose(task.frame)
+    truth = T_cam_board if task.ground_truth == "poses" else (board.T_cam_board if board.trusted else NAN_POSE)
+    T_est = np.asarray(row["T_cam_board_est"], dtype=np.float64).reshape(4, 4)
+    E_t_mm, E_r_deg = map(float, pose_errors(T_est, truth))  # IV-C: the board is the truth (or the poses)
+    if row["status"] in DATA_FLAGS:  # a flagged frame is no evidence: no error is reported for it
+        E_t_mm = E_r_deg = np.nan
+    E_t_board_exact_mm, E_r_board_exact_deg = map(float, pose_errors(board.T_cam_board, T_cam_board))
+    exact_0 = NAN_POSE if task.T_cam0_board_exact is None else task.T_cam0_board_exact
+    anchor = task.model.anchor
+    E_t_truth_mm, E_r_truth_deg = truth_error(board.T_cam_board, T_cam_board, anchor.T_cam_board, exact_0)
+    E_t_placement_mm, E_r_placement_deg = map(float, pose_errors(anchor.T_cam_board, exact_0))
+    return dict(E_t_mm=E_t_mm, E_r_deg=E_r_deg, board_status=board.status, board_reason=board.reason,
+                board_n_points=board.n_points, board_n_dropped=board.n_dropped, board_rms_px=board.rms_px,
+                board_sigma_t_mm=board.sigma_t_mm, board_sigma_r_deg=board.sigma_r_deg, truth_board=board.board,
                 E_t_board_exact_mm=E_t_board_exact_mm, E_r_board_exact_deg=E_r_board_exact_deg,
-                E_t_truth_mm=E_t_truth_mm, E_r_truth_deg=E_r_truth_deg, anchor_status=model.anchor.status,
-                E_t_placement_mm=E_t_placement_mm, E_r_placement_deg=E_r_placement_deg,
-                T_cam_board_est=T_est.ravel().tolist(),
-            )
-        )
-    return rows
+                E_t_truth_mm=E_t_truth_mm, E_r_truth_deg=E_r_truth_deg, anchor_status=anchor.status,
+                E_t_placement_mm=E_t_placement_mm, E_r_placement_deg=E_r_placement_deg)
+
+
+def handed_over_rows(tasks: list[FrameTask], results: list[tuple[list[dict[str, Any]], tuple[BoardPose, ...]]],
+                     params: ExtractParams) -> list[dict[str, Any]]:
+    """The rows of one dataset's frames (``tasks`` and their :func:`frame_rows` results, in order), each frame whose
+    own board pose is not trusted judged by the first handover board that is (ground_truth.py, "Handover boards")."""
+    rows = [list(frame_result[0]) for frame_result in results]
+    if not tasks or not tasks[0].handover_boards:
+        return [row for frame in rows for row in frame]
+    model = tasks[0].model
+    links = [handover(model.anchor, other) for other in model.handover_anchors]
+    for task, frame, (_, boards) in zip(tasks, rows, results):
+        if boards[0].trusted or not frame or frame[0]["status"] in DATA_FLAGS:
+            continue
+        for k, link in enumerate(links, start=1):
+            if link is None or not boards[k].trusted:
+                continue
+            carried = handed_over(boards[k], link, params.ground_truth, k)
+            if carried.trusted:
+                frame[:] = [row | judged(row, carried, task) for row in frame]
+                break
+    return [row for frame in rows for row in frame]
 
 
 def extract_datasets(
@@ -296,14 +347,18 @@ def extract_datasets(
             frame, dataset.path(frame["file"]), cache_dir / Path(frame["file"]).with_suffix(".npz"),
             cache_dir / Path(frame["file"]).with_suffix(".evidence.npz"), model, dataset.meta.get("board"),
             dataset.camera, tuple(methods), params, dataset.meta.get("ground_truth", "board"), exact_model_pose(dataset),
-            robot_board_pose(dataset, model),
+            robot_board_pose(dataset, model), tuple(dataset.meta.get("handover_boards") or ()),
         )
         for dataset, cache_dir, model in zip(datasets, cache_dirs, models)
         for frame in dataset.frames.assign(world=dataset.meta["world"], trajectory=dataset.meta["trajectory"])
             .to_dict("records")
     ]
     results = workers.map(frame_rows, tasks, desc=f"frames of {len(datasets)} dataset(s)", progress=progress)
-    return pd.DataFrame([row for rows in results for row in rows])
+    rows = []
+    for dataset in datasets:
+        mine = [k for k, task in enumerate(tasks) if task.frame["dataset"] == dataset.name]
+        rows += handed_over_rows([tasks[k] for k in mine], [results[k] for k in mine], params)
+    return pd.DataFrame(rows)
 
 
 def robot_board_pose(dataset: Dataset, model: StoredModel) -> np.ndarray | None:

@@ -22,14 +22,29 @@ API, docs/references.md "OpenCV 5"), undistorted by the calibrated lens and matc
 A pose that passes has status ``ok``; one that fails 2 or 3 has status ``bad_ground_truth`` and a reason, and is no
 ground truth (its frame's errors are NaN, the frame is listed, not counted as a localization error). ``board_not_
 detected`` / ``board_pnp_failed``: nothing to check.
+
+**Handover boards** (issue 39). Where the target or the image's edge takes the dataset's own board (A) from a frame,
+another board of the scene (B, meta.json's ``handover_boards``) may judge it: the camera's motion since model image 0
+read from B, T_cam_B T_cam0_B^-1, carried to where M_t was placed, T_cam0_A. So T_cam_A = T_cam_B T_BA with
+T_BA = T_cam0_B^-1 T_cam0_A, both poses of model image 0 (:func:`handover`, :func:`handed_over`). Model image 0's own
+pose T_cam0_A then cancels from what the ground truth adds to E_t, as M_t carries it: a perfect localization
+returns T_cam_cam0 T_cam0_A, and so does a perfect B. (A T_BA averaged over the images where both boards are seen
+would not: on the synthetic two-board scene of tests/localization/test_extract.py it added model image 0's own
+0.7 mm error to every handed-over frame.) The handed-over pose is trusted when step 3's rule holds at A's origin: the
+error it predicts there, sqrt(sigma_B(p)^2 + sigma_B0(p)^2), p = A's origin in B's frame, sigma_B(p) and
+sigma_B0(p) what the covariances of B's pose in the frame and in model image 0 predict for p (:func:`sigma_t_at`,
+which at p = 0 is sigma_t), and the rotation's, the two poses' sigma_r combined alike, stay within ``max_sigma_t_mm`` and ``max_sigma_r_deg``. The frame then
+says which board judged it (``board``: 0 its own, k its k-th handover board). B must be trusted in model image 0.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import cv2
 import numpy as np
+
+from scipy.spatial.transform import Rotation
 
 from poseintegrity.boards import Board, Charuco, board_from_dict, scaled
 from poseintegrity.defaults import published
@@ -39,7 +54,8 @@ from poseintegrity.lens import Camera
 from poseintegrity.params.extract import GroundTruthParams
 from poseintegrity.poses import NAN_POSE, inverse, pose_errors, pose_from_rvec_tvec
 
-__all__ = ["BoardPose", "board_from_dict", "board_pose", "detect_board_points", "consistent_fit", "truth_error"]
+__all__ = ["BoardPose", "Handover", "board_from_dict", "board_pose", "detect_board_points", "consistent_fit",
+           "handed_over", "handover", "sigma_t_at", "truth_error"]
 
 LM_CRITERIA = (cv2.TERM_CRITERIA_EPS | cv2.TERM_CRITERIA_COUNT, 50, 1e-12)
 
@@ -53,7 +69,9 @@ class BoardPose:
         "bad_image"); reason : why it is not "ok" ("" when it is)
     n_points : board points of the final fit; n_dropped : groups dropped by the consistency check
     rms_px : RMS reprojection residual of the final fit; sigma_t_mm, sigma_r_deg : its predicted uncertainty at the
-        board origin (NaN without a fit)
+        board origin (NaN without a fit); covariance : (6, 6) of (rvec, tvec) (rad, mm), s^2 (J^T J)^-1 (NaN without
+        a fit)
+    board : which board gave the pose: 0 the dataset's own, k > 0 its k-th handover board (module docstring)
     """
 
     T_cam_board: np.ndarray
@@ -64,6 +82,8 @@ class BoardPose:
     rms_px: float = float("nan")
     sigma_t_mm: float = float("nan")
     sigma_r_deg: float = float("nan")
+    covariance: np.ndarray = field(default_factory=lambda: np.full((6, 6), np.nan))
+    board: int = 0
 
     @property
     def trusted(self) -> bool:
@@ -172,8 +192,9 @@ def consistent_fit(object_points: np.ndarray, image_points: np.ndarray, groups: 
 
 
 def predicted_uncertainty(object_points: np.ndarray, image_points: np.ndarray, K: np.ndarray, pose,
-                          noise_floor_px: float) -> tuple[float, float, float]:
-    """Step 3: (rms_px, sigma_t_mm, sigma_r_deg) of a fitted pose, from s^2 (J^T J)^-1 (module docstring)."""
+                          noise_floor_px: float) -> tuple[float, float, float, np.ndarray]:
+    """Step 3: (rms_px, sigma_t_mm, sigma_r_deg, covariance (6, 6) of (rvec, tvec)) of a fitted pose, from
+    s^2 (J^T J)^-1 (module docstring)."""
     projected, jacobian = cv2.projectPoints(object_points, pose[0], pose[1], K, None)
     residual = projected.reshape(-1, 2) - image_points
     n = len(object_points)
@@ -183,10 +204,10 @@ def predicted_uncertainty(object_points: np.ndarray, image_points: np.ndarray, K
     try:
         covariance = s2 * np.linalg.inv(J.T @ J)
     except np.linalg.LinAlgError:
-        return rms, float("inf"), float("inf")
+        return rms, float("inf"), float("inf"), np.full((6, 6), np.inf)
     sigma_r = float(np.degrees(np.sqrt(max(np.trace(covariance[:3, :3]), 0.0))))
     sigma_t = float(np.sqrt(max(np.trace(covariance[3:, 3:]), 0.0)))
-    return rms, sigma_t, sigma_r
+    return rms, sigma_t, sigma_r, covariance
 
 
 def board_pose(image: np.ndarray, board: Board | dict, camera: Camera, params: GroundTruthParams | None = None
@@ -216,11 +237,11 @@ def board_pose(image: np.ndarray, board: Board | dict, camera: Camera, params: G
     if pose is None:
         return no_pose("board_pnp_failed", "OpenCV found no pose for the board's points", len(object_points))
     n_groups, n_dropped = len(np.unique(groups[keep])), len(np.unique(groups)) - len(np.unique(groups[keep]))
-    rms, sigma_t, sigma_r = predicted_uncertainty(object_points[keep], image_points[keep], K, pose,
-                                                  params.noise_floor_px)
+    rms, sigma_t, sigma_r, covariance = predicted_uncertainty(object_points[keep], image_points[keep], K, pose,
+                                                              params.noise_floor_px)
     T = pose_from_rvec_tvec(*pose)
     checked = dict(T_cam_board=T, n_points=int(keep.sum()), n_dropped=n_dropped, rms_px=rms, sigma_t_mm=sigma_t,
-                   sigma_r_deg=sigma_r)
+                   sigma_r_deg=sigma_r, covariance=covariance)
     unit, needed = ("corners", params.min_corners) if isinstance(board, Charuco) else ("markers", params.min_markers)
     if n_groups < needed:
         return BoardPose(status="bad_ground_truth", reason=f"{n_groups} consistent board {unit} ({n_dropped} "
@@ -244,3 +265,47 @@ def truth_error(T_cam_board: np.ndarray, T_cam_board_exact: np.ndarray, T_cam0_b
     when any pose is unknown."""
     perfect = T_cam_board_exact @ inverse(T_cam0_board_exact) @ T_cam0_board
     return tuple(float(e) for e in pose_errors(T_cam_board, perfect))
+
+
+def sigma_t_at(pose: BoardPose, point: np.ndarray) -> float:
+    """RMS error (mm) of a board-frame point (3,) mm, in the camera frame, that the pose's covariance predicts:
+    sqrt(trace(J C J^T)), J = [d(R(rvec) p) / d rvec, I] (3, 6) (OpenCV's Rodrigues Jacobian); sigma_t at p = 0."""
+    rvec, _ = cv2.Rodrigues(np.asarray(pose.T_cam_board[:3, :3], np.float64))
+    _, dR = cv2.Rodrigues(rvec)  # (3, 9): row k is d vec(R) / d rvec_k, R row-major
+    J = np.hstack([(dR.reshape(3, 3, 3) @ np.asarray(point, np.float64)).T, np.eye(3)])
+    return float(np.sqrt(max(np.trace(J @ pose.covariance @ J.T), 0.0)))
+
+
+@dataclass(frozen=True)
+class Handover:
+    """How the dataset's own board (A) stands in a handover board's (B) frame (module docstring): T_BA (4, 4) mm,
+    from their poses in model image 0, and the errors B's pose there predicts: ``sigma_mm`` at A's origin (RMS),
+    ``sigma_r_deg`` of its rotation."""
+
+    T_BA: np.ndarray
+    sigma_mm: float
+    sigma_r_deg: float
+
+
+def handover(own: BoardPose, other: BoardPose) -> Handover | None:
+    """T_BA of a handover board from the two boards' poses in model image 0 (``own``: A's, ``other``: B's); None
+    unless B's is trusted (A's places M_t whatever its status)."""
+    if not other.trusted or not np.all(np.isfinite(own.T_cam_board)):
+        return None
+    T_BA = inverse(other.T_cam_board) @ own.T_cam_board
+    return Handover(T_BA, sigma_t_at(other, T_BA[:3, 3]), other.sigma_r_deg)
+
+
+def handed_over(pose: BoardPose, link: Handover, params: GroundTruthParams, board: int) -> BoardPose:
+    """The dataset's own board pose T_cam_A = T_cam_B T_BA read from handover board ``board``'s pose ``pose`` (B's,
+    trusted), checked at A's origin (module docstring); ``bad_ground_truth`` with the reason when it fails there."""
+    T = pose.T_cam_board @ link.T_BA
+    sigma_t = float(np.hypot(sigma_t_at(pose, link.T_BA[:3, 3]), link.sigma_mm))
+    sigma_r = float(np.hypot(pose.sigma_r_deg, link.sigma_r_deg))
+    checked = dict(T_cam_board=T, n_points=pose.n_points, n_dropped=pose.n_dropped, rms_px=pose.rms_px,
+                   sigma_t_mm=sigma_t, sigma_r_deg=sigma_r, board=board)
+    if sigma_t > params.max_sigma_t_mm or sigma_r > params.max_sigma_r_deg:
+        return BoardPose(status="bad_ground_truth", reason=f"handover board {board}: predicted uncertainty "
+                         f"{sigma_t:.3f} mm / {sigma_r:.3f} deg at the dataset board's origin exceeds "
+                         f"{params.max_sigma_t_mm:g} mm / {params.max_sigma_r_deg:g} deg", **checked)
+    return BoardPose(status="ok", **checked)

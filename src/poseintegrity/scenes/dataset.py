@@ -396,9 +396,12 @@ def finish_dataset(params: GenerateParams, root: Path, plan: DatasetPlan, trip: 
                    scene: catalog.Scene, camera: Camera) -> dict:
     """Once its images are written: the dataset's frames.parquet, meta.json and camera.yaml (``camera``: the world's
     calibration estimate), then its partial folder renamed to ``root / plan.dataset``; returns its row of the index.
-    The dataset's ground truth is its trajectory's board (:meth:`~.catalog.Scene.board_for`)."""
+    The dataset's ground truth is its trajectory's board (:meth:`~.catalog.Scene.board_for`); the scene's other
+    boards are its handover boards."""
     spec = params.scenes[plan.scene_index]
     board = scene.board_for(trajectory_index(params, plan))
+    # the scene's other boards, each whole in model image 0: they judge the frames this board cannot (a handover)
+    others = [b.board.as_dict() for b in scene.boards if b is not board]
     truth = true_camera(params.camera)
     f_px = truth.K[0, 0]
     tmp, final = _partial(root, plan.dataset), root / plan.dataset
@@ -426,7 +429,7 @@ def finish_dataset(params: GenerateParams, root: Path, plan: DatasetPlan, trip: 
         "dataset": plan.dataset, "world": plan.world, "scene": spec.name, "targets": list(spec.targets),
         "trajectory": plan.trajectory, "azimuth_deg": plan.azimuth_deg, "offset_deg": plan.offset_deg,
         "n_stops": len(trip.stops), "images_per_stop": params.images_per_stop,
-        "board": board.board.as_dict(), "model": model, "model_baseline_mm": params.model_baseline_mm,
+        "board": board.board.as_dict(), "handover_boards": others, "model": model, "model_baseline_mm": params.model_baseline_mm,
         "distance_mm": trip.distance_mm,
         "true_camera": {"K": truth.K.tolist(), "dist": truth.dist.tolist()},  # a diagnostic: stage 02 never reads it
     }
