@@ -87,7 +87,26 @@ def rendered_board(generate, scene_world, T_world_cam: np.ndarray, focus_mm: flo
     return board_pose(image, board.board, Camera(lens.K, lens.dist, lens.width, lens.height))
 
 
-def test_a_board_that_would_leave_the_view_late_is_placed_wholly_in_view_and_found_whole(params):
+def corners_in_view(board: catalog.SceneBoard, T_world_cam: np.ndarray, generate) -> int:
+    """How many of the board's inner corners have all four of their squares inside the image of the pinhole of the
+    true intrinsics (OpenCV's projectPoints): the corners a ChArUco detector can interpolate from their markers."""
+    drawing = board.drawing
+    sx, sy, square = drawing.squares_x, drawing.squares_y, drawing.size_mm[0] / drawing.squares_x
+    lattice = np.array([[i * square, j * square, 0.0] for j in range(sy + 1) for i in range(sx + 1)])
+    camera = true_camera(generate.camera)
+    T = inverse(T_world_cam) @ board.T_world_board
+    pixels, _ = cv2.projectPoints(lattice, *_rvec_tvec(T), camera.K, None)
+    depth = lattice @ T[:3, 2] + T[2, 3]
+    u, v = pixels.reshape(-1, 2).T
+    inside = ((depth > 0) & (u >= 0) & (u <= camera.width - 1) & (v >= 0) & (v <= camera.height - 1)).reshape(
+        sy + 1, sx + 1)
+    return sum(inside[j - 1:j + 2, i - 1:i + 2].all() for j in range(1, sy) for i in range(1, sx))
+
+
+def test_a_board_that_would_leave_the_view_late_is_moved_and_judges_every_stop(params):
+    """Issue 30's board leaves the image late in scene_4's arc; the plan serves every stop: at each, at least
+    MIN_PLAN_CORNERS inner corners in view (counted by OpenCV's projection), and rendered at the stop where the old
+    board left the view, the new one is found with every corner in view and its pose trusted."""
     index = 3  # the main world's scene_4: a printed block at 360 mm
     focus = params.generate.scenes[index].distance_mm
     before, old = world(params, index, "facing_camera", AZIMUTHS)
@@ -100,14 +119,19 @@ def test_a_board_that_would_leave_the_view_late_is_placed_wholly_in_view_and_fou
     assert new.scene.plan.unserved == (0,) * len(AZIMUTHS)  # every stop served
     new_stops = stops(after, params.protocol, new.scene, index)
     for poses, b in zip(new_stops, new.scene.board_of):
-        assert min(share_in_view(paper(new.scene.boards[b], 0.0), T, after) for T in poses) == pytest.approx(1.0)
+        assert min(corners_in_view(new.scene.boards[b], T, after) for T in poses) >= board_plan.MIN_PLAN_CORNERS
     missed = rendered_board(before, old, stops(before, params.protocol, old.scene, index)[arc][stop], focus, old_board)
-    found = rendered_board(after, new, new_stops[arc][stop], focus, new.scene.board_for(arc))
+    board = new.scene.board_for(arc)
+    found = rendered_board(after, new, new_stops[arc][stop], focus, board)
     assert missed.n_points + missed.n_dropped < 24
-    assert found.status == "ok" and found.n_points + found.n_dropped == 24  # all (7 - 1) x (5 - 1) corners found
+    assert found.status == "ok"
+    assert found.n_points + found.n_dropped >= corners_in_view(board, new_stops[arc][stop], after)
 
 
-def test_where_one_board_cannot_serve_every_arc_a_second_one_with_its_own_ids_stands_apart(params):
+def test_where_one_board_cannot_serve_every_arc_a_second_one_with_its_own_ids_stands_apart(params, monkeypatch):
+    """Asked for every corner of a board in view (a stricter rule than the plan's), one board cannot serve scene_3's
+    three arcs: the plan adds a second, with marker ids of its own, that never overlaps the first in the image."""
+    monkeypatch.setattr(board_plan, "MIN_PLAN_CORNERS", 24)
     index = 2  # the main world's scene_3: a printed block at 320 mm, three arcs; a limit on sigma_t loose enough
     generate, built = world(params, index, "planned", params.generate.arcs.azimuths_deg, 0.3)  # that the view decides
     scene, plan = built.scene, built.scene.plan
@@ -141,17 +165,24 @@ def test_the_predicted_uncertainty_is_opencvs_at_any_point_of_the_board():
         assert got == pytest.approx(expected, rel=1e-9)
 
 
-def test_a_board_whose_white_margin_leaves_the_image_serves_and_is_found_whole(params):
-    """A 7 x 5 board facing a camera 300 mm away (K of f = 1024 px): with its pattern's left edge 10 px inside the image
-    and its 6 mm white margin (20 px) beyond the edge, the plan serves the pose and OpenCV's ChArUco detector finds all
-    24 corners in a synthetic image of it; with the pattern's edge 10 px outside, the plan does not serve it."""
+def test_a_board_partly_beyond_the_image_serves_while_half_its_corners_are_found(params):
+    """A 7 x 5 board facing a camera 300 mm away (K of f = 1024 px, squares of 51.2 px), its pattern's left edge 10 px
+    inside the image (its 6 mm white margin beyond the edge), then two and three squares and 10 px beyond it: the plan
+    counts 24, 12 and 8 inner corners found (a corner needs its four squares' markers) and serves the first two
+    (MIN_PLAN_CORNERS = 12); OpenCV's ChArUco detector, in synthetic images of the printed board so cut, finds all 24
+    corners, then at least the 12 the plan counts."""
     generate = params.generate.world("main")
     drawing = generate.board.drawing()
     K, width, height, depth = np.array([[1024.0, 0.0, 484.0], [0.0, 1024.0, 304.0], [0.0, 0.0, 1.0]]), 968, 608, 300.0
     pattern = np.array(drawing.size_mm, float)
     margin = generate.board.margin_mm
-    served = []
-    for left_px in (10.0, -10.0):
+    square_px = drawing.square_mm * K[0, 0] / depth
+    px_per_mm = 8.0
+    texture = textures.board_texture(drawing, px_per_mm, margin)
+    scale = K[0, 0] / depth / px_per_mm
+    top = K[1, 2] - pattern[1] / 2 * K[1, 1] / depth
+    counted, served, found = [], [], []
+    for left_px in (10.0, -2 * square_px - 10.0, -3 * square_px - 10.0):
         left_mm = (left_px - K[0, 2]) * depth / K[0, 0]
         centre = np.array([[left_mm + pattern[0] / 2, 0.0, depth]])
         axes = [np.array([v]) for v in np.eye(3)]  # x right, y down, z into the board: its print faces the camera
@@ -161,19 +192,28 @@ def test_a_board_whose_white_margin_leaves_the_image_serves_and_is_found_whole(p
         judged = board_plan._judge(c, [np.eye(4)], [], (drawing.squares_x, drawing.squares_y), cells,
                                    drawing.marker_mm / drawing.square_mm, K, width, height, depth, generate.camera,
                                    generate.sensor.blur_sigma_px)
+        counted.append(int(board_plan._seen(
+            _lattice_in_image(left_px, square_px, drawing, K, width, height), (drawing.squares_x, drawing.squares_y)
+        ).sum()))
         served.append(bool(judged.served[0, 0]))
-    assert served == [True, False]
-    # the image of the first pose: the printed board (with its margin) scaled to the camera's px per mm, cut by the
-    # image's left edge
-    px_per_mm = 8.0
-    texture = textures.board_texture(drawing, px_per_mm, margin)
-    scale = K[0, 0] / depth / px_per_mm
-    top = K[1, 2] - pattern[1] / 2 * K[1, 1] / depth
-    shift = np.array([[scale, 0.0, 10.0 - margin * px_per_mm * scale], [0.0, scale, top - margin * px_per_mm * scale]])
-    image = cv2.warpAffine(texture, shift, (width, height), flags=cv2.INTER_AREA, borderValue=255)
-    assert image[:, 0].min() > 150  # the image's edge cuts the white margin
-    object_points, _, _ = detect_board_points(image, drawing)
-    assert len(object_points) == (drawing.squares_x - 1) * (drawing.squares_y - 1)
+        # the printed board (with its margin) scaled to the camera's px per mm, cut by the image's left edge
+        shift = np.array([[scale, 0.0, left_px - margin * px_per_mm * scale],
+                          [0.0, scale, top - margin * px_per_mm * scale]])
+        image = cv2.warpAffine(texture, shift, (width, height), flags=cv2.INTER_AREA, borderValue=255)
+        if left_px > 0:
+            assert image[:, 0].min() > 150  # the image's edge cuts the white margin only
+        found.append(len(detect_board_points(image, drawing)[0]))
+    assert counted == [24, 12, 8] and served == [True, True, False]
+    assert found[0] == 24 and found[1] >= 12
+
+
+def _lattice_in_image(left_px: float, square_px: float, drawing, K, width: int, height: int) -> np.ndarray:
+    """(1, lattice) which corners of the squares of a board facing the camera, its left edge at ``left_px``, are in
+    the image (rows of board_plan._lattice)."""
+    u = left_px + square_px * np.arange(drawing.squares_x + 1)
+    v = K[1, 2] + square_px * (np.arange(drawing.squares_y + 1) - drawing.squares_y / 2)
+    uu, vv = np.meshgrid(u, v)
+    return ((uu >= 0) & (uu <= width - 1) & (vv >= 0) & (vv <= height - 1)).reshape(1, -1)
 
 
 def test_the_plans_margin_on_sigma_t_is_how_far_stage_02s_estimate_scatters():
