@@ -1,10 +1,12 @@
 import io
+import json
 import shutil
 
 import numpy as np
 import pytest
 from scipy.stats import spearmanr
 
+import loc_synthetic as synthetic
 from poseintegrity.localization import extract as E
 from poseintegrity.localization.dataset import DatasetError, load_dataset
 from poseintegrity.poses import pose_errors
@@ -132,11 +134,9 @@ def test_unknown_dataset_in_params_is_named(synthetic_data_dir, extract_params, 
 def test_a_frame_whose_board_is_hidden_is_judged_by_the_handover_board(tmp_path, extract_params, workers):
     """Two boards in the plane; from stop 2 on the dataset's own board is out of the images. Those frames are judged
     by the handover board (truth_board 1, trusted): what it adds to E_t (against the exact motion since model image 0,
-    carried to where M_t was placed) is within 3 x its predicted sigma_t; the frames where the own board is seen keep it (truth_board 0). Without handover_boards in
-    meta.json the hidden frames are not judged."""
-    import json
-
-    import loc_synthetic as synthetic
+    carried to where M_t was placed) is within 3 x its predicted sigma_t; the frames where the own board is seen keep
+    it (truth_board 0). Without handover_boards in meta.json the hidden frames are not judged; a handover board with
+    the own board's marker ids is refused, naming the key."""
 
     row = synthetic.write_dataset(tmp_path, "two", np.random.default_rng(21), stops=(5.0, 15.0, 25.0, 35.0),
                                   second_board=True, hidden_from_stop=2)

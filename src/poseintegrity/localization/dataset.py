@@ -13,8 +13,8 @@ What is checked before any work, each failure a :class:`DatasetError` naming the
 - ``meta.json`` readable and holding what stages 02 and 05 read (:class:`Meta`): the dataset's name as in the
   index, its world and trajectory, its ground-truth source (``ground_truth``: ``board``, the default, or ``poses``
   for recorded data whose frames' poses come from an external system), the board (a dictionary OpenCV knows, its
-  marker ids inside it; needed with ``board``; optional handover boards, whose ids must differ), two model images, masks and a rigid finite relative pose (and with
-  ``poses`` model image 0's pose ``T_cam0_ref``);
+  marker ids inside it; needed with ``board``; optional handover boards, whose ids must differ), two model images,
+  masks and a rigid finite relative pose (and with ``poses`` model image 0's pose ``T_cam0_ref``);
 - ``camera.yaml`` readable, every field valid (positive focal lengths, the plumb_bob model, a lens that does not
   fold the image);
 - ``frames.parquet`` readable, with its columns, at least one row, one row per (stop, image) and per file, finite stop positions,
