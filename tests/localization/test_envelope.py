@@ -3,7 +3,7 @@ import pandas as pd
 import pytest
 
 from poseintegrity.localization.envelope import (
-    CRITERIA, actual_envelope, envelopes, headline, stop_criteria,
+    CRITERIA, actual_envelope, envelopes, headline, loosening, stop_criteria,
 )
 from poseintegrity.localization.envelope_causes import envelope_causes
 from poseintegrity.protocol import FAILED_FRAME_RULES, EnvelopeParams
@@ -216,3 +216,63 @@ def test_the_cause_is_read_where_the_ending_criterion_fails_not_where_another_on
     row = envelope_causes(table, [(2.0, 3.0)], RULES, "usac_magsac").iloc[0]
     assert row["theta_a"] == pytest.approx(1.5 / 3.5 * 6.75) and row["limit"] == "translation"
     assert (row["cause"], row["truth_shift"], row["unmeasured_stops"]) == ("ground_truth", pytest.approx(3.0), 2)
+
+
+def _judged_table(scales):
+    """One arc of 4 stops, 2 frames each, E_t 0.5, 1.0, 3.0, 5.0 mm and E_r 0.5 deg; from stop 2 on the board pose
+    is refused by the trust rule's limits alone, at truth scales ``scales`` (t, r): no E_t_mm there, only the
+    errors against that pose (E_*_loose)."""
+    rows = []
+    for s, error in enumerate([0.5, 1.0, 3.0, 5.0]):
+        for image in range(2):
+            refused = s >= 2
+            rows.append(dict(world="main", dataset="d", trajectory="arc", stop=s, image=image, theta_deg=2.25 * s,
+                             x_mm=0.0, method="usac_magsac", status="ok", E_t_mm=np.nan if refused else error,
+                             E_r_deg=np.nan if refused else 0.5, E_t_loose_mm=error, E_r_loose_deg=0.5,
+                             truth_scale_t=scales[0] if refused else 0.5, truth_scale_r=scales[1] if refused else 0.5,
+                             E_t_exact_mm=error, E_r_exact_deg=0.5, n_inliers=100 - 20 * s,
+                             board_status="bad_ground_truth" if refused else "ok", board_n_dropped=0,
+                             board_sigma_t_mm=0.15 * (scales[0] if refused else 0.5)))
+    return pd.DataFrame(rows)
+
+
+def test_a_looser_tolerance_is_judged_by_the_poses_fine_enough_for_it():
+    tolerances = [(2.0, 3.0), (4.0, 10.0)]  # 4 mm / 10 deg is 2 x looser in E_t and 3.3 x in E_r
+    np.testing.assert_allclose(loosening((4.0, 10.0), tolerances), [2.0, 10.0 / 3.0])
+    np.testing.assert_allclose(loosening((2.0, 3.0), tolerances), [1.0, 1.0])
+    with pytest.warns(UserWarning, match="not measured"):  # 2 mm / 3 deg
+        fine = headline(envelopes(_judged_table((1.8, 3.0)), tolerances, RULES), RULES).set_index("tolerance")
+    # 2 mm / 3 deg: stops 2-3 unmeasured and none failed before: no envelope; 4 mm: 1.0 mm at 2.25 deg and 5.0 mm
+    # at 6.75 deg read from the poses within 2 x / 3.3 x the limits, crossing at 2.25 + 3 / 4 x 4.5 deg
+    assert np.isnan(fine.loc["2mm_3deg", "theta_a"]) and fine.loc["2mm_3deg", "status"] == "not_measured"
+    assert fine.loc["4mm_10deg", "theta_a"] == pytest.approx(2.25 + 0.75 * 4.5)
+    assert fine.loc["4mm_10deg", "status"] == "ok"
+    with pytest.warns(UserWarning, match="not measured"):  # a pose too uncertain in either axis judges nothing
+        for scales in ((2.1, 1.0), (1.0, 3.4), (np.nan, np.nan)):
+            coarse = headline(envelopes(_judged_table(scales), tolerances, RULES), RULES).set_index("tolerance")
+            assert coarse["theta_a"].isna().all()
+
+
+def test_the_tightest_tolerance_and_tables_without_the_loose_columns_are_judged_as_before():
+    tolerances = [(2.0, 3.0), (4.0, 10.0)]
+    table = _judged_table((1.5, 1.5))
+    table.loc[table.stop == 3, ["E_t_mm", "E_r_deg", "board_status"]] = [5.0, 0.5, "ok"]  # measured: 2 mm readable
+    with_loose = envelopes(table, tolerances, RULES)
+    without = envelopes(table.drop(columns=["E_t_loose_mm", "E_r_loose_deg", "truth_scale_t", "truth_scale_r"]),
+                        tolerances, RULES)
+    tight = with_loose["tolerance"] == "2mm_3deg"
+    pd.testing.assert_frame_equal(with_loose[tight], without[tight])
+    # 4 mm without the loose columns reads across the refused stop 2: 1.0 at 2.25, 5.0 at 6.75 deg
+    loose = with_loose[~tight & (with_loose.rule == "fail_fraction")]["theta_a"].iloc[0]
+    assert loose == pytest.approx(2.25 + 0.75 * 4.5)
+    assert without[~tight & (without.rule == "fail_fraction")]["theta_a"].iloc[0] == pytest.approx(2.25 + 0.75 * 4.5)
+    assert without[~tight & (without.rule == "fail_fraction")]["status"].iloc[0] == "unmeasured_stops"
+    assert with_loose[~tight & (with_loose.rule == "fail_fraction")]["status"].iloc[0] == "ok"
+
+
+def test_the_causes_of_a_looser_tolerance_count_only_the_poses_that_cannot_judge_it():
+    causes = envelope_causes(_judged_table((1.8, 3.0)), [(2.0, 3.0), (4.0, 10.0)], RULES, "usac_magsac")
+    row = causes.set_index("tolerance").loc["4mm_10deg"]
+    assert (row["cause"], row["limit"]) == ("estimate", "translation") and row["board_untrusted_share"] == 0.0
+    assert row["theta_a"] == pytest.approx(2.25 + 0.75 * 4.5) == row["theta_a_exact"]
+    assert causes.set_index("tolerance").loc["2mm_3deg", "cause"] == "unmeasured"

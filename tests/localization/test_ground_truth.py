@@ -12,7 +12,7 @@ from poseintegrity.errors import ArgumentError
 from poseintegrity.lens import Camera
 from poseintegrity.localization.ground_truth import (
     BoardPose, board_pose, consistent_fit, detect_board_points, handed_over, handover, no_pose, predicted_uncertainty,
-    sigma_t_at, truth_error,
+    sigma_t_at, truth_error, truth_scale,
 )
 from poseintegrity.params.extract import GroundTruthParams
 from poseintegrity.poses import pose_errors, pose_from_rvec_tvec, pose_matrix
@@ -116,6 +116,23 @@ def test_two_markers_in_view_are_too_few_to_check_and_no_ground_truth():
     result = board_pose(image, synthetic.BOARD, synthetic.CAMERA, CHECKS)
     assert result.status == "bad_ground_truth" and "fewer than 3" in result.reason
     assert np.all(np.isfinite(result.T_cam_board))  # the refused fit is kept, for diagnosis
+    assert not result.consistent and np.isnan(truth_scale(result, CHECKS)).all()  # it judges no looser tolerance
+
+
+def test_a_pose_refused_by_the_limits_alone_has_its_uncertainty_in_units_of_them():
+    """The whole board at 40 deg: trusted under the published-like limits; under limits a third of its predicted
+    uncertainty, refused by step 3 alone, consistent, at truth scales of 3 on both axes."""
+    plane, _ = synthetic.canvas(np.random.default_rng(0))
+    image = synthetic.render(plane, synthetic.arc_pose(40.0, azimuth_deg=90.0))
+    trusted = board_pose(image, synthetic.BOARD, synthetic.CAMERA, CHECKS)
+    assert trusted.trusted and trusted.consistent
+    np.testing.assert_allclose(truth_scale(trusted, CHECKS), [trusted.sigma_t_mm / CHECKS.max_sigma_t_mm,
+                                                               trusted.sigma_r_deg / CHECKS.max_sigma_r_deg])
+    strict = CHECKS.model_copy(update=dict(max_sigma_t_mm=trusted.sigma_t_mm / 3, max_sigma_r_deg=trusted.sigma_r_deg / 3))
+    refused = board_pose(image, synthetic.BOARD, synthetic.CAMERA, strict)
+    assert refused.status == "bad_ground_truth" and "predicted uncertainty" in refused.reason and refused.consistent
+    np.testing.assert_allclose(truth_scale(refused, strict), [3.0, 3.0])
+    np.testing.assert_array_equal(refused.T_cam_board, trusted.T_cam_board)  # the same fit, only judged otherwise
 
 
 def _projected_board(T: np.ndarray, noise_px: float, rng: np.random.Generator):

@@ -42,3 +42,23 @@ def test_recorded_data_without_exact_poses_describe_the_board_and_judge_nothing(
     result = truth_accuracy(table([np.nan] * 10, ["ok"] * 9 + ["bad_ground_truth"]))
     assert result["r11_passed"] is None and np.isnan(result["p99_E_t_truth_mm"])
     assert result["trusted_share"] == pytest.approx(0.9) and result["median_rms_px"] == pytest.approx(0.05)
+
+
+def test_a_looser_tolerance_has_its_bar_over_the_frames_that_judge_it():
+    # 100 trusted frames within 0.45 mm, and 20 refused by the limits alone at 1.5 x them whose error is 0.8 mm
+    # (deg / 4): 4 mm / 10 deg (2 x and 3.3 x looser) takes them, against its bar of 1.0 mm / 1.67 deg
+    tolerances = [(2.0, 3.0), (4.0, 10.0)]
+    frames = table([*np.linspace(0.0, 0.45, 100), *[0.8] * 20], ["ok"] * 100 + ["bad_ground_truth"] * 20)
+    refused = frames["board_status"] == "bad_ground_truth"
+    frames = frames.assign(truth_scale_t=np.where(refused, 1.5, 0.5), truth_scale_r=np.where(refused, 1.5, 0.5))
+    result = truth_accuracy(frames, tolerances)
+    loose = result["by_tolerance"]["4mm_10deg"]
+    assert loose["k"] == pytest.approx([2.0, 10.0 / 3.0]) and loose["bar"] == pytest.approx([1.0, 5.0 / 3.0])
+    assert loose["judged_share"] == pytest.approx(1.0) and loose["p99_E_t_truth_mm"] == pytest.approx(0.8)
+    assert loose["passed"] is True and result["r11_passed"] is True
+    assert result["p99_E_t_truth_mm"] <= 0.45  # the tightest tolerance's quantile is over the trusted frames alone
+    worse = truth_accuracy(frames.assign(E_t_truth_mm=np.where(refused, 1.2, frames["E_t_truth_mm"])), tolerances)
+    assert worse["by_tolerance"]["4mm_10deg"]["passed"] is False and worse["r11_passed"] is False
+    beyond = truth_accuracy(frames.assign(truth_scale_t=np.where(refused, 2.5, 0.5)), tolerances)
+    assert beyond["by_tolerance"]["4mm_10deg"]["judged_share"] == pytest.approx(100 / 120)
+    assert "by_tolerance" in truth_accuracy(frames) and truth_accuracy(frames)["by_tolerance"] == {}

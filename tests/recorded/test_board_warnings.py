@@ -6,6 +6,7 @@ the frames."""
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 from foreign_datasets import Folder, write_folder
@@ -52,6 +53,15 @@ def test_a_board_too_small_is_named_once_with_the_tolerance_it_can_judge_and_the
     assert f"warning: {message}" in (ROOT / "docs" / "recorded-data.md").read_text()  # where a user meets it
     with pytest.warns(UserWarning, match="not measured up to their end"):  # and the envelope says it cannot tell
         ends = headline(envelopes(table, [(2.0, 3.0)], published("protocol.envelope")), published("protocol.envelope"))
+    # a tolerance looser than what the board can judge on both axes is judged by the same poses, unchanged params
+    refused = table[table["board_status"] == "bad_ground_truth"]
+    assert refused["E_t_mm"].isna().all() and refused["E_t_loose_mm"].notna().any()
+    assert (refused["truth_scale_t"] > 1).all()
+    looser = (float(round(2.5 * warning["tightest_tolerance_mm"])), 20.0)
+    with pytest.warns(UserWarning, match="not measured up to their end"):  # 2 mm / 3 deg, as below
+        judged = headline(envelopes(table, [(2.0, 3.0), looser], published("protocol.envelope")),
+                          published("protocol.envelope")).set_index("tolerance")
+    assert np.isfinite(judged.loc[f"{looser[0]:g}mm_{looser[1]:g}deg", "theta_a"])
     summary = dataset_summary(table, ends, "epnp")
     assert summary["trusted_share"].iloc[0] == pytest.approx(warning["trusted_share"])
     assert summary["min_corners_in_view"].iloc[0] >= 12  # the whole grid is found: it is too small, not hidden

@@ -6,8 +6,10 @@ board origin exceeds ``extract.ground_truth.max_sigma_t_mm``: that limit keeps t
 it within R11's bar, a quarter of the tightest tolerance (the 99th percentile of the error is 2-4 x the predicted
 sigma_t; docs/references.md, "Ground-truth boards"). The same ratio maps a board's predicted sigma_t to the tightest
 tolerance it can judge: ``sigma_t / max_sigma_t_mm`` times the tightest E_t tolerance of ``protocol.tolerances``.
-A user whose board is too small (a 3 x 2 ArUco grid at 260 mm is predicted to 0.2-0.4 mm) learns that tolerance, and
-that loosening ``max_sigma_t_mm`` judges only tolerances that large.
+A user whose board is too small (a 3 x 2 ArUco grid at 260 mm is predicted to 0.2-0.4 mm) learns that tolerance: a
+looser tolerance of that size beside the tightest is judged by these poses as they are
+(:func:`~poseintegrity.localization.envelope.judged_errors`), and loosening ``max_sigma_t_mm`` judges only tolerances
+that large.
 """
 
 from __future__ import annotations
@@ -80,6 +82,8 @@ def _message(dataset: str, world: str, rows: pd.DataFrame, trusted: float, sigma
             f"(median), above {limit}. The tightest tolerance this board can judge is about {judges:.1f} mm / "
             f"{max(degrees, tightest_deg):.1f} deg. To judge "
             f"{tightest:g} mm: a larger board, nearer the camera, with more markers or corners (a ChArUco board: its "
-            f"corners are located more precisely), turned away from facing the camera by 20-40 deg; or, for a looser "
-            f"tolerance, set extract.ground_truth.max_sigma_t_mm to {sigma_t:.2f}{rotation} and judge tolerances "
-            f"of {judges:.1f} mm or more (protocol.tolerances).")
+            f"corners are located more precisely), turned away from facing the camera by 20-40 deg. A looser "
+            f"tolerance of protocol.tolerances, {judges:.1f} mm / {max(degrees, tightest_deg):.1f} deg or more, is "
+            f"judged by these poses as they are (each tolerance by the poses within the limits times how much looser "
+            f"it is than the tightest); to judge no tighter one, set extract.ground_truth.max_sigma_t_mm to "
+            f"{sigma_t:.2f}{rotation} and judge tolerances of {judges:.1f} mm or more (protocol.tolerances).")

@@ -36,6 +36,13 @@ measured stops say: an optimistic envelope. A criterion not measured before the 
 all, leaves no envelope to read: theta_a is then NaN (``censored`` False, ``status`` ``not_measured``), warned about
 naming the dataset, unless the first stop already fails; the prediction stage leaves such a dataset out of the
 scoring, naming it (prediction.sweeps.attach_envelopes), and any other NaN theta_a is refused (tables.check_envelopes).
+
+Each tolerance is judged by the board poses fine enough for it (:func:`judged_errors`, ours, issue 39): the trust
+rule's limits keep the ground truth's error within a quarter of the tightest tolerance (R11), and a tolerance k_t
+times looser in E_t and k_r times in E_r also takes the frames whose pose was refused by those limits alone, up to
+(k_t, k_r) times them (:func:`~poseintegrity.localization.ground_truth.truth_scale`). The tightest tolerance's errors
+are ``E_t_mm`` and ``E_r_deg`` themselves; a table without the ``LOOSE_ERRORS`` columns (written before) judges every
+tolerance by them.
 """
 
 from __future__ import annotations
@@ -123,6 +130,36 @@ def actual_envelope(theta: np.ndarray, criteria: np.ndarray, bounds: np.ndarray)
 GROUND_TRUTH_ERRORS = ("E_t_mm", "E_r_deg")  # against the ground truth (IV-C): the paper's metric
 EXACT_ERRORS = ("E_t_exact_mm", "E_r_exact_deg")  # against the renderer's exact pose: a diagnostic, not the paper's
 CRITERIA = ("translation", "rotation", "no_pose")  # what each column of stop_criteria bounds
+LOOSE_ERRORS = ("E_t_loose_mm", "E_r_loose_deg")  # against poses refused by the trust rule's limits alone
+TRUTH_SCALES = ("truth_scale_t", "truth_scale_r")  # their predicted uncertainty over those limits
+
+
+def loosening(tolerance: tuple[float, float], tolerances: list[tuple[float, float]]) -> np.ndarray:
+    """(2,) how many times looser ``tolerance`` is than the tightest of ``tolerances`` in E_t and in E_r (their
+    smallest E_t, their smallest E_r), at least 1: its ground truth may be that many times as uncertain (module
+    docstring)."""
+    tightest = np.min(np.asarray(tolerances, dtype=float).reshape(-1, 2), axis=0)
+    return np.maximum(1.0, np.asarray(tolerance, dtype=float) / tightest)
+
+
+def judges(frames: pd.DataFrame, k: np.ndarray) -> np.ndarray:
+    """(n,) whether each frame's board pose, refused by the trust rule's limits alone, is fine enough for a tolerance
+    ``k`` (:func:`loosening`) times the tightest: its truth scales within k (NaN scales never are)."""
+    return ((frames[TRUTH_SCALES[0]].to_numpy(dtype=float) <= k[0])
+            & (frames[TRUTH_SCALES[1]].to_numpy(dtype=float) <= k[1]))
+
+
+def judged_errors(frames: pd.DataFrame, tolerance: tuple[float, float],
+                  tolerances: list[tuple[float, float]]) -> pd.DataFrame:
+    """``frames`` with E_t_mm and E_r_deg as ``tolerance`` is judged (module docstring): where they are NaN, the
+    errors against a pose refused by the trust rule's limits alone that :func:`judges` it. Unchanged for the tightest
+    tolerance, or without the LOOSE_ERRORS and TRUTH_SCALES columns (a table written before them)."""
+    k = loosening(tolerance, tolerances)
+    if np.all(k == 1.0) or not {*LOOSE_ERRORS, *TRUTH_SCALES} <= set(frames.columns):
+        return frames
+    fine = frames["E_t_mm"].isna().to_numpy() & judges(frames, k)
+    return frames.assign(E_t_mm=np.where(fine, frames["E_t_loose_mm"], frames["E_t_mm"]),
+                         E_r_deg=np.where(fine, frames["E_r_loose_deg"], frames["E_r_deg"]))
 
 
 def stop_criteria(frames: pd.DataFrame, tolerance: tuple[float, float], rule: str,
@@ -173,8 +210,9 @@ def envelopes(table: pd.DataFrame, tolerances: list[tuple[float, float]], envelo
         position = "x_mm" if trajectory == "line" else "theta_deg"
         theta = frames.groupby("stop", sort=True)[position].mean().to_numpy()
         for tolerance in tolerances:
+            judged = judged_errors(frames, tolerance, tolerances) if errors == GROUND_TRUTH_ERRORS else frames
             for rule in FAILED_FRAME_RULES:
-                criteria, bounds = stop_criteria(frames, tolerance, rule, envelope, errors)
+                criteria, bounds = stop_criteria(judged, tolerance, rule, envelope, errors)
                 theta_a, censored, unmeasured, _ = actual_envelope(theta, criteria, bounds)
                 rows.append(dict(world=world, dataset=dataset, trajectory=trajectory, tolerance=tolerance_name(tolerance),
                                  method=method, rule=rule, theta_a=theta_a, censored=censored,

@@ -20,7 +20,9 @@ headline PnP method and failed-frame rule:
 - ``theta_a`` beside ``theta_a_exact`` (the same envelope against the exact pose, a diagnostic), and the mean n_i
   at theta_a (linearly interpolated between the stops' means);
 - ``unmeasured_stops``: how many stops up to the first failing one had no error to average (no trusted ground truth
-  in any posed frame): theta_a was read across them (:func:`~.envelope.actual_envelope` skips them);
+  in any posed frame): theta_a was read across them (:func:`~.envelope.actual_envelope` skips them); a looser
+  tolerance is judged by the board poses fine enough for it (:func:`~.envelope.judged_errors`), and its
+  ``board_untrusted_share`` counts the frames whose pose is not;
 - ``E_t_at_end``, ``sigma_t_pred_at_end``: at the first failing stop, the mean measured E_t and the mean predicted
   RMS E_t of its posed frames (issue 38, :mod:`.pose_covariance`): how far the predicted error saw the end coming.
 """
@@ -31,7 +33,7 @@ import numpy as np
 import pandas as pd
 
 from poseintegrity.localization.envelope import (CRITERIA, EXACT_ERRORS, GROUND_TRUTH_ERRORS, actual_envelope,
-                                                 stop_criteria)
+                                                 TRUTH_SCALES, judged_errors, judges, loosening, stop_criteria)
 from poseintegrity.localization.truth_accuracy import R11_BAR
 from poseintegrity.protocol import EnvelopeParams, tolerance_name
 
@@ -47,14 +49,15 @@ def envelope_causes(table: pd.DataFrame, tolerances: list[tuple[float, float]], 
     ``table`` under the headline rule ``envelope.failed_frames``. The ``board_*`` columns describe the frames of the
     first failing stop (the last stop when the envelope is censored)."""
     rows = []
-    for (world, dataset, trajectory), frames in table[table["method"] == method].groupby(
+    for (world, dataset, trajectory), everything in table[table["method"] == method].groupby(
             ["world", "dataset", "trajectory"], sort=True):
         position = "x_mm" if trajectory == "line" else "theta_deg"
-        per_stop = frames.groupby("stop", sort=True)
+        per_stop = everything.groupby("stop", sort=True)
         stops, theta = per_stop[position].mean().index.to_numpy(), per_stop[position].mean().to_numpy()
         n_inliers = per_stop["n_inliers"].mean().to_numpy()
-        has_exact = bool(frames[list(EXACT_ERRORS)].notna().any().any())
+        has_exact = bool(everything[list(EXACT_ERRORS)].notna().any().any())
         for tolerance in tolerances:
+            frames = judged_errors(everything, tolerance, tolerances)
             criteria, bounds = stop_criteria(frames, tolerance, envelope.failed_frames, envelope)
             theta_a, censored, _, criterion = actual_envelope(theta, criteria, bounds)
             exact = (stop_criteria(frames, tolerance, envelope.failed_frames, envelope, EXACT_ERRORS)
@@ -72,7 +75,7 @@ def envelope_causes(table: pd.DataFrame, tolerances: list[tuple[float, float]], 
                        n_inliers_at_theta_a=float(np.interp(theta_a, theta, n_inliers)) if np.isfinite(theta_a)
                        else float("nan"),
                        unmeasured_stops=int(np.isnan(criteria[: failing + 1, :2]).all(axis=1).sum()),
-                       board_untrusted_share=float((at_stop["board_status"] != "ok").mean()),
+                       board_untrusted_share=float(_untrusted(at_stop, loosening(tolerance, tolerances)).mean()),
                        board_dropped_share=float((at_stop["board_n_dropped"] > 0).mean()),
                        board_sigma_t_mm=float(at_stop["board_sigma_t_mm"].median()),
                        E_t_at_end=float(at_stop["E_t_mm"].mean()),
@@ -82,6 +85,12 @@ def envelope_causes(table: pd.DataFrame, tolerances: list[tuple[float, float]], 
                                                                               criteria, bounds, same_frames, row)
             rows.append(row)
     return pd.DataFrame(rows, columns=COLUMNS)
+
+
+def _untrusted(frames: pd.DataFrame, k: np.ndarray) -> np.ndarray:
+    """Which frames' board pose cannot judge a tolerance ``k`` times the tightest (:func:`~.envelope.judges`)."""
+    untrusted = (frames["board_status"] != "ok").to_numpy()
+    return untrusted & ~judges(frames, k) if set(TRUTH_SCALES) <= set(frames.columns) else untrusted
 
 
 def _exact_where_truth(frames: pd.DataFrame) -> pd.DataFrame:

@@ -32,9 +32,9 @@ from poseintegrity.localization.matching import match_ratio_test
 from poseintegrity.params.extract import ExtractParams
 from poseintegrity.localization.target_model import TargetModel
 
-EVIDENCE_VERSION = 5  # bump when the cached content or its layout changes (3: the checked board pose, issue 30;
+EVIDENCE_VERSION = 6  # bump when the cached content or its layout changes (3: the checked board pose, issue 30;
 # 4: the matched model points' indices, whose covariances the predicted error needs, issue 38; 5: the board poses'
-# covariances and the handover boards' poses, issue 39)
+# covariances and the handover boards' poses, issue 39; 6: whether a board pose passed checks 1-2, issue 39)
 
 
 @dataclass(frozen=True)
@@ -109,7 +109,8 @@ def _pose_arrays(prefix: str, pose: BoardPose) -> dict[str, Any]:
     return {f"{prefix}_T_cam_board": pose.T_cam_board, f"{prefix}_status": pose.status,
             f"{prefix}_reason": pose.reason, f"{prefix}_n_points": pose.n_points, f"{prefix}_n_dropped": pose.n_dropped,
             f"{prefix}_rms_px": pose.rms_px, f"{prefix}_sigma_t_mm": pose.sigma_t_mm,
-            f"{prefix}_sigma_r_deg": pose.sigma_r_deg, f"{prefix}_covariance": pose.covariance}
+            f"{prefix}_sigma_r_deg": pose.sigma_r_deg, f"{prefix}_covariance": pose.covariance,
+            f"{prefix}_consistent": pose.consistent}
 
 
 def _stored_pose(stored, prefix: str, board: int = 0) -> BoardPose:
@@ -117,7 +118,7 @@ def _stored_pose(stored, prefix: str, board: int = 0) -> BoardPose:
     return BoardPose(stored[f"{prefix}_T_cam_board"], str(stored[f"{prefix}_status"]), str(stored[f"{prefix}_reason"]),
                      *(int(stored[f"{prefix}_{k}"]) for k in ("n_points", "n_dropped")),
                      *(float(stored[f"{prefix}_{k}"]) for k in ("rms_px", "sigma_t_mm", "sigma_r_deg")),
-                     stored[f"{prefix}_covariance"], board)
+                     stored[f"{prefix}_covariance"], board, bool(stored[f"{prefix}_consistent"]))
 
 
 def frame_evidence(

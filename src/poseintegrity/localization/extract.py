@@ -13,7 +13,10 @@ workers of the ``parallel`` section (:class:`~poseintegrity.parallel.Workers`):
    artifacts (III-C) and E_t/E_r against the ground truth, the board pose of the frame (IV-C): ``E_t_mm``,
    ``E_r_deg`` (NaN without a pose, and without a trusted board pose: ``board_status`` other than "ok", e.g.
    ``bad_ground_truth`` with its ``board_reason``; such a frame keeps its localization status and n_i, it is only
-   not judged); against the exact renderer pose as a diagnostic: ``E_t_exact_mm``, ``E_r_exact_deg``. The board
+   not judged); the same against a board pose refused by the trust rule's limits alone, which judges looser
+   tolerances (``E_t_loose_mm``, ``E_r_loose_deg``, NaN where the board gave no consistent fit; ``truth_scale_t``,
+   ``truth_scale_r``: its predicted uncertainty over the limits, :func:`.ground_truth.truth_scale`); against the
+   exact renderer pose as a diagnostic: ``E_t_exact_mm``, ``E_r_exact_deg``. The board
    pose's own errors: ``E_*_board_exact`` (against the exact pose, absolute) and ``E_*_truth`` (what it adds to E_t
    and E_r: relative to model image 0's, :func:`~poseintegrity.localization.ground_truth.truth_error`; R11); the
    model placement's (``E_*_placement``: model image 0's board pose against its exact pose, ``anchor_status`` its
@@ -49,7 +52,7 @@ from poseintegrity.localization.frame_artifacts import frame_artifacts
 from poseintegrity.localization.frame_pnp import frame_pnp
 from poseintegrity.localization.kinematic_consistency import kinematic_errors, reported_pose
 from poseintegrity.localization.ground_truth import (
-    BoardPose, board_from_dict, board_pose, handed_over, handover, no_pose, truth_error,
+    BoardPose, board_from_dict, board_pose, handed_over, handover, no_pose, truth_error, truth_scale,
 )
 from poseintegrity.params.extract import ExtractParams
 from poseintegrity.localization.pnp import PnPResult, failed, solve_checked
@@ -294,17 +297,23 @@ def judged(row: dict[str, Any], board: BoardPose, task: FrameTask) -> dict[str, 
     of frames.parquet with ``ground_truth: poses``): E_t and E_r (NaN without a trusted pose, and on a flagged row),
     the board's columns, and what the board pose adds to E_t and E_r (R11)."""
     T_cam_board = exact_pose(task.frame)
-    truth = T_cam_board if task.ground_truth == "poses" else (board.T_cam_board if board.trusted else NAN_POSE)
+    poses = task.ground_truth == "poses"
+    truth = T_cam_board if poses else (board.T_cam_board if board.trusted else NAN_POSE)
+    loose = T_cam_board if poses else (board.T_cam_board if board.consistent else NAN_POSE)
     T_est = np.asarray(row["T_cam_board_est"], dtype=np.float64).reshape(4, 4)
     E_t_mm, E_r_deg = map(float, pose_errors(T_est, truth))  # IV-C: the board is the truth (or the poses)
+    E_t_loose_mm, E_r_loose_deg = map(float, pose_errors(T_est, loose))  # judges the looser tolerances
+    scale_t, scale_r = truth_scale(board, task.params.ground_truth)
     if row["status"] in DATA_FLAGS:  # a flagged frame is no evidence: no error is reported for it
-        E_t_mm = E_r_deg = np.nan
+        E_t_mm = E_r_deg = E_t_loose_mm = E_r_loose_deg = np.nan
     E_t_board_exact_mm, E_r_board_exact_deg = map(float, pose_errors(board.T_cam_board, T_cam_board))
     exact_0 = NAN_POSE if task.T_cam0_board_exact is None else task.T_cam0_board_exact
     anchor = task.model.anchor
     E_t_truth_mm, E_r_truth_deg = truth_error(board.T_cam_board, T_cam_board, anchor.T_cam_board, exact_0)
     E_t_placement_mm, E_r_placement_deg = map(float, pose_errors(anchor.T_cam_board, exact_0))
-    return dict(E_t_mm=E_t_mm, E_r_deg=E_r_deg, board_status=board.status, board_reason=board.reason,
+    return dict(E_t_mm=E_t_mm, E_r_deg=E_r_deg, E_t_loose_mm=E_t_loose_mm, E_r_loose_deg=E_r_loose_deg,
+                truth_scale_t=scale_t, truth_scale_r=scale_r,
+                board_status=board.status, board_reason=board.reason,
                 board_n_points=board.n_points, board_n_dropped=board.n_dropped, board_rms_px=board.rms_px,
                 board_sigma_t_mm=board.sigma_t_mm, board_sigma_r_deg=board.sigma_r_deg, truth_board=board.board,
                 E_t_board_exact_mm=E_t_board_exact_mm, E_r_board_exact_deg=E_r_board_exact_deg,

@@ -74,7 +74,8 @@ def realism_metrics(
       arcs whose theta_a lies within 0.01 deg of a stop, <= 0.5
     - R11 (a measurement finer than what it judges) ``truth_accuracy``
       (:func:`~poseintegrity.localization.truth_accuracy.truth_accuracy`): what the board's ground truth adds to E_t
-      and E_r, 99th percentile <= 0.5 mm and 0.5 deg over the frames whose board pose is trusted
+      and E_r, 99th percentile <= 0.5 mm and 0.5 deg over the frames whose board pose is trusted, and k times that
+      over the frames judging a tolerance k times looser
     ``n_bars_passed`` / ``n_bars`` count the bars of ``passed``.
 
     recorded : the rows are recorded data (:mod:`poseintegrity.recorded`), not a rendered world: the same values
@@ -83,7 +84,7 @@ def realism_metrics(
     method, sampled = protocol.pnp_method, protocol.sampled_stops.arc
     envelope_table = headline(envelope_table, protocol.envelope)
     rows = table[table["method"] == method]
-    truth = truth_accuracy(rows)
+    truth = truth_accuracy(rows, protocol.tolerances)
     arcs = rows[rows["trajectory"] == "arc"]
     per_stop = arcs.groupby(["dataset", "stop"]).agg(theta=("theta_deg", "mean"), n_i=("n_inliers", "mean"))
     spearman = {

@@ -338,6 +338,12 @@ def _truth_rows(stage: str, prefix: str, section: str, world: str = "") -> list[
         Headline(stage, f"{key}.p99_E_r_truth_deg", f"{at}R11: ... to E_r, 99th percentile (deg)", "-", "<= 0.5",
                  section=section),
         Headline(stage, f"{key}.median_E_t_truth_mm", f"{at}... median (mm)", section=section),
+        Headline(stage, f"{key}.by_tolerance.4mm_10deg.p99_E_t_truth_mm", f"{at}R11 at 4 mm / 10 deg, over the frames "
+                 "fine enough for it (its bar 2 x 0.5 mm): 99th percentile (mm)", "-", "<= 1.0", section=section),
+        Headline(stage, f"{key}.by_tolerance.4mm_10deg.p99_E_r_truth_deg", f"{at}... (deg; bar 3.3 x 0.5 deg)", "-",
+                 "<= 1.67", section=section),
+        Headline(stage, f"{key}.by_tolerance.4mm_10deg.judged_share", f"{at}frames whose board pose judges 4 mm / "
+                 "10 deg", fmt="{:.1%}", section=section),
         Headline(stage, f"{key}.placement_max_E_t_mm",
                  f"{at}model placement: model image 0's board pose vs exact, largest over datasets (mm)",
                  section=section),
