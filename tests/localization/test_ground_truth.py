@@ -128,7 +128,8 @@ def test_a_pose_refused_by_the_limits_alone_has_its_uncertainty_in_units_of_them
     assert trusted.trusted and trusted.consistent
     np.testing.assert_allclose(truth_scale(trusted, CHECKS), [trusted.sigma_t_mm / CHECKS.max_sigma_t_mm,
                                                                trusted.sigma_r_deg / CHECKS.max_sigma_r_deg])
-    strict = CHECKS.model_copy(update=dict(max_sigma_t_mm=trusted.sigma_t_mm / 3, max_sigma_r_deg=trusted.sigma_r_deg / 3))
+    strict = CHECKS.model_copy(update=dict(max_sigma_t_mm=trusted.sigma_t_mm / 3,
+                                           max_sigma_r_deg=trusted.sigma_r_deg / 3))
     refused = board_pose(image, synthetic.BOARD, synthetic.CAMERA, strict)
     assert refused.status == "bad_ground_truth" and "predicted uncertainty" in refused.reason and refused.consistent
     np.testing.assert_allclose(truth_scale(refused, strict), [3.0, 3.0])

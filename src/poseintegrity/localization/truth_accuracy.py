@@ -6,10 +6,10 @@ relative exact pose (:func:`~poseintegrity.localization.ground_truth.truth_error
 ``E_r_truth_deg``). The bar: its 99th percentile over the frames whose board pose is trusted is at most a quarter of
 the tightest tolerance, 0.5 mm and 0.5 deg; a tolerance k_t times looser in E_t and k_r in E_r is judged by the
 poses of truth scales within (k_t, k_r) too (:func:`~poseintegrity.localization.envelope.judged_errors`), and over
-them its bar is (k_t x 0.5 mm, k_r x 0.5 deg) (``by_tolerance``; ``r11_passed`` asks every tolerance's). Beside it, the absolute error of model image 0's board pose (the model
-placement, ``E_*_placement``), and how the board's own checks went (frames not trusted and why, markers or corners
-dropped, residuals, predicted uncertainty): on recorded data, where there is no exact pose, these describe the ground
-truth alone.
+them its bar is (k_t x 0.5 mm, k_r x 0.5 deg) (``by_tolerance``; ``r11_passed`` asks every tolerance's). Beside
+it, the absolute error of model image 0's board pose (the model placement, ``E_*_placement``), and how the board's
+own checks went (frames not trusted and why, markers or corners dropped, residuals, predicted uncertainty): on
+recorded data, where there is no exact pose, these describe the ground truth alone.
 """
 
 from __future__ import annotations
@@ -29,8 +29,8 @@ FRAME_KEYS = ["dataset", "stop", "image"]
 def truth_accuracy(table: pd.DataFrame, tolerances: list[tuple[float, float]] = ()) -> dict[str, Any]:
     """R11 and the board's checks over an artifacts table's frames (one row per frame is used: the board does not
     depend on the PnP method). ``tolerances``: the protocol's, whose looser ones are checked too (``by_tolerance``:
-    per tolerance name its ``k`` (k_t, k_r), ``judged_share`` of the frames, ``p99_E_t_truth_mm``, ``p99_E_r_truth_deg``, ``bar``
-    and ``passed``). Keys: ``n_frames``; ``trusted_share`` (board status "ok"); ``status_shares``;
+    per tolerance name its ``k`` (k_t, k_r), ``judged_share`` of the frames, ``p99_E_t_truth_mm``,
+    ``p99_E_r_truth_deg``, ``bar`` and ``passed``). Keys: ``n_frames``; ``trusted_share`` (board status "ok"); ``status_shares``;
     ``untrusted_share_by_dataset``; ``dropped_share`` (frames whose check dropped a marker or corner);
     ``median_rms_px``, ``median_sigma_t_mm``, ``median_sigma_r_deg``, ``median_points``; with exact poses:
     ``median_E_t_truth_mm``, ``p99_E_t_truth_mm``, ``max_E_t_truth_mm`` and the same in deg, ``placement_*`` (median

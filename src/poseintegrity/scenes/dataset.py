@@ -400,7 +400,8 @@ def finish_dataset(params: GenerateParams, root: Path, plan: DatasetPlan, trip: 
     boards are its handover boards."""
     spec = params.scenes[plan.scene_index]
     board = scene.board_for(trajectory_index(params, plan))
-    # the scene's other boards, each whole in model image 0: they judge the frames this board cannot (a handover)
+    # the scene's other boards judge the frames this board cannot (a handover; stage 02 takes one only where it is
+    # trusted in model image 0)
     others = [b.board.as_dict() for b in scene.boards if b is not board]
     truth = true_camera(params.camera)
     f_px = truth.K[0, 0]
