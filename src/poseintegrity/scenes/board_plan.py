@@ -442,77 +442,94 @@ def plan_boards(sizes_mm: list[float], squares: tuple[int, int], marker_share: f
     c = _candidates(sizes_mm, squares, margin_mm, aim, model_pair[0], target_centre)
     c = c.subset(_judge(c, poses[:1], *judge).alive)  # model image 0 drops most, cheaply: the rest judged alone
     judged = _judge(c, poses, *judge)
-    alive = np.flatnonzero(judged.alive)
-    if not len(alive):
+    if not judged.alive.any():
         raise PlacementError(
             f"{where}: no place beside the target keeps a board of {min(sizes_mm):g}-{max(sizes_mm):g} mm squares "
             f"wholly in model image 0 and clear of the targets along every trajectory; smaller "
             f"generate.board.sizes_mm, a larger distance_mm, fewer or smaller targets (generate.scapula.length_mm) "
             f"would leave room")
-    # what stage 02's estimate of sigma_t reaches in a share 1 - TRUSTED_SHARE of frames, by the corners found
-    spread = np.array([estimate_spread(n) if n > 3 else np.inf for n in range(judged.visible.shape[2] + 1)])
-    sigma = judged.sigma_t[alive] * spread[judged.visible[alive].sum(axis=2)]
-    ok = judged.served[alive] & (sigma <= plan_sigma_t_mm)  # (alive, poses): served within the limit alone
-    failing = np.stack([(~ok[:, i]).sum(axis=1) for i in index], axis=1)  # (alive, trajectories)
-    worst = np.stack([judged.sigma_t[alive][:, i].max(axis=1) for i in index], axis=1)
-    lever = np.linalg.norm(c.origin[alive] - target_centre, axis=1)
-
-    def rank(boards: tuple[int, ...]) -> tuple:
-        """A single board (index into alive) is better the more trajectories it serves, the fewer poses it fails,
-        the smaller its worst predicted sigma_t (to SIGMA_STEP_MM) and the shorter its lever arm."""
-        fails = failing[list(boards)].min(axis=0)
-        served = [worst[boards[0], t] for t in range(len(index)) if not fails[t]]
-        return (-int((fails == 0).sum()), int(fails.sum()), np.round(max(served, default=0.0) / SIGMA_STEP_MM),
-                float(lever[list(boards)].sum()), boards)
-
-    chosen = min(((k,) for k in range(len(alive))), key=rank)
-    best = rank(chosen)
-    service = _Service((0,) * len(index), tuple(int(f) for f in failing[chosen[0]]))
-    if max_boards > 1 and failing[chosen[0]].any():
+    ranking = _Ranking(c, judged, poses, index, squares, K, plan_sigma_t_mm, target_centre)
+    chosen = min(((k,) for k in range(len(ranking.alive))), key=ranking.rank)
+    best = ranking.rank(chosen)
+    service = _Service((0,) * len(index), tuple(int(f) for f in ranking.failing[chosen[0]]))
+    if max_boards > 1 and ranking.failing[chosen[0]].any():
         # a pair: each of the best boards alone with the boards apart from it that leave the fewest poses unserved
         # by either (what a handover could at best reach), the best PAIR_POOL of them tried
-        pool = sorted(range(len(alive)), key=lambda k: rank((k,)))[:PAIR_POOL]
+        alive, ok, lever = ranking.alive, ranking.ok, ranking.lever
+        pool = sorted(range(len(alive)), key=lambda k: ranking.rank((k,)))[:PAIR_POOL]
         apart = _apart(c, alive[pool], alive, poses, K)
-
-        def pair(a: int, b: int) -> tuple[tuple, _Service]:
-            """Per trajectory the board of the two that, with the other taking over where it fails (the handover),
-            fails the fewest of its poses (model image 0 by its own board: its pose places M_t); ranked as a
-            single board."""
-            via = {(own, other): _handover_sigma_t(c, judged, alive[own], alive[other], poses, squares, K,
-                                                   ~ok[own] & judged.served[alive[other]], spread)
-                   for own, other in ((a, b), (b, a))}
-            primary, fails, sigmas = [], [], []
-            for t, i in enumerate(index):
-                options = []
-                for k, (own, other) in enumerate(((a, b), (b, a))):
-                    effective = np.where(ok[own, i], sigma[own, i], via[own, other][i])
-                    effective[0] = sigma[own, i[0]] if ok[own, i[0]] else np.inf
-                    options.append((int((effective > plan_sigma_t_mm).sum()), int(failing[own, t]), k, effective))
-                f, _, k, effective = min(options, key=lambda o: o[:3])
-                primary.append(k)
-                fails.append(f)
-                sigmas.append(effective.max() if f == 0 else 0.0)
-            fails_ = np.array(fails)
-            return ((-int((fails_ == 0).sum()), int(fails_.sum()), np.round(max(sigmas, default=0.0) / SIGMA_STEP_MM),
-                     float(lever[[a, b]].sum()), (a, b)), _Service(tuple(primary), tuple(fails)))
-
         for a, apart_a in zip(pool, apart):
             either = np.stack([(~(ok[a, i] | ok[:, i])).sum(axis=1) for i in index], axis=1)  # (alive, trajectories)
             others = np.flatnonzero(apart_a & (np.arange(len(alive)) != a))
             tried = others[np.lexsort((lever[others], either[others].sum(axis=1), -(either[others] == 0).sum(axis=1)))]
             for b in tried[:PAIR_POOL]:
-                ranked, served = pair(a, int(b))
+                ranked, served = ranking.pair(a, int(b))
                 if ranked < best:
                     chosen, best, service = (a, int(b)), ranked, served
     board_of, unserved = service
     planned = []
     for b, k in enumerate(chosen):
         served = [t for t in range(len(index)) if board_of[t] == b]
-        sigma = max((worst[k, t] for t in served if not failing[k, t]), default=float("nan"))
-        in_view = _worst_in_view(c, alive[k], [poses[p] for t in served for p in index[t]], K, width, height)
-        planned.append(PlannedBoard(float(c.square[alive[k]]), b * (squares[0] * squares[1] // 2),
-                                    _placement(c, alive[k], in_view), float(sigma)))
+        sigma = max((ranking.worst[k, t] for t in served if not ranking.failing[k, t]), default=float("nan"))
+        i = ranking.alive[k]
+        in_view = _worst_in_view(c, i, [poses[p] for t in served for p in index[t]], K, width, height)
+        planned.append(PlannedBoard(float(c.square[i]), b * (squares[0] * squares[1] // 2), _placement(c, i, in_view),
+                                    float(sigma)))
     return BoardPlan(tuple(planned), board_of, unserved)
+
+
+class _Ranking:
+    """How well the candidates that stay alive (``alive``: their indices into ``c``) serve the trajectories (``index``:
+    per trajectory its poses' indices into ``poses``), alone (:meth:`rank`) and in pairs (:meth:`pair`).
+
+    Per alive candidate and pose: ``sigma``, the predicted sigma_t times what stage 02's estimate of it reaches in a
+    share 1 - TRUSTED_SHARE of frames by the corners found (:func:`estimate_spread`), and ``ok``, served within
+    ``limit_mm`` by the board alone; per alive candidate and trajectory: ``failing``, the poses it does not serve so,
+    and ``worst``, its worst predicted sigma_t; ``lever``: from its origin to the target (mm)."""
+
+    def __init__(self, c: _Candidates, judged: _Judged, poses: list[np.ndarray], index: list[np.ndarray],
+                 squares: tuple[int, int], K: np.ndarray, limit_mm: float, target_centre: np.ndarray):
+        self.c, self.judged, self.poses, self.index, self.squares, self.K = c, judged, poses, index, squares, K
+        self.limit_mm = limit_mm
+        self.alive = alive = np.flatnonzero(judged.alive)
+        self.spread = np.array([estimate_spread(n) if n > 3 else np.inf for n in range(judged.visible.shape[2] + 1)])
+        self.sigma = judged.sigma_t[alive] * self.spread[judged.visible[alive].sum(axis=2)]
+        self.ok = judged.served[alive] & (self.sigma <= limit_mm)  # (alive, poses)
+        self.failing = np.stack([(~self.ok[:, i]).sum(axis=1) for i in index], axis=1)  # (alive, trajectories)
+        self.worst = np.stack([judged.sigma_t[alive][:, i].max(axis=1) for i in index], axis=1)
+        self.lever = np.linalg.norm(c.origin[alive] - target_centre, axis=1)
+
+    def rank(self, boards: tuple[int, ...]) -> tuple:
+        """A single board (index into alive) is better the more trajectories it serves, the fewer poses it fails,
+        the smaller its worst predicted sigma_t (to SIGMA_STEP_MM) and the shorter its lever arm."""
+        fails = self.failing[list(boards)].min(axis=0)
+        served = [self.worst[boards[0], t] for t in range(len(self.index)) if not fails[t]]
+        return (-int((fails == 0).sum()), int(fails.sum()), np.round(max(served, default=0.0) / SIGMA_STEP_MM),
+                float(self.lever[list(boards)].sum()), boards)
+
+    def pair(self, a: int, b: int) -> tuple[tuple, _Service]:
+        """Per trajectory the board of the two (indices into alive) that, with the other taking over where it fails
+        (the handover), fails the fewest of its poses (model image 0 by its own board: its pose places M_t); ranked
+        as :meth:`rank` ranks a single board."""
+        alive, ok, sigma = self.alive, self.ok, self.sigma
+        via = {(own, other): _handover_sigma_t(self.c, self.judged, alive[own], alive[other], self.poses,
+                                               self.squares, self.K, ~ok[own] & self.judged.served[alive[other]],
+                                               self.spread)
+               for own, other in ((a, b), (b, a))}
+        primary, fails, sigmas = [], [], []
+        for t, i in enumerate(self.index):
+            options = []
+            for k, (own, other) in enumerate(((a, b), (b, a))):
+                effective = np.where(ok[own, i], sigma[own, i], via[own, other][i])
+                effective[0] = sigma[own, i[0]] if ok[own, i[0]] else np.inf
+                options.append((int((effective > self.limit_mm).sum()), int(self.failing[own, t]), k, effective))
+            f, _, k, effective = min(options, key=lambda o: o[:3])
+            primary.append(k)
+            fails.append(f)
+            sigmas.append(effective.max() if f == 0 else 0.0)
+        fails_ = np.array(fails)
+        return ((-int((fails_ == 0).sum()), int(fails_.sum()), np.round(max(sigmas, default=0.0) / SIGMA_STEP_MM),
+                 float(self.lever[[a, b]].sum()), (a, b)), _Service(tuple(primary), tuple(fails)))
 
 
 @dataclass(frozen=True)
