@@ -276,3 +276,14 @@ def test_the_causes_of_a_looser_tolerance_count_only_the_poses_that_cannot_judge
     assert (row["cause"], row["limit"]) == ("estimate", "translation") and row["board_untrusted_share"] == 0.0
     assert row["theta_a"] == pytest.approx(2.25 + 0.75 * 4.5) == row["theta_a_exact"]
     assert causes.set_index("tolerance").loc["2mm_3deg", "cause"] == "unmeasured"
+
+
+def test_a_looser_tolerances_ground_truth_is_judged_against_its_own_bar():
+    # 4 mm / 10 deg fails at stop 2 against the ground truth (4.4 mm) but not against the exact pose (3.7 mm): the
+    # ground truth moved it across by 0.7 mm, beyond R11's 0.5 mm for 2 mm / 3 deg but within 2 x 0.5 mm for 4 mm
+    table = _causes_table([0.5, 1.0, 4.4, 6.0], [0.5, 1.0, 3.7, 3.7])
+    causes = envelope_causes(table, [(2.0, 3.0), (4.0, 10.0)], RULES, "usac_magsac").set_index("tolerance")
+    assert causes.loc["4mm_10deg", "cause"] == "resolution"
+    assert causes.loc["4mm_10deg", "truth_shift"] == pytest.approx(0.7)
+    alone = envelope_causes(table, [(4.0, 10.0)], RULES, "usac_magsac").iloc[0]  # the tightest: its bar is 0.5 mm
+    assert alone["cause"] == "ground_truth"

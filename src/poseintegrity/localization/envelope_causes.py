@@ -11,7 +11,8 @@ headline PnP method and failed-frame rule:
   criterion is taken against the renderer's exact pose (``E_*_exact``) *on the same frames* (those whose board pose
   was trusted). If it exceeds the bound too, the envelope ended on the estimate (``estimate``). If it stays within, the ground truth moved the criterion across the
   bound by ``truth_shift`` (criterion against the ground truth minus against the exact pose): by more than the
-  ground truth's own accuracy bar (R11, :data:`~poseintegrity.localization.truth_accuracy.R11_BAR`) that is a fault of
+  ground truth's own accuracy bar (R11, :data:`~poseintegrity.localization.truth_accuracy.R11_BAR`, scaled for a
+  looser tolerance as its ground truth is, :func:`~.envelope.loosening`) that is a fault of
   the ground truth (``ground_truth``); by no more, the ground truth was as good as R11 asks and the estimate's error
   lay within its resolution of the bound (``resolution``): no ground truth of that accuracy can say on which side of
   the bound that stop falls. Recorded data have no exact pose: the board's own consistency at that stop stands in
@@ -81,8 +82,9 @@ def envelope_causes(table: pd.DataFrame, tolerances: list[tuple[float, float]], 
                        E_t_at_end=float(at_stop["E_t_mm"].mean()),
                        sigma_t_pred_at_end=float(at_stop["sigma_t_pred_mm"].mean()) if "sigma_t_pred_mm" in at_stop
                        else float("nan"))  # a table without the predicted error (written before issue 38)
+            bar = loosening(tolerance, tolerances) * np.asarray(R11_BAR)  # R11's bar for this tolerance
             row["limit"], row["cause"], row["truth_shift"] = _limit_and_cause(theta_a, censored, criterion, failing,
-                                                                              criteria, bounds, same_frames, row)
+                                                                              criteria, bounds, same_frames, row, bar)
             rows.append(row)
     return pd.DataFrame(rows, columns=COLUMNS)
 
@@ -103,10 +105,12 @@ def _exact_where_truth(frames: pd.DataFrame) -> pd.DataFrame:
 
 
 def _limit_and_cause(theta_a: float, censored: bool, criterion: int, failing: int, criteria: np.ndarray,
-                     bounds: np.ndarray, same_frames: np.ndarray | None, row: dict) -> tuple[str, str, float]:
+                     bounds: np.ndarray, same_frames: np.ndarray | None, row: dict,
+                     bar: np.ndarray) -> tuple[str, str, float]:
     """(limit, cause, truth_shift) of one envelope (module docstring); ``failing``: the first failing stop's index;
     ``criteria`` (m, b) against the ground truth, ``same_frames`` (m, b) against the exact pose on the same frames
-    (None without exact poses). truth_shift is NaN where no error limit was compared with the exact pose."""
+    (None without exact poses); ``bar`` (2,): R11's bar of the tolerance (mm, deg). truth_shift is NaN where no
+    error limit was compared with the exact pose."""
     if not np.isfinite(theta_a):
         return "unmeasured", "unmeasured", float("nan")
     if censored:
@@ -119,6 +123,6 @@ def _limit_and_cause(theta_a: float, censored: bool, criterion: int, failing: in
         shift = float(criteria[failing, criterion] - value)
         if not (np.isfinite(value) and value <= bounds[criterion]):
             return limit, "estimate", shift
-        return limit, "ground_truth" if shift > R11_BAR[criterion] else "resolution", shift
+        return limit, "ground_truth" if shift > bar[criterion] else "resolution", shift
     suspect = row["board_untrusted_share"] > 0 or row["board_dropped_share"] > 0
     return limit, "ground_truth" if suspect else "estimate", float("nan")
