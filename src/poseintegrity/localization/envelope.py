@@ -143,16 +143,20 @@ def loosening(tolerance: tuple[float, float], tolerances: list[tuple[float, floa
 
 
 def judges(frames: pd.DataFrame, k: np.ndarray) -> np.ndarray:
-    """(n,) whether each frame's board pose, refused by the trust rule's limits alone, is fine enough for a tolerance
-    ``k`` (:func:`loosening`) times the tightest: its truth scales within k (NaN scales never are)."""
-    return ((frames[TRUTH_SCALES[0]].to_numpy(dtype=float) <= k[0])
-            & (frames[TRUTH_SCALES[1]].to_numpy(dtype=float) <= k[1]))
+    """(n,) whether each frame's board pose is fine enough for a tolerance ``k`` (:func:`loosening`) times the
+    tightest: trusted (board status "ok"), or refused by the trust rule's limits alone with truth scales within k
+    (NaN scales never are; a table without the TRUTH_SCALES columns has the trusted ones alone)."""
+    trusted = (frames["board_status"] == "ok").to_numpy()
+    if not set(TRUTH_SCALES) <= set(frames.columns):
+        return trusted
+    return trusted | ((frames[TRUTH_SCALES[0]].to_numpy(dtype=float) <= k[0])
+                      & (frames[TRUTH_SCALES[1]].to_numpy(dtype=float) <= k[1]))
 
 
 def judged_errors(frames: pd.DataFrame, tolerance: tuple[float, float],
                   tolerances: list[tuple[float, float]]) -> pd.DataFrame:
     """``frames`` with E_t_mm and E_r_deg as ``tolerance`` is judged (module docstring): where they are NaN, the
-    errors against a pose refused by the trust rule's limits alone that :func:`judges` it. Unchanged for the tightest
+    errors against a pose (refused by the trust rule's limits alone) that :func:`judges` it. Unchanged for the tightest
     tolerance, or without the LOOSE_ERRORS and TRUTH_SCALES columns (a table written before them)."""
     k = loosening(tolerance, tolerances)
     if np.all(k == 1.0) or not {*LOOSE_ERRORS, *TRUTH_SCALES} <= set(frames.columns):

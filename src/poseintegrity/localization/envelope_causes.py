@@ -34,7 +34,7 @@ import numpy as np
 import pandas as pd
 
 from poseintegrity.localization.envelope import (CRITERIA, EXACT_ERRORS, GROUND_TRUTH_ERRORS, actual_envelope,
-                                                 TRUTH_SCALES, judged_errors, judges, loosening, stop_criteria)
+                                                 judged_errors, judges, loosening, stop_criteria)
 from poseintegrity.localization.truth_accuracy import R11_BAR
 from poseintegrity.protocol import EnvelopeParams, tolerance_name
 
@@ -76,7 +76,7 @@ def envelope_causes(table: pd.DataFrame, tolerances: list[tuple[float, float]], 
                        n_inliers_at_theta_a=float(np.interp(theta_a, theta, n_inliers)) if np.isfinite(theta_a)
                        else float("nan"),
                        unmeasured_stops=int(np.isnan(criteria[: failing + 1, :2]).all(axis=1).sum()),
-                       board_untrusted_share=float(_untrusted(at_stop, loosening(tolerance, tolerances)).mean()),
+                       board_untrusted_share=float(1.0 - judges(at_stop, loosening(tolerance, tolerances)).mean()),
                        board_dropped_share=float((at_stop["board_n_dropped"] > 0).mean()),
                        board_sigma_t_mm=float(at_stop["board_sigma_t_mm"].median()),
                        E_t_at_end=float(at_stop["E_t_mm"].mean()),
@@ -87,12 +87,6 @@ def envelope_causes(table: pd.DataFrame, tolerances: list[tuple[float, float]], 
                                                                               criteria, bounds, same_frames, row, bar)
             rows.append(row)
     return pd.DataFrame(rows, columns=COLUMNS)
-
-
-def _untrusted(frames: pd.DataFrame, k: np.ndarray) -> np.ndarray:
-    """Which frames' board pose cannot judge a tolerance ``k`` times the tightest (:func:`~.envelope.judges`)."""
-    untrusted = (frames["board_status"] != "ok").to_numpy()
-    return untrusted & ~judges(frames, k) if set(TRUTH_SCALES) <= set(frames.columns) else untrusted
 
 
 def _exact_where_truth(frames: pd.DataFrame) -> pd.DataFrame:

@@ -70,7 +70,7 @@ def truth_accuracy(table: pd.DataFrame, tolerances: list[tuple[float, float]] = 
         k = loosening(tolerance, tolerances)
         if np.all(k == 1.0) or not set(TRUTH_SCALES) <= set(frames.columns):
             continue
-        judging = frames[(frames["board_status"] == "ok").to_numpy() | judges(frames, k)]
+        judging = frames[judges(frames, k)]
         p99 = [float(judging[c].dropna().quantile(0.99)) if judging[c].notna().any() else float("nan")
                for c in ("E_t_truth_mm", "E_r_truth_deg")]
         bar = (float(k[0] * R11_BAR[0]), float(k[1] * R11_BAR[1]))
