@@ -76,7 +76,7 @@ def envelope_causes(table: pd.DataFrame, tolerances: list[tuple[float, float]], 
                        n_inliers_at_theta_a=float(np.interp(theta_a, theta, n_inliers)) if np.isfinite(theta_a)
                        else float("nan"),
                        unmeasured_stops=int(np.isnan(criteria[: failing + 1, :2]).all(axis=1).sum()),
-                       board_untrusted_share=float(1.0 - judges(at_stop, loosening(tolerance, tolerances)).mean()),
+                       board_untrusted_share=float((~judges(at_stop, loosening(tolerance, tolerances))).mean()),
                        board_dropped_share=float((at_stop["board_n_dropped"] > 0).mean()),
                        board_sigma_t_mm=float(at_stop["board_sigma_t_mm"].median()),
                        E_t_at_end=float(at_stop["E_t_mm"].mean()),
