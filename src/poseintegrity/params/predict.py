@@ -49,6 +49,15 @@ class UncertaintyParams(Section):
     n_bootstrap: int = Field(ge=2, le=10_000, description="bootstrap refits per dataset (method bootstrap)")
 
 
+class HeadlineIntervalParams(Section):
+    """Ours (issue 49): the interval of every headline (max mean SPL at zero incursion, its gain over static, its share
+    of the ceiling), from a scene-clustered bootstrap that chooses the operating point again in each draw
+    (prediction/intervals.py)."""
+
+    n_draws: int = Field(ge=100, le=GRID, description="bootstrap draws (scenes resampled with replacement), e.g. 2000")
+    level: float = Field(gt=0, lt=1, description="two-sided coverage of the percentile interval, e.g. 0.9: 5-95 %")
+
+
 class ErrorPredictorParams(Section):
     """Ours (issue 38): the predictors that stop where k x the predicted localization error reaches the tolerance
     (prediction/error_predictors.py). The operating point is the safety factor k, swept geometrically."""
@@ -101,6 +110,7 @@ class PredictParams(Section):
         " choice; first = headline"
     )
     uncertainty: UncertaintyParams
+    intervals: HeadlineIntervalParams
     error: ErrorPredictorParams
     tail_n_t_max: int = Field(
         ge=1, le=GRID, description="the tail diagnosis: an arc whose long range theta_p exceeds theta_a at every swept n_t up"

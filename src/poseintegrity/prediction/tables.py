@@ -17,6 +17,7 @@ import pandas as pd
 from poseintegrity.artifact_models import FIT_STATUSES
 from poseintegrity.artifact_models.fitted import OK
 from poseintegrity.prediction.ceiling import ceiling, ceiling_share
+from poseintegrity.prediction.intervals import INTERVAL_METHOD, live_intervals, world_intervals
 from poseintegrity.prediction.loso import loso_summary
 from poseintegrity.prediction.metrics import (best_operating_point, operating_curves, relative_improvement,
                                                with_metrics)
@@ -28,6 +29,7 @@ from poseintegrity.prediction.sweeps import (
 )
 from poseintegrity.prediction.tails import tail_metrics
 from poseintegrity.protocol import FAILED_FRAME_RULES, ProtocolParams
+from poseintegrity.seeding import keyed_rng
 
 
 def best_table(curves: pd.DataFrame, max_incursion_rate: float = 0.0) -> pd.DataFrame:
@@ -126,6 +128,12 @@ def table_metrics(table: pd.DataFrame, curves: pd.DataFrame, predict: PredictPar
     beside the paper's keys: <free-width predictor> as the others, with relative_improvement_vs_<its eq. 1
     counterpart>; tails.<long_range | long_range_free_width>.<tolerance>.{n_overshooting, datasets}
     (:func:`.tails.tail_metrics`). NaN where there is no value (written as null).
+
+    Ours (issue 49), beside every predictor's headline: ``gain`` (SPL - static SPL, deg), ``relative_gain`` (as Tables
+    I-II), and ``interval`` (:func:`.intervals.headline_intervals`: bootstrap intervals of the SPL, the gains and the
+    ceiling share with the operating point chosen again in each draw, leave-one-arc-out ranges); ``intervals``: how
+    they were drawn and, per tolerance, the arcs and scenes behind them and the paired differences of the predictors;
+    ``straight_line.interval`` and ``pnp.<method>.interval`` the long range predictor's on the lines and each method.
     """
     best = best_table(curves)
 
@@ -137,15 +145,28 @@ def table_metrics(table: pd.DataFrame, curves: pd.DataFrame, predict: PredictPar
     tolerances = sorted(table["tolerance"].unique())
     static_mean = float(np.mean([get("static", "arc", t)[0] for t in tolerances]))
     limits = ceiling(table, best, protocol.pnp_method, tolerances)
-    metrics: dict = {"ceiling": limits}
-    for predictor in (*PAPER_PREDICTORS, "long_range_lower", *RELATIVE_PREDICTORS, *FREE_WIDTH_PREDICTORS,
-                      *ERROR_PREDICTORS):
+    predictors = (*PAPER_PREDICTORS, "long_range_lower", *RELATIVE_PREDICTORS, *FREE_WIDTH_PREDICTORS,
+                  *ERROR_PREDICTORS)
+    draws = predict.intervals
+
+    def spread(predictors: tuple[str, ...], method: str, trajectory: str, tolerances: list[str]) -> dict:
+        return world_intervals(table, predictors, tolerances, method, trajectory, draws.n_draws, draws.level,
+                               predict.seed)
+
+    arcs = spread(predictors, protocol.pnp_method, "arc", tolerances)
+    metrics: dict = {"ceiling": limits, "intervals": {
+        "method": INTERVAL_METHOD, "n_draws": draws.n_draws, "level": draws.level,
+        **{t: {k: arcs[t].get(k) for k in ("n_arcs", "n_scenes", "pairs")} for t in tolerances}}}
+    for predictor in predictors:
         point_key = OPERATING_POINT_KEY.get(predictor, "best_n_t")
         entry: dict = {}
         for tolerance in tolerances:
             spl, point = get(predictor, "arc", tolerance)
+            static = get("static", "arc", tolerance)[0]
             entry[tolerance] = {"max_mean_spl_zero_incursion": spl, point_key: point,
-                                "ceiling_share": ceiling_share(spl, limits[tolerance])}
+                                "ceiling_share": ceiling_share(spl, limits[tolerance]), "gain": spl - static,
+                                "relative_gain": relative_improvement(spl, static),
+                                "interval": arcs[tolerance].get(predictor, {})}
             if predictor in (*PAPER_PREDICTORS, *ERROR_PREDICTORS):
                 entry[tolerance]["decided_by"] = deciding_datasets(table, predictor, protocol.pnp_method, "arc",
                                                                    tolerance, point)
@@ -173,6 +194,8 @@ def table_metrics(table: pd.DataFrame, curves: pd.DataFrame, predict: PredictPar
         "static_max_mean_spl_zero_incursion": get("static", "line", tol)[0],
         "relative_improvement": relative_improvement(get("long_range", "line", tol)[0], get("static", "line", tol)[0]),
     }
+    lines = spread(("static", "long_range", "error_long_range"), protocol.pnp_method, "line", [tol])[tol]
+    metrics["straight_line"] |= {"n_lines": lines["n_arcs"], "interval": lines.get("long_range", {})}
     metrics["pnp"] = {
         str(method): {
             "tolerance": tol,
@@ -180,6 +203,8 @@ def table_metrics(table: pd.DataFrame, curves: pd.DataFrame, predict: PredictPar
             "best_n_t": get("long_range", "arc", tol, method)[1],
             "error_long_range_max_mean_spl_zero_incursion": get("error_long_range", "arc", tol, method)[0],
             "static_max_mean_spl_zero_incursion": get("static", "arc", tol, method)[0],
+            "interval": spread(("static", "long_range", "error_long_range"), str(method), "arc",
+                               [tol])[tol].get("long_range", {}),
         }
         for method in sorted(table["method"].unique())
     }
@@ -196,7 +221,8 @@ def headline_metrics(
     loso.<predictor>.<tolerance>.{heldout_incursion_rate, heldout_mean_spl, ceiling_share, ...} at the first target
     rate (the held-out mean SPL's share of the world's ceiling); live.{n_t, incursions, n_trials, envelope_share,
     n_flagged_fits, static_*} (V-C), and live.error_next_step.{k, incursions, n_trials, envelope_share,
-    n_flagged_fits} for ``error_live`` (:func:`live_trials` of "error_next_step" at ``error_live_k``, ours)."""
+    n_flagged_fits} for ``error_live`` (:func:`live_trials` of "error_next_step" at ``error_live_k``, ours); each with
+    ``interval``, the live trials resampled by scene (:func:`.intervals.live_intervals`, ours)."""
     metrics = table_metrics(table, curves, predict, protocol)
     metrics["loso"] = loso_summary(loso, predict.loso_target_rates[0])
     for entry in metrics["loso"].values():
@@ -208,8 +234,17 @@ def headline_metrics(
         "static_incursions": float(live["static_incursion"].sum()),
         "static_envelope_share": float(live["static_share"].mean()),
     }  # fmt: skip
+    live_rows = table[(table["trajectory"] == "arc") & (table["method"] == protocol.pnp_method)
+                      & (table["tolerance"] == predict.live_tolerance)]
+
+    def live_spread(predictor: str, point: float) -> dict:  # ours (issue 49): resampled by scene
+        return live_intervals(live_rows, predictor, point, predict.intervals.n_draws, predict.intervals.level,
+                              keyed_rng(predict.seed, "live intervals", predictor))
+
+    metrics["live"]["interval"] = live_spread("next_step", predict.live_n_t)
     if error_live is not None:
-        metrics["live"]["error_next_step"] = {"k": float(error_live_k), **_live_figures(error_live)}
+        metrics["live"]["error_next_step"] = {"k": float(error_live_k), **_live_figures(error_live),
+                                              "interval": live_spread("error_next_step", error_live_k)}
     return metrics
 
 
