@@ -235,6 +235,10 @@ class EvaluationParams(Section):
     multi_tool_frames: int = Field(ge=1, le=FRAMES_MAX)  # frames of the two-tool and phantom-rich runs
     phantom_rich_max: int = Field(ge=0, le=1000)  # phantoms per frame (binomial, p_phantom) in the phantom-rich scene
     second_tool: list[MarkerPoint]  # m; checked against markers_body (TrackParams)
+    # ours (issue 49): intervals of the headline rates and errors, blocks of the recording resampled with replacement
+    interval_draws: int = Field(ge=100, le=100_000)
+    interval_level: float = Field(gt=0, lt=1)  # two-sided, e.g. 0.9: the 5-95 % of the draws
+    interval_block_s: float = Field(gt=0, le=600)  # s: frames this close share a motion, an occlusion, a phantom
 
 
 class TrackParams(Section):

@@ -26,13 +26,14 @@ from poseintegrity.params.track import TrackParams
 from poseintegrity.tracking.experiments.peers import filter_speed, pykalman_time_update
 from poseintegrity.tracking.experiments.filter_runs import experiment_rng, study_filter_runs, run_filter_task
 from poseintegrity.tracking.experiments.accuracy import (
-    accuracy_recording, accuracy_and_occlusion, noise_against_lag, published_against_our_sigmas,
+    accuracy_frames, accuracy_recording, accuracy_and_occlusion, noise_against_lag, published_against_our_sigmas,
 )
 from poseintegrity.tracking.experiments.success import (
     SuccessRun, success_runs, success_recording, success_rates, two_tools_success,
 )
 from poseintegrity.tracking.experiments.robustness import ten_metre_jump, recording_replay
 from poseintegrity.tracking.experiments.timing import timing_table
+from poseintegrity.tracking.experiments.intervals import rate_interval, rms_interval
 
 
 @dataclass(frozen=True)
@@ -87,6 +88,15 @@ def run_study(params: TrackParams, recording_folder: Path, workers: Workers) -> 
     geometry = np.array(params.markers_body)
     speed = filter_speed(geometry, params.filter, ev.timing_repeats, experiment_rng(params, "speed"))
     rate = dict(zip(success.run, success.rate))
+    ukf = tables["ukf"]
+    ukf_rows = ukf[(ukf.kind == "frame") & ukf.frame.isin(accuracy_frames(no_filter))]
+    intervals = {  # ours (issue 49): the headline rates and errors, blocks of their recording resampled
+        "success_rates": {run: rate_interval(success_frames[f"success_{run}"], params, run)
+                          for run in ("a_markers4", "a_markers3", "b_markers4", "b_markers3")},
+        "rms_axis_mm": {"ukf": rms_interval(ukf_rows, "axis_mm", params, "ukf axis_mm")},
+        "rms_euler_deg": {"ukf": rms_interval(ukf_rows, "euler_deg", params, "ukf euler_deg")},
+        "block_s": params.evaluation.interval_block_s, "level": params.evaluation.interval_level,
+        "n_draws": params.evaluation.interval_draws}
     metrics = {
         **accuracy,
         "rms_mm": {run: v["norm_mm"] for run, v in accuracy["rms"].items()},
@@ -97,6 +107,7 @@ def run_study(params: TrackParams, recording_folder: Path, workers: Workers) -> 
         "success_rate": {"markers4": rate["a_markers4"], "markers3": rate["a_markers3"]},
         "success_rates": rate,
         "success_possible": dict(zip(success.run, success.possible)),
+        "intervals": intervals,
         "sigmas_motion_a": sigma_metrics,
         "small_blobs": sweep_summary(blobs),
         "multi_tool_success": multi_tool.groupby(["scene", "tool"]).correct.mean().unstack().to_dict(orient="index"),
