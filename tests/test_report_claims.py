@@ -9,7 +9,7 @@ import re
 import pytest
 
 from poseintegrity import paper_results as paper
-from poseintegrity.report.claims import RULE, TITLE, gain_grade, level_grade
+from poseintegrity.report.claims import RULE, TITLE, interval_grade
 from poseintegrity.report.headline_file import HEADLINE_FILE, headline_metrics
 from poseintegrity.report.summary import read_metrics, render_summary
 from repository import ROOT
@@ -40,9 +40,25 @@ def with_issue_38(metrics: dict) -> dict:
     return metrics
 
 
-def before_issue_38(metrics: dict) -> dict:
-    """The metrics as a run before issue 38 wrote them: no ceiling, no shares, no error predictors."""
+def before_issue_49(metrics: dict) -> dict:
+    """The metrics as a run before issue 49 wrote them: no interval anywhere (every verdict then undecided)."""
     metrics = copy.deepcopy(metrics)
+    for stage in ("predictors", "validation", "tracking"):
+        table = metrics[stage]
+        table.pop("intervals", None)
+        for entry in table.values():
+            if isinstance(entry, dict):
+                entry.pop("interval", None)
+                for value in entry.values():
+                    if isinstance(value, dict) and "max_mean_spl_zero_incursion" in value:  # a predictor's entry
+                        for key in ("interval", "gain", "relative_gain"):
+                            value.pop(key, None)
+    return metrics
+
+
+def before_issue_38(metrics: dict) -> dict:
+    """The metrics as a run before issue 38 wrote them: no ceiling, no shares, no error predictors (no intervals)."""
+    metrics = before_issue_49(metrics)
     for stage in ("predictors", "validation"):
         table = metrics[stage]
         for key in ("ceiling", *OURS):
@@ -55,7 +71,8 @@ def before_issue_38(metrics: dict) -> dict:
 
 
 OLD = before_issue_38(COMMITTED)
-FIXTURES = {"committed": COMMITTED, "before issue 38": OLD, "issue 38": with_issue_38(OLD)}
+FIXTURES = {"committed": COMMITTED, "before issue 49": before_issue_49(COMMITTED), "before issue 38": OLD,
+            "issue 38": with_issue_38(OLD)}
 
 
 def section(summary: str) -> list[str]:
@@ -100,12 +117,29 @@ def assert_shows(cell: str, values: list, where: str):
 
 def verdict(grades: list[int]) -> str:
     """The rule as the section states it: the weakest world decides; no world, not applicable."""
-    return ("reproduced", "direction only", "not reproduced")[max(grades)] if grades else "not applicable"
+    return ("reproduced", "undecided", "not reproduced")[max(grades)] if grades else "not applicable"
 
 
-def grade(gain, margin: float) -> int:
-    """One world, by the rule's words: its way by >= half the paper's margin; its way by less; not its way / none."""
-    return 2 if gain is None or gain <= 0 else 0 if gain >= margin / 2 else 1
+def grade(interval) -> int:
+    """One world, by the rule's words: the interval of our gain above zero; below zero or none; else (it holds zero,
+    or there is none) undecided."""
+    if not isinstance(interval, list):
+        return 1
+    low, high = interval
+    return 2 if high is None or high < 0 else 0 if low is not None and low > 0 else 1
+
+
+def level(interval, theirs: float, higher_is_better: bool) -> int:
+    """A rate's or an error's grade: the interval of ours minus the paper's (theirs minus ours for an error)."""
+    if not isinstance(interval, list) or None in interval:
+        return 1
+    return grade(sorted(end - theirs if higher_is_better else theirs - end for end in interval))
+
+
+def ends(entry: dict, key: str) -> list:
+    """An interval's two ends as a cell shows them (None: "none", not a number), nothing when the metrics hold none."""
+    interval = entry.get("interval", {}).get(key) if isinstance(entry, dict) else None
+    return list(interval) if isinstance(interval, list) else []
 
 
 def expectations(m: dict) -> dict[str, tuple[list[list], list, str]]:
@@ -128,59 +162,78 @@ def expectations(m: dict) -> dict[str, tuple[list[list], list, str]]:
         for t in TOLERANCES:
             entries = [get(m, s, f"{predictor}.{t}") for s, _ in WORLDS]
             statics = [get(m, s, f"static.{t}.max_mean_spl_zero_incursion") for s, _ in WORLDS]
-            cells = [[e["max_mean_spl_zero_incursion"], st, e["best_n_t"], share(s, predictor, t)]
+            cells = [[e["max_mean_spl_zero_incursion"], st, e.get("gain"), *ends(e, "gain"), e.get("relative_gain"),
+                      e["best_n_t"], share(s, predictor, t), *ends(e, "ceiling_share")]
                      for e, st, (s, _) in zip(entries, statics, WORLDS)]
-            margin = spl[predictor][t] / spl["static"][t] - 1
-            spls = [e["max_mean_spl_zero_incursion"] for e in entries]
-            grades = [grade(None if s is None else s / st - 1, margin) for s, st in zip(spls, statics)]
+            grades = [2 if e["max_mean_spl_zero_incursion"] is None else grade(e.get("interval", {}).get("gain"))
+                      for e in entries]
             w = weakest(grades)
-            arc = entries[w]["decided_by"][0]
+            arcs, static_arcs = entries[w]["decided_by"], get(m, WORLDS[w][0], f"static.{t}.decided_by")
             cause = next(c for c in get(m, "artifacts", f"{WORLDS[w][1]}envelope_causes")
-                         if c["dataset"] == arc and c["tolerance"] == t)
+                         if c["dataset"] == arcs[0] and c["tolerance"] == t)
             out[f"{name} over static, {paper.TOLERANCE_LABELS[t]}"] = (
-                cells, [entries[w]["best_n_t"], cause["theta_a"]], verdict(grades))
-    gains = [get(m, s, "long_range.relative_improvement_vs_mlp") for s, _ in WORLDS]
-    grades = [grade(g, paper.WINDSOR_IMPROVEMENTS["long_range_vs_mlp"]) for g in gains]
+                cells, [len(arcs), get(m, WORLDS[w][0], f"ceiling.{t}.n_arcs") if "ceiling" in m[WORLDS[w][0]] else None,
+                        entries[w]["best_n_t"], cause["theta_a"], len(static_arcs)], verdict(grades))
+    pair = "long_range vs mlp"
+    pairs = [[get(m, s, "intervals")[t]["pairs"][pair] if "intervals" in m[s] else {} for t in TOLERANCES]
+             for s, _ in WORLDS]
+    grades = [max(grade(p.get("difference")) for p in world) for world in pairs]
+    w = weakest(grades)
     out["MLP"] = ([[get(m, s, f"mlp.{t}.max_mean_spl_zero_incursion") for t in TOLERANCES]
-                   + [share(s, "mlp", t) for t in TOLERANCES] + [g] for (s, _), g in zip(WORLDS, gains)],
-                  [get(m, WORLDS[weakest(grades)][0], "fit_status.mlp.non_physical")], verdict(grades))
+                   + [x for t in TOLERANCES for x in (share(s, "mlp", t), *ends(get(m, s, f"mlp.{t}"), "ceiling_share"))]
+                   + [get(m, s, "long_range.relative_improvement_vs_mlp")]
+                   + [x for p in world for x in (p.get("point"), *p.get("difference", []))]
+                   for (s, _), world in zip(WORLDS, pairs)],
+                  [get(m, WORLDS[w][0], "fit_status.mlp.non_physical")]
+                  + [x for t in TOLERANCES for x in (*(len(get(m, WORLDS[w][0], f"{p}.{t}.decided_by"))
+                                                       for p in ("long_range", "mlp")),
+                                                     get(m, WORLDS[w][0], f"ceiling.{t}.n_arcs")
+                                                     if "ceiling" in m[WORLDS[w][0]] else None)], verdict(grades))
     for predictor in OURS:
         if predictor in m["predictors"]:
             out[f"ours: {OURS_NAMES.get(predictor, predictor.replace('_', ' '))}"] = (
                 [[x for t in TOLERANCES for x in (get(m, s, f"{predictor}.{t}.max_mean_spl_zero_incursion"),
-                                                   get(m, s, f"{predictor}.{t}.best_k"), share(s, predictor, t))]
+                                                   get(m, s, f"{predictor}.{t}.best_k"), share(s, predictor, t),
+                                                   *ends(get(m, s, f"{predictor}.{t}"), "ceiling_share"))]
                  for s, _ in WORLDS], [], "-")
     lines = [get(m, s, "straight_line") for s, _ in WORLDS]
-    margin = paper.WINDSOR_IMPROVEMENTS["straight_line_vs_static"]
-    grades = [grade(line["relative_improvement"], margin) for line in lines]
+    grades = [2 if line["long_range_max_mean_spl_zero_incursion"] is None else grade(line.get("interval", {}).get("gain"))
+              for line in lines]
     r8 = f"{WORLDS[weakest(grades)][1]}realism.line_x_a_mean_over_min_2mm3deg"
     out["straight lines"] = ([[line["relative_improvement"], line["long_range_max_mean_spl_zero_incursion"],
-                               line["static_max_mean_spl_zero_incursion"]] for line in lines],
-                             [get(m, "artifacts", r8)], verdict(grades))
+                               line["static_max_mean_spl_zero_incursion"], *ends(line, "gain")] for line in lines],
+                             [lines[weakest(grades)].get("n_lines"), get(m, "artifacts", r8)], verdict(grades))
     variants = ("epnp", "p3p", "ap3p")
     pnp = [[get(m, s, f"pnp.{v}") for v in variants] for s, _ in WORLDS]
-    grades = [max(grade(e["max_mean_spl_zero_incursion"] / e["static_max_mean_spl_zero_incursion"] - 1, 0.0)
+    grades = [max(2 if e["max_mean_spl_zero_incursion"] is None else grade(e.get("interval", {}).get("gain"))
                   for e in entries) for entries in pnp]
     out["PnP variants"] = ([[x for e in entries
-                             for x in (e["max_mean_spl_zero_incursion"], e["static_max_mean_spl_zero_incursion"])]
+                             for x in (e["max_mean_spl_zero_incursion"], e["static_max_mean_spl_zero_incursion"],
+                                       *ends(e, "gain"))]
                             for entries in pnp],
                            [get(m, "pnp", f"{WORLDS[weakest(grades)][1]}methods.{v}.failure_rate")
                             for v in ("usac_magsac", *variants)], verdict(grades))
     live = m["predictors"]["live"]  # the main world's only: validation.json has none
-    margin = paper.WINDSOR_LIVE["envelope_share"] / paper.WINDSOR_LIVE["static_envelope_share"] - 1
-    grades = [2 if live["incursions"] else grade(live["envelope_share"] / live["static_envelope_share"] - 1, margin)]
+    grades = [2 if live["incursions"] else grade(live.get("interval", {}).get("envelope_share_gain"))]
     out["live trials"] = ([[live["n_t"], live["incursions"], live["n_trials"], live["envelope_share"],
-                            live["static_envelope_share"]], []],
-                          [m["predictors"]["next_step"][live["tolerance"]]["best_n_t"]], verdict(grades))
+                            live["static_envelope_share"], *ends(live, "envelope_share_gain")], []],
+                          [m["predictors"]["next_step"][live["tolerance"]]["best_n_t"],
+                           len(m["predictors"]["static"][live["tolerance"]]["decided_by"]),
+                           m["predictors"]["ceiling"][live["tolerance"]]["n_arcs"] if "ceiling" in m["predictors"]
+                           else None], verdict(grades))
     rates, black = m["tracking"]["success_rates"], paper.BLACK_RESULTS
+    intervals = m["tracking"].get("intervals", {})
     for n in (4, 3):
-        reached = rates[f"a_markers{n}"] >= black["success_rate"][f"markers{n}"]
-        out[f"correct pose, {n} markers"] = ([[rates[f"a_markers{n}"]], []], [rates[f"b_markers{n}"]],
-                                             verdict([0 if reached else 2]))
+        interval = intervals.get("success_rates", {}).get(f"a_markers{n}")
+        out[f"correct pose, {n} markers"] = ([[rates[f"a_markers{n}"], *(interval or [])], []], [rates[f"b_markers{n}"]],
+                                             verdict([level(interval, black["success_rate"][f"markers{n}"], True)]))
     mm, deg = m["tracking"]["rms_axis_mm"], m["tracking"]["rms_euler_deg"]
-    out["accuracy"] = ([[mm["ukf"], deg["ukf"]], []], [mm["no_filter"], deg["no_filter"]],
-                       verdict([0 if mm["ukf"] <= black["rms_mm"]["ukf"] and deg["ukf"] <= black["rms_deg"]["ukf"]
-                                else 2]))
+    mm_interval = intervals.get("rms_axis_mm", {}).get("ukf")
+    deg_interval = intervals.get("rms_euler_deg", {}).get("ukf")
+    out["accuracy"] = ([[mm["ukf"], *(mm_interval or []), deg["ukf"], *(deg_interval or [])], []],
+                       [mm["no_filter"], deg["no_filter"]],
+                       verdict([max(level(mm_interval, black["rms_mm"]["ukf"], False),
+                                    level(deg_interval, black["rms_deg"]["ukf"], False))]))
     return out
 
 
@@ -214,13 +267,33 @@ def test_a_run_without_the_ceiling_says_so():
 
 
 def test_the_rule_word_for_word():
-    """Each verdict word of the rule, at its bounds (a margin of 0.76: half is 0.38)."""
-    assert [gain_grade(g, 0.76) for g in (0.38, 0.3799, 1e-9, 0.0, -0.2, None)] == [0, 1, 1, 2, 2, 2]
-    assert gain_grade(1e-9, 0.0) == 0  # no published margin (Fig. 6): its way at all is enough
-    assert [level_grade(v, 0.9863, higher_is_better=True) for v in (0.9863, 0.99, 0.98, None)] == [0, 0, 2, 2]
-    assert [level_grade(v, 1.77, higher_is_better=False) for v in (1.77, 1.1, 1.8)] == [0, 0, 2]
-    for word in ("*reproduced*", "*direction only*", "*not reproduced*", "*not applicable*", "weakest world"):
+    """Each verdict word of the rule, at its bounds: the interval of our gain, not its point value, decides."""
+    cases = ([0.1, 2.0], [1e-9, 0.5], [0.0, 2.0], [-1.0, 2.0], [None, 2.0], [-2.0, -0.1], [-2.0, 0.0], [None, None],
+             None, [1.0])
+    assert [interval_grade(c) for c in cases] == [0, 0, 1, 1, 1, 2, 1, 2, 1, 1]
+    for word in ("*reproduced*", "*undecided*", "*not reproduced*", "*not applicable*", "weakest world", "interval"):
         assert word in RULE
+
+
+def test_a_planted_table_whose_verdict_the_interval_flips():
+    """The same point values, two intervals: a gain whose interval clears zero is reproduced, the same gain whose
+    interval holds zero is undecided; the point value never decides."""
+    metrics = copy.deepcopy(COMMITTED)
+    for stage in ("predictors", "validation"):
+        entry = metrics[stage]["long_range"]["2mm_3deg"]
+        entry["max_mean_spl_zero_incursion"], entry["gain"] = 20.0, 7.0
+        entry["interval"] = dict(entry.get("interval", {}), gain=[0.4, 9.0])
+    row = next(cells for claim, cells in table(render_summary(metrics, [])).items()
+               if claim.startswith("long range over static, 2 mm/3 deg"))
+    assert row[-2] == "reproduced"
+    metrics["validation"]["long_range"]["2mm_3deg"]["interval"]["gain"] = [-0.4, 9.0]  # one world's interval holds zero
+    row = next(cells for claim, cells in table(render_summary(metrics, [])).items()
+               if claim.startswith("long range over static, 2 mm/3 deg"))
+    assert row[-2] == "undecided"
+    metrics["validation"]["long_range"]["2mm_3deg"]["interval"]["gain"] = [-3.0, -0.5]  # below zero
+    row = next(cells for claim, cells in table(render_summary(metrics, [])).items()
+               if claim.startswith("long range over static, 2 mm/3 deg"))
+    assert row[-2] == "not reproduced"
 
 
 def test_nothing_run_is_not_run_and_no_world_is_not_applicable():
@@ -247,16 +320,21 @@ def test_the_first_section_is_one_screen_before_any_stage_table(metrics):
 
 
 def test_the_headline_file_holds_the_headline_of_each_world():
-    """headline.json (what DVC shows): per world and tolerance the paper's four predictors and their ceiling shares,
-    issue 38's under ``ours``, R11 and the tracking success rates; a few dozen values; the committed one is stage 07's
-    from the committed metrics."""
+    """headline.json (what DVC shows): per world and tolerance the paper's four predictors and their ceiling shares
+    with their intervals, issue 38's shares under ``ours``, R11 and the tracking success rates; at most ~120 values;
+    the committed one is stage 07's from the committed metrics."""
     full = headline_metrics(FIXTURES["issue 38"])
     assert list(full) == ["main", "validation", "tracking"]
     main = full["main"]["2mm_3deg"]
     assert main["long_range"] == COMMITTED["predictors"]["long_range"]["2mm_3deg"]["max_mean_spl_zero_incursion"]
     assert main["long_range_ceiling_share"] == FIXTURES["issue 38"]["predictors"]["long_range"]["2mm_3deg"][
         "ceiling_share"] and "static_ceiling_share" not in main
-    assert full["validation"]["ours"]["4mm_10deg"]["error_combined"] == 17.0 + OURS.index("error_combined") + 1 + 1
+    assert full["validation"]["ours"]["4mm_10deg"]["error_combined_ceiling_share"] == pytest.approx(
+        0.55 + 0.01 * OURS.index("error_combined") - 0.1)  # ours: the shares alone (their SPLs stay detailed)
+    assert "error_combined" not in full["validation"]["ours"]["4mm_10deg"]
+    shares = headline_metrics(COMMITTED)["main"]["2mm_3deg"]
+    assert [shares["long_range_ceiling_share_low"], shares["long_range_ceiling_share_high"]] == COMMITTED[
+        "predictors"]["long_range"]["2mm_3deg"]["interval"]["ceiling_share"]  # each share's interval: two values
     assert full["validation"]["r11_p99_E_t_mm"] == COMMITTED["artifacts"]["worlds"]["validation"]["realism"][
         "truth_accuracy"]["p99_E_t_truth_mm"]
     assert full["tracking"]["a_markers3"] == COMMITTED["tracking"]["success_rates"]["a_markers3"]
@@ -264,7 +342,7 @@ def test_the_headline_file_holds_the_headline_of_each_world():
     def count(block):
         return sum(count(v) if isinstance(v, dict) else 1 for v in block.values())
 
-    assert 24 <= count(headline_metrics(COMMITTED)) <= count(full) <= 72
+    assert 24 <= count(full) <= count(headline_metrics(COMMITTED)) <= 120  # what `dvc metrics diff` can show
     committed = json.loads((ROOT / "reports" / "metrics" / HEADLINE_FILE).read_text())
     assert committed == json.loads(json.dumps(headline_metrics(COMMITTED)))
     recorded = headline_metrics(RECORDED)

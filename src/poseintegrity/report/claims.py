@@ -10,8 +10,8 @@ incursion, and the static baseline reaches about the smallest theta_a, so mean /
 of predictors.json and validation.json) bounds any predictor's gain over static; (SPL - static SPL) / (mean theta_a -
 static SPL) (``<predictor>.<tolerance>.ceiling_share``) is the share of it a predictor reaches.
 
-The verdict compares ours on each world with the paper's margin (:func:`gain_grade`, :func:`level_grade`); the
-weakest world decides. The paper's margins are read from :mod:`poseintegrity.paper_results`.
+The verdict reads the interval of our gain over each claim's baseline on each world (:func:`interval_grade`; issue 49:
+a point value over 21 arcs moves by tens of points with one arc); the weakest world decides. The paper's margins are read from :mod:`poseintegrity.paper_results`.
 """
 
 from __future__ import annotations
@@ -28,12 +28,15 @@ from poseintegrity.report.recorded import recorded_source
 from poseintegrity.worlds import FIRST, world_order
 
 TITLE = "What held, where, and by how much"
-VERDICTS = ("reproduced", "direction only", "not reproduced")  # grades 0, 1, 2 of one world
-NOT_APPLICABLE, UNMEASURED = "not applicable", "no world here measured it"
-RULE = ("**Verdict**, one per claim, the weakest world deciding: *reproduced*: ours goes the paper's way by at least "
-        "half the paper's margin (a gain over the claim's baseline; for a rate or an error: at least as good as the "
-        "paper's); *direction only*: its way, by less; *not reproduced*: not its way, or no operating point at zero "
-        "incursion (none); *not applicable*: no world here measures it. Rows marked ours are no claim of the "
+VERDICTS = ("reproduced", "undecided", "not reproduced")  # grades 0, 1, 2 of one world
+NOT_APPLICABLE, UNMEASURED = "not applicable", "no world here measures it"
+RULE = ("**Verdict**, one per claim, the weakest world deciding, read from the 90 % interval of our gain over the "
+        "claim's baseline (static, the MLP, or the paper's own rate or error), never from its point value. The "
+        "interval resamples what the result rests on: the scenes with replacement, the operating point chosen again "
+        "at zero incursion in each draw (`predict.intervals`); the tracking's 5-s blocks of frames (`track.evaluation`). *reproduced*: the "
+        "interval lies above zero, on the paper's side; *undecided*: it holds zero, so these data cannot tell; *not "
+        "reproduced*: it lies below zero, or there is no operating point at zero incursion; *not applicable*: no world "
+        "here measures it. A world whose metrics hold no interval is undecided. Rows marked ours are no claim of the "
         "papers: no verdict.")
 SPL, SHARE, RATE = "{:.1f}", "{:.0%}", "{:.2%}"
 NAMES = {"static": "static", "long_range": "long range", "next_step": "next step", "mlp": "MLP",
@@ -77,32 +80,22 @@ class Row:
     link: str
 
 
-def gain_grade(gain: float | None, margin: float) -> int:
-    """One world's grade (index into :data:`VERDICTS`) of a claim that a predictor gains ``margin`` (the paper's,
-    relative) over its baseline: 0 for at least half of it, 1 for less, 2 for none (``gain`` <= 0 or None)."""
-    if gain is None or gain <= 0:
+def interval_grade(interval) -> int:
+    """One world's grade (index into :data:`VERDICTS`) of a claim by the interval [low, high] of our gain over its
+    baseline (None at an end: no operating point there, lower than any gain): 0 when the low end lies above zero, 2
+    when the high end lies below zero or is None (no operating point in most draws), 1 otherwise (the interval holds
+    zero, or there is no interval)."""
+    if not isinstance(interval, (list, tuple)) or len(interval) != 2:
+        return 1
+    low, high = interval
+    if high is None or high < 0:
         return 2
-    return 0 if gain >= margin / 2 else 1
-
-
-def level_grade(ours: float | None, theirs: float, higher_is_better: bool) -> int:
-    """One world's grade of a claim that a rate (``higher_is_better``) or an error reaches the paper's value ``theirs``:
-    0 for at least as good, 2 otherwise."""
-    if ours is None:
-        return 2
-    return 0 if (ours >= theirs if higher_is_better else ours <= theirs) else 2
+    return 0 if low is not None and low > 0 else 1
 
 
 def verdict(grades: list[int]) -> str:
     """The claim's word: the weakest of its worlds' grades; :data:`NOT_APPLICABLE` when no world measured it."""
     return VERDICTS[max(grades)] if grades else NOT_APPLICABLE
-
-
-def _gain(ours, baseline) -> float | None:
-    """ours / baseline - 1 (for the verdict only, never shown); None when ours is None (no operating point)."""
-    if ours is None:
-        return None
-    return float("inf") if baseline is None or baseline <= 0 else ours / baseline - 1
 
 
 def anchor(title: str) -> str:
@@ -128,12 +121,26 @@ class Reader:
             return "none"
         return fmt.format(value) if isinstance(value, (int, float)) and not isinstance(value, bool) else str(value)
 
+    def interval(self, stage: str, key: str, fmt: str = SPL) -> str:
+        """An interval [low, high] as "[low, high]" (an end without an operating point: "none"); "" when absent."""
+        value = lookup(self.metrics, stage, key)
+        if not isinstance(value, (list, tuple)) or len(value) != 2:
+            return ""
+        return "[" + ", ".join("none" if end is None else fmt.format(end) for end in value) + "]"
+
     def share(self, stage: str, *entries: str) -> str:
-        """The predictor's share of the ceiling at each of ``entries`` (``<predictor>.<tolerance>``), e.g. "22% of
-        ceiling" or "9% · 10% of ceiling"; "ceiling share not measured" when the metrics hold none of them."""
+        """The predictor's share of the ceiling at each of ``entries`` (``<predictor>.<tolerance>``) with its interval,
+        e.g. "22% [5%, 40%] of ceiling" or "9% [..] · 10% [..] of ceiling"; "ceiling share not measured" when the
+        metrics hold none of them."""
         if all(self.value(stage, f"{entry}.ceiling_share") is MISSING for entry in entries):
             return "ceiling share " + absent(self.metrics, stage)
-        return " · ".join(self.text(stage, f"{entry}.ceiling_share", SHARE) for entry in entries) + " of ceiling"
+        return " · ".join(" ".join(filter(None, (self.text(stage, f"{entry}.ceiling_share", SHARE), self.interval(
+            stage, f"{entry}.interval.ceiling_share", SHARE)))) for entry in entries) + " of ceiling"
+
+    def gain(self, stage: str, key: str, unit: str = "deg") -> str:
+        """A gain (``key``: ``<...>.gain``, and ``<...>.interval.gain`` beside it) as "+2.4 deg [-0.9, +5.1]"."""
+        return " ".join(filter(None, (f"{self.text(stage, key, '{:+.1f}')} {unit}",
+                                      self.interval(stage, key.rsplit('.', 1)[0] + ".interval.gain", "{:+.1f}"))))
 
 
 def _weakest(grades: dict[int, int]) -> int:
@@ -158,23 +165,38 @@ def _ceiling_row(read: Reader, worlds: list[World], links: dict[str, str]) -> Ro
                f"{bound} (the paper's lab: 7.0 deg, >= 2)", cells, "-", why, links["realism"])
 
 
-def _deciding_arc(read: Reader, world: World, predictor: str, tolerance: str) -> str:
-    """Which arc holds the predictor's n_t on ``world`` and how its envelope ends (artifacts.json ``envelope_causes``,
+def _held_by(read: Reader, world: World, predictor: str, tolerance: str) -> str:
+    """How many arcs hold the predictor's operating point and static's size on ``world`` (they incur at the next
+    bolder one), of how many, the first of them and how its envelope ends (artifacts.json ``envelope_causes``,
     report/deciding.py)."""
-    entry = f"{predictor}.{tolerance}"
-    arcs = read.value(world.stage, f"{entry}.decided_by")
-    if arcs is MISSING or not arcs:
-        return f"{world.name}: no arc holds its n_t"
+    n_arcs = read.value(world.stage, f"ceiling.{tolerance}.n_arcs")
+    of = f" of {n_arcs:g}" if isinstance(n_arcs, (int, float)) else ""
+    held = {p: read.value(world.stage, f"{p}.{tolerance}.decided_by") for p in (predictor, "static")}
+    held = {p: arcs if isinstance(arcs, list) else [] for p, arcs in held.items()}
+    if not held[predictor]:
+        return f"{world.name}: no arc holds its operating point; static held by {len(held['static'])}{of} arcs"
+    arc = held[predictor][0]
     causes = read.value("artifacts", f"{world.prefix}envelope_causes")
-    row = next((c for c in causes if c.get("dataset") == arcs[0] and c.get("tolerance") == tolerance),
+    row = next((c for c in causes if c.get("dataset") == arc and c.get("tolerance") == tolerance),
                {}) if isinstance(causes, list) else {}
     ending = ENDINGS.get(row.get("cause"), f"on {row.get('cause')}").split(" (")[0]  # without the parenthesis
     ends = f", which ends {ending} at {SPL.format(row['theta_a'])} deg" if row.get("theta_a") is not None else ""
-    return f"{world.name}: {arcs[0]} holds n_t at {read.text(world.stage, f'{entry}.best_n_t', '{:g}')}{ends}"
+    return (f"{world.name}: {len(held[predictor])}{of} arcs hold n_t at "
+            f"{read.text(world.stage, f'{predictor}.{tolerance}.best_n_t', '{:g}')} ({arc}{ends}); static held by "
+            f"{len(held['static'])}")
+
+
+def _arcs_holding(read: Reader, world: World, tolerance: str) -> str:
+    """How many arcs hold long range's and the MLP's operating points at ``tolerance`` on ``world``, of how many."""
+    held = [read.value(world.stage, f"{p}.{tolerance}.decided_by") for p in ("long_range", "mlp")]
+    n_arcs = read.text(world.stage, f"ceiling.{tolerance}.n_arcs", "{:g}")
+    counts = " · ".join(str(len(arcs)) if isinstance(arcs, list) else "-" for arcs in held)
+    return f"{paper.TOLERANCE_LABELS[tolerance]}: n_t held by {counts} of {n_arcs} arcs"
 
 
 def _over_static_row(read: Reader, worlds: list[World], predictor: str, tolerance: str, links: dict[str, str]) -> Row:
-    """Tables I-III: the predictor's max mean SPL at zero incursion beside static's, its n_t, its ceiling share."""
+    """Tables I-III: the predictor's max mean SPL at zero incursion beside static's, the gain with its interval (the
+    verdict reads it), the relative gain as the paper gives it, its n_t, its ceiling share with its interval."""
     theirs = paper.WINDSOR_SPL_ZERO_INCURSION
     margin = theirs[predictor][tolerance] / theirs["static"][tolerance] - 1
     entry, static = f"{predictor}.{tolerance}", f"static.{tolerance}.max_mean_spl_zero_incursion"
@@ -184,45 +206,40 @@ def _over_static_row(read: Reader, worlds: list[World], predictor: str, toleranc
         if spl is MISSING or read.value(world.stage, static) is MISSING:
             cells.append(absent(read.metrics, world.stage))
             continue
-        grades[i] = gain_grade(_gain(spl, read.value(world.stage, static)), margin)
+        grades[i] = 2 if spl is None else interval_grade(read.value(world.stage, f"{entry}.interval.gain"))
         cells.append(f"{read.text(world.stage, f'{entry}.max_mean_spl_zero_incursion')} vs "
-                     f"{read.text(world.stage, static)}, n_t {read.text(world.stage, f'{entry}.best_n_t', '{:g}')}; "
-                     f"{read.share(world.stage, entry)}")
-    why = _deciding_arc(read, worlds[_weakest(grades)], predictor, tolerance) if grades else UNMEASURED
+                     f"{read.text(world.stage, static)}: {read.gain(world.stage, f'{entry}.gain')} "
+                     f"({read.text(world.stage, f'{entry}.relative_gain', '{:+.0%}')}), n_t "
+                     f"{read.text(world.stage, f'{entry}.best_n_t', '{:g}')}; {read.share(world.stage, entry)}")
+    why = _held_by(read, worlds[_weakest(grades)], predictor, tolerance) if grades else UNMEASURED
     return Row(f"{NAMES[predictor]} over static, {paper.TOLERANCE_LABELS[tolerance]} ({TABLES[predictor]})",
                f"{theirs[predictor][tolerance]:.1f} vs {theirs['static'][tolerance]:.1f} deg ({margin:+.0%}), n_t "
                f"{paper.WINDSOR_THRESHOLDS[predictor][tolerance]}", cells, verdict(list(grades.values())), why,
                links["envelopes"])
 
 
-def _graded_gain(read: Reader, worlds: list[World], key: str, margin: float,
-                 cell: Callable[[str], str]) -> tuple[list[str], dict[int, int]]:
-    """(cells, grades) of a claim judged on one relative gain ``key`` per world against the paper's ``margin``: a
-    world without the key shows why (``absent``) and is not graded; the others show ``cell(stage)``."""
+def _mlp_row(read: Reader, worlds: list[World], links: dict[str, str]) -> Row:
+    """Table I: the MLP's max mean SPL and ceiling share per tolerance; the claim is long range's gain over it, judged
+    per tolerance on the paired difference of the two on the same draws (the weaker tolerance decides)."""
+    margin = paper.WINDSOR_IMPROVEMENTS["long_range_vs_mlp"]
+    pair = "intervals.{}.pairs.long_range vs mlp.difference"
     cells, grades = [], {}
     for i, world in enumerate(worlds):
-        gain = read.value(world.stage, key)
-        if gain is MISSING:
+        if read.value(world.stage, "long_range.relative_improvement_vs_mlp") is MISSING:
             cells.append(absent(read.metrics, world.stage))
             continue
-        grades[i] = gain_grade(gain, margin)
-        cells.append(cell(world.stage))
-    return cells, grades
-
-
-def _mlp_row(read: Reader, worlds: list[World], links: dict[str, str]) -> Row:
-    """Table I: the MLP's max mean SPL and ceiling share per tolerance; the claim is long range's gain over it."""
-    margin = paper.WINDSOR_IMPROVEMENTS["long_range_vs_mlp"]
-
-    def cell(stage: str) -> str:
-        spl = " · ".join(read.text(stage, f"mlp.{t}.max_mean_spl_zero_incursion") for t in paper.TOLERANCES)
-        shares = read.share(stage, *(f"mlp.{t}" for t in paper.TOLERANCES))
-        return f"{spl} ({shares}); long range {read.text(stage, 'long_range.relative_improvement_vs_mlp', '{:+.1%}')}"
-
-    cells, grades = _graded_gain(read, worlds, "long_range.relative_improvement_vs_mlp", margin, cell)
+        grades[i] = max(interval_grade(read.value(world.stage, pair.format(t))) for t in paper.TOLERANCES)
+        spl = " · ".join(read.text(world.stage, f"mlp.{t}.max_mean_spl_zero_incursion") for t in paper.TOLERANCES)
+        shares = read.share(world.stage, *(f"mlp.{t}" for t in paper.TOLERANCES))
+        differences = " · ".join(
+            f"{read.text(world.stage, pair.format(t).replace('difference', 'point'), '{:+.1f}')} deg "
+            f"{read.interval(world.stage, pair.format(t), '{:+.1f}')}".rstrip() for t in paper.TOLERANCES)
+        cells.append(f"{spl} ({shares}); long range "
+                     f"{read.text(world.stage, 'long_range.relative_improvement_vs_mlp', '{:+.1%}')}: {differences}")
     world = worlds[_weakest(grades)] if grades else None
     why = (f"{world.name}: the MLP's fits are non-physical in "
-           f"{read.text(world.stage, 'fit_status.mlp.non_physical', SHARE)} of its rows" if world else UNMEASURED)
+           f"{read.text(world.stage, 'fit_status.mlp.non_physical', SHARE)} of its rows; "
+           + "; ".join(_arcs_holding(read, world, t) for t in paper.TOLERANCES) if world else UNMEASURED)
     theirs = paper.WINDSOR_SPL_ZERO_INCURSION["mlp"]
     return Row("MLP, and long range over it (Table I)", " · ".join(f"{theirs[t]:.1f}" for t in paper.TOLERANCES)
                + f" deg; long range {margin:+.1%}", cells, verdict(list(grades.values())), why, links["fits"])
@@ -243,17 +260,22 @@ def _ours_row(read: Reader, worlds: list[World], predictor: str, links: dict[str
 
 
 def _lines_row(read: Reader, worlds: list[World], links: dict[str, str]) -> Row:
-    """Fig. 7: long range over static on the straight lines (V-A)."""
+    """Fig. 7: long range over static on the straight lines (V-A); a world's lines resampled one by one."""
     margin = paper.WINDSOR_IMPROVEMENTS["straight_line_vs_static"]
-
-    def cell(stage: str) -> str:
-        return (f"{read.text(stage, 'straight_line.relative_improvement', '{:+.1%}')} ("
-                f"{read.text(stage, 'straight_line.long_range_max_mean_spl_zero_incursion')} vs "
-                f"{read.text(stage, 'straight_line.static_max_mean_spl_zero_incursion')} mm)")
-
-    cells, grades = _graded_gain(read, worlds, "straight_line.relative_improvement", margin, cell)
+    cells, grades = [], {}
+    for i, world in enumerate(worlds):
+        if read.value(world.stage, "straight_line.relative_improvement") is MISSING:
+            cells.append(absent(read.metrics, world.stage))
+            continue
+        spl = read.value(world.stage, "straight_line.long_range_max_mean_spl_zero_incursion")
+        grades[i] = 2 if spl is None else interval_grade(read.value(world.stage, "straight_line.interval.gain"))
+        cells.append(f"{read.text(world.stage, 'straight_line.relative_improvement', '{:+.1%}')} ("
+                     f"{read.text(world.stage, 'straight_line.long_range_max_mean_spl_zero_incursion')} vs "
+                     f"{read.text(world.stage, 'straight_line.static_max_mean_spl_zero_incursion')} mm; gain "
+                     f"{read.interval(world.stage, 'straight_line.interval.gain', '{:+.1f}') or 'no interval'} mm)")
     world = worlds[_weakest(grades)] if grades else None
-    why = (f"{world.name}: R8, lines' mean / smallest x_a, is "
+    why = (f"{world.name}: {read.text(world.stage, 'straight_line.n_lines', '{:g}')} lines of one scene, resampled "
+           f"one by one; R8, lines' mean / smallest x_a, is "
            f"{read.text('artifacts', f'{world.prefix}realism.line_x_a_mean_over_min_2mm3deg', '{:.2f}')}"
            if world else UNMEASURED)
     return Row("straight lines: long range over static, 2 mm/3 deg (Fig. 7)", f"{margin:+.1%}", cells,
@@ -270,9 +292,11 @@ def _pnp_row(read: Reader, worlds: list[World], links: dict[str, str]) -> Row:
             static = read.value(world.stage, f"pnp.{method}.static_max_mean_spl_zero_incursion")
             if spl is MISSING or static is MISSING:
                 continue
-            variant_grades.append(gain_grade(_gain(spl, static), 0.0))
+            variant_grades.append(2 if spl is None else interval_grade(
+                read.value(world.stage, f"pnp.{method}.interval.gain")))
             shown.append(f"{name} {read.text(world.stage, f'pnp.{method}.max_mean_spl_zero_incursion')} vs "
-                         f"{read.text(world.stage, f'pnp.{method}.static_max_mean_spl_zero_incursion')}")
+                         f"{read.text(world.stage, f'pnp.{method}.static_max_mean_spl_zero_incursion')} "
+                         f"{read.interval(world.stage, f'pnp.{method}.interval.gain', '{:+.1f}')}".rstrip())
         if variant_grades:
             grades[i] = max(variant_grades)
         cells.append(" · ".join(shown) or absent(read.metrics, world.stage))
@@ -287,7 +311,6 @@ def _pnp_row(read: Reader, worlds: list[World], links: dict[str, str]) -> Row:
 def _live_row(read: Reader, worlds: list[World], links: dict[str, str]) -> Row:
     """Fig. 9, V-C: next step at a fixed n_t, no incursion and more of the envelope used than by static."""
     live = paper.WINDSOR_LIVE
-    margin = live["envelope_share"] / live["static_envelope_share"] - 1
     cells, grades = [], {}
     for i, world in enumerate(worlds):
         share, static = (read.value(world.stage, f"live.{key}") for key in ("envelope_share", "static_envelope_share"))
@@ -295,17 +318,22 @@ def _live_row(read: Reader, worlds: list[World], links: dict[str, str]) -> Row:
             cells.append(absent(read.metrics, world.stage))
             continue
         incursions = read.value(world.stage, "live.incursions")
-        grades[i] = 2 if incursions not in (0, 0.0) else gain_grade(_gain(share, static), margin)
+        grades[i] = 2 if incursions not in (0, 0.0) else interval_grade(
+            read.value(world.stage, "live.interval.envelope_share_gain"))
         cells.append(f"n_t {read.text(world.stage, 'live.n_t', '{:g}')}: "
                      f"{read.text(world.stage, 'live.incursions', '{:g}')} incursions in "
                      f"{read.text(world.stage, 'live.n_trials', '{:g}')}; "
                      f"{read.text(world.stage, 'live.envelope_share', '{:.1%}')} of the envelope vs static "
-                     f"{read.text(world.stage, 'live.static_envelope_share', '{:.1%}')}")
+                     f"{read.text(world.stage, 'live.static_envelope_share', '{:.1%}')} "
+                     f"{read.interval(world.stage, 'live.interval.envelope_share_gain', '{:+.1%}')}".rstrip())
     if grades:
         world = worlds[_weakest(grades)]
         tolerance = read.value(world.stage, "live.tolerance")
+        static = read.value(world.stage, f"static.{tolerance}.decided_by")
         why = (f"{world.name}: next step's own n_t at {paper.TOLERANCE_LABELS.get(tolerance, tolerance)} is "
-               f"{read.text(world.stage, f'next_step.{tolerance}.best_n_t', '{:g}')}")
+               f"{read.text(world.stage, f'next_step.{tolerance}.best_n_t', '{:g}')}; static's size held by "
+               f"{len(static) if isinstance(static, list) else '-'} of "
+               f"{read.text(world.stage, f'ceiling.{tolerance}.n_arcs', '{:g}')} arcs")
     else:
         why = UNMEASURED
     return Row(f"live trials: next step at n_t {live['n_t']}, 4 mm/10 deg (Fig. 9)",
@@ -319,12 +347,23 @@ def _tracking_cells(worlds: list[World], text: str) -> list[str]:
     return [text] + ["-"] * (len(worlds) - 1)
 
 
+def _level_grade(read: Reader, key: str, theirs: float, higher_is_better: bool) -> int:
+    """The grade of a claim that the tracking's rate or error (``key`` of tracking.json, its interval at
+    ``intervals.<key>``) is at least as good as the paper's ``theirs``: the interval of our gain over it (ours - theirs
+    for a rate, theirs - ours for an error) read by :func:`interval_grade`."""
+    interval = read.value("tracking", f"intervals.{key}")
+    if not isinstance(interval, (list, tuple)) or len(interval) != 2 or None in interval:
+        return interval_grade(None)
+    gains = [end - theirs if higher_is_better else theirs - end for end in interval]
+    return interval_grade(sorted(gains))
+
+
 def _markers_row(read: Reader, worlds: list[World], markers: int, links: dict[str, str]) -> Row:
     """Black and Salcudean III: the share of frames with the correct pose, with 4 or 3 markers (motion (a))."""
     theirs = paper.BLACK_RESULTS["success_rate"][f"markers{markers}"]
-    ours = read.value("tracking", f"success_rates.a_markers{markers}")
-    grades = [] if ours is MISSING else [level_grade(ours, theirs, higher_is_better=True)]
-    cell = ("simulation, motion (a): " + read.text("tracking", f"success_rates.a_markers{markers}", RATE)
+    key = f"success_rates.a_markers{markers}"
+    grades = [] if read.value("tracking", key) is MISSING else [_level_grade(read, key, theirs, True)]
+    cell = (f"simulation, motion (a): {read.text('tracking', key, RATE)} {read.interval('tracking', f'intervals.{key}', RATE)}".rstrip()
             if grades else absent(read.metrics, "tracking"))
     why = f"the stress motion (b): {read.text('tracking', f'success_rates.b_markers{markers}', RATE)}" if grades \
         else UNMEASURED
@@ -335,12 +374,14 @@ def _markers_row(read: Reader, worlds: list[World], markers: int, links: dict[st
 def _accuracy_row(read: Reader, worlds: list[World], links: dict[str, str]) -> Row:
     """Black and Salcudean III: RMS position (mm, per axis) and Euler-angle (deg) error with the UKF."""
     theirs = paper.BLACK_RESULTS
-    mm, deg = read.value("tracking", "rms_axis_mm.ukf"), read.value("tracking", "rms_euler_deg.ukf")
-    grades = [] if MISSING in (mm, deg) else [max(level_grade(mm, theirs["rms_mm"]["ukf"], higher_is_better=False),
-                                                  level_grade(deg, theirs["rms_deg"]["ukf"], higher_is_better=False))]
-    cell = (f"simulation: {read.text('tracking', 'rms_axis_mm.ukf', '{:.2f}')} mm / "
-            f"{read.text('tracking', 'rms_euler_deg.ukf', '{:.2f}')} deg" if grades
-            else absent(read.metrics, "tracking"))
+    keys = ("rms_axis_mm.ukf", "rms_euler_deg.ukf")
+    grades = [] if any(read.value("tracking", key) is MISSING for key in keys) else [max(
+        _level_grade(read, keys[0], theirs["rms_mm"]["ukf"], False),
+        _level_grade(read, keys[1], theirs["rms_deg"]["ukf"], False))]
+    cell = (f"simulation: {read.text('tracking', keys[0], '{:.2f}')} mm "
+            f"{read.interval('tracking', f'intervals.{keys[0]}', '{:.2f}')} / "
+            f"{read.text('tracking', keys[1], '{:.2f}')} deg {read.interval('tracking', f'intervals.{keys[1]}', '{:.2f}')}"
+            .replace("  ", " ").rstrip() if grades else absent(read.metrics, "tracking"))
     why = (f"without the filter: {read.text('tracking', 'rms_axis_mm.no_filter', '{:.2f}')} mm / "
            f"{read.text('tracking', 'rms_euler_deg.no_filter', '{:.2f}')} deg" if grades else UNMEASURED)
     return Row("accuracy: RMS error per axis with the UKF (Black & Salcudean III)",
@@ -364,6 +405,45 @@ def claim_rows(metrics: dict[str, dict], worlds: list[World], links: dict[str, s
     return rows
 
 
+POPULATION_ROWS = ("long_range", "next_step", "mlp", "error_long_range", "error_next_step", "error_next_step_observed",
+                   "error_combined")  # the summary's lines of the population (issue 49), one per predictor
+
+
+def population_lines(metrics: dict[str, dict]) -> list[str]:
+    """The population's lines (``population.json``, issue 49): per predictor and tolerance, the median share of the
+    ceiling over the worlds with its 10-90 % range at the world's own operating point and at the point chosen on the
+    other worlds, the share of worlds with zero incursion at that point, and the worlds in which it beats long range
+    with the sign test's p. No lines when the population has not run."""
+    read = Reader(metrics)
+    if read.value("population", "n_worlds") is MISSING:
+        return []
+
+    def cell(predictor: str, tolerance: str) -> str:
+        at = f"across.{tolerance}.{predictor}"
+        own = (f"{read.text('population', f'{at}.own.median_share', SHARE)} "
+               f"{read.interval('population', f'{at}.own.share_10_90', SHARE)}")
+        others = (f"{read.text('population', f'{at}.others.median_share', SHARE)} "
+                  f"{read.interval('population', f'{at}.others.share_10_90', SHARE)}, zero incursion in "
+                  f"{read.text('population', f'{at}.others.zero_incursion_worlds', SHARE)} of worlds")
+        pair = f"paired.own.{tolerance}.{predictor} vs long_range"
+        wins = "-" if predictor == "long_range" else (
+            f"{read.text('population', f'{pair}.wins', '{:g}')}-{read.text('population', f'{pair}.losses', '{:g}')} "
+            f"(p {read.text('population', f'{pair}.sign_test_p', '{:.2f}')})")
+        return f"{own} | {others} | {wins}"
+
+    n = read.text("population", "n_worlds", "{:g}")
+    head = " | ".join(f"{paper.TOLERANCE_LABELS[t]}: own point | others' point | beats long range, worlds"
+                      for t in paper.TOLERANCES)
+    return [f"**On a population of {n} rendered worlds** (issue 49; each the paper's protocol, drawn from params.yaml "
+            "`population`): the median share of the ceiling over the worlds [its 10-90 % range], at each world's own "
+            "operating point and at the point chosen on the other worlds (`population.json` `rule`); the worlds in "
+            "which it beats long range at their own points, won-lost (two-sided sign test). "
+            "[Figure](figures/08_population.png).", "",
+            f"| predictor | {head} |", "| --- |" + " --- |" * 3 * len(paper.TOLERANCES)] + [
+            f"| {NAMES[p]} | " + " | ".join(cell(p, t) for t in paper.TOLERANCES) + " |"
+            for p in POPULATION_ROWS if read.value("population", f"across.{paper.TOLERANCES[0]}.{p}") is not MISSING]
+
+
 def claims_section(metrics: dict[str, dict]) -> list[str]:
     """Markdown lines of the first section: what held, on which world, by how much, and why not (module docstring)."""
     recorded = recorded_source(metrics) is not None
@@ -383,4 +463,5 @@ def claims_section(metrics: dict[str, dict]) -> list[str]:
              + " | verdict | why |", "| --- | --- |" + " --- |" * len(worlds) + " --- | --- |"]
     lines += [f"| {row.claim} | {row.paper} | " + " | ".join(row.cells)
               + f" | {row.verdict} | [{row.why}]({row.link}) |" for row in rows]
-    return [*lines, "", f"Figures: {figures}.", ""]
+    population = population_lines(metrics)
+    return [*lines, "", f"Figures: {figures}.", "", *population, *([""] if population else [])]
