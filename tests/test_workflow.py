@@ -15,6 +15,20 @@ from repository import outside_references
 ROOT = Path(__file__).resolve().parents[1]
 NOTEBOOKS = sorted((ROOT / "notebooks").glob("*.ipynb"))
 DVC = yaml.safe_load((ROOT / "dvc.yaml").read_text())
+POPULATION = yaml.safe_load((ROOT / "population" / "dvc.yaml").read_text())  # issue 49: `make population`
+
+
+def notebook_stages() -> list[tuple[Path, str, dict]]:
+    """(notebook, stage name, stage) of every stage that runs a notebook: the paper-scale pipeline's (named after its
+    notebook) and the population's (a foreach stage's body; its commands name the notebooks they run)."""
+    found = [(notebook, notebook.stem, DVC["stages"][notebook.stem]) for notebook in NOTEBOOKS
+             if notebook.stem in DVC["stages"]]
+    for name, stage in POPULATION["stages"].items():
+        body = stage.get("do", stage)
+        commands = body["cmd"] if isinstance(body["cmd"], list) else [body["cmd"]]
+        found += [(notebook, f"population/dvc.yaml:{name}", body) for notebook in NOTEBOOKS
+                  if any(f"notebooks/{notebook.name}" in command for command in commands)]
+    return found
 
 
 @pytest.mark.parametrize("notebook", NOTEBOOKS, ids=[p.stem for p in NOTEBOOKS])
@@ -39,13 +53,29 @@ def test_every_notebook_has_a_stage_running_it_through_the_stage_runner():
     """poseintegrity.stage writes the executed notebook, its HTML and a timing file, and reads `parallel`."""
     stages = DVC["stages"]
     for notebook in NOTEBOOKS:
-        stage = stages[notebook.stem]
+        if notebook.stem not in stages:  # the population's (population/dvc.yaml)
+            stage = next(stage for nb, name, stage in notebook_stages() if nb == notebook)
+        else:
+            stage = stages[notebook.stem]
         assert stage["cmd"].endswith(f"python -m poseintegrity.stage notebooks/{notebook.name}")
         assert f"notebooks/{notebook.name}" in stage["deps"]
         assert "parallel" in stage["params"]
         outs = [next(iter(out)) if isinstance(out, dict) else out for out in stage["outs"]]
         assert f"reports/notebooks/{notebook.name}" in outs and f"reports/notebooks/{notebook.stem}.html" in outs
         assert {f"reports/metrics/timing/{notebook.stem}.json": {"cache": False}} in stage["outs"]
+
+
+def test_the_population_runs_the_paper_s_notebooks_on_each_world():
+    """population/dvc.yaml: per world, stages 01, 02 and 04's notebooks on the world's params file, in its folder."""
+    for name, notebook in (("generate", "01_generate_datasets"), ("extract", "02_extract_artifacts"),
+                           ("predict", "04_predictor_sweeps")):
+        stage = POPULATION["stages"][name]
+        assert stage["foreach"] == "${population.worlds}" and stage["do"]["wdir"] == ".."
+        command = " ".join(stage["do"]["cmd"]).split()
+        at = command.index(f"notebooks/{notebook}.ipynb")
+        assert command[at + 1:at + 7] == ["--params", "data/population/${item}/params.yaml", "--data",
+                                          "data/population/${item}", "--reports", f"data/population/${{item}}/{name}"]
+        assert "parallel" in stage["do"]["params"] and "population.worlds" not in stage["do"]["params"]
 
 
 def _imported_modules(source: str, package: str = "") -> set[str]:
@@ -104,12 +134,12 @@ def test_every_stage_depends_on_every_source_file_its_notebook_runs():
     """A change to a module a stage runs re-runs the stage: the import closure of each notebook (static) lies
     inside the stage's source deps, so dvc.lock cannot call results current that another version of the code made."""
     missing = {}
-    for notebook in NOTEBOOKS:
-        deps = [ROOT / d for d in DVC["stages"][notebook.stem]["deps"] if str(d).startswith("src/")]
+    for notebook, name, stage in notebook_stages():
+        deps = [ROOT / d for d in stage["deps"] if str(d).startswith("src/")]
         closure = _import_closure(notebook)
         assert len(closure) > 5, notebook.name  # the walk found the package
         if lost := sorted(str(f.relative_to(ROOT)) for f in closure if not any(f == d or d in f.parents for d in deps)):
-            missing[notebook.stem] = lost
+            missing[name] = lost
     assert not missing, f"stages run source files they do not depend on in dvc.yaml: {missing}"
 
 
@@ -193,11 +223,12 @@ def test_dvc_lock_matches_committed_notebooks_and_params():
 
     from ruamel.yaml import YAML  # YAML 1.2 as DVC reads it (PyYAML would take the lock's 1e-12 for a string)
 
-    lock_path = ROOT / "dvc.lock"
-    assert lock_path.exists(), "dvc.lock is committed with every paper-scale run (make repro writes it)"
-    lock = YAML(typ="safe").load(lock_path.read_text())
     params = YAML(typ="safe").load((ROOT / "params.yaml").read_text())
-    for name, stage in lock["stages"].items():
+    stages = {}
+    for lock_path, run_by in ((ROOT / "dvc.lock", "make repro"), (ROOT / "population" / "dvc.lock", "make population")):
+        assert lock_path.exists(), f"{lock_path.name} is committed with every run ({run_by} writes it)"
+        stages |= YAML(typ="safe").load(lock_path.read_text())["stages"]
+    for name, stage in stages.items():
         for dep in stage.get("deps", []):
             if dep["path"].startswith("notebooks/"):
                 digest = hashlib.md5((ROOT / dep["path"]).read_bytes()).hexdigest()

@@ -41,6 +41,7 @@ from poseintegrity.parallel import ParallelParams
 from poseintegrity.params.extract import ExtractParams
 from poseintegrity.params.fit import FitParams
 from poseintegrity.params.generate import GenerateParams
+from poseintegrity.params.population import PopulationParams
 from poseintegrity.params.predict import PredictParams
 from poseintegrity.params.track import TrackParams
 from poseintegrity.protocol import ProtocolParams
@@ -66,6 +67,7 @@ class Params(BaseModel):
     fit: FitParams  # stage 03
     predict: PredictParams  # stage 04
     track: TrackParams  # stage 06
+    population: PopulationParams  # population/dvc.yaml: the worlds the predictors are judged on (issue 49)
     parallel: ParallelParams  # every stage: where the per-frame and per-dataset tasks run
 
 
