@@ -73,3 +73,36 @@ def test_a_world_not_in_the_list_is_refused_naming_it(tmp_path):
                          capture_output=True, text=True)
     assert run.returncode == 2 and "w99" in run.stderr and "Traceback" not in run.stderr
     assert not (tmp_path / "w99.yaml").exists()
+
+
+def test_a_scene_the_robot_cannot_serve_is_drawn_again_and_the_file_says_why(tmp_path, monkeypatch):
+    from poseintegrity.population import draw
+
+    refused = []
+
+    def problem(generate, protocol, index):  # the third scene refused at its first two draws
+        scene = generate.scenes[index]
+        if index == 2 and len(refused) < 2:
+            refused.append(scene.distance_mm)
+            return f"scene {scene.name}: refused"
+        return None
+
+    monkeypatch.setattr(draw, "arc_problem", problem)
+    generate, redrawn = draw.served_world(ROOT / "params.yaml", "w01")
+    assert [line.split(":")[0] for line in redrawn] == ["w01_s3 drawn again (draw 2)", "w01_s3 drawn again (draw 3)"]
+    assert generate["scenes"][2] == draw.draw_scene(PARAMS.population, "w01", 2, 2)  # its third draw
+    assert generate["scenes"][1] == draw.draw_scene(PARAMS.population, "w01", 1)  # the others at their first
+    monkeypatch.setattr(draw, "arc_problem", lambda *args: "scene: never")
+    with pytest.raises(PoseIntegrityError, match="scene 1 not served by the robot in 20 draws"):
+        draw.served_world(ROOT / "params.yaml", "w01")
+
+
+def test_the_robot_check_refuses_a_scene_stage_01_would_refuse():
+    """arc_problem is stage 01's own check (robot placement): a scene at 900 mm, far beyond a UR5e's reach, and the
+    main world's own scenes, which stage 01 renders."""
+    from poseintegrity.scenes.dataset import arc_problem
+
+    far = PARAMS.generate.model_copy(update={"lines": None, "scenes": [PARAMS.generate.scenes[0].model_copy(
+        update={"distance_mm": 900.0})]})
+    assert "base placements" in arc_problem(far, PARAMS.protocol, 0)
+    assert arc_problem(PARAMS.generate, PARAMS.protocol, 0) is None

@@ -162,14 +162,25 @@ def _held_phantom(name: str, params: "GenerateParams", spec: "SceneSpec", view_d
     return T, [(name, placed), (f"{name}_stand", stand)]
 
 
-def build_scene(spec: "SceneSpec", index: int, params: "GenerateParams", protocol: "ProtocolParams",
-                session: str = "arc", plan: board_plan.BoardPlan | None = None) -> Scene:
-    """Lay out scene ``spec`` (index = its position in params, seeds the arrangement with ``params.seed``) for one
-    session: its arcs (``"arc"``) or, on the lines' scene, its lines (``"line"``). Each session has its own model pair
-    (IV-D), and the lab stands the ground-truth boards where that session's trajectories (``protocol``) keep them in
-    view; targets, their stands and the table are the same in both, the clutter keeps clear of the boards' sight lines.
-    A board that fits nowhere raises :class:`~.board_placement.PlacementError`; ``plan``: the boards' plan found by an
-    earlier call for the same session (the search is skipped: workers rebuild a scene the main process laid out)."""
+@dataclass(frozen=True)
+class Arrangement:
+    """A scene's targets on the table, before its boards and clutter: the scene's generator (``rng``, drawn as far as
+    the targets; the boards and the clutter draw on from it), the model camera's direction around the target
+    (``yaw``, rad) and towards it (``view_dir`` (3,)), the table and targets placed (with a scapula's stand), each
+    target's T_world_target (4, 4) and the point the camera looks at (``aim`` (3,), mm: the targets' mean)."""
+
+    rng: np.random.Generator
+    yaw: float
+    view_dir: np.ndarray
+    placed: tuple[tuple[str, meshes.Mesh], ...]
+    target_poses: list[np.ndarray]
+    aim: np.ndarray
+
+
+def arrange(spec: "SceneSpec", index: int, params: "GenerateParams") -> Arrangement:
+    """The targets of scene ``spec`` (index = its position in params) placed on the table (:class:`Arrangement`):
+    where the camera will look and from where, before any board is planned (``build_scene`` goes on from here; a
+    world's population draw checks from it that the robot reaches the scene, population/draw.py)."""
     rng = keyed_rng(params.seed, "scene", index)
     yaw = np.deg2rad(rng.uniform(-20, 20))  # direction of the model camera around the target
     elev = np.deg2rad(spec.elevation_deg)
@@ -189,7 +200,20 @@ def build_scene(spec: "SceneSpec", index: int, params: "GenerateParams", protoco
             placed.append((name, target_mesh(name, params).transformed(T)))
         target_poses.append(T)
     aim = np.mean([T[:3, 3] for T in target_poses], axis=0)
+    return Arrangement(rng, float(yaw), view_dir, tuple(placed), target_poses, aim)
 
+
+def build_scene(spec: "SceneSpec", index: int, params: "GenerateParams", protocol: "ProtocolParams",
+                session: str = "arc", plan: board_plan.BoardPlan | None = None) -> Scene:
+    """Lay out scene ``spec`` (index = its position in params, seeds the arrangement with ``params.seed``) for one
+    session: its arcs (``"arc"``) or, on the lines' scene, its lines (``"line"``). Each session has its own model pair
+    (IV-D), and the lab stands the ground-truth boards where that session's trajectories (``protocol``) keep them in
+    view; targets, their stands and the table are the same in both, the clutter keeps clear of the boards' sight lines.
+    A board that fits nowhere raises :class:`~.board_placement.PlacementError`; ``plan``: the boards' plan found by an
+    earlier call for the same session (the search is skipped: workers rebuild a scene the main process laid out)."""
+    arranged = arrange(spec, index, params)
+    rng, yaw, view_dir, placed, target_poses, aim = (arranged.rng, arranged.yaw, arranged.view_dir,
+                                                     list(arranged.placed), arranged.target_poses, arranged.aim)
     board_yaw = yaw + np.pi + rng.uniform(-0.3, 0.3)  # drawn for either placement: the clutter after it lies alike
     n_trajectories = len(params.arcs.azimuths_deg) if session == "arc" else len(params.lines.offsets_deg)
     if params.board.placement == "flat":

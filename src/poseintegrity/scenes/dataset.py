@@ -54,7 +54,7 @@ from poseintegrity.scenes.calibration_views import CalibrationSession, calibrati
 from poseintegrity.scenes.camera import Intrinsics, true_camera
 from poseintegrity.scenes.foam import ReliefVolume, bone_foam_relief
 from poseintegrity.params.generate import BoneFoamParams, GenerateParams
-from poseintegrity.scenes.robot import Robot, accuracy, trip_path
+from poseintegrity.scenes.robot import ReachError, Robot, accuracy, trip_path
 from poseintegrity.scenes.textures import build_atlas
 from poseintegrity.seeding import keyed_rng
 
@@ -105,8 +105,10 @@ class Trip:
     stops: list[trajectories.Stop]
 
 
-def plan_trip(params: GenerateParams, protocol: ProtocolParams, plan: DatasetPlan, scene: catalog.Scene) -> Trip:
-    """The commanded model pair and stops of ``plan`` in ``scene``; the trajectory spans ``protocol``'s range."""
+def plan_trip(params: GenerateParams, protocol: ProtocolParams, plan: DatasetPlan,
+              scene: catalog.Scene | catalog.Arrangement) -> Trip:
+    """The commanded model pair and stops of ``plan`` in ``scene`` (its aim and view direction: a scene laid out, or
+    its targets arranged); the trajectory spans ``protocol``'s range."""
     # the straight lines have their own model pair (IV-D), closer to the target: the robot backs away from it
     distance_mm = params.scenes[plan.scene_index].distance_mm if plan.trajectory == "arc" else params.lines.distance_mm
     model_views = trajectories.model_pair(scene.aim, scene.view_dir, distance_mm, params.model_baseline_mm)
@@ -169,6 +171,30 @@ def check_world(params: GenerateParams, protocol: ProtocolParams, world: str = "
                     _check_in_view(mesh.vertices @ T_cam_world[:3, :3].T + T_cam_world[:3, 3], cam,
                                    f"{scenes_key(world)}.{index}", name, distance)
     return scenes
+
+
+def arc_problem(params: GenerateParams, protocol: ProtocolParams, index: int) -> str | None:
+    """Why scene ``index`` of a world cannot give its arcs, found from its targets' arrangement before any board is
+    planned (seconds less than :func:`check_world`; a world of the population is drawn again where this says so,
+    population/draw.py): a target out of either model view (:func:`_check_in_view`), or the world's robot reaching
+    no base placement from which it serves every arc (:func:`drive_scene`'s placement). None: it can."""
+    spec, cam = params.scenes[index], Intrinsics.from_params(params.camera)
+    arranged = catalog.arrange(spec, index, params)
+    try:
+        for T_world_cam in trajectories.model_pair(arranged.aim, arranged.view_dir, spec.distance_mm,
+                                                   params.model_baseline_mm):
+            T_cam_world = inverse(T_world_cam)
+            for name, mesh in arranged.placed:
+                if name in spec.targets:
+                    _check_in_view(mesh.vertices @ T_cam_world[:3, :3].T + T_cam_world[:3, 3], cam,
+                                   f"{scenes_key('main')}.{index}", name, spec.distance_mm)
+        trips = [plan_trip(params, protocol, plan, arranged) for plan in plan_datasets(params)
+                 if plan.scene_index == index and plan.trajectory == "arc"]
+        Robot.from_params(params.robot, keyed_rng(params.seed, "robot")).placed(
+            [trip_path(trip) for trip in trips], arranged.aim, spec.name)
+    except (WorldError, ReachError) as error:
+        return str(error)
+    return None
 
 
 def _check_in_view(points_cam: np.ndarray, cam: Intrinsics, key: str, name: str, distance: float) -> None:
