@@ -203,9 +203,11 @@ def headline_intervals(rows: pd.DataFrame, predictors: tuple[str, ...], pairs: t
     return result
 
 
-# the predictors compared in pairs, in the order "A vs B" is read (A - B): ours before the paper's, so that the keys
-# say "next_step vs long_range" (V-B) and "long_range vs mlp" (Table I)
-PAIRED = ("error_combined", "error_next_step_observed", "error_next_step", "error_long_range", "next_step",
+# every predictor but static (whose pairs are the gains) compared in pairs, in the order "A vs B" is read (A - B):
+# ours before the paper's, a variant before its predictor, so that the keys say "next_step vs long_range" (V-B),
+# "long_range vs mlp" (Table I), "long_range_free_width vs long_range"
+PAIRED = ("error_combined", "error_next_step_observed", "error_next_step", "error_long_range", "next_step_free_width",
+          "long_range_free_width", "next_step_relative", "long_range_relative", "next_step", "long_range_lower",
           "long_range", "mlp")
 PAIRS = tuple((a, b) for i, a in enumerate(PAIRED) for b in PAIRED[i + 1:])
 
