@@ -106,3 +106,17 @@ def test_the_robot_check_refuses_a_scene_stage_01_would_refuse():
         update={"distance_mm": 900.0})]})
     assert "base placements" in arc_problem(far, PARAMS.protocol, 0)
     assert arc_problem(PARAMS.generate, PARAMS.protocol, 0) is None
+
+
+@pytest.mark.parametrize(("key", "value", "message"), [
+    ("n_clutter", [9, 3], "population.draw.n_clutter: a range"),
+    ("targets", [["scapula"], ["femur"]], "population.draw.targets.1: must be distinct target names"),
+    ("distance_mm", [440.0, 270.0], "population.draw.distance_mm"),
+    ("scenes_per_world", 1, "population.draw.scenes_per_world"),
+])
+def test_a_bad_distribution_is_refused_naming_its_key(key, value, message):
+    from poseintegrity.config import ParamsError, merge, parse_params, read_raw
+
+    raw, base = read_raw(ROOT / "params.yaml")
+    with pytest.raises(ParamsError, match=message.replace(".", r"\.")):
+        parse_params(merge(raw, {"population": {"draw": {key: value}}}), "params.yaml", base)
