@@ -359,3 +359,28 @@ def test_every_link_of_the_first_section_leads_to_a_heading_below_it(metrics):
     assert {"#the-rendered-worlds-realism" if metrics is COMMITTED else "#your-datasets-described",
             "#envelopes-and-why-they-end", "#predictors", "#pnp-variants", "#tracking", "#fits"} == links
     assert links <= headings
+
+
+def test_the_population_has_a_line_per_predictor_on_the_first_screen():
+    """population.json (issue 49) on the first screen: per predictor and tolerance the median share with its 10-90 %
+    range at its own and at the others' point, the zero-incursion share of worlds, and the paired wins against long
+    range (a pair written the other way, "long_range vs mlp", read as the MLP's losses)."""
+    across = {t: {p: {"own": {"median_share": 0.3 + i / 100, "share_10_90": [0.1, 0.5]},
+                      "others": {"median_share": 0.2, "share_10_90": [None, 0.4], "zero_incursion_worlds": 0.75}}
+                  for i, p in enumerate(("long_range", "next_step", "mlp", "error_next_step"))} for t in TOLERANCES}
+    pairs = {t: {"next_step vs long_range": {"wins": 9, "losses": 3, "ties": 0, "sign_test_p": 0.146},
+                 "error_next_step vs long_range": {"wins": 11, "losses": 1, "ties": 0, "sign_test_p": 0.0063},
+                 "long_range vs mlp": {"wins": 10, "losses": 2, "ties": 0, "sign_test_p": 0.039}} for t in TOLERANCES}
+    metrics = copy.deepcopy(COMMITTED) | {"population": {"n_worlds": 12, "across": across, "paired": {"own": pairs}}}
+    lines = section(render_summary(metrics, []))
+    assert any(line.startswith("**On a population of 12 rendered worlds**") for line in lines)
+    rows = {line.split(" | ")[0].strip("| "): line.strip("|").split(" | ")[1:] for line in lines
+            if line.startswith("| ") and "own point" not in line and "---" not in line}
+    assert_shows(rows["MLP"][2], [2, 10, 0.039], "MLP against long range")  # 2 won, 10 lost
+    assert_shows(rows["error next step"][2], [11, 1, 0.0063], "error next step")
+    assert_shows(rows["next step"][0], [0.31, 0.1, 0.5], "next step, own point")
+    assert_shows(rows["next step"][1], [0.2, 0.4, 0.75], "next step, others' point")  # the low end: none
+    assert "long range" in rows and "error long range" not in rows  # a line per predictor the population holds
+    assert len(lines) <= 40
+    unrun = {stage: entry for stage, entry in COMMITTED.items() if stage != "population"}
+    assert not any("population" in line for line in section(render_summary(unrun, [])))  # not run: no lines

@@ -425,9 +425,11 @@ def population_lines(metrics: dict[str, dict]) -> list[str]:
         others = (f"{read.text('population', f'{at}.others.median_share', SHARE)} "
                   f"{read.interval('population', f'{at}.others.share_10_90', SHARE)}, zero incursion in "
                   f"{read.text('population', f'{at}.others.zero_incursion_worlds', SHARE)} of worlds")
-        pair = f"paired.own.{tolerance}.{predictor} vs long_range"
+        pair, won, lost = f"paired.own.{tolerance}.{predictor} vs long_range", "wins", "losses"
+        if read.value("population", pair) is MISSING:  # the pair read the other way: "long_range vs mlp"
+            pair, won, lost = f"paired.own.{tolerance}.long_range vs {predictor}", "losses", "wins"
         wins = "-" if predictor == "long_range" else (
-            f"{read.text('population', f'{pair}.wins', '{:g}')}-{read.text('population', f'{pair}.losses', '{:g}')} "
+            f"{read.text('population', f'{pair}.{won}', '{:g}')}-{read.text('population', f'{pair}.{lost}', '{:g}')} "
             f"(p {read.text('population', f'{pair}.sign_test_p', '{:.2f}')})")
         return f"{own} | {others} | {wins}"
 
