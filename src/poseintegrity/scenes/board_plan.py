@@ -63,14 +63,18 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import cv2
+import numba
 import numpy as np
+from llvmlite import ir
+from numba import types
+from numba.extending import intrinsic
 from scipy.spatial import ConvexHull
 from scipy.stats import chi2
 
 from poseintegrity.poses import inverse, pose_matrix
 from poseintegrity.scenes.board_placement import (
     CLEARANCE_PX, GRID_RIGHT_MM, GRID_UP_MM, NEAR_MM, POST_BEHIND_MM, POST_RADIUS_MM, TABLE_CLEARANCE_MM,
-    BoardPlacement, PlacementError, hits, near_targets, pixels, project, vertices_inside,
+    BoardPlacement, PlacementError, near_targets, pixels, project, vertices_inside,
 )
 from poseintegrity.scenes.optics import defocus_sigma_px
 
@@ -147,6 +151,14 @@ class _Candidates:
         return (self.centre[keep, None, :] + offsets[..., :1] * self.x_b[keep, None, :]
                 + offsets[..., 1:] * self.y_b[keep, None, :])
 
+    def pixels(self, fractions: np.ndarray, of: np.ndarray, keep: np.ndarray, view: np.ndarray, K: np.ndarray
+               ) -> tuple[np.ndarray, np.ndarray]:
+        """:func:`~.board_placement.pixels` (k, m, 2) of :meth:`on_board`'s points (k, m, 3) at ``view``
+        (T_cam_world), to the bit, and whether each is in front of the camera (k, m); ``keep``: indices."""
+        uv, front = np.empty((len(keep), len(fractions), 2)), np.empty((len(keep), len(fractions)), bool)
+        _board_pixels(self.centre, self.x_b, self.y_b, of, keep, fractions, view, K, uv, front)
+        return uv, front
+
     def post(self, keep: np.ndarray, n: int = 24) -> np.ndarray:
         """(k, n, 3): points along the post's axis from the table to its top."""
         top = self.post_top[keep]
@@ -187,9 +199,9 @@ def _candidates(sizes_mm: list[float], squares: tuple[int, int], margin_mm: floa
 @dataclass
 class _Judged:
     """Per candidate (n) and pose (p): ``alive`` (n,): whole, in focus and uncovered in model image 0 and covering
-    nothing at any pose; ``served`` (n, p): criteria 1-3 hold; ``sigma_t`` (n, p) predicted (inf where not served);
-    ``noise`` (n, p): the corner noise (px) at that pose's blur (NaN where not served); ``visible`` (n, p, m): which
-    of its m inner corners are found there."""
+    nothing at any pose; for the candidates alive (the others are left False, inf, NaN): ``served`` (n, p): criteria
+    1-3 hold; ``sigma_t`` (n, p) predicted (inf where not served); ``noise`` (n, p): the corner noise (px) at that
+    pose's blur (NaN where not served); ``visible`` (n, p, m): which of its m inner corners are found there."""
 
     alive: np.ndarray
     served: np.ndarray
@@ -210,70 +222,217 @@ class Obstacle:
     hidden_matters: bool
 
 
+@dataclass(frozen=True)
+class _Mask:
+    """Image pixels near an obstacle (:func:`~.board_placement.near_targets`), kept as their bounding box: ``pixels``
+    (rows, columns) from pixel column ``u0`` and row ``v0`` (outside it the whole image's mask is False)."""
+
+    pixels: np.ndarray
+    u0: int
+    v0: int
+
+    @classmethod
+    def near(cls, hull: np.ndarray, width: int, height: int, clearance_px: float) -> _Mask:
+        """The pixels within ``clearance_px`` of an image hull (h, 2)."""
+        mask = near_targets([hull], width, height, clearance_px)
+        rows, columns = np.flatnonzero(mask.any(axis=1)), np.flatnonzero(mask.any(axis=0))
+        if len(rows) == 0:
+            return cls(np.zeros((0, 0), bool), 0, 0)
+        return cls(mask[rows[0]:rows[-1] + 1, columns[0]:columns[-1] + 1], int(columns[0]), int(rows[0]))
+
+    def reaches(self, low: np.ndarray, high: np.ndarray) -> np.ndarray:
+        """(k,) whether boxes from ``low`` to ``high`` (k, 2: u, v px) come within a pixel of the mask's: a point
+        rounds onto a pixel of the mask only from within half a pixel of it."""
+        rows, columns = self.pixels.shape
+        return ((high[:, 0] >= self.u0 - 1) & (low[:, 0] <= self.u0 + columns) & (high[:, 1] >= self.v0 - 1)
+                & (low[:, 1] <= self.v0 + rows))
+
+    def on(self, points: np.ndarray, front: np.ndarray) -> np.ndarray:
+        """(k, l) whether each point (k, l, 2 px) in front of the camera (``front`` (k, l)) falls on the mask, rounded
+        to its pixel."""
+        rows, columns = self.pixels.shape
+        u = np.round(points[..., 0]).astype(np.int64) - self.u0
+        v = np.round(points[..., 1]).astype(np.int64) - self.v0
+        inside = front & (u >= 0) & (u < columns) & (v >= 0) & (v < rows)
+        on = np.zeros(u.shape, bool)
+        on[inside] = self.pixels[v[inside], u[inside]]
+        return on
+
+
+@dataclass(frozen=True)
+class _Sighted:
+    """An obstacle in one pose's image: its hull (h, 2 px), its depth (its vertices' mean, mm), the pixels within
+    CLEARANCE_PX of it (``near``) and, for a target, those a post in front of it must keep off (``post``: CLEARANCE_PX
+    and the post's radius at the target's depth)."""
+
+    obstacle: Obstacle
+    hull: np.ndarray
+    distance: float
+    near: _Mask
+    post: _Mask | None
+
+
+def _sighted(obstacles: list[Obstacle], view: np.ndarray, K: np.ndarray, width: int, height: int
+             ) -> list[_Sighted]:
+    """The obstacles some vertex of which is in front of the camera at ``view`` (T_cam_world), as it sees them."""
+    out = []
+    for obstacle in obstacles:
+        hull = _hull(project(obstacle.vertices, view, K))
+        if len(hull) == 0:
+            continue
+        distance = obstacle.vertices.mean(axis=0) @ view[2, :3] + view[2, 3]
+        post = (_Mask.near(hull, width, height, CLEARANCE_PX + POST_RADIUS_MM * K[0, 0] / max(distance, NEAR_MM))
+                if obstacle.hidden_matters else None)
+        out.append(_Sighted(obstacle, hull, distance, _Mask.near(hull, width, height, CLEARANCE_PX), post))
+    return out
+
+
+@dataclass(frozen=True)
+class _Camera:
+    """What the criteria ask of the camera and the boards: the pinhole (K (3, 3), width, height px), its lens
+    (focused at ``focus_mm``, ``camera``'s depth of field, its own blur ``blur_sigma_px``) and the boards' squares
+    (squares_x, squares_y) and markers (``marker_cells`` bit cells across, ``marker_share`` of a square)."""
+
+    K: np.ndarray
+    width: int
+    height: int
+    focus_mm: float
+    camera: object
+    blur_sigma_px: float
+    squares: tuple[int, int]
+    marker_cells: float
+    marker_share: float
+
+
+class _View:
+    """The candidates ``idx`` (k,) of ``c`` at one pose (``view``: T_cam_world), beside the obstacles ``sighted`` there.
+
+    The image tests of the criteria (on the image, on an obstacle's grown hull) run only on the candidates whose
+    image can reach what they test: where the paper's corners are all in front of the camera (``bounded``), every
+    point of the board in front of it projects inside their hull, within its bounding box ``low``-``high`` (k, 2 px)
+    (and a post's inside its ends'); the other candidates pass those tests, as they would pixel by pixel."""
+
+    def __init__(self, c: _Candidates, idx: np.ndarray, view: np.ndarray, sighted: list[_Sighted], cam: _Camera):
+        self.c, self.idx, self.view, self.sighted, self.cam = c, idx, view, sighted, cam
+        self.corners = c.on_board(PAPER, c.paper, idx)  # (k, 4, 3) the paper's
+        self.quad, self.front = pixels(self.corners, view, cam.K)
+        self.low, self.high = self.quad.min(axis=1), self.quad.max(axis=1)
+        edges = np.roll(self.quad, -1, axis=1) - self.quad
+        area = np.abs(np.sum(self.quad[..., 0] * edges[..., 1] - self.quad[..., 1] * edges[..., 0], axis=1)) / 2
+        # a board seen edge on (no area) is tested point by point: a point on its line is "inside" the quad
+        self.bounded = self.front.all(axis=1) & (area > 1.0)
+        self.board_depth = c.centre[idx] @ view[2, :3] + view[2, 3]
+
+    def subset(self, keep: np.ndarray) -> _View:
+        return _View(self.c, self.idx[keep], self.view, self.sighted, self.cam)
+
+    def lattice(self, which: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Pixels (j, l, 2) of the squares' corners (:func:`_lattice`) of the candidates ``which`` (a mask, j of
+        them), and whether each is in front of the camera (j, l)."""
+        return self.c.pixels(_lattice(self.cam.squares), self.c.pattern, self.idx[which], self.view, self.cam.K)
+
+    def shown(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Criteria 1 and 3 (not yet what obstacles hide): ok (k,), which squares' corners are in the image (k, l)
+        and the blur (k, px) at the board's nearest or farthest corner."""
+        c, cam, view = self.c, self.cam, self.view
+        width, height = cam.width, cam.height
+        pattern, pattern_front = pixels(c.on_board(PAPER, c.pattern, self.idx), view, cam.K)
+        depth = self.corners @ view[2, :3] + view[2, 3]  # (k, 4)
+        # a paper in front of the camera and a pixel inside the image's edges: every square's corner in the image
+        inside = (self.bounded & (depth.min(axis=1) > NEAR_MM + 1.0) & (self.low >= 1.0).all(axis=1)
+                  & (self.high[:, 0] <= width - 2) & (self.high[:, 1] <= height - 2))
+        in_image = np.ones((len(self.idx), len(_lattice(cam.squares))), bool)
+        points, points_front = self.lattice(~inside)
+        in_image[~inside] = (points_front & (points[..., 0] >= 0) & (points[..., 0] <= width - 1)
+                             & (points[..., 1] >= 0) & (points[..., 1] <= height - 1))
+        # the blur at the board's nearest and farthest corners against a marker's bit cell where the pattern's
+        # outline is shortest in the image (far and foreshortened)
+        blur = np.hypot(cam.blur_sigma_px, defocus_sigma_px(np.clip(depth, NEAR_MM, None), cam.focus_mm, cam.camera)
+                        ).max(axis=1)
+        sides = np.linalg.norm(np.roll(pattern, -1, axis=1) - pattern, axis=2) / np.array(cam.squares * 2, float)
+        cell = sides.min(axis=1) * cam.marker_share / cam.marker_cells
+        ok = (pattern_front.all(axis=1) & (_seen(in_image, cam.squares).sum(axis=1) >= MIN_PLAN_CORNERS)
+              & (cell >= MIN_CELL_PX) & (blur <= FOCUS_BLUR_PER_CELL * cell))
+        return ok, in_image, blur
+
+    def found(self, in_image: np.ndarray) -> np.ndarray:
+        """(k, m) which inner corners are found: their squares' corners in the image (``in_image`` (k, l)) and off
+        every obstacle nearer than the board (on its grown hull: criterion 2)."""
+        good = in_image.copy()
+        for sighted in self.sighted:
+            hides = ~(self.board_depth < sighted.distance) & (~self.bounded | sighted.near.reaches(self.low, self.high))
+            if hides.any():
+                good[hides] &= ~sighted.near.on(*self.lattice(hides))
+        return _seen(good, self.cam.squares)
+
+    def covers(self) -> np.ndarray:
+        """(k,) whether each board covers a target (criterion 2): where its outline, sampled at most OUTLINE_STEP_PX
+        apart along the longest edge of all k papers in the image, falls on the target's grown hull, a vertex of
+        the hull lies inside its paper, or its post falls on the hull grown by the post's radius, and the board is
+        nearer (their centres' depths)."""
+        c, K, view = self.c, self.cam.K, self.view
+        quad, front = self.quad, self.front
+        edge_px = np.nanmax(np.linalg.norm(np.roll(quad, -1, axis=1) - quad, axis=2)[front.all(axis=1)], initial=0.0)
+        s = np.linspace(-0.5, 0.5, int(np.ceil(min(edge_px, 4 * self.cam.width) / OUTLINE_STEP_PX)) + 2)
+        outline = np.vstack([np.column_stack([s, np.full_like(s, e)]) for e in (-0.5, 0.5)]
+                            + [np.column_stack([np.full_like(s, e), s]) for e in (-0.5, 0.5)])
+        top = c.post_top[self.idx]
+        post_ends, post_front = pixels(np.stack([top * np.array([1.0, 1.0, 0.0]), top], axis=1), view, K)
+        post_low, post_high, post_bounded = post_ends.min(axis=1), post_ends.max(axis=1), post_front.all(axis=1)
+        covers = np.zeros(len(self.idx), bool)
+        for sighted in self.sighted:
+            if not sighted.obstacle.hidden_matters:
+                continue
+            nearer = self.board_depth < sighted.distance
+            paper = nearer & (~self.bounded | sighted.near.reaches(self.low, self.high))
+            if paper.any():
+                on = sighted.near.on(*c.pixels(outline, c.paper, self.idx[paper], view, K)).any(axis=1)
+                covers[paper] |= on | vertices_inside(quad[paper], sighted.hull)
+            post = nearer & (~post_bounded | sighted.post.reaches(post_low, post_high))
+            if post.any():
+                covers[post] |= sighted.post.on(*pixels(c.post(self.idx[post]), view, K)).any(axis=1)
+        return covers
+
+
 def _judge(c: _Candidates, poses: list[np.ndarray], obstacles: list[Obstacle], squares: tuple[int, int],
            marker_cells: float, marker_share: float, K: np.ndarray, width: int, height: int, focus_mm: float,
            camera, blur_sigma_px: float) -> _Judged:
     """Criteria 1-4 of the module docstring for every candidate at every pose. Criterion 2 in two parts: where a
     board and an obstacle overlap in the image (the board's outline, sampled at most OUTLINE_STEP_PX apart, on the
-    obstacle's hull grown by CLEARANCE_PX, or a hull vertex inside the board; its post likewise), the nearer one
+    obstacle's hull grown by CLEARANCE_PX, or a hull vertex inside it; its post likewise), the nearer one
     covers the other (their centres' depths): a board covering a target is dropped, one covered does not serve that
-    pose. A candidate failing 1-3 at pose 0 (model image 0) is dropped too (``alive`` False)."""
+    pose. A candidate failing 1-3 at pose 0 (model image 0) is dropped too (``alive`` False).
+
+    In two passes: first which candidates stay, pose by pose in order (the outline's samples follow the longest
+    edge among the candidates still alive), then, for those alone, what they serve at every pose."""
     n, p = len(c.centre), len(poses)
     m = (squares[0] - 1) * (squares[1] - 1)
+    cam = _Camera(K, width, height, focus_mm, camera, blur_sigma_px, squares, marker_cells, marker_share)
     alive = c.on_board(PAPER, c.paper, np.ones(n, bool))[..., 2].min(axis=1) >= TABLE_CLEARANCE_MM
+    views, sighted = [], []
+    for k, T_world_cam in enumerate(poses):
+        if not alive.any():
+            break
+        views.append(inverse(T_world_cam))
+        sighted.append(_sighted(obstacles, views[k], K, width, height))
+        at = _View(c, np.flatnonzero(alive), views[k], sighted[k], cam)
+        if k == 0:  # 1 and 3 first, on the pattern's and the paper's corners: in model image 0 they drop most
+            ok, in_image, _ = at.shown()
+            alive[at.idx[~ok]] = False
+            at, in_image = at.subset(ok), in_image[ok]
+            alive[at.idx] = ~at.covers() & (at.found(in_image).sum(axis=1) >= MIN_PLAN_CORNERS)
+        else:
+            alive[at.idx] = ~at.covers()
     served = np.zeros((n, p), bool)
     sigma_t = np.full((n, p), np.inf)
     noises = np.full((n, p), np.nan)
     visible = np.zeros((n, p, m), bool)
-    inner, lattice = _inner(squares), _lattice(squares)
-    for k, T_world_cam in enumerate(poses):
-        if not alive.any():
-            break
-        view = inverse(T_world_cam)
-        # 1 and 3 first, on the pattern's and the paper's corners: in model image 0 they drop most candidates
-        corners = c.on_board(PAPER, c.paper, alive)
-        quad, front = pixels(corners, view, K)
-        pattern, pattern_front = pixels(c.on_board(PAPER, c.pattern, alive), view, K)
-        points, points_front = pixels(c.on_board(lattice, c.pattern, alive), view, K)
-        in_image = (points_front & (points[..., 0] >= 0) & (points[..., 0] <= width - 1) & (points[..., 1] >= 0)
-                    & (points[..., 1] <= height - 1))
-        # the blur at the board's nearest and farthest corners against a marker's bit cell where the pattern's
-        # outline is shortest in the image (far and foreshortened)
-        depth = corners @ view[2, :3] + view[2, 3]  # (k, 4)
-        blur = np.hypot(blur_sigma_px, defocus_sigma_px(np.clip(depth, NEAR_MM, None), focus_mm, camera)).max(axis=1)
-        sides = np.linalg.norm(np.roll(pattern, -1, axis=1) - pattern, axis=2) / np.array(squares * 2, float)
-        cell = sides.min(axis=1) * marker_share / marker_cells
-        ok = (pattern_front.all(axis=1) & (_seen(in_image, squares).sum(axis=1) >= MIN_PLAN_CORNERS)
-              & (cell >= MIN_CELL_PX) & (blur <= FOCUS_BLUR_PER_CELL * cell))
-        if k == 0:
-            alive[np.flatnonzero(alive)[~ok]] = False
-            quad, front, corners, blur, points, points_front, in_image, ok = (
-                quad[ok], front[ok], corners[ok], blur[ok], points[ok], points_front[ok], in_image[ok], ok[ok])
-        idx = np.flatnonzero(alive)
-        # 2: who covers whom
-        edge_px = np.nanmax(np.linalg.norm(np.roll(quad, -1, axis=1) - quad, axis=2)[front.all(axis=1)], initial=0.0)
-        s = np.linspace(-0.5, 0.5, int(np.ceil(min(edge_px, 4 * width) / OUTLINE_STEP_PX)) + 2)
-        outline = np.vstack([np.column_stack([s, np.full_like(s, e)]) for e in (-0.5, 0.5)]
-                            + [np.column_stack([np.full_like(s, e), s]) for e in (-0.5, 0.5)])
-        outline_px = pixels(c.on_board(outline, c.paper, alive), view, K)
-        post_px = pixels(c.post(alive), view, K)
-        board_depth = c.centre[alive] @ view[2, :3] + view[2, 3]
-        covers = np.zeros(len(idx), bool)
-        hidden = np.zeros(points.shape[:2], bool)  # lattice points behind a nearer obstacle
-        for obstacle in obstacles:
-            hull = _hull(project(obstacle.vertices, view, K))
-            if len(hull) == 0:
-                continue
-            distance = obstacle.vertices.mean(axis=0) @ view[2, :3] + view[2, 3]
-            near = near_targets([hull], width, height, CLEARANCE_PX)
-            overlap = hits(*outline_px, near) | vertices_inside(quad, hull)
-            nearer = board_depth < distance
-            covers |= overlap & nearer & obstacle.hidden_matters
-            hidden |= _on(points, points_front, near) & ~nearer[:, None]
-            if obstacle.hidden_matters:  # the post in front of it
-                covers |= nearer & hits(*post_px, near_targets(
-                    [hull], width, height, CLEARANCE_PX + POST_RADIUS_MM * K[0, 0] / max(distance, NEAR_MM)))
-        seen = _seen(in_image & ~hidden, squares)
+    idx = np.flatnonzero(alive)
+    inner = _inner(squares)
+    for k, (view, sight) in enumerate(zip(views, sighted) if len(idx) else ()):
+        at = _View(c, idx, view, sight, cam)
+        ok, in_image, blur = at.shown()
+        seen = at.found(in_image)
         ok &= seen.sum(axis=1) >= MIN_PLAN_CORNERS
         # 4: the board pose's predicted sigma_t at its origin from its inner corners found, at the corner noise of
         # this blur
@@ -283,7 +442,6 @@ def _judge(c: _Candidates, poses: list[np.ndarray], obstacles: list[Obstacle], s
         visible[idx[ok], k] = seen[ok]
         sigma_t[idx[ok], k] = noise * _unit_sigma_t(c.on_board(inner, c.pattern, idx[ok]), c.origin[idx[ok]], view, K,
                                                     seen[ok])
-        alive[idx] = ~covers & (ok if k == 0 else True)
     return _Judged(alive, served, sigma_t, noises, visible)
 
 
@@ -307,36 +465,27 @@ def _seen(good: np.ndarray, squares: tuple[int, int]) -> np.ndarray:
     return seen.reshape(len(good), (sy - 1) * (sx - 1))
 
 
-def _on(points: np.ndarray, front: np.ndarray, mask: np.ndarray) -> np.ndarray:
-    """(k, l) whether each point (k, l, 2) in front of the camera falls on ``mask`` (height, width)."""
-    height, width = mask.shape
-    u, v = np.round(points[..., 0]).astype(np.int64), np.round(points[..., 1]).astype(np.int64)
-    inside = front & (u >= 0) & (u < width) & (v >= 0) & (v < height)
-    on = np.zeros(u.shape, bool)
-    on[inside] = mask[v[inside], u[inside]]
-    return on
-
-
 def _inner(squares: tuple[int, int]) -> np.ndarray:
     """(m, 2) a board's inner (chessboard) corners as fractions of its pattern about the centre."""
     sx, sy = squares
     return np.array([[(i + 1) / sx - 0.5, (j + 1) / sy - 0.5] for j in range(sy - 1) for i in range(sx - 1)])
 
 
-def _handover_sigma_t(c: _Candidates, judged: _Judged, a: int, b: int, poses: list[np.ndarray],
+def _handover_sigma_t(c: _Candidates, judged: _Judged, a: int, b: int, views: np.ndarray,
                       squares: tuple[int, int], K: np.ndarray, need: np.ndarray, spread: np.ndarray) -> np.ndarray:
     """(p,) the sigma_t (mm) at board ``a``'s origin of a frame judged by board ``b`` (a handover: stage 02 carries
     the camera's motion since model image 0, read from b, to a's origin, :func:`~poseintegrity.localization.
     ground_truth.handed_over`): hypot of what b's corners found, at their corner noise, predict for a's origin at the
-    pose and at model image 0 (pose 0), times ``spread`` (by the corners found, :func:`estimate_spread`); inf where b
-    does not serve the pose, or where ``need`` (p,) is False."""
-    out = np.full(len(poses), np.inf)
+    pose (``views`` (p, 4, 4): T_cam_world) and at model image 0 (pose 0), times ``spread`` (by the corners found,
+    :func:`estimate_spread`); inf where b does not serve the pose, or where ``need`` (p,) is False."""
+    out = np.full(len(views), np.inf)
     at = np.flatnonzero(judged.served[b] & need)
     if len(at):
+        poses = np.concatenate([[0], at])
         corners = c.on_board(_inner(squares), c.pattern, np.array([b]))
-        unit = [_unit_sigma_t(corners, c.origin[[a]], inverse(poses[k]), K, judged.visible[b, k][None])[0]
-                for k in (0, *at)]
-        sigma = judged.noise[b, [0, *at]] * np.array(unit)
+        unit = _unit_sigma_t(np.repeat(corners, len(poses), axis=0), np.repeat(c.origin[[a]], len(poses), axis=0),
+                             views[poses], K, judged.visible[b, poses])
+        sigma = judged.noise[b, poses] * unit
         out[at] = np.hypot(sigma[1:], sigma[0]) * spread[judged.visible[b, at].sum(axis=1)]
     return out
 
@@ -347,33 +496,110 @@ def _hull(points: np.ndarray) -> np.ndarray:
     return cv2.convexHull(points.astype(np.float32)).reshape(-1, 2) if len(points) else points
 
 
+SINGULAR_COND = 1e12  # an information matrix this ill-conditioned predicts nothing: sigma_t inf
+
+
 def _unit_sigma_t(corners: np.ndarray, origin: np.ndarray, view: np.ndarray, K: np.ndarray,
                   seen: np.ndarray | None = None) -> np.ndarray:
     """(k,) RMS error (mm) of the board origin predicted from the corners (k, m, 3, world) at unit pixel noise:
     sqrt(trace of the translation block of (J^T J)^-1), J (2m, 6) the Jacobian of the corners' pixels with respect to
     a small rotation about the camera origin and the translation of the board (the translation block does not
-    depend on how the rotation is parametrized: OpenCV's rvec gives the same)."""
+    depend on how the rotation is parametrized: OpenCV's rvec gives the same). ``view``: T_cam_world (4, 4), or one
+    per board (k, 4, 4); ``seen`` (k, m): the corners found (default: all)."""
     if len(corners) == 0:
         return np.empty(0)
-    P = corners @ view[:3, :3].T + view[:3, 3]  # (k, m, 3) camera frame
-    t = origin @ view[:3, :3].T + view[:3, 3]  # (k, 3)
-    X, Y, Z = P[..., 0], P[..., 1], np.clip(P[..., 2], NEAR_MM, None)
-    zeros = np.zeros_like(Z)
-    d_point = np.stack([np.stack([K[0, 0] / Z, zeros, -K[0, 0] * X / Z**2], -1),
-                        np.stack([zeros, K[1, 1] / Z, -K[1, 1] * Y / Z**2], -1)], -2)  # (k, m, 2, 3)
-    r = P - t[:, None, :]  # rotation moves r: d P = omega x r = -[r]_x omega
-    skew = np.zeros((*r.shape, 3))
-    skew[..., 0, 1], skew[..., 0, 2], skew[..., 1, 2] = -r[..., 2], r[..., 1], -r[..., 0]
-    skew[..., 1, 0], skew[..., 2, 0], skew[..., 2, 1] = r[..., 2], -r[..., 1], r[..., 0]
-    J = np.concatenate([d_point @ -skew, d_point], axis=-1)  # (k, m, 2, 6)
-    if seen is not None:  # only the corners found (k, m)
-        J = J * seen[..., None, None]
-    J = J.reshape(len(P), -1, 6)  # (k, 2m, 6)
-    information = np.einsum("kai,kaj->kij", J, J)
-    singular = np.linalg.cond(information) > 1e12
-    information[singular] = np.eye(6)
-    covariance = np.linalg.inv(information)
+    views = np.broadcast_to(view, (len(corners), 4, 4))
+    seen = np.ones(corners.shape[:2], bool) if seen is None else seen
+    information = np.zeros((len(corners), 6, 6))
+    _information(corners, origin, views, K[0, 0], K[1, 1], seen, information)
+    covariance = np.empty_like(information)
+    try:
+        covariance[...] = np.linalg.inv(information)
+        # cond = |A|_2 |A^-1|_2 <= |A|_F |A^-1|_F: the SVD (np.linalg.cond) only where this bound does not rule it out
+        with np.errstate(over="ignore"):
+            doubt = ~(np.linalg.norm(information, axis=(1, 2)) * np.linalg.norm(covariance, axis=(1, 2))
+                      <= SINGULAR_COND / 10)
+    except np.linalg.LinAlgError:  # one is singular to the bit
+        doubt = np.ones(len(corners), bool)
+    singular = np.zeros(len(corners), bool)
+    if doubt.any():
+        singular[doubt] = np.linalg.cond(information[doubt]) > SINGULAR_COND
+        information[singular] = np.eye(6)
+        covariance[doubt] = np.linalg.inv(information[doubt])
     return np.where(singular, np.inf, np.sqrt(np.clip(np.trace(covariance[:, 3:, 3:], axis1=1, axis2=2), 0.0, None)))
+
+
+@intrinsic
+def _fma(typingctx, a, b, c):
+    """a b + c rounded once (LLVM's fma): OpenBLAS's kernels multiply and add so."""
+    def codegen(context, builder, signature, args):
+        double = ir.DoubleType()
+        return builder.call(builder.module.declare_intrinsic("llvm.fma", [double],
+                                                             ir.FunctionType(double, [double] * 3)), args)
+
+    return types.float64(types.float64, types.float64, types.float64), codegen
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")  # no fastmath: IEEE float64, no reassociation or FMA unasked
+def _board_pixels(centre, x_b, y_b, of, keep, fractions, view, K, uv, front):
+    """uv (k, m, 2), front (k, m) of :meth:`_Candidates.pixels`, in numpy's order of operations (the matrix product
+    by the view's rotation as OpenBLAS computes it: fused multiply-adds from zero, term by term)."""
+    for a in range(len(keep)):
+        i = keep[a]
+        for j in range(len(fractions)):
+            u, v = fractions[j, 0] * of[i, 0], fractions[j, 1] * of[i, 1]
+            p0 = centre[i, 0] + u * x_b[i, 0] + v * y_b[i, 0]
+            p1 = centre[i, 1] + u * x_b[i, 1] + v * y_b[i, 1]
+            p2 = centre[i, 2] + u * x_b[i, 2] + v * y_b[i, 2]
+            x = _fma(p2, view[0, 2], _fma(p1, view[0, 1], _fma(p0, view[0, 0], 0.0))) + view[0, 3]
+            y = _fma(p2, view[1, 2], _fma(p1, view[1, 1], _fma(p0, view[1, 0], 0.0))) + view[1, 3]
+            z = _fma(p2, view[2, 2], _fma(p1, view[2, 1], _fma(p0, view[2, 0], 0.0))) + view[2, 3]
+            front[a, j] = z > NEAR_MM
+            z = z if z > NEAR_MM else 1.0
+            uv[a, j, 0] = K[0, 0] * x / z + K[0, 2]
+            uv[a, j, 1] = K[1, 1] * y / z + K[1, 2]
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")  # no fastmath: IEEE float64, no reassociation or FMA unasked
+def _information(corners, origin, views, fx, fy, seen, out):
+    """out (k, 6, 6, zeros) += J^T J of :func:`_unit_sigma_t` for corners (k, m, 3), origins (k, 3), views
+    (k, 4, 4), focal lengths fx, fy px and the corners found (k, m), to the bit as numpy computed them: a matrix
+    product of 3 terms (OpenBLAS) is a fused multiply-add from zero, term by term; the einsum of J^T J sums the
+    products in order. A corner not found (J times 0) adds only zeros: skipped."""
+    J = np.empty((2, 6))
+    for n in range(corners.shape[0]):
+        R, T = views[n, :3, :3], views[n, :3, 3]
+        o0, o1, o2 = origin[n, 0], origin[n, 1], origin[n, 2]
+        t0 = _fma(o2, R[0, 2], _fma(o1, R[0, 1], _fma(o0, R[0, 0], 0.0))) + T[0]
+        t1 = _fma(o2, R[1, 2], _fma(o1, R[1, 1], _fma(o0, R[1, 0], 0.0))) + T[1]
+        t2 = _fma(o2, R[2, 2], _fma(o1, R[2, 1], _fma(o0, R[2, 0], 0.0))) + T[2]
+        for i in range(corners.shape[1]):
+            if not seen[n, i]:
+                continue
+            x0, x1, x2 = corners[n, i, 0], corners[n, i, 1], corners[n, i, 2]
+            X = _fma(x2, R[0, 2], _fma(x1, R[0, 1], _fma(x0, R[0, 0], 0.0))) + T[0]
+            Y = _fma(x2, R[1, 2], _fma(x1, R[1, 1], _fma(x0, R[1, 0], 0.0))) + T[1]
+            Z = _fma(x2, R[2, 2], _fma(x1, R[2, 1], _fma(x0, R[2, 0], 0.0))) + T[2]
+            r0, r1, r2 = X - t0, Y - t1, Z - t2  # before Z is clipped
+            Z = max(Z, NEAR_MM)
+            # d(pixel)/d(point) (2, 3): [[fx / Z, 0, -fx X / Z^2], [0, fy / Z, -fy Y / Z^2]]; times -[r]_x, whose
+            # diagonal is -0.0 (the negated zeros of [r]_x)
+            for row in range(2):
+                if row == 0:
+                    d0, d1, d2 = fx / Z, 0.0, -fx * X / (Z * Z)
+                else:
+                    d0, d1, d2 = 0.0, fy / Z, -fy * Y / (Z * Z)
+                J[row, 0] = _fma(d2, r1, _fma(d1, -r2, _fma(d0, -0.0, 0.0)))
+                J[row, 1] = _fma(d2, -r0, _fma(d1, -0.0, _fma(d0, r2, 0.0)))
+                J[row, 2] = _fma(d2, -0.0, _fma(d1, r0, _fma(d0, -r1, 0.0)))
+                J[row, 3], J[row, 4], J[row, 5] = d0, d1, d2
+            for row in range(2):
+                for a in range(6):
+                    for b in range(a, 6):
+                        out[n, a, b] = out[n, a, b] + J[row, a] * J[row, b]
+        for a in range(6):
+            for b in range(a):
+                out[n, a, b] = out[n, b, a]
 
 
 def _placement(c: _Candidates, i: int, in_view: float) -> BoardPlacement:
@@ -491,6 +717,7 @@ class _Ranking:
                  squares: tuple[int, int], K: np.ndarray, limit_mm: float, target_centre: np.ndarray):
         self.c, self.judged, self.poses, self.index, self.squares, self.K = c, judged, poses, index, squares, K
         self.limit_mm = limit_mm
+        self.views = np.array([inverse(T) for T in poses])  # T_cam_world (p, 4, 4)
         self.alive = alive = np.flatnonzero(judged.alive)
         self.spread = np.array([estimate_spread(n) if n > 3 else np.inf for n in range(judged.visible.shape[2] + 1)])
         self.sigma = judged.sigma_t[alive] * self.spread[judged.visible[alive].sum(axis=2)]
@@ -512,7 +739,7 @@ class _Ranking:
         (the handover), fails the fewest of its poses (model image 0 by its own board: its pose places M_t); ranked
         as :meth:`rank` ranks a single board."""
         alive, ok, sigma = self.alive, self.ok, self.sigma
-        via = {(own, other): _handover_sigma_t(self.c, self.judged, alive[own], alive[other], self.poses,
+        via = {(own, other): _handover_sigma_t(self.c, self.judged, alive[own], alive[other], self.views,
                                                self.squares, self.K, ~ok[own] & self.judged.served[alive[other]],
                                                self.spread)
                for own, other in ((a, b), (b, a))}
