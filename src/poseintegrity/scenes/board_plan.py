@@ -541,23 +541,89 @@ def _fma(typingctx, a, b, c):
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")  # no fastmath: IEEE float64, no reassociation or FMA unasked
+def _project(p0, p1, p2, view, K):
+    """(u, v, in front of the camera) of the world point (p0, p1, p2) as :func:`~.board_placement.pixels` computes
+    them, to the bit: its matrix product by the view's rotation as OpenBLAS does, fused multiply-adds from zero, term
+    by term."""
+    x = _fma(p2, view[0, 2], _fma(p1, view[0, 1], _fma(p0, view[0, 0], 0.0))) + view[0, 3]
+    y = _fma(p2, view[1, 2], _fma(p1, view[1, 1], _fma(p0, view[1, 0], 0.0))) + view[1, 3]
+    z = _fma(p2, view[2, 2], _fma(p1, view[2, 1], _fma(p0, view[2, 0], 0.0))) + view[2, 3]
+    front = z > NEAR_MM
+    z = z if front else 1.0
+    return K[0, 0] * x / z + K[0, 2], K[1, 1] * y / z + K[1, 2], front
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")  # no fastmath: IEEE float64, no reassociation or FMA unasked
 def _board_pixels(centre, x_b, y_b, of, keep, fractions, view, K, uv, front):
-    """uv (k, m, 2), front (k, m) of :meth:`_Candidates.pixels`, in numpy's order of operations (the matrix product
-    by the view's rotation as OpenBLAS computes it: fused multiply-adds from zero, term by term)."""
+    """uv (k, m, 2), front (k, m) of :meth:`_Candidates.pixels`, the points as :meth:`_Candidates.on_board` computes
+    them."""
     for a in range(len(keep)):
         i = keep[a]
         for j in range(len(fractions)):
             u, v = fractions[j, 0] * of[i, 0], fractions[j, 1] * of[i, 1]
-            p0 = centre[i, 0] + u * x_b[i, 0] + v * y_b[i, 0]
-            p1 = centre[i, 1] + u * x_b[i, 1] + v * y_b[i, 1]
-            p2 = centre[i, 2] + u * x_b[i, 2] + v * y_b[i, 2]
-            x = _fma(p2, view[0, 2], _fma(p1, view[0, 1], _fma(p0, view[0, 0], 0.0))) + view[0, 3]
-            y = _fma(p2, view[1, 2], _fma(p1, view[1, 1], _fma(p0, view[1, 0], 0.0))) + view[1, 3]
-            z = _fma(p2, view[2, 2], _fma(p1, view[2, 1], _fma(p0, view[2, 0], 0.0))) + view[2, 3]
-            front[a, j] = z > NEAR_MM
-            z = z if z > NEAR_MM else 1.0
-            uv[a, j, 0] = K[0, 0] * x / z + K[0, 2]
-            uv[a, j, 1] = K[1, 1] * y / z + K[1, 2]
+            uv[a, j, 0], uv[a, j, 1], front[a, j] = _project(centre[i, 0] + u * x_b[i, 0] + v * y_b[i, 0],
+                                                             centre[i, 1] + u * x_b[i, 1] + v * y_b[i, 1],
+                                                             centre[i, 2] + u * x_b[i, 2] + v * y_b[i, 2], view, K)
+
+
+def _pixels(points: np.ndarray, views: np.ndarray, K: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`~.board_placement.pixels` (p, k, m, 2) of world points (k, m, 3) at every view (p, 4, 4: T_cam_world),
+    and whether each is in front of the camera (p, k, m)."""
+    uv, front = np.empty((len(views), *points.shape[:2], 2)), np.empty((len(views), *points.shape[:2]), bool)
+    _pixels_at(points, views, K, uv, front)
+    return uv, front
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def _pixels_at(points, views, K, uv, front):
+    for p in range(len(views)):
+        for k in range(points.shape[0]):
+            for m in range(points.shape[1]):
+                uv[p, k, m, 0], uv[p, k, m, 1], front[p, k, m] = _project(points[k, m, 0], points[k, m, 1],
+                                                                          points[k, m, 2], views[p], K)
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def _apart_at(papers_1, posts_1, seen_1, papers_2, posts_2, seen_2, apart):
+    """apart (m, n) of :func:`_apart` from the boards' :func:`_outlines` (m and n boards), a pair's poses looked at
+    until its boards overlap."""
+    for i in range(apart.shape[0]):
+        for j in range(apart.shape[1]):
+            apart[i, j] = True
+            for p in range(len(papers_1)):
+                if seen_1[p, i] and seen_2[p, j] and (_overlap(papers_1[p, i], papers_2[p, j])
+                                                      or _overlap(papers_1[p, i], posts_2[p, j])
+                                                      or _overlap(posts_1[p, i], papers_2[p, j])):
+                    apart[i, j] = False
+                    break
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")  # no fastmath: IEEE float64, no reassociation or FMA
+def _overlap(a, b):
+    """Whether the convex polygons a (p, 2) and b (q, 2) (a segment when 2 points) come within CLEARANCE_PX of each
+    other: no separating axis among their edges' normals (the separating axis theorem)."""
+    return not (_separates(a, b) or _separates(b, a))
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")  # no fastmath: IEEE float64, no reassociation or FMA
+def _separates(a, b):
+    """Whether along the normal of an edge of polygon a (p, 2) polygon b (q, 2) lies more than CLEARANCE_PX beyond
+    it. The normal is the edge turned by 90 deg over its length (at least 1e-9), each projection the sum of two
+    products, in this order."""
+    for e in range(len(a)):
+        nx, ny = -(a[(e + 1) % len(a), 1] - a[e, 1]), a[(e + 1) % len(a), 0] - a[e, 0]
+        length = max(np.sqrt(nx * nx + ny * ny), 1e-9)
+        nx, ny = nx / length, ny / length
+        own_low, own_high, other_low, other_high = np.inf, -np.inf, np.inf, -np.inf
+        for q in range(len(a)):
+            d = nx * a[q, 0] + ny * a[q, 1]
+            own_low, own_high = min(own_low, d), max(own_high, d)
+        for q in range(len(b)):
+            d = nx * b[q, 0] + ny * b[q, 1]
+            other_low, other_high = min(other_low, d), max(other_high, d)
+        if max(other_low - own_high, own_low - other_high) > CLEARANCE_PX:
+            return True
+    return False
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")  # no fastmath: IEEE float64, no reassociation or FMA unasked
@@ -608,40 +674,23 @@ def _placement(c: _Candidates, i: int, in_view: float) -> BoardPlacement:
                           top * np.array([1.0, 1.0, 0.0]), top, in_view)
 
 
-def _apart(c: _Candidates, first: np.ndarray, second: np.ndarray, poses: list[np.ndarray], K: np.ndarray
+def _apart(c: _Candidates, first: np.ndarray, second: np.ndarray, views: np.ndarray, K: np.ndarray
            ) -> np.ndarray:
     """(m, n) whether each board of ``first`` (m,) and each of ``second`` (n,) stay apart in the image at every
-    pose: neither paper overlaps the other's paper, nor the other's post (a segment from its foot to its top), with
-    CLEARANCE_PX to spare, so that neither covers the other wherever it serves."""
-    apart = np.ones((len(first), len(second)), bool)
-    ends = np.array([0, -1])
-    for T_world_cam in poses:
-        view = inverse(T_world_cam)
-        (papers_1, front_1), (papers_2, front_2) = (pixels(c.on_board(PAPER, c.paper, b), view, K) for b in (first, second))
-        (posts_1, post_front_1), (posts_2, post_front_2) = (pixels(c.post(b)[:, ends], view, K) for b in (first, second))
-        seen_1 = front_1.all(axis=1) & post_front_1.all(axis=1)  # a board partly behind the camera is not in the image
-        seen_2 = front_2.all(axis=1) & post_front_2.all(axis=1)
-        overlap = _overlap(papers_1, papers_2) | _overlap(papers_1, posts_2) | _overlap(posts_1, papers_2)
-        apart &= ~(seen_1[:, None] & seen_2[None, :] & overlap)
+    pose (``views`` (p, 4, 4): T_cam_world): neither paper overlaps the other's paper, nor the other's post (a segment
+    from its foot to its top), with CLEARANCE_PX to spare, so that neither covers the other wherever it serves."""
+    apart = np.empty((len(first), len(second)), bool)
+    _apart_at(*_outlines(c, first, views, K), *_outlines(c, second, views, K), apart)
     return apart
 
 
-def _overlap(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """(m, n): whether the convex polygons a[i] (m, p, 2) and b[j] (n, q, 2) (a segment when 2 points) come within
-    CLEARANCE_PX of each other: no separating axis among their edges' normals (the separating axis theorem)."""
-    def normals(polygon: np.ndarray) -> np.ndarray:
-        edges = np.roll(polygon, -1, axis=1) - polygon
-        n = np.stack([-edges[..., 1], edges[..., 0]], axis=-1)
-        return n / np.maximum(np.linalg.norm(n, axis=-1, keepdims=True), 1e-9)
-
-    na, nb = normals(a), normals(b)
-    own_a, a_on_b = np.einsum("ikd,ipd->ikp", na, a), np.einsum("jkd,ipd->ijkp", nb, a)
-    own_b, b_on_a = np.einsum("jkd,jpd->jkp", nb, b), np.einsum("ikd,jpd->ijkp", na, b)
-    gap_a = np.maximum(b_on_a.min(axis=-1) - own_a.max(axis=-1)[:, None], own_a.min(axis=-1)[:, None]
-                       - b_on_a.max(axis=-1))  # (m, n, k) along a's axes
-    gap_b = np.maximum(a_on_b.min(axis=-1) - own_b.max(axis=-1)[None], own_b.min(axis=-1)[None]
-                       - a_on_b.max(axis=-1))  # along b's axes
-    return ~((gap_a > CLEARANCE_PX).any(axis=-1) | (gap_b > CLEARANCE_PX).any(axis=-1))
+def _outlines(c: _Candidates, boards: np.ndarray, views: np.ndarray, K: np.ndarray
+              ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Per pose (``views`` (p, 4, 4): T_cam_world) the images of the boards' papers (p, k, 4, 2) and posts (p, k, 2,
+    2: foot, top), and whether each board is in the image (p, k): a board partly behind the camera is not."""
+    (papers, paper_front), (posts, post_front) = (_pixels(points, views, K) for points in (
+        c.on_board(PAPER, c.paper, boards), c.post(boards, 2)))
+    return papers, posts, paper_front.all(axis=-1) & post_front.all(axis=-1)
 
 
 def plan_boards(sizes_mm: list[float], squares: tuple[int, int], marker_share: float, marker_cells: float,
@@ -675,23 +724,21 @@ def plan_boards(sizes_mm: list[float], squares: tuple[int, int], marker_share: f
             f"generate.board.sizes_mm, a larger distance_mm, fewer or smaller targets (generate.scapula.length_mm) "
             f"would leave room")
     ranking = _Ranking(c, judged, poses, index, squares, K, plan_sigma_t_mm, target_centre)
-    chosen = min(((k,) for k in range(len(ranking.alive))), key=ranking.rank)
+    singles = ranking.singles()
+    chosen = (int(singles[0]),)
     best = ranking.rank(chosen)
     service = _Service((0,) * len(index), tuple(int(f) for f in ranking.failing[chosen[0]]))
     if max_boards > 1 and ranking.failing[chosen[0]].any():
         # a pair: each of the best boards alone with the boards apart from it that leave the fewest poses unserved
         # by either (what a handover could at best reach), the best PAIR_POOL of them tried
         alive, ok, lever = ranking.alive, ranking.ok, ranking.lever
-        pool = sorted(range(len(alive)), key=lambda k: ranking.rank((k,)))[:PAIR_POOL]
-        apart = _apart(c, alive[pool], alive, poses, K)
-        for a, apart_a in zip(pool, apart):
+        for a in (int(k) for k in singles[:PAIR_POOL]):
             either = np.stack([(~(ok[a, i] | ok[:, i])).sum(axis=1) for i in index], axis=1)  # (alive, trajectories)
-            others = np.flatnonzero(apart_a & (np.arange(len(alive)) != a))
-            tried = others[np.lexsort((lever[others], either[others].sum(axis=1), -(either[others] == 0).sum(axis=1)))]
-            for b in tried[:PAIR_POOL]:
-                ranked, served = ranking.pair(a, int(b))
+            order = np.lexsort((lever, either.sum(axis=1), -(either == 0).sum(axis=1)))
+            for b in _first_apart(c, alive, a, order[order != a], ranking.views, K):
+                ranked, served = ranking.pair(a, b)
                 if ranked < best:
-                    chosen, best, service = (a, int(b)), ranked, served
+                    chosen, best, service = (a, b), ranked, served
     board_of, unserved = service
     planned = []
     for b, k in enumerate(chosen):
@@ -702,6 +749,19 @@ def plan_boards(sizes_mm: list[float], squares: tuple[int, int], marker_share: f
         planned.append(PlannedBoard(float(c.square[i]), b * (squares[0] * squares[1] // 2), _placement(c, i, in_view),
                                     float(sigma)))
     return BoardPlan(tuple(planned), board_of, unserved)
+
+
+def _first_apart(c: _Candidates, alive: np.ndarray, a: int, order: np.ndarray, views: np.ndarray, K: np.ndarray
+                 ) -> list[int]:
+    """The first PAIR_POOL boards of ``order`` (indices into ``alive``, the candidates' indices) that stay apart from
+    board ``a`` (:func:`_apart`), looked at in blocks twice as long each time (the boards best completing ``a`` are
+    often beside it: hundreds may overlap it before PAIR_POOL stand apart)."""
+    found, start, size = [], 0, PAIR_POOL
+    while len(found) < PAIR_POOL and start < len(order):
+        block = order[start:start + size]
+        found += [int(b) for b in block[_apart(c, alive[[a]], alive[block], views, K)[0]]]
+        start, size = start + size, 2 * size
+    return found[:PAIR_POOL]
 
 
 class _Ranking:
@@ -715,7 +775,7 @@ class _Ranking:
 
     def __init__(self, c: _Candidates, judged: _Judged, poses: list[np.ndarray], index: list[np.ndarray],
                  squares: tuple[int, int], K: np.ndarray, limit_mm: float, target_centre: np.ndarray):
-        self.c, self.judged, self.poses, self.index, self.squares, self.K = c, judged, poses, index, squares, K
+        self.c, self.judged, self.index, self.squares, self.K = c, judged, index, squares, K
         self.limit_mm = limit_mm
         self.views = np.array([inverse(T) for T in poses])  # T_cam_world (p, 4, 4)
         self.alive = alive = np.flatnonzero(judged.alive)
@@ -725,6 +785,12 @@ class _Ranking:
         self.failing = np.stack([(~self.ok[:, i]).sum(axis=1) for i in index], axis=1)  # (alive, trajectories)
         self.worst = np.stack([judged.sigma_t[alive][:, i].max(axis=1) for i in index], axis=1)
         self.lever = np.linalg.norm(c.origin[alive] - target_centre, axis=1)
+
+    def singles(self) -> np.ndarray:
+        """The alive candidates (indices into alive) ordered by :meth:`rank` of each alone, best first."""
+        whole = self.failing == 0  # (alive, trajectories)
+        worst = np.round(np.where(whole, self.worst, 0.0).max(axis=1) / SIGMA_STEP_MM)  # 0 where none is served
+        return np.lexsort((np.arange(len(self.alive)), self.lever, worst, self.failing.sum(axis=1), -whole.sum(axis=1)))
 
     def rank(self, boards: tuple[int, ...]) -> tuple:
         """A single board (index into alive) is better the more trajectories it serves, the fewer poses it fails,
