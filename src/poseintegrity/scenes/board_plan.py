@@ -60,6 +60,7 @@ draw.
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import cv2
@@ -74,7 +75,7 @@ from scipy.stats import chi2
 from poseintegrity.poses import inverse, pose_matrix
 from poseintegrity.scenes.board_placement import (
     CLEARANCE_PX, GRID_RIGHT_MM, GRID_UP_MM, NEAR_MM, POST_BEHIND_MM, POST_RADIUS_MM, TABLE_CLEARANCE_MM,
-    BoardPlacement, PlacementError, near_targets, pixels, project, vertices_inside,
+    BoardPlacement, PlacementError, near_targets, project, vertices_inside,
 )
 from poseintegrity.scenes.optics import defocus_sigma_px
 
@@ -147,17 +148,10 @@ class _Candidates:
     def on_board(self, fractions: np.ndarray, of: np.ndarray, keep: np.ndarray) -> np.ndarray:
         """World points (k, m, 3) of board-plane points given as fractions (m, 2) of the size ``of`` (n, 2) about
         the centre, of the candidates ``keep`` (k of n: a mask or their indices)."""
-        offsets = fractions[None, :, :] * of[keep, None, :]  # (k, m, 2)
-        return (self.centre[keep, None, :] + offsets[..., :1] * self.x_b[keep, None, :]
-                + offsets[..., 1:] * self.y_b[keep, None, :])
-
-    def pixels(self, fractions: np.ndarray, of: np.ndarray, keep: np.ndarray, view: np.ndarray, K: np.ndarray
-               ) -> tuple[np.ndarray, np.ndarray]:
-        """:func:`~.board_placement.pixels` (k, m, 2) of :meth:`on_board`'s points (k, m, 3) at ``view``
-        (T_cam_world), to the bit, and whether each is in front of the camera (k, m); ``keep``: indices."""
-        uv, front = np.empty((len(keep), len(fractions), 2)), np.empty((len(keep), len(fractions)), bool)
-        _board_pixels(self.centre, self.x_b, self.y_b, of, keep, fractions, view, K, uv, front)
-        return uv, front
+        keep = np.flatnonzero(keep) if keep.dtype == bool else keep
+        points = np.empty((len(keep), len(fractions), 3))
+        _on_board_at(self.centre, self.x_b, self.y_b, of, keep, fractions, points)
+        return points
 
     def post(self, keep: np.ndarray, n: int = 24) -> np.ndarray:
         """(k, n, 3): points along the post's axis from the table to its top."""
@@ -250,13 +244,18 @@ class _Mask:
     def on(self, points: np.ndarray, front: np.ndarray) -> np.ndarray:
         """(k, l) whether each point (k, l, 2 px) in front of the camera (``front`` (k, l)) falls on the mask, rounded
         to its pixel."""
-        rows, columns = self.pixels.shape
-        u = np.round(points[..., 0]).astype(np.int64) - self.u0
-        v = np.round(points[..., 1]).astype(np.int64) - self.v0
-        inside = front & (u >= 0) & (u < columns) & (v >= 0) & (v < rows)
-        on = np.zeros(u.shape, bool)
-        on[inside] = self.pixels[v[inside], u[inside]]
+        on = np.empty(front.shape, bool)
+        _on_mask(points, front, self.pixels, self.u0, self.v0, on)
         return on
+
+    def touched(self, c: _Candidates, fractions: np.ndarray, of: np.ndarray, keep: np.ndarray, view: np.ndarray,
+                K: np.ndarray) -> np.ndarray:
+        """(k,) whether any of the board-plane points of each candidate ``keep`` (k,) (:meth:`_Candidates.on_board`)
+        falls on the mask at ``view`` (T_cam_world): :meth:`on` of their pixels, each board's looked at until one
+        does."""
+        touched = np.empty(len(keep), bool)
+        _touched(c.centre, c.x_b, c.y_b, of, keep, fractions, view, K, self.pixels, self.u0, self.v0, touched)
+        return touched
 
 
 @dataclass(frozen=True)
@@ -315,8 +314,8 @@ class _View:
     def __init__(self, c: _Candidates, idx: np.ndarray, view: np.ndarray, sighted: list[_Sighted], cam: _Camera):
         self.c, self.idx, self.view, self.sighted, self.cam = c, idx, view, sighted, cam
         self.corners = c.on_board(PAPER, c.paper, idx)  # (k, 4, 3) the paper's
-        self.quad, self.front = pixels(self.corners, view, cam.K)
-        self.low, self.high = self.quad.min(axis=1), self.quad.max(axis=1)
+        self.quad, self.front = _pixels(self.corners, view, cam.K)
+        self.low, self.high = _least(self.quad), _most(self.quad)
         edges = np.roll(self.quad, -1, axis=1) - self.quad
         area = np.abs(np.sum(self.quad[..., 0] * edges[..., 1] - self.quad[..., 1] * edges[..., 0], axis=1)) / 2
         # a board seen edge on (no area) is tested point by point: a point on its line is "inside" the quad
@@ -329,28 +328,34 @@ class _View:
     def lattice(self, which: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Pixels (j, l, 2) of the squares' corners (:func:`_lattice`) of the candidates ``which`` (a mask, j of
         them), and whether each is in front of the camera (j, l)."""
-        return self.c.pixels(_lattice(self.cam.squares), self.c.pattern, self.idx[which], self.view, self.cam.K)
+        return _pixels(self.c.on_board(_lattice(self.cam.squares), self.c.pattern, self.idx[which]), self.view,
+                       self.cam.K)
 
     def shown(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Criteria 1 and 3 (not yet what obstacles hide): ok (k,), which squares' corners are in the image (k, l)
         and the blur (k, px) at the board's nearest or farthest corner."""
         c, cam, view = self.c, self.cam, self.view
         width, height = cam.width, cam.height
-        pattern, pattern_front = pixels(c.on_board(PAPER, c.pattern, self.idx), view, cam.K)
+        pattern, pattern_front = _pixels(c.on_board(PAPER, c.pattern, self.idx), view, cam.K)
         depth = self.corners @ view[2, :3] + view[2, 3]  # (k, 4)
-        # a paper in front of the camera and a pixel inside the image's edges: every square's corner in the image
-        inside = (self.bounded & (depth.min(axis=1) > NEAR_MM + 1.0) & (self.low >= 1.0).all(axis=1)
-                  & (self.high[:, 0] <= width - 2) & (self.high[:, 1] <= height - 2))
-        in_image = np.ones((len(self.idx), len(_lattice(cam.squares))), bool)
-        points, points_front = self.lattice(~inside)
-        in_image[~inside] = (points_front & (points[..., 0] >= 0) & (points[..., 0] <= width - 1)
-                             & (points[..., 1] >= 0) & (points[..., 1] <= height - 1))
+        # the squares' corners lie in the pattern's image where its corners are in front of the camera: all in the
+        # image where that is inside the image's edges by a pixel (and the paper in front by a millimetre), none
+        # where it lies a pixel beyond one
+        low, high, whole = _least(pattern), _most(pattern), pattern_front.all(axis=1)
+        inside = (whole & (_least(depth) > NEAR_MM + 1.0) & (low >= 1.0).all(axis=1) & (high[:, 0] <= width - 2)
+                  & (high[:, 1] <= height - 2))
+        beyond = whole & ((high[:, 0] < -1.0) | (low[:, 0] > width) | (high[:, 1] < -1.0) | (low[:, 1] > height))
+        in_image = np.repeat(inside[:, None], len(_lattice(cam.squares)), axis=1)
+        rest = ~inside & ~beyond
+        points, points_front = self.lattice(rest)
+        in_image[rest] = (points_front & (points[..., 0] >= 0) & (points[..., 0] <= width - 1)
+                          & (points[..., 1] >= 0) & (points[..., 1] <= height - 1))
         # the blur at the board's nearest and farthest corners against a marker's bit cell where the pattern's
         # outline is shortest in the image (far and foreshortened)
-        blur = np.hypot(cam.blur_sigma_px, defocus_sigma_px(np.clip(depth, NEAR_MM, None), cam.focus_mm, cam.camera)
-                        ).max(axis=1)
-        sides = np.linalg.norm(np.roll(pattern, -1, axis=1) - pattern, axis=2) / np.array(cam.squares * 2, float)
-        cell = sides.min(axis=1) * cam.marker_share / cam.marker_cells
+        blur = _most(np.hypot(cam.blur_sigma_px, defocus_sigma_px(np.clip(depth, NEAR_MM, None), cam.focus_mm,
+                                                                   cam.camera)))
+        sides = _length(np.roll(pattern, -1, axis=1) - pattern) / np.array(cam.squares * 2, float)
+        cell = _least(sides) * cam.marker_share / cam.marker_cells
         ok = (pattern_front.all(axis=1) & (_seen(in_image, cam.squares).sum(axis=1) >= MIN_PLAN_CORNERS)
               & (cell >= MIN_CELL_PX) & (blur <= FOCUS_BLUR_PER_CELL * cell))
         return ok, in_image, blur
@@ -372,25 +377,24 @@ class _View:
         nearer (their centres' depths)."""
         c, K, view = self.c, self.cam.K, self.view
         quad, front = self.quad, self.front
-        edge_px = np.nanmax(np.linalg.norm(np.roll(quad, -1, axis=1) - quad, axis=2)[front.all(axis=1)], initial=0.0)
+        edge_px = np.nanmax(_length(np.roll(quad, -1, axis=1) - quad)[front.all(axis=1)], initial=0.0)
         s = np.linspace(-0.5, 0.5, int(np.ceil(min(edge_px, 4 * self.cam.width) / OUTLINE_STEP_PX)) + 2)
         outline = np.vstack([np.column_stack([s, np.full_like(s, e)]) for e in (-0.5, 0.5)]
                             + [np.column_stack([np.full_like(s, e), s]) for e in (-0.5, 0.5)])
         top = c.post_top[self.idx]
-        post_ends, post_front = pixels(np.stack([top * np.array([1.0, 1.0, 0.0]), top], axis=1), view, K)
-        post_low, post_high, post_bounded = post_ends.min(axis=1), post_ends.max(axis=1), post_front.all(axis=1)
+        post_ends, post_front = _pixels(np.stack([top * np.array([1.0, 1.0, 0.0]), top], axis=1), view, K)
+        post_low, post_high, post_bounded = _least(post_ends), _most(post_ends), post_front.all(axis=1)
         covers = np.zeros(len(self.idx), bool)
-        for sighted in self.sighted:
+        for sighted in self.sighted:  # each test on the boards that do not cover a target yet
             if not sighted.obstacle.hidden_matters:
                 continue
             nearer = self.board_depth < sighted.distance
-            paper = nearer & (~self.bounded | sighted.near.reaches(self.low, self.high))
-            if paper.any():
-                on = sighted.near.on(*c.pixels(outline, c.paper, self.idx[paper], view, K)).any(axis=1)
-                covers[paper] |= on | vertices_inside(quad[paper], sighted.hull)
-            post = nearer & (~post_bounded | sighted.post.reaches(post_low, post_high))
-            if post.any():
-                covers[post] |= sighted.post.on(*pixels(c.post(self.idx[post]), view, K)).any(axis=1)
+            paper = np.flatnonzero(nearer & ~covers & (~self.bounded | sighted.near.reaches(self.low, self.high)))
+            covers[paper] = sighted.near.touched(c, outline, c.paper, self.idx[paper], view, K)
+            paper = paper[~covers[paper]]
+            covers[paper] = vertices_inside(quad[paper], sighted.hull)
+            post = np.flatnonzero(nearer & ~covers & (~post_bounded | sighted.post.reaches(post_low, post_high)))
+            covers[post] = sighted.post.on(*_pixels(c.post(self.idx[post]), view, K)).any(axis=1)
         return covers
 
 
@@ -445,6 +449,21 @@ def _judge(c: _Candidates, poses: list[np.ndarray], obstacles: list[Obstacle], s
     return _Judged(alive, served, sigma_t, noises, visible)
 
 
+def _least(a: np.ndarray) -> np.ndarray:
+    """a.min(axis=1), the same values: numpy reduces along a short axis slowly, element-wise minima of its slices fast."""
+    return functools.reduce(np.minimum, np.moveaxis(a, 1, 0))
+
+
+def _most(a: np.ndarray) -> np.ndarray:
+    """a.max(axis=1), the same values (:func:`_least`)."""
+    return functools.reduce(np.maximum, np.moveaxis(a, 1, 0))
+
+
+def _length(v: np.ndarray) -> np.ndarray:
+    """np.linalg.norm(v, axis=-1) of 2-vectors (..., 2), to the bit (sqrt(x x + y y)), without its reduction."""
+    return np.sqrt(v[..., 0] * v[..., 0] + v[..., 1] * v[..., 1])
+
+
 def _lattice(squares: tuple[int, int]) -> np.ndarray:
     """((squares_y + 1) (squares_x + 1), 2) the corners of a board's squares, its outline's included, as fractions of
     its pattern about the centre, row by row."""
@@ -458,11 +477,8 @@ def _seen(good: np.ndarray, squares: tuple[int, int]) -> np.ndarray:
     interpolated from the markers of the squares about it."""
     sx, sy = squares
     grid = good.reshape(len(good), sy + 1, sx + 1)
-    seen = np.ones((len(good), sy - 1, sx - 1), bool)
-    for dj in range(3):
-        for di in range(3):
-            seen &= grid[:, dj:dj + sy - 1, di:di + sx - 1]
-    return seen.reshape(len(good), (sy - 1) * (sx - 1))
+    rows = grid[:, :-2] & grid[:, 1:-1] & grid[:, 2:]  # (k, sy - 1, sx + 1): three rows about each inner row
+    return (rows[:, :, :-2] & rows[:, :, 1:-1] & rows[:, :, 2:]).reshape(len(good), (sy - 1) * (sx - 1))
 
 
 def _inner(squares: tuple[int, int]) -> np.ndarray:
@@ -553,25 +569,63 @@ def _project(p0, p1, p2, view, K):
     return K[0, 0] * x / z + K[0, 2], K[1, 1] * y / z + K[1, 2], front
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy")  # no fastmath: IEEE float64, no reassociation or FMA unasked
-def _board_pixels(centre, x_b, y_b, of, keep, fractions, view, K, uv, front):
-    """uv (k, m, 2), front (k, m) of :meth:`_Candidates.pixels`, the points as :meth:`_Candidates.on_board` computes
-    them."""
+@numba.njit(cache=True, nogil=True, error_model="numpy")  # no fastmath: IEEE float64, no reassociation or FMA
+def _board_point(centre, x_b, y_b, of, i, fraction):
+    """World point (3 floats) of the board-plane point ``fraction`` (2,) of the size of[i] about candidate i's centre,
+    in numpy's order of operations (:meth:`_Candidates.on_board`): the centre, plus the offset along x_b, plus the
+    offset along y_b."""
+    u, v = fraction[0] * of[i, 0], fraction[1] * of[i, 1]
+    return (centre[i, 0] + u * x_b[i, 0] + v * y_b[i, 0], centre[i, 1] + u * x_b[i, 1] + v * y_b[i, 1],
+            centre[i, 2] + u * x_b[i, 2] + v * y_b[i, 2])
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def _on_board_at(centre, x_b, y_b, of, keep, fractions, points):
+    """points (k, m, 3) of :meth:`_Candidates.on_board` (``keep``: indices)."""
     for a in range(len(keep)):
-        i = keep[a]
         for j in range(len(fractions)):
-            u, v = fractions[j, 0] * of[i, 0], fractions[j, 1] * of[i, 1]
-            uv[a, j, 0], uv[a, j, 1], front[a, j] = _project(centre[i, 0] + u * x_b[i, 0] + v * y_b[i, 0],
-                                                             centre[i, 1] + u * x_b[i, 1] + v * y_b[i, 1],
-                                                             centre[i, 2] + u * x_b[i, 2] + v * y_b[i, 2], view, K)
+            points[a, j, 0], points[a, j, 1], points[a, j, 2] = _board_point(centre, x_b, y_b, of, keep[a],
+                                                                             fractions[j])
 
 
-def _pixels(points: np.ndarray, views: np.ndarray, K: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`~.board_placement.pixels` (p, k, m, 2) of world points (k, m, 3) at every view (p, 4, 4: T_cam_world),
-    and whether each is in front of the camera (p, k, m)."""
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def _on_pixel(u, v, front, pixels, u0, v0):
+    """Whether the image point (u, v px), in front of the camera (``front``), rounds (half to even, as np.round) onto
+    a True pixel of ``pixels`` (rows, columns), a mask's box from column u0 and row v0."""
+    if not front:
+        return False
+    u, v = np.rint(u) - u0, np.rint(v) - v0
+    return 0 <= u < pixels.shape[1] and 0 <= v < pixels.shape[0] and pixels[int(v), int(u)]
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def _on_mask(uv, front, pixels, u0, v0, on):
+    """on (k, l) of :meth:`_Mask.on`."""
+    for k in range(uv.shape[0]):
+        for l in range(uv.shape[1]):
+            on[k, l] = _on_pixel(uv[k, l, 0], uv[k, l, 1], front[k, l], pixels, u0, v0)
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def _touched(centre, x_b, y_b, of, keep, fractions, view, K, pixels, u0, v0, touched):
+    """touched (k,) of :meth:`_Mask.touched`."""
+    for a in range(len(keep)):
+        touched[a] = False
+        for j in range(len(fractions)):
+            p0, p1, p2 = _board_point(centre, x_b, y_b, of, keep[a], fractions[j])
+            u, v, front = _project(p0, p1, p2, view, K)
+            if _on_pixel(u, v, front, pixels, u0, v0):
+                touched[a] = True
+                break
+
+
+def _pixels(points: np.ndarray, view: np.ndarray, K: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`~.board_placement.pixels` (k, m, 2) of world points (k, m, 3) at ``view`` (T_cam_world (4, 4), or one
+    per pose (p, 4, 4): then (p, k, m, 2)), to the bit, and whether each is in front of the camera (k, m or p, k, m)."""
+    views = view.reshape(-1, 4, 4)
     uv, front = np.empty((len(views), *points.shape[:2], 2)), np.empty((len(views), *points.shape[:2]), bool)
     _pixels_at(points, views, K, uv, front)
-    return uv, front
+    return (uv, front) if view.ndim == 3 else (uv[0], front[0])
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
@@ -867,7 +921,7 @@ def _worst_in_view(c: _Candidates, i: int, poses: list[np.ndarray], K: np.ndarra
     grid = c.on_board(np.column_stack([gx.ravel(), gy.ravel()]), c.paper, keep)
     shares = []
     for T in poses:
-        uv, front = pixels(grid, inverse(T), K)
+        uv, front = _pixels(grid, inverse(T), K)
         shares.append(float((front & (uv[..., 0] >= 0) & (uv[..., 0] <= width - 1) & (uv[..., 1] >= 0)
                              & (uv[..., 1] <= height - 1)).mean()))
     return min(shares, default=1.0)
