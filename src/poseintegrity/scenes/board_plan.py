@@ -99,6 +99,7 @@ SIGMA_STEP_MM = 0.01  # predicted sigma_t closer than this count as equal: the l
 PAIR_POOL = 25  # pairs: each of the 25 best single boards with the 25 boards apart from it that best complete it
 OUTLINE_STEP_PX = 10.0  # outline samples at most this far apart: less than 2 CLEARANCE_PX, so a crossing is caught
 TRUSTED_SHARE = 0.95  # of a served stop's frames stage 02 should trust (issue 39's target share of trusted frames)
+SINGULAR_COND = 1e12  # an information matrix this ill-conditioned predicts nothing: sigma_t inf
 
 
 @dataclass(frozen=True)
@@ -311,7 +312,8 @@ class _View:
     point of the board in front of it projects inside their hull, within its bounding box ``low``-``high`` (k, 2 px)
     (and a post's inside its ends'); the other candidates pass those tests, as they would pixel by pixel."""
 
-    def __init__(self, c: _Candidates, idx: np.ndarray, view: np.ndarray, sighted: list[_Sighted], cam: _Camera):
+    def __init__(self, c: _Candidates, idx: np.ndarray, view: np.ndarray, sighted: list[_Sighted], cam: _Camera,
+                 board_depth: np.ndarray | None = None):
         self.c, self.idx, self.view, self.sighted, self.cam = c, idx, view, sighted, cam
         self.corners = c.on_board(PAPER, c.paper, idx)  # (k, 4, 3) the paper's
         self.quad, self.front = _pixels(self.corners, view, cam.K)
@@ -320,7 +322,8 @@ class _View:
         area = np.abs(np.sum(self.quad[..., 0] * edges[..., 1] - self.quad[..., 1] * edges[..., 0], axis=1)) / 2
         # a board seen edge on (no area) is tested point by point: a point on its line is "inside" the quad
         self.bounded = self.front.all(axis=1) & (area > 1.0)
-        self.board_depth = c.centre[idx] @ view[2, :3] + view[2, 3]
+        # the boards' centres' depths (k,), unless given
+        self.board_depth = c.centre[idx] @ view[2, :3] + view[2, 3] if board_depth is None else board_depth
 
     def subset(self, keep: np.ndarray) -> _View:
         return _View(self.c, self.idx[keep], self.view, self.sighted, self.cam)
@@ -356,7 +359,7 @@ class _View:
                                                                    cam.camera)))
         sides = _length(np.roll(pattern, -1, axis=1) - pattern) / np.array(cam.squares * 2, float)
         cell = _least(sides) * cam.marker_share / cam.marker_cells
-        ok = (pattern_front.all(axis=1) & (_seen(in_image, cam.squares).sum(axis=1) >= MIN_PLAN_CORNERS)
+        ok = (whole & (_seen(in_image, cam.squares).sum(axis=1) >= MIN_PLAN_CORNERS)
               & (cell >= MIN_CELL_PX) & (blur <= FOCUS_BLUR_PER_CELL * cell))
         return ok, in_image, blur
 
@@ -413,7 +416,9 @@ def _judge(c: _Candidates, poses: list[np.ndarray], obstacles: list[Obstacle], s
     m = (squares[0] - 1) * (squares[1] - 1)
     cam = _Camera(K, width, height, focus_mm, camera, blur_sigma_px, squares, marker_cells, marker_share)
     alive = c.on_board(PAPER, c.paper, np.ones(n, bool))[..., 2].min(axis=1) >= TABLE_CLEARANCE_MM
-    views, sighted = [], []
+    # per pose: T_cam_world, the obstacles seen, the boards' depths (numpy's (k, 3) @ (3,) rounds a single row
+    # otherwise than more: the second pass takes them from the first, which had the boards then alive)
+    views, sighted, depths = [], [], np.full((p, n), np.nan)
     for k, T_world_cam in enumerate(poses):
         if not alive.any():
             break
@@ -427,14 +432,15 @@ def _judge(c: _Candidates, poses: list[np.ndarray], obstacles: list[Obstacle], s
             alive[at.idx] = ~at.covers() & (at.found(in_image).sum(axis=1) >= MIN_PLAN_CORNERS)
         else:
             alive[at.idx] = ~at.covers()
+        depths[k, at.idx] = at.board_depth
     served = np.zeros((n, p), bool)
     sigma_t = np.full((n, p), np.inf)
     noises = np.full((n, p), np.nan)
     visible = np.zeros((n, p, m), bool)
     idx = np.flatnonzero(alive)
     inner = _inner(squares)
-    for k, (view, sight) in enumerate(zip(views, sighted) if len(idx) else ()):
-        at = _View(c, idx, view, sight, cam)
+    for k, (view, sight) in enumerate(zip(views, sighted)):
+        at = _View(c, idx, view, sight, cam, depths[k, idx])
         ok, in_image, blur = at.shown()
         seen = at.found(in_image)
         ok &= seen.sum(axis=1) >= MIN_PLAN_CORNERS
@@ -512,8 +518,6 @@ def _hull(points: np.ndarray) -> np.ndarray:
     return cv2.convexHull(points.astype(np.float32)).reshape(-1, 2) if len(points) else points
 
 
-SINGULAR_COND = 1e12  # an information matrix this ill-conditioned predicts nothing: sigma_t inf
-
 
 def _unit_sigma_t(corners: np.ndarray, origin: np.ndarray, view: np.ndarray, K: np.ndarray,
                   seen: np.ndarray | None = None) -> np.ndarray:
@@ -521,10 +525,11 @@ def _unit_sigma_t(corners: np.ndarray, origin: np.ndarray, view: np.ndarray, K: 
     sqrt(trace of the translation block of (J^T J)^-1), J (2m, 6) the Jacobian of the corners' pixels with respect to
     a small rotation about the camera origin and the translation of the board (the translation block does not
     depend on how the rotation is parametrized: OpenCV's rvec gives the same). ``view``: T_cam_world (4, 4), or one
-    per board (k, 4, 4); ``seen`` (k, m): the corners found (default: all)."""
+    per board (k, 4, 4); ``seen`` (k, m): the corners found (default: all). J^T J compiled (:func:`_information`),
+    inverted by numpy's LAPACK."""
     if len(corners) == 0:
         return np.empty(0)
-    views = np.broadcast_to(view, (len(corners), 4, 4))
+    views = np.ascontiguousarray(np.broadcast_to(view, (len(corners), 4, 4)))
     seen = np.ones(corners.shape[:2], bool) if seen is None else seen
     information = np.zeros((len(corners), 6, 6))
     _information(corners, origin, views, K[0, 0], K[1, 1], seen, information)
@@ -557,13 +562,20 @@ def _fma(typingctx, a, b, c):
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")  # no fastmath: IEEE float64, no reassociation or FMA unasked
+def _to_camera(p0, p1, p2, view):
+    """The world point (p0, p1, p2) in the camera frame of ``view`` (T_cam_world), as numpy's ``points @ R.T + t``
+    computes it: the product by the rotation as OpenBLAS's kernels do, fused multiply-adds from zero, term by term,
+    then the translation added."""
+    return (_fma(p2, view[0, 2], _fma(p1, view[0, 1], _fma(p0, view[0, 0], 0.0))) + view[0, 3],
+            _fma(p2, view[1, 2], _fma(p1, view[1, 1], _fma(p0, view[1, 0], 0.0))) + view[1, 3],
+            _fma(p2, view[2, 2], _fma(p1, view[2, 1], _fma(p0, view[2, 0], 0.0))) + view[2, 3])
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")  # no fastmath: IEEE float64, no reassociation or FMA unasked
 def _project(p0, p1, p2, view, K):
-    """(u, v, in front of the camera) of the world point (p0, p1, p2) as :func:`~.board_placement.pixels` computes
-    them, to the bit: its matrix product by the view's rotation as OpenBLAS does, fused multiply-adds from zero, term
-    by term."""
-    x = _fma(p2, view[0, 2], _fma(p1, view[0, 1], _fma(p0, view[0, 0], 0.0))) + view[0, 3]
-    y = _fma(p2, view[1, 2], _fma(p1, view[1, 1], _fma(p0, view[1, 0], 0.0))) + view[1, 3]
-    z = _fma(p2, view[2, 2], _fma(p1, view[2, 1], _fma(p0, view[2, 0], 0.0))) + view[2, 3]
+    """(u, v, in front of the camera) of the world point (p0, p1, p2) at ``view`` (T_cam_world), as
+    :func:`~.board_placement.pixels` computes them, to the bit."""
+    x, y, z = _to_camera(p0, p1, p2, view)
     front = z > NEAR_MM
     z = z if front else 1.0
     return K[0, 0] * x / z + K[0, 2], K[1, 1] * y / z + K[1, 2], front
@@ -630,6 +642,7 @@ def _pixels(points: np.ndarray, view: np.ndarray, K: np.ndarray) -> tuple[np.nda
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
 def _pixels_at(points, views, K, uv, front):
+    """uv (p, k, m, 2), front (p, k, m) of :func:`_pixels`."""
     for p in range(len(views)):
         for k in range(points.shape[0]):
             for m in range(points.shape[1]):
@@ -683,23 +696,17 @@ def _separates(a, b):
 @numba.njit(cache=True, nogil=True, error_model="numpy")  # no fastmath: IEEE float64, no reassociation or FMA unasked
 def _information(corners, origin, views, fx, fy, seen, out):
     """out (k, 6, 6, zeros) += J^T J of :func:`_unit_sigma_t` for corners (k, m, 3), origins (k, 3), views
-    (k, 4, 4), focal lengths fx, fy px and the corners found (k, m), to the bit as numpy computed them: a matrix
-    product of 3 terms (OpenBLAS) is a fused multiply-add from zero, term by term; the einsum of J^T J sums the
-    products in order. A corner not found (J times 0) adds only zeros: skipped."""
+    (k, 4, 4), focal lengths fx, fy px and the corners found (k, m), to the bit as numpy computed them with matrix
+    products (the camera frame, :func:`_to_camera`; d(pixel)/d(point) times -[r]_x: OpenBLAS's fused multiply-adds
+    from zero, term by term) and an einsum over the corners (the products summed in order from zero). A corner not
+    found (its rows of J times 0) adds only zeros to a sum that is never -0: skipped."""
     J = np.empty((2, 6))
     for n in range(corners.shape[0]):
-        R, T = views[n, :3, :3], views[n, :3, 3]
-        o0, o1, o2 = origin[n, 0], origin[n, 1], origin[n, 2]
-        t0 = _fma(o2, R[0, 2], _fma(o1, R[0, 1], _fma(o0, R[0, 0], 0.0))) + T[0]
-        t1 = _fma(o2, R[1, 2], _fma(o1, R[1, 1], _fma(o0, R[1, 0], 0.0))) + T[1]
-        t2 = _fma(o2, R[2, 2], _fma(o1, R[2, 1], _fma(o0, R[2, 0], 0.0))) + T[2]
+        t0, t1, t2 = _to_camera(origin[n, 0], origin[n, 1], origin[n, 2], views[n])
         for i in range(corners.shape[1]):
             if not seen[n, i]:
                 continue
-            x0, x1, x2 = corners[n, i, 0], corners[n, i, 1], corners[n, i, 2]
-            X = _fma(x2, R[0, 2], _fma(x1, R[0, 1], _fma(x0, R[0, 0], 0.0))) + T[0]
-            Y = _fma(x2, R[1, 2], _fma(x1, R[1, 1], _fma(x0, R[1, 0], 0.0))) + T[1]
-            Z = _fma(x2, R[2, 2], _fma(x1, R[2, 1], _fma(x0, R[2, 0], 0.0))) + T[2]
+            X, Y, Z = _to_camera(corners[n, i, 0], corners[n, i, 1], corners[n, i, 2], views[n])
             r0, r1, r2 = X - t0, Y - t1, Z - t2  # before Z is clipped
             Z = max(Z, NEAR_MM)
             # d(pixel)/d(point) (2, 3): [[fx / Z, 0, -fx X / Z^2], [0, fy / Z, -fy Y / Z^2]]; times -[r]_x, whose
