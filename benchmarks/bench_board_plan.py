@@ -115,7 +115,8 @@ def main() -> None:
     laid_out = sessions(everything)  # this tree's kernels compiled (or loaded) on the way
     total = {"old": [0.0, 0.0], "new": [0.0, 0.0]}
     written, all_equal = [], True
-    print(f"{'session':18s} {'old s':>7s} {'new s':>7s} {'ratio':>6s}   {'old CPU':>7s} {'new CPU':>7s} {'ratio':>6s}  equal")
+    print(f"{'session':18s} {'old s':>7s} {'new s':>7s} {'ratio':>6s}   {'old CPU':>7s} {'new CPU':>7s} {'ratio':>6s}  "
+          f"equal")
     for world, index, session, call_args, call_kwargs in laid_out:
         wall, cpu = {"old": [], "new": []}, {"old": [], "new": []}
         for _ in range(args.repeats):
@@ -127,8 +128,9 @@ def main() -> None:
         for k in total:
             total[k] = [t + m for t, m in zip(total[k], medians[k])]
         (ow, oc), (nw, nc) = medians["old"], medians["new"]
-        print(f"{world + ' ' + str(index) + ' ' + session:18s} {ow:7.2f} {nw:7.2f} {nw / ow:6.3f}   {oc:7.2f} {nc:7.2f} "
-              f"{nc / oc:6.3f}  {equal}", flush=True)
+        label = f"{world} {index} {session}"
+        print(f"{label:18s} {ow:7.2f} {nw:7.2f} {nw / ow:6.3f}   {oc:7.2f} {nc:7.2f} {nc / oc:6.3f}  {equal}",
+              flush=True)
         written.append(fixture(world, index, session, old))
     (ow, oc), (nw, nc) = total["old"], total["new"]
     print(f"{'total':18s} {ow:7.2f} {nw:7.2f} {nw / ow:6.3f}   {oc:7.2f} {nc:7.2f} {nc / oc:6.3f}  {all_equal}")
