@@ -110,7 +110,8 @@ def judge_world(table: pd.DataFrame, curves: pd.DataFrame, points: dict[str, pd.
                              row.incursion_rate) else np.nan,
                          "share": ceiling_share(spl, entry) if entry else np.nan,
                          "gain": spl - entry["static_spl"] if entry else np.nan,
-                         "mean_theta_a": entry.get("mean_theta_a", np.nan), "static_spl": entry.get("static_spl", np.nan)})
+                         "mean_theta_a": entry.get("mean_theta_a", np.nan),
+                         "static_spl": entry.get("static_spl", np.nan)})
     return pd.DataFrame(rows)
 
 
@@ -132,7 +133,8 @@ def across_worlds(judged: pd.DataFrame) -> dict:
     result: dict = {}
     for (tolerance, predictor, kind), rows in judged.groupby(["tolerance", "predictor", "point"], sort=True):
         entry = {"n_worlds": int(rows["world"].nunique()),
-                 "median_share": _quantiles(rows["share"], (0.5,))[0], "share_10_90": _quantiles(rows["share"], (0.1, 0.9)),
+                 "median_share": _quantiles(rows["share"], (0.5,))[0],
+                 "share_10_90": _quantiles(rows["share"], (0.1, 0.9)),
                  "median_gain": _quantiles(rows["gain"], (0.5,))[0], "gain_10_90": _quantiles(rows["gain"], (0.1, 0.9))}
         if kind != "own":
             rate = rows["incursion_rate"]

@@ -130,8 +130,8 @@ class Draws:
 
 def headline_draws(rows: pd.DataFrame, predictors: tuple[str, ...], weights_for) -> tuple[Draws, np.ndarray]:
     """(:class:`Draws`, the arcs (d,) in weight order) of prediction-table ``rows`` of one method, trajectory and
-    tolerance. ``weights_for`` maps the arcs (d,) to the (b, d) weights (:func:`~poseintegrity.resampling.cluster_weights`,
-    :func:`leave_one_out_weights`). The arcs are static's (every scored dataset has a static row)."""
+    tolerance. ``weights_for`` maps the arcs (d,) to the (b, d) weights
+    (:func:`~poseintegrity.resampling.cluster_weights`, :func:`leave_one_out_weights`). The arcs are static's (every scored dataset has a static row)."""
     datasets = np.sort(rows.loc[rows["predictor"] == "static", "dataset"].unique())
     weights = weights_for(datasets)
     by_predictor = {p: part for p, part in rows.groupby("predictor", sort=False)}

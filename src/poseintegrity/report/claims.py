@@ -11,7 +11,8 @@ of predictors.json and validation.json) bounds any predictor's gain over static;
 static SPL) (``<predictor>.<tolerance>.ceiling_share``) is the share of it a predictor reaches.
 
 The verdict reads the interval of our gain over each claim's baseline on each world (:func:`interval_grade`; issue 49:
-a point value over 21 arcs moves by tens of points with one arc); the weakest world decides. The paper's margins are read from :mod:`poseintegrity.paper_results`.
+a point value over 21 arcs moves by tens of points with one arc); the weakest world decides. The paper's figures are
+read from :mod:`poseintegrity.paper_results`.
 """
 
 from __future__ import annotations
@@ -33,9 +34,9 @@ NOT_APPLICABLE, UNMEASURED = "not applicable", "no world here measures it"
 RULE = ("**Verdict**, one per claim, the weakest world deciding, read from the 90 % interval of our gain over the "
         "claim's baseline (static, the MLP, or the paper's own rate or error), never from its point value. The "
         "interval resamples what the result rests on: the scenes with replacement, the operating point chosen again "
-        "at zero incursion in each draw (`predict.intervals`); the tracking's 5-s blocks of frames (`track.evaluation`). *reproduced*: the "
-        "interval lies above zero, on the paper's side; *undecided*: it holds zero, so these data cannot tell; *not "
-        "reproduced*: it lies below zero, or there is no operating point at zero incursion; *not applicable*: no world "
+        "at zero incursion in each draw (`predict.intervals`); the tracking's 5-s blocks of frames "
+        "(`track.evaluation`). *reproduced*: the interval lies above zero, on the paper's side; *undecided*: it holds "
+        "zero, so these data cannot tell; *not reproduced*: it lies below zero, or there is no operating point at zero incursion; *not applicable*: no world "
         "here measures it. A world whose metrics hold no interval is undecided. Rows marked ours are no claim of the "
         "papers: no verdict.")
 SPL, SHARE, RATE = "{:.1f}", "{:.0%}", "{:.2%}"
@@ -363,8 +364,8 @@ def _markers_row(read: Reader, worlds: list[World], markers: int, links: dict[st
     theirs = paper.BLACK_RESULTS["success_rate"][f"markers{markers}"]
     key = f"success_rates.a_markers{markers}"
     grades = [] if read.value("tracking", key) is MISSING else [_level_grade(read, key, theirs, True)]
-    cell = (f"simulation, motion (a): {read.text('tracking', key, RATE)} {read.interval('tracking', f'intervals.{key}', RATE)}".rstrip()
-            if grades else absent(read.metrics, "tracking"))
+    shown = f"{read.text('tracking', key, RATE)} {read.interval('tracking', f'intervals.{key}', RATE)}".rstrip()
+    cell = f"simulation, motion (a): {shown}" if grades else absent(read.metrics, "tracking")
     why = f"the stress motion (b): {read.text('tracking', f'success_rates.b_markers{markers}', RATE)}" if grades \
         else UNMEASURED
     return Row(f"correct pose, {markers} markers (Black & Salcudean III)", f"{theirs:.2%}",
@@ -380,7 +381,8 @@ def _accuracy_row(read: Reader, worlds: list[World], links: dict[str, str]) -> R
         _level_grade(read, keys[1], theirs["rms_deg"]["ukf"], False))]
     cell = (f"simulation: {read.text('tracking', keys[0], '{:.2f}')} mm "
             f"{read.interval('tracking', f'intervals.{keys[0]}', '{:.2f}')} / "
-            f"{read.text('tracking', keys[1], '{:.2f}')} deg {read.interval('tracking', f'intervals.{keys[1]}', '{:.2f}')}"
+            f"{read.text('tracking', keys[1], '{:.2f}')} deg "
+            f"{read.interval('tracking', f'intervals.{keys[1]}', '{:.2f}')}"
             .replace("  ", " ").rstrip() if grades else absent(read.metrics, "tracking"))
     why = (f"without the filter: {read.text('tracking', 'rms_axis_mm.no_filter', '{:.2f}')} mm / "
            f"{read.text('tracking', 'rms_euler_deg.no_filter', '{:.2f}')} deg" if grades else UNMEASURED)

@@ -5,8 +5,8 @@ Per world (:func:`~poseintegrity.report.claims.metric_worlds`) and tolerance: th
 static, long range, next step and the MLP and each one's share of the ceiling with its interval (issue 49: two values,
 ``_low`` and ``_high``); issue 38's error predictors' shares and intervals, where the metrics hold them, in the world's
 ``ours`` block (the paper's stay the headline: DVC shows the file's columns in key order, and folds the last ones
-first on a narrow terminal; their SPLs stay in the detailed files, so that the file keeps to ~110 values); per world R11 (what the board's ground truth adds to E_t
-and E_r, 99th percentile); the tracking success rates. A key the detailed metrics lack is left out, never invented.
+first on a narrow terminal; their SPLs stay in the detailed files, so that the file keeps to ~110 values); per world
+R11 (what the board's ground truth adds to E_t and E_r, 99th percentile); the tracking success rates. A key the detailed metrics lack is left out, never invented.
 """
 
 from __future__ import annotations
