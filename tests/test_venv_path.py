@@ -79,6 +79,8 @@ t = yaml.safe_load(open("params.yaml"))["extract"]["reprojection_threshold_px"]
 def moved(value):
     if isinstance(value, dict):
         return {key: moved(item) for key, item in value.items()}
+    if isinstance(value, list):  # an interval's ends
+        return [moved(item) for item in value]
     return value * t / 0.6 if isinstance(value, float) else value
 metrics = read_metrics(Path(sys.argv[1]))
 for stage in ("predictors", "validation"):
@@ -148,10 +150,11 @@ def test_the_readmes_experiment_commands_run_as_written(tmp_path):
     # pager shows the params and the headline's first columns, the paper's long range first, and folds the rest
     first = "main.2mm_3deg.long_range"
     changed = readme(".venv/bin/dvc exp show --only-changed")
-    assert first in changed and "main.ours.2mm_3deg.error_long_range" in changed
+    assert first in changed  # the headline's first columns; `metrics diff` below lists every one, ours too
     screen = fits(readme(".venv/bin/dvc exp show --only-changed --no-pager"))
     header = screen.splitlines()[1].split()
-    assert header[2] == first and "…" in header and "extract.reprojection_threshold_px" in header
+    assert header[2] == first and "…" in header  # the param beside it, its name cut short with ~110 metrics:
+    assert any(name.startswith("extract.reprojection_th") for name in header[3:])
     diff = fits(readme(".venv/bin/dvc metrics diff ransac-0.4 ransac-0.9"))
     rows = [line.split() for line in diff.splitlines()[1:]]
     assert {row[0] for row in rows} == {declared[0]}
@@ -161,7 +164,8 @@ def test_the_readmes_experiment_commands_run_as_written(tmp_path):
                 for key in (flat(value, f"{prefix}{name}.") if isinstance(value, dict) else [f"{prefix}{name}"])]
 
     moved = {key for key in flat(headline) if not key.startswith(("tracking.", "main.r11", "validation.r11"))}
-    assert moved <= {row[1] for row in rows} and 40 <= len(flat(headline)) <= 80  # every SPL and share: a few dozen
+    missing = moved - {row[1] for row in rows}
+    assert not missing and 40 <= len(flat(headline)) <= 120, (sorted(missing), len(flat(headline)))  # a hundred at most
     readme(".venv/bin/dvc plots diff ransac-0.4 ransac-0.6 ransac-0.9")
     page = (tmp_path / "dvc_plots" / "index.html").read_text()
     assert all(f"ransac-{t}" in page for t in ("0.4", "0.6", "0.9"))

@@ -16,6 +16,7 @@ import shutil
 import pytest
 import yaml
 
+from notebook_run import NotebookServer
 from project_copy import DVC, project_copy, run, write_params
 from repository import ROOT
 
@@ -83,3 +84,15 @@ def test_make_population_runs_the_population_then_the_summary():
     commands = [line for line in dry if "dvc repro" in line]
     assert commands[0].endswith("dvc repro population/dvc.yaml") and commands[1].endswith("dvc repro")
     assert "make population" in (ROOT / "README.md").read_text()
+
+
+def test_the_population_s_notebook_runs_as_it_is_in_jupyterlab(population):
+    """Notebook 08 opened in JupyterLab and run (Run All Cells, no parameters injected) in the population's project:
+    it reads and writes the files its stage does."""
+    work = population[0]
+    written = work / "reports" / "metrics" / "population.json"
+    before = written.read_text()
+    written.unlink()
+    with NotebookServer(work) as server:
+        server.run("notebooks/08_population.ipynb")
+    assert written.read_text() == before  # the same bytes as its stage's run
