@@ -144,19 +144,19 @@ def _same_pose(a: BoardPose, b: BoardPose) -> bool:
 def test_boards_sharing_one_marker_detection_find_what_each_finds_alone(boards, seen, monkeypatch):
     """Two boards of one dictionary (ids from 0 and from a first_id of their own) in one image: found from one
     shared ImageMarkers, in either order, each board's points and checked pose are bit for bit what the board found
-    detecting the image's markers alone. Seen whole, and with the second, farther board partly painted over and two
-    of its markers' codes damaged by a bit, which only its own layout recovers (the refinement must start from the
-    detection, not from what the other board's refinement made of it)."""
-    flipped, hidden = (((1, 3, (2, 2)), (1, 1, (3, 1)), (0, 4, (1, 2))), (180.0, 30.0, 260.0, 100.0)
+    detecting the image's markers alone. Seen whole, and with the second, farther board partly painted over and
+    markers of both damaged by a bit, which only each board's own layout recovers (each board's refinement must
+    start from the detection, not from what the other's made of it)."""
+    flipped, hidden = (((1, 3, (2, 2)), (1, 1, (3, 1)), (0, 2, (1, 1))), (180.0, 30.0, 260.0, 100.0)
                        ) if seen == "second_hidden_and_far" else ((), None)
     image = _two_boards(boards, [(0.0, 0.0), (140.0, 0.0)], flipped, hidden)
     alone = [_found_alone(image, board) for board in boards]
-    if seen == "second_hidden_and_far":  # the premise: some markers are found by refinement only
-        far = boards[1].cv_board()
-        detector = cv2.aruco.ArucoDetector(far.getDictionary(), detector_parameters())
-        corners, detected, rejected = detector.detectMarkers(image)
-        refined = detector.refineDetectedMarkers(image, far, corners, detected, rejected)[1]
-        assert np.isin(refined, far.getIds()).sum() > np.isin(detected, far.getIds()).sum()
+    if seen == "second_hidden_and_far":  # the premise: each board has markers found by its refinement only
+        for cv_board in (board.cv_board() for board in boards):
+            detector = cv2.aruco.ArucoDetector(cv_board.getDictionary(), detector_parameters())
+            corners, detected, rejected = detector.detectMarkers(image)
+            refined = detector.refineDetectedMarkers(image, cv_board, corners, detected, rejected)[1]
+            assert np.isin(refined, cv_board.getIds()).sum() > np.isin(detected, cv_board.getIds()).sum()
         assert 4 <= len(alone[1][0]) < len(alone[0][0])
     else:
         assert all(len(points) == len(alone[0][0]) > 0 for points, _, _ in alone)
