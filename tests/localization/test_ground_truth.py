@@ -2,17 +2,20 @@
 consistency check against known corrupted corners, the predicted uncertainty against a Monte Carlo, the trust
 statuses, and what a ground-truth error adds to E_t (truth_error) on known answers."""
 
+import dataclasses
+
 import cv2
 import numpy as np
 import pytest
 
 import loc_synthetic as synthetic
-from poseintegrity.boards import ArucoGrid, Charuco, board_from_dict
+from poseintegrity.boards import ArucoGrid, Charuco, board_from_dict, scaled
 from poseintegrity.errors import ArgumentError
 from poseintegrity.lens import Camera
+from poseintegrity.localization import ground_truth
 from poseintegrity.localization.ground_truth import (
-    BoardPose, board_pose, consistent_fit, detect_board_points, handed_over, handover, no_pose, predicted_uncertainty,
-    sigma_t_at, truth_error, truth_scale,
+    BoardPose, ImageMarkers, board_pose, consistent_fit, detect_board_points, detector_parameters, handed_over,
+    handover, no_pose, predicted_uncertainty, sigma_t_at, truth_error, truth_scale,
 )
 from poseintegrity.params.extract import GroundTruthParams
 from poseintegrity.poses import pose_errors, pose_from_rvec_tvec, pose_matrix
@@ -66,6 +69,111 @@ def test_two_charuco_boards_in_one_image_each_find_their_own_corners():
     assert board_from_dict(second.as_dict()) == second and second.as_dict()["first_id"] == 17
     with pytest.raises(ArgumentError, match="board: markers 40 .. 56 do not fit DICT_4X4_50"):
         board_from_dict(second.as_dict() | {"first_id": 40})
+
+
+PLANE_PX = 6  # texels per mm of the two-board plane below; its texel (0, 0) is centred at PLANE_MM[:2] + 0.5 / 6
+PLANE_MM = (-20.0, -20.0, 280.0, 100.0)
+TWO_BOARD_CAMERA = Camera(np.array([[900.0, 0, 500], [0, 900.0, 300], [0, 0, 1]]), np.zeros(5), 1000, 600)
+T_TWO_BOARDS = pose_matrix(Rotation.from_euler("xy", [10, -35], degrees=True).as_matrix(), [-120.0, -40.0, 330.0])
+
+
+def _two_boards(boards, at_mm, flipped=(), hidden=None) -> np.ndarray:
+    """(600, 1000) uint8 image of ``boards`` on one plane (origins at ``at_mm``, mm), seen from T_TWO_BOARDS at
+    35 deg, the second board farther. ``flipped``: (board index, marker index, (row, col)) cells of a marker's bit
+    grid inverted, a bit error that detection refuses and the board's layout recovers; ``hidden``: (x0, y0, x1, y1)
+    mm of the plane painted over, part of a board out of view."""
+    x_min, y_min, x_max, y_max = PLANE_MM
+    plane = np.full((round((y_max - y_min) * PLANE_PX), round((x_max - x_min) * PLANE_PX)), 200, np.uint8)
+    texel = lambda x, y: (round((y - y_min) * PLANE_PX), round((x - x_min) * PLANE_PX))  # noqa: E731
+    for board, (x, y) in zip(boards, at_mm):
+        tile = board.cv_board().generateImage(tuple(round(s * PLANE_PX) for s in board.size_mm))
+        v, u = texel(x, y)
+        plane[v:v + tile.shape[0], u:u + tile.shape[1]] = tile
+    for k, marker, (row, col) in flipped:
+        board, (x, y) = boards[k], at_mm[k]
+        cell = board.cv_board().getMarkerLength() / 6  # a 4 x 4 code and its border bits
+        corner = board.cv_board().getObjPoints()[marker][0]
+        (v0, u0), (v1, u1) = (texel(x + corner[0] + (col + i) * cell, y + corner[1] + (row + i) * cell) for i in (0, 1))
+        plane[v0 + 2:v1 - 2, u0 + 2:u1 - 2] = 255 - plane[v0 + 2:v1 - 2, u0 + 2:u1 - 2]
+    if hidden is not None:
+        (v0, u0), (v1, u1) = texel(*hidden[:2]), texel(*hidden[2:])
+        plane[v0:v1, u0:u1] = 90
+    A = np.array([[1 / PLANE_PX, 0, x_min + 0.5 / PLANE_PX], [0, 1 / PLANE_PX, y_min + 0.5 / PLANE_PX], [0, 0, 1]])
+    H = TWO_BOARD_CAMERA.K @ T_TWO_BOARDS[:3, [0, 1, 3]] @ A
+    return cv2.warpPerspective(plane, H, (1000, 600), flags=cv2.INTER_LINEAR, borderValue=128)
+
+
+def _found_alone(image: np.ndarray, board) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """detect_board_points as it was before the markers were shared: each board detecting the image's markers
+    itself (a ChArUco board by detectBoard(image) with tryRefineMarkers; a GridBoard by detectMarkers with sub-pixel
+    corners and refineDetectedMarkers)."""
+    cv_board, empty = board.cv_board(), (np.empty((0, 3)), np.empty((0, 2)), np.empty(0, int))
+    if isinstance(board, Charuco):
+        charuco = cv2.aruco.CharucoParameters()
+        charuco.tryRefineMarkers = True
+        corners, ids, _, _ = cv2.aruco.CharucoDetector(cv_board, charuco, detector_parameters()).detectBoard(image)
+        if ids is None or len(ids) == 0:
+            return empty
+        object_points, image_points, groups = (cv_board.getChessboardCorners()[ids.ravel()], corners.reshape(-1, 2),
+                                               np.arange(len(ids)))
+    else:
+        parameters = detector_parameters()
+        parameters.cornerRefinementMethod = cv2.aruco.CORNER_REFINE_SUBPIX
+        detector = cv2.aruco.ArucoDetector(cv_board.getDictionary(), parameters)
+        corners, ids, rejected = detector.detectMarkers(image)
+        if ids is not None and len(ids):
+            corners, ids, _, _ = detector.refineDetectedMarkers(image, cv_board, corners, ids, rejected)
+        if ids is None or len(ids) == 0:
+            return empty
+        object_points, image_points = (a.reshape(len(a), -1) for a in cv_board.matchImagePoints(corners, ids))
+        groups = np.repeat(np.arange(len(object_points) // 4), 4)
+    return scaled(object_points, board), np.asarray(image_points, np.float64), groups
+
+
+def _same_pose(a: BoardPose, b: BoardPose) -> bool:
+    """Every field of the two poses equal, bit for bit (NaN where the other has NaN)."""
+    return all(np.array_equal(x, y, equal_nan=not isinstance(x, str))
+               for x, y in zip(dataclasses.astuple(a), dataclasses.astuple(b)))
+
+
+@pytest.mark.parametrize("boards", [
+    (Charuco("DICT_4X4_50", 7, 5, 15.0, 11.0), Charuco("DICT_4X4_50", 7, 5, 15.0, 11.0, first_id=17)),
+    (ArucoGrid("DICT_4X4_50", 4, 3, 20.0, 5.0), ArucoGrid("DICT_4X4_50", 4, 3, 20.0, 5.0, first_id=12)),
+], ids=["charuco", "aruco_grid"])
+@pytest.mark.parametrize("seen", ["both_whole", "second_hidden_and_far"])
+def test_boards_sharing_one_marker_detection_find_what_each_finds_alone(boards, seen, monkeypatch):
+    """Two boards of one dictionary (ids from 0 and from a first_id of their own) in one image: found from one
+    shared ImageMarkers, in either order, each board's points and checked pose are bit for bit what the board found
+    detecting the image's markers alone. Seen whole, and with the second, farther board partly painted over and
+    markers of both damaged by a bit, which only each board's own layout recovers (each board's refinement must
+    start from the detection, not from what the other's made of it)."""
+    flipped, hidden = (((1, 3, (2, 2)), (1, 1, (3, 1)), (0, 2, (1, 1))), (180.0, 30.0, 260.0, 100.0)
+                       ) if seen == "second_hidden_and_far" else ((), None)
+    image = _two_boards(boards, [(0.0, 0.0), (140.0, 0.0)], flipped, hidden)
+    alone = [_found_alone(image, board) for board in boards]
+    if seen == "second_hidden_and_far":  # the premise: each board has markers found by its refinement only
+        for cv_board in (board.cv_board() for board in boards):
+            detector = cv2.aruco.ArucoDetector(cv_board.getDictionary(), detector_parameters())
+            corners, detected, rejected = detector.detectMarkers(image)
+            refined = detector.refineDetectedMarkers(image, cv_board, corners, detected, rejected)[1]
+            assert np.isin(refined, cv_board.getIds()).sum() > np.isin(detected, cv_board.getIds()).sum()
+        assert 4 <= len(alone[1][0]) < len(alone[0][0])
+    else:
+        assert all(len(points) == len(alone[0][0]) > 0 for points, _, _ in alone)
+    for order in ((0, 1), (1, 0)):
+        markers = ImageMarkers(image)
+        for k in order:
+            shared = detect_board_points(image, boards[k], markers)
+            assert all(np.array_equal(a, b) for a, b in zip(shared, alone[k]))
+    markers = ImageMarkers(image)
+    shared_poses = [board_pose(image, board, TWO_BOARD_CAMERA, CHECKS, markers) for board in boards]
+    monkeypatch.setattr(ground_truth, "detect_board_points", lambda image, board, markers=None: _found_alone(
+        image, board))
+    for shared, board in zip(shared_poses, boards):
+        assert shared.status in ("ok", "bad_ground_truth")
+        assert _same_pose(shared, board_pose(image, board, TWO_BOARD_CAMERA, CHECKS))
+    with pytest.raises(ArgumentError, match="markers: detected in another image"):
+        detect_board_points(image.copy(), boards[0], markers)
 
 
 def test_board_corners_are_undistorted_by_the_camera_before_the_pose():

@@ -27,7 +27,7 @@ from poseintegrity.lens import Camera
 from poseintegrity.localization.features import (
     ImageReadError, cached_features, decode_gray, features_key, read_image_bytes, write_npz,
 )
-from poseintegrity.localization.ground_truth import BoardPose, board_from_dict, board_pose, no_pose
+from poseintegrity.localization.ground_truth import BoardPose, ImageMarkers, board_from_dict, board_pose, no_pose
 from poseintegrity.localization.matching import match_ratio_test
 from poseintegrity.params.extract import ExtractParams
 from poseintegrity.localization.target_model import TargetModel
@@ -143,10 +143,11 @@ def frame_evidence(
     features = cached_features(image_path, features_path, params.clahe, params.sift, data=data, image=image)
     model_index, image_points = correspondences(features, model, params.ratio_test, camera)
     object_points = model.points[model_index]
-    truth = (board_pose(image, board_from_dict(board), camera, params.ground_truth) if board is not None
+    markers = ImageMarkers(image)  # one marker detection for the board and its handover boards (same poses)
+    truth = (board_pose(image, board_from_dict(board), camera, params.ground_truth, markers) if board is not None
              else no_pose("no_board", "recorded poses are the ground truth"))  # no board: recorded poses instead
-    handover = tuple(replace(board_pose(image, board_from_dict(other), camera, params.ground_truth), board=k + 1)
-                     for k, other in enumerate(handover_boards))
+    handover = tuple(replace(board_pose(image, board_from_dict(other), camera, params.ground_truth, markers),
+                             board=k + 1) for k, other in enumerate(handover_boards))
     write_npz(evidence_path, key=key, object_points=object_points, model_index=model_index, image_points=image_points,
               n_keypoints=features.n_keypoints, n_handover=len(handover), **_pose_arrays("board", truth),
               **{k: v for n, pose in enumerate(handover) for k, v in _pose_arrays(f"handover{n}", pose).items()})

@@ -1,9 +1,10 @@
 """Board-based ground truth (Windsor et al. IV-C), checked before it judges anything.
 
 The board's points are found (an ArUco GridBoard: ``ArucoDetector`` with sub-pixel corners, four per marker; a
-ChArUco board: ``CharucoDetector.detectBoard``, whose chessboard corners are refined by ``cornerSubPix``; OpenCV 5
-API, docs/references.md "OpenCV 5"), undistorted by the calibrated lens and matched to the printed board's points
-(:mod:`poseintegrity.boards`). Then, before a pose is trusted:
+ChArUco board: ``CharucoDetector.detectBoard``, whose chessboard corners are refined by ``cornerSubPix``; an image's
+markers detected once for all its boards, :class:`ImageMarkers`; OpenCV 5 API, docs/references.md "OpenCV 5"),
+undistorted by the calibrated lens and matched to the printed board's points (:mod:`poseintegrity.boards`). Then,
+before a pose is trusted:
 
 1. **Consistency of each group** (a marker's four corners; a ChArUco corner on its own). A marker partly hidden by the
    target is still decoded by OpenCV, with a corner several pixels off, and a fit through it is millimetres off. Each
@@ -61,8 +62,8 @@ from poseintegrity.lens import Camera
 from poseintegrity.params.extract import GroundTruthParams
 from poseintegrity.poses import NAN_POSE, inverse, pose_errors, pose_from_rvec_tvec
 
-__all__ = ["BoardPose", "Handover", "board_from_dict", "board_pose", "detect_board_points", "consistent_fit",
-           "handed_over", "handover", "sigma_t_at", "truth_error", "truth_scale"]
+__all__ = ["BoardPose", "Handover", "ImageMarkers", "board_from_dict", "board_pose", "detect_board_points",
+           "consistent_fit", "handed_over", "handover", "sigma_t_at", "truth_error", "truth_scale"]
 
 LM_CRITERIA = (cv2.TERM_CRITERIA_EPS | cv2.TERM_CRITERIA_COUNT, 50, 1e-12)
 
@@ -114,28 +115,66 @@ def no_pose(status: str, reason: str, n_points: int = 0) -> BoardPose:
     return BoardPose(NAN_POSE.copy(), status, reason, n_points)
 
 
-def detect_board_points(image: np.ndarray, board: Board) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+class ImageMarkers:
+    """The ArUco markers of one 8-bit gray image (h, w), detected once per dictionary (and corner refinement: a
+    GridBoard's are sub-pixel, a ChArUco board's not) and shared by every board drawn from it: a frame's own board
+    and its handover boards (ids from their ``first_id``, one dictionary) read the same detection. Each board then
+    recovers its own missed markers from it, as the per-board detection did: the same OpenCV calls on the same
+    arrays, so the same points, bit for bit (tests/localization/test_ground_truth.py). Why: marker detection on the
+    whole image is most of a board's cost; a profile of stage 02 on an arc dataset with a handover board spent
+    12.4 s of 40.6 s in 402 ``detectBoard`` calls for 200 frames, each detecting the markers anew.
+
+    image : (h, w) uint8, the image every board is found in (:func:`detect_board_points` checks it is this one)
+    """
+
+    def __init__(self, image: np.ndarray) -> None:
+        self.image = image
+        self._detected: dict[tuple[str, bool], tuple] = {}
+
+    def of_board(self, board: Board, cv_board: "cv2.aruco.Board") -> tuple[tuple[np.ndarray, ...], np.ndarray | None]:
+        """The markers of ``board`` (its OpenCV board ``cv_board``): corners, n arrays (1, 4, 2) float32 sensor px,
+        and ids (n, 1) int32 (None when none is found). Those detected in the image (any id of the dictionary), then
+        those the board's layout predicts, searched again among the rejected candidates (defocused, far views;
+        ``refineDetectedMarkers`` on copies: it may edit what it is given, and every board starts from the
+        detection). A ChArUco board's markers are detected as ``CharucoDetector.detectBoard`` with
+        ``tryRefineMarkers`` detects them itself (OpenCV's default RefineParameters); a GridBoard's with sub-pixel
+        corners, the points of its pose."""
+        subpixel = not isinstance(board, Charuco)
+        if (board.dictionary, subpixel) not in self._detected:
+            parameters = detector_parameters()
+            if subpixel:
+                parameters.cornerRefinementMethod = cv2.aruco.CORNER_REFINE_SUBPIX
+            detector = cv2.aruco.ArucoDetector(cv_board.getDictionary(), parameters)
+            self._detected[board.dictionary, subpixel] = (detector, *detector.detectMarkers(self.image))
+        detector, corners, ids, rejected = self._detected[board.dictionary, subpixel]
+        if ids is None or len(ids) == 0:
+            return (), None
+        corners, ids, _, _ = detector.refineDetectedMarkers(self.image, cv_board, [c.copy() for c in corners],
+                                                            ids.copy(), [r.copy() for r in rejected])
+        return corners, ids
+
+
+def detect_board_points(image: np.ndarray, board: Board, markers: ImageMarkers | None = None
+                        ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The board points found in an 8-bit gray image (h, w): printed board points (n, 3) mm, their image points
     (n, 2) sensor px, and each point's group (n,) int (a marker's four corners share one; ChArUco corners are one
-    each). Empty arrays when nothing is found."""
+    each). Empty arrays when nothing is found. ``markers``: the image's :class:`ImageMarkers`, shared with the other
+    boards found in it (detected here when None)."""
+    markers = ImageMarkers(image) if markers is None else markers
+    if markers.image is not image:
+        raise ArgumentError("markers: detected in another image than the one the board is searched in")
     cv_board = board.cv_board()
-    if isinstance(board, Charuco):
-        charuco = cv2.aruco.CharucoParameters()
-        charuco.tryRefineMarkers = True  # markers the layout predicts are searched again (defocused, far views)
-        corners, ids, _, _ = cv2.aruco.CharucoDetector(cv_board, charuco, detector_parameters()).detectBoard(image)
+    corners, ids = markers.of_board(board, cv_board)
+    if ids is None or len(ids) == 0:  # (detectBoard given no markers would detect them itself)
+        return np.empty((0, 3)), np.empty((0, 2)), np.empty(0, int)
+    if isinstance(board, Charuco):  # the chessboard corners between the markers, refined by cornerSubPix
+        corners, ids, _, _ = cv2.aruco.CharucoDetector(cv_board, cv2.aruco.CharucoParameters(), detector_parameters()
+                                                       ).detectBoard(image, markerCorners=corners, markerIds=ids)
         if ids is None or len(ids) == 0:
             return np.empty((0, 3)), np.empty((0, 2)), np.empty(0, int)
         object_points = cv_board.getChessboardCorners()[ids.ravel()]
         image_points, groups = corners.reshape(-1, 2), np.arange(len(ids))
     else:
-        parameters = detector_parameters()
-        parameters.cornerRefinementMethod = cv2.aruco.CORNER_REFINE_SUBPIX  # sub-pixel corners for pose
-        detector = cv2.aruco.ArucoDetector(cv_board.getDictionary(), parameters)
-        corners, ids, rejected = detector.detectMarkers(image)
-        if ids is not None and len(ids):  # markers the layout predicts are searched again among the rejected
-            corners, ids, _, _ = detector.refineDetectedMarkers(image, cv_board, corners, ids, rejected)
-        if ids is None or len(ids) == 0:
-            return np.empty((0, 3)), np.empty((0, 2)), np.empty(0, int)
         object_points, image_points = cv_board.matchImagePoints(corners, ids)
         if object_points is None or len(object_points) == 0:
             return np.empty((0, 3)), np.empty((0, 2)), np.empty(0, int)
@@ -230,15 +269,16 @@ def predicted_uncertainty(object_points: np.ndarray, image_points: np.ndarray, K
     return rms, sigma_t, sigma_r, covariance
 
 
-def board_pose(image: np.ndarray, board: Board | dict, camera: Camera, params: GroundTruthParams | None = None
-               ) -> BoardPose:
+def board_pose(image: np.ndarray, board: Board | dict, camera: Camera, params: GroundTruthParams | None = None,
+               markers: ImageMarkers | None = None) -> BoardPose:
     """The checked pose of ``board`` in an 8-bit gray image (h, w) of ``camera`` (module docstring).
 
     image : (h, w) uint8 (colour or 16-bit images are converted, anything else refused,
     :func:`~poseintegrity.grayscale.as_gray8`); board : a :mod:`poseintegrity.boards` board or its dict; camera : a
-    checked :class:`~poseintegrity.lens.Camera`; params : ``extract.ground_truth`` (params.yaml's by default).
-    Never raises on what an image shows: a board not found, too few consistent points or too uncertain a pose are
-    statuses.
+    checked :class:`~poseintegrity.lens.Camera`; params : ``extract.ground_truth`` (params.yaml's by default);
+    markers : the image's :class:`ImageMarkers` when other boards are found in the same (h, w) uint8 image (one
+    marker detection for them all; the same pose as without). Never raises on what an image shows: a board not
+    found, too few consistent points or too uncertain a pose are statuses.
     """
     if not isinstance(camera, Camera):
         raise ArgumentError(f"camera: expected a poseintegrity.lens.Camera, got {type(camera).__name__}")
@@ -247,7 +287,7 @@ def board_pose(image: np.ndarray, board: Board | dict, camera: Camera, params: G
         raise ArgumentError(f"board: expected a poseintegrity.boards board or its dict, got {type(board).__name__}")
     params = published("extract.ground_truth") if params is None else params
     image = as_gray8("image", image)
-    object_points, sensor_points, groups = detect_board_points(image, board)
+    object_points, sensor_points, groups = detect_board_points(image, board, markers)
     if len(object_points) < 4:
         return no_pose("board_not_detected", f"{len(object_points)} board points found (a pose needs 4)",
                        len(object_points))
