@@ -40,7 +40,8 @@ class WorldDraw(Section):
     n_clutter: Annotated[tuple[Annotated[int, Field(ge=0, le=20)], Annotated[int, Field(ge=0, le=20)]], FromList] = (
         Field(description="[fewest, most] clutter objects per scene"))
     glenoid_tilt_deg: ordered_range(ge=-45, le=45) = Field(description="each of a scapula's two glenoid tilts")
-    targets: distinct(Annotated[tuple[str, ...], FromList]) = Field(min_length=1, description="the target combinations a scene draws from")
+    targets: distinct(Annotated[tuple[str, ...], FromList]) = Field(
+        min_length=1, description="the target combinations a scene draws from")
     lights: LightRanges
 
     @model_validator(mode="after")
