@@ -82,8 +82,12 @@ def section(summary: str) -> list[str]:
 
 
 def table(summary: str) -> dict[str, list[str]]:
-    """The first section's table: claim -> its cells (paper, ours per world, verdict, why)."""
-    rows = [line.strip("|").split(" | ") for line in section(summary) if line.startswith("| ") and "---" not in line]
+    """The first section's table of claims (its first table; the population's follows it): claim -> its cells
+    (paper, ours per world, verdict, why)."""
+    lines = section(summary)
+    start = next(i for i, line in enumerate(lines) if line.startswith("| claim"))
+    end = next((i for i in range(start, len(lines)) if not lines[i].startswith("| ")), len(lines))
+    rows = [line.strip("|").split(" | ") for line in lines[start:end] if "---" not in line]
     return {cells[0].strip(): [c.strip() for c in cells[1:]] for cells in rows[1:]}
 
 

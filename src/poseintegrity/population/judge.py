@@ -181,13 +181,29 @@ def judge_population(worlds: dict[str, tuple[pd.DataFrame, pd.DataFrame]], main_
     return pd.concat(judged, ignore_index=True)
 
 
+GROUND_TRUTH = ("trusted_share", "p99_E_t_truth_mm", "p99_E_r_truth_deg", "r11_passed")  # realism.truth_accuracy
+
+
+def world_realism(artifacts: dict) -> dict:
+    """What one world's stage-02 metrics (artifacts.json) say of its ground truth and realism: the share of frames
+    whose board pose is trusted, R11 (what the board adds to E_t and E_r, 99th percentile; passed: within the bar
+    of a quarter of the tightest tolerance) and how many of the realism bars it passes. A world's predictors are
+    judged against that ground truth: where R11 fails, a theta_a within its error of the tolerance is not known."""
+    realism = artifacts.get("realism", {})
+    truth = realism.get("truth_accuracy", {})
+    return {key: truth.get(key) for key in GROUND_TRUTH} | {
+        "realism_bars_passed": realism.get("n_bars_passed"),
+        "realism_bars": sum(isinstance(v, bool) for v in realism.get("passed", {}).values())}
+
+
 def population_metrics(judged: pd.DataFrame, chosen: pd.DataFrame, applied: dict[str, pd.DataFrame],
-                       zero_incursion_worlds: float) -> dict:
+                       zero_incursion_worlds: float, realism: dict[str, dict] | None = None) -> dict:
     """The content of ``reports/metrics/population.json``: n_worlds, worlds, the rule, ``across``
     (:func:`across_worlds`), ``paired`` at the own and at the others' points (:func:`paired`), ``per_world``
     (``<world>.<tolerance>.<predictor>.<point>``: operating_point, mean_spl, incursion_rate, share, gain), the points
     chosen on the whole population (``chosen_on_population``) and those points ``applied`` to other worlds (the main
-    and validation worlds: :func:`judge_world` rows at point "population")."""
+    and validation worlds: :func:`judge_world` rows at point "population"); ``realism``: per world
+    :func:`world_realism` (``ground_truth``), with the number of worlds whose R11 passed."""
     figures = ["operating_point", "mean_spl", "incursion_rate", "share", "gain"]
 
     def nested(rows: pd.DataFrame) -> dict:
@@ -209,4 +225,6 @@ def population_metrics(judged: pd.DataFrame, chosen: pd.DataFrame, applied: dict
                                  for t, group in chosen.groupby("tolerance")},
         "applied": {world: nested(rows) for world, rows in applied.items()},
         "per_world": {world: nested(rows) for world, rows in judged.groupby("world")},
+        "ground_truth": (realism or {}) | {"r11_passed_worlds": sum(bool(r.get("r11_passed")) for r in
+                                                                    (realism or {}).values())},
     }

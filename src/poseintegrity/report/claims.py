@@ -407,8 +407,8 @@ def claim_rows(metrics: dict[str, dict], worlds: list[World], links: dict[str, s
     return rows
 
 
-POPULATION_ROWS = ("long_range", "next_step", "mlp", "error_long_range", "error_next_step", "error_next_step_observed",
-                   "error_combined")  # the summary's lines of the population (issue 49), one per predictor
+POPULATION_ROWS = ("static", "long_range", "next_step", "mlp", "error_long_range", "error_next_step",
+                   "error_next_step_observed", "error_combined")  # the summary's lines of the population (issue 49)
 
 
 def population_lines(metrics: dict[str, dict]) -> list[str]:
@@ -430,7 +430,7 @@ def population_lines(metrics: dict[str, dict]) -> list[str]:
         pair, won, lost = f"paired.own.{tolerance}.{predictor} vs long_range", "wins", "losses"
         if read.value("population", pair) is MISSING:  # the pair read the other way: "long_range vs mlp"
             pair, won, lost = f"paired.own.{tolerance}.long_range vs {predictor}", "losses", "wins"
-        wins = "-" if predictor == "long_range" else (
+        wins = "-" if predictor in ("long_range", "static") else (
             f"{read.text('population', f'{pair}.{won}', '{:g}')}-{read.text('population', f'{pair}.{lost}', '{:g}')} "
             f"(p {read.text('population', f'{pair}.sign_test_p', '{:.2f}')})")
         return f"{own} | {others} | {wins}"
@@ -438,9 +438,12 @@ def population_lines(metrics: dict[str, dict]) -> list[str]:
     n = read.text("population", "n_worlds", "{:g}")
     head = " | ".join(f"{paper.TOLERANCE_LABELS[t]}: own point | others' point | beats long range, worlds"
                       for t in paper.TOLERANCES)
+    r11 = read.value("population", "ground_truth.r11_passed_worlds")
+    truth = f"; R11 passed in {r11} of them" if r11 is not MISSING else ""
     return [f"**On a population of {n} rendered worlds** (issue 49; each the paper's protocol, drawn from params.yaml "
-            "`population`): the median share of the ceiling over the worlds [its 10-90 % range], at each world's own "
-            "operating point and at the point chosen on the other worlds (`population.json` `rule`); the worlds in "
+            f"`population`{truth}): the median share of the ceiling over the worlds [its 10-90 % range], at each "
+            "world's own operating point and at the point chosen on the other worlds (`population.json` `rule`), "
+            "both against the world's own static baseline (static's own share is 0 by definition); the worlds in "
             "which it beats long range at their own points, won-lost (two-sided sign test). "
             "[Figure](figures/08_population.png).", "",
             f"| predictor | {head} |", "| --- |" + " --- |" * 3 * len(paper.TOLERANCES)] + [
