@@ -142,3 +142,43 @@ def band_figure(bands: pd.DataFrame, limits: dict[str, dict[str, dict]], level: 
                  f"(the ceiling); dotted: smallest theta_a", fontsize=9, y=1.0)
     fig.tight_layout()
     return fig
+
+
+POINT_KINDS = {"own": "its own point", "main": "the main world's point", "others": "the other worlds' point"}
+
+
+def population_figure(judged: pd.DataFrame, predictors: list[str]) -> plt.Figure:
+    """Each predictor's share of the world's ceiling over the population's worlds (issue 49), a column per tolerance:
+    a dot per world at each kind of operating point (:data:`POINT_KINDS`), filled where the world had no incursion
+    there and hollow where it had (its SPL then counts what the robot got past its envelope), a bar at the median.
+    judged : rows of :func:`~poseintegrity.population.judge.judge_population` (world, tolerance, predictor, point,
+    share, incursion_rate)."""
+    tolerances = sorted(judged["tolerance"].unique())
+    fig, axes = plt.subplots(1, len(tolerances), figsize=(6.5 * len(tolerances), 0.55 * len(predictors) + 1.6),
+                             squeeze=False, sharey=True)
+    colours = dict(zip(POINT_KINDS, sns.color_palette("tab10", len(POINT_KINDS))))
+    for ax, tolerance in zip(axes[0], tolerances):
+        for i, predictor in enumerate(predictors):
+            for j, (kind, label) in enumerate(POINT_KINDS.items()):
+                rows = judged[(judged["tolerance"] == tolerance) & (judged["predictor"] == predictor)
+                              & (judged["point"] == kind)]
+                y = i + (j - 1) * 0.25
+                safe = rows["incursion_rate"] == 0
+                share = rows["share"].clip(-1.0, 1.0)
+                ax.scatter(share[safe], np.full(safe.sum(), y), s=22, color=colours[kind],
+                           label=label if i == 0 else None)
+                ax.scatter(share[~safe], np.full((~safe).sum(), y), s=22, facecolors="none",
+                           edgecolors=colours[kind],
+                           label=f"{label}, with incursions" if i == 0 and kind != "own" else None)  # own: never
+                if len(rows):
+                    ax.plot([rows["share"].median()] * 2, [y - 0.1, y + 0.1], color="black", lw=2)
+        ax.axvline(0.0, color="grey", ls=":", lw=1)
+        ax.set(title=tolerance, xlim=(-1.05, 1.05), xlabel="share of the world's ceiling (0: its static; 1: knew every "
+                                                              "envelope)")
+        ax.set_yticks(range(len(predictors)), [p.replace("_", " ") for p in predictors])
+    axes[0, 0].invert_yaxis()
+    axes[0, -1].legend(fontsize=7, loc="lower right")
+    fig.suptitle(f"Each predictor over {judged['world'].nunique()} worlds of the population (bars: medians; shares "
+                 f"below -1 drawn at -1)", y=1.0)
+    fig.tight_layout()
+    return fig
