@@ -408,7 +408,7 @@ def claim_rows(metrics: dict[str, dict], worlds: list[World], links: dict[str, s
 
 
 POPULATION_ROWS = ("static", "long_range", "next_step", "mlp", "error_long_range", "error_next_step",
-                   "error_next_step_observed", "error_combined")  # the summary's lines of the population (issue 49)
+                   "error_next_step_observed")  # the summary's lines of the population (issue 49)
 
 
 def population_lines(metrics: dict[str, dict]) -> list[str]:
