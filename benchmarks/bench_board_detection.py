@@ -20,10 +20,7 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
-import importlib.util
-import subprocess
 import sys
-import tempfile
 import time
 from pathlib import Path
 
@@ -37,22 +34,12 @@ from poseintegrity.localization.dataset import DatasetError, load_dataset, load_
 from poseintegrity.localization.features import read_gray
 from poseintegrity.localization.ground_truth import ImageMarkers, board_pose
 
-ROOT = Path(__file__).resolve().parents[1]
+from git_reference import ROOT, module_at  # benchmarks/ (the scripts run from the repository root)
 
 
 def reference_ground_truth(commit: str):
     """localization/ground_truth.py at ``commit``, imported as the module ``ground_truth_<commit>``."""
-    source = subprocess.run(["git", "-C", str(ROOT), "show",
-                             f"{commit}:src/poseintegrity/localization/ground_truth.py"],
-                            check=True, capture_output=True, text=True).stdout
-    name = f"ground_truth_{commit}"
-    path = Path(tempfile.mkdtemp()) / f"{name}.py"
-    path.write_text(source)
-    spec = importlib.util.spec_from_file_location(name, path)
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[name] = module  # its dataclasses look their module up
-    spec.loader.exec_module(module)
-    return module
+    return module_at(commit, "src/poseintegrity/localization/ground_truth.py")
 
 
 def same(a, b) -> bool:

@@ -20,11 +20,8 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
-import importlib.util
 import json
-import subprocess
 import sys
-import tempfile
 import time
 from pathlib import Path
 
@@ -34,21 +31,12 @@ import numpy as np
 from poseintegrity.config import load_params
 from poseintegrity.scenes import board_plan, dataset
 
-ROOT = Path(__file__).resolve().parents[1]
+from git_reference import ROOT, module_at  # benchmarks/ (the scripts run from the repository root)
 
 
 def reference_planner(commit: str):
     """scenes/board_plan.py at ``commit``, imported as the module ``board_plan_<commit>``."""
-    source = subprocess.run(["git", "-C", str(ROOT), "show", f"{commit}:src/poseintegrity/scenes/board_plan.py"],
-                            check=True, capture_output=True, text=True).stdout
-    name = f"board_plan_{commit}"
-    path = Path(tempfile.mkdtemp()) / f"{name}.py"
-    path.write_text(source)
-    spec = importlib.util.spec_from_file_location(name, path)
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[name] = module  # its dataclasses look their module up
-    spec.loader.exec_module(module)
-    return module
+    return module_at(commit, "src/poseintegrity/scenes/board_plan.py")
 
 
 def sessions(everything) -> list[tuple[str, int, str, tuple, dict]]:
