@@ -164,12 +164,8 @@ def check_world(params: GenerateParams, protocol: ProtocolParams, world: str = "
     scenes = dict(zip(sessions(params), built))
     for (index, session), scene in scenes.items():
         distance = params.scenes[index].distance_mm if session == "arc" else params.lines.distance_mm
-        for T_world_cam in trajectories.model_pair(scene.aim, scene.view_dir, distance, params.model_baseline_mm):
-            T_cam_world = inverse(T_world_cam)
-            for name, mesh in scene.placed:
-                if name in scene.target_objects:
-                    _check_in_view(mesh.vertices @ T_cam_world[:3, :3].T + T_cam_world[:3, 3], cam,
-                                   f"{scenes_key(world)}.{index}", name, distance)
+        _check_targets_in_view(scene, scene.target_objects, distance, params.model_baseline_mm, cam,
+                               f"{scenes_key(world)}.{index}")
     return scenes
 
 
@@ -181,13 +177,8 @@ def arc_problem(params: GenerateParams, protocol: ProtocolParams, index: int) ->
     spec, cam = params.scenes[index], Intrinsics.from_params(params.camera)
     arranged = catalog.arrange(spec, index, params)
     try:
-        for T_world_cam in trajectories.model_pair(arranged.aim, arranged.view_dir, spec.distance_mm,
-                                                   params.model_baseline_mm):
-            T_cam_world = inverse(T_world_cam)
-            for name, mesh in arranged.placed:
-                if name in spec.targets:
-                    _check_in_view(mesh.vertices @ T_cam_world[:3, :3].T + T_cam_world[:3, 3], cam,
-                                   f"{scenes_key('main')}.{index}", name, spec.distance_mm)
+        _check_targets_in_view(arranged, spec.targets, spec.distance_mm, params.model_baseline_mm, cam,
+                               f"{scenes_key('main')}.{index}")
         trips = [plan_trip(params, protocol, plan, arranged) for plan in plan_datasets(params)
                  if plan.scene_index == index and plan.trajectory == "arc"]
         Robot.from_params(params.robot, keyed_rng(params.seed, "robot")).placed(
@@ -195,6 +186,17 @@ def arc_problem(params: GenerateParams, protocol: ProtocolParams, index: int) ->
     except (WorldError, ReachError) as error:
         return str(error)
     return None
+
+
+def _check_targets_in_view(scene: catalog.Scene | catalog.Arrangement, targets: tuple[str, ...] | list[str],
+                           distance: float, baseline_mm: float, cam: Intrinsics, key: str) -> None:
+    """WorldError naming ``key`` unless each of ``targets`` among the scene's placed meshes lies mostly inside both
+    images of the model pair at ``distance`` (mm) from its aim point (:func:`_check_in_view`)."""
+    for T_world_cam in trajectories.model_pair(scene.aim, scene.view_dir, distance, baseline_mm):
+        T_cam_world = inverse(T_world_cam)
+        for name, mesh in scene.placed:
+            if name in targets:
+                _check_in_view(mesh.vertices @ T_cam_world[:3, :3].T + T_cam_world[:3, 3], cam, key, name, distance)
 
 
 def _check_in_view(points_cam: np.ndarray, cam: Intrinsics, key: str, name: str, distance: float) -> None:
