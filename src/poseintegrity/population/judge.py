@@ -44,7 +44,6 @@ from poseintegrity.prediction.transfer import DECIMALS
 # its share and its zero-incursion worlds were the same at every kind of point at 4 mm / 10 deg: 14 %, 100 %)
 JUDGED = ("static", "long_range", "mlp", "next_step", "error_long_range", "error_next_step",
           "error_next_step_observed")
-POINTS = ("own", "main", "others")  # the operating points of the module docstring
 KEYS = ["predictor", "tolerance"]
 
 
