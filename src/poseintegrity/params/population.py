@@ -64,6 +64,15 @@ class TransferParams(Section):
         "among those points, the one of largest mean SPL over them (population/judge.py says why)")
 
 
+class HazardTrainingParams(Section):
+    """Ours (issue 50): how the failure hazard is trained on the worlds (population/hazard.py)."""
+
+    C: float = Field(gt=0, le=1e6, description="inverse L2 strength of the logistic regression (scikit-learn's C)")
+    calibration_folds: int = Field(ge=2, le=100, description="folds by world whose held-out log odds calibrate it")
+    importance_repeats: int = Field(ge=1, le=1000, description="shuffles per column of the permutation importance")
+    seed: Seed = Field(description="seed of the permutation importance's shuffles")
+
+
 class PopulationParams(Section):
     """A population of rendered worlds (issue 49): which worlds, how each is drawn, how points transfer."""
 
@@ -71,3 +80,4 @@ class PopulationParams(Section):
     worlds: distinct(WorldName) = Field(min_length=2, description="the worlds' names; each a DVC stage of its own")
     draw: WorldDraw
     transfer: TransferParams
+    hazard: HazardTrainingParams

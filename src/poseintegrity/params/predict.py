@@ -82,6 +82,28 @@ class ErrorPredictorParams(Section):
         return np.round(np.geomspace(self.k_min, self.k_max, self.n_k), 9)
 
 
+class HazardPredictorParams(Section):
+    """Ours (issue 50): the predictors that stop where the failure hazard reaches h (prediction/hazard). The models are
+    trained on the population's worlds (population/hazard.py); stage 04 applies the file ``model``."""
+
+    model: str = Field(min_length=1, description="the hazard models stage 04 applies, a path from the project's root "
+                                                 "(written by `make population`); a missing file runs no hazard rows")
+    h_min: float = Field(gt=0, lt=1, description="smallest hazard h of the sweep")
+    h_max: float = Field(gt=0, lt=1, description="largest hazard h of the sweep")
+    n_h: int = Field(ge=2, le=GRID, description="hazards swept, h_min .. h_max in geometric steps")
+
+    @model_validator(mode="after")
+    def _check(self) -> HazardPredictorParams:
+        if self.h_max <= self.h_min:
+            raise KeyRule("h_max", f"must be > h_min ({self.h_min}), got {self.h_max}")
+        return self
+
+    @property
+    def levels(self) -> np.ndarray:
+        """The swept hazards h : (n_h,) float, geometric from h_min to h_max (rounded to 1e-9 as the k grid)."""
+        return np.round(np.geomspace(self.h_min, self.h_max, self.n_h), 9)
+
+
 class PredictParams(Section):
     """Stage 04: predictors, the n_t sweep, the static baseline, LOSO threshold choice, live-trial simulation."""
 
@@ -112,6 +134,7 @@ class PredictParams(Section):
     uncertainty: UncertaintyParams
     intervals: HeadlineIntervalParams
     error: ErrorPredictorParams
+    hazard: HazardPredictorParams
     tail_n_t_max: int = Field(
         ge=1, le=GRID, description="the tail diagnosis: an arc whose long range theta_p exceeds theta_a at every swept n_t up"
         " to this one, one of n_t_min .. n_t_max"

@@ -9,6 +9,7 @@
     loso.py         n_t from a target incursion rate by leave-one-scene-out cross-validation (VI, future work), pooled
     tails.py        ours: the arcs whose long range theta_p overshoots theta_a at every n_t (eq. 1's long tail)
     error_predictors.py  ours: long range / next step on the predicted localization error, operating point k
+    hazard/         ours: the failure hazard from evidence without ground truth, and the predictors on it (h)
     ceiling.py      ours: the ceiling of any predictor's gain over static, and each predictor's share of it
     uncertainty.py  a prediction interval on theta_p (fit covariance or bootstrap) and its lower bound
     supervisor.py   NextStepSupervisor: the next-step predictor as a component of a robot loop

@@ -206,7 +206,7 @@ def headline_intervals(rows: pd.DataFrame, predictors: tuple[str, ...], pairs: t
 # every predictor but static (whose pairs are the gains) compared in pairs, in the order "A vs B" is read (A - B):
 # ours before the paper's, a variant before its predictor, so that the keys say "next_step vs long_range" (V-B),
 # "long_range vs mlp" (Table I), "long_range_free_width vs long_range"
-PAIRED = ("error_combined", "error_next_step_observed", "error_next_step", "error_long_range", "next_step_free_width",
+PAIRED = ("hazard_next_step", "hazard_long_range", "error_combined", "error_next_step_observed", "error_next_step", "error_long_range", "next_step_free_width",
           "long_range_free_width", "next_step_relative", "long_range_relative", "next_step", "long_range_lower",
           "long_range", "mlp")
 PAIRS = tuple((a, b) for i, a in enumerate(PAIRED) for b in PAIRED[i + 1:])
@@ -256,6 +256,30 @@ def live_intervals(rows: pd.DataFrame, predictor: str, point: float, n_draws: in
         mean_static = np.einsum("bd,db->b", weights, static_share) / weights.sum(axis=1)
         return {"envelope_share_gain": percentile_interval(mean_ours - mean_static, level),
                 "relative_gain": percentile_interval(mean_ours / mean_static - 1.0, level)}
+
+
+def fixed_point_interval(rows: pd.DataFrame, predictor: str, point: float, n_draws: int, level: float,
+                         rng: np.random.Generator) -> dict:
+    """``predictor`` at an operating point chosen elsewhere (another world, the population), resampled by scene: its
+    mean SPL and R_i at ``point``, and its share of the ceiling against the static baseline and the ceiling of each
+    draw (static's size chosen again in each). rows : the prediction table's rows of one method, arcs and tolerance
+    (static's among them). Returns {mean_spl, incursion_rate, share, share_interval, incursion_rate_interval}; {}
+    where the rows hold no such point."""
+    datasets = np.sort(rows.loc[rows["predictor"] == "static", "dataset"].unique())
+    ours, static = (family(rows[rows["predictor"] == p], datasets) for p in (predictor, "static"))
+    column = np.flatnonzero(np.isclose(ours.points, point))
+    if not len(datasets) or not len(column):
+        return {}
+    everything = np.ones((1, len(datasets)))
+    weights = np.vstack([everything, cluster_weights(np.array([scene_of(n) for n in datasets]), n_draws, rng)])
+    spl, rate = (values[:, column[0]] for values in curves(ours, weights))
+    static_spl, _ = select(static, weights, conservative_high=False)
+    mean_theta_a = (weights @ ours.theta_a) / weights.sum(axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        share = (spl - static_spl) / (mean_theta_a - static_spl)
+    return {"mean_spl": float(spl[0]), "incursion_rate": float(rate[0]), "share": float(share[0]),
+            "share_interval": percentile_interval(share[1:], level),
+            "incursion_rate_interval": percentile_interval(rate[1:], level)}
 
 
 def rate_bands(rows: pd.DataFrame, predictors: tuple[str, ...], rates: np.ndarray, n_draws: int, level: float,

@@ -16,7 +16,9 @@ k x the predicted localization error reaches the tolerance (operating point: the
 "error_next_step_observed", the latter calibrated on each arc by the robot's kinematics (datasets with the robot's
 poses only). Their theta_p
 depends on the tolerance, so their rows name it (column ``tolerance``; empty for every other predictor, whose
-theta_p serves every tolerance). "error_combined", the earlier stop of the error predictor and the paper's at its
+theta_p serves every tolerance). Ours too (issue 50, :mod:`.hazard`): "hazard_next_step" and "hazard_long_range", which stop where the failure
+hazard, trained on the population's worlds, reaches h (operating point: h; rows per tolerance, arcs of the paper's
+PnP method). "error_combined", the earlier stop of the error predictor and the paper's at its
 chosen n_t, is made from both after the operating points are chosen (:func:`combined_rows`).
 Only "long_range", "error_long_range" and "static" run on PnP methods other than ``protocol.pnp_method`` (Fig. 6).
 
@@ -41,6 +43,7 @@ from poseintegrity.parallel import Workers
 from poseintegrity.tables import TableError, check_artifacts, check_envelopes
 from poseintegrity.prediction.metrics import with_metrics
 from poseintegrity.prediction.error_predictors import COUNT_TREND, combined, error_long_range, error_next_step
+from poseintegrity.prediction.hazard.applied import HAZARD_PREDICTORS, HazardSet, hazard_rows
 from poseintegrity.params.predict import PredictParams
 from poseintegrity.prediction.predictors import (
     NO_FIT,
@@ -65,11 +68,13 @@ FREE_WIDTH_PREDICTORS = ("long_range_free_width", "next_step_free_width")  # our
 ERROR_PREDICTORS = ("error_long_range", "error_next_step", "error_next_step_observed",
                     "error_combined")  # ours: on the predicted error
 FITTED_PREDICTORS = ("long_range", "long_range_lower", "mlp", "next_step", *RELATIVE_PREDICTORS,
-                     *FREE_WIDTH_PREDICTORS, *ERROR_PREDICTORS)  # fmt: skip
+                     *FREE_WIDTH_PREDICTORS, *ERROR_PREDICTORS, *HAZARD_PREDICTORS)  # fmt: skip
 PAPER_COUNTERPART = {"long_range_free_width": "long_range", "next_step_free_width": "next_step"}  # same predictor
-CONSERVATIVE_HIGH = {"static": False}  # a larger operating point is more conservative for n_t, not for a size
+CONSERVATIVE_HIGH = {"static": False, "hazard_next_step": False, "hazard_long_range": False}
+# a larger operating point is more conservative for n_t and k, not for a size or a hazard h
 OPERATING_POINT_KEY = {"static": "best_size", "long_range_relative": "best_fraction",
-                       "next_step_relative": "best_fraction"} | {p: "best_k" for p in ERROR_PREDICTORS}
+                       "next_step_relative": "best_fraction"} | {p: "best_k" for p in ERROR_PREDICTORS} | {
+                       p: "best_h" for p in HAZARD_PREDICTORS}
 # predictors.json name of the best operating point
 
 
@@ -186,10 +191,11 @@ def _predict_task(task: tuple[Series, str], predict: PredictParams, fit: FitPara
 
 def sweep(
     artifacts: pd.DataFrame, predict: PredictParams, fit: FitParams, protocol: ProtocolParams, workers: Workers,
-    progress: bool = True,
+    progress: bool = True, hazard: HazardSet | None = None,
 ) -> pd.DataFrame:  # fmt: skip
     """theta_p of every predictor, dataset, PnP method and operating point (rows of COLUMNS), one task per dataset
-    and PnP method on ``workers``.
+    and PnP method on ``workers``; the hazard predictors' rows too where ``hazard`` is given
+    (:func:`~poseintegrity.prediction.hazard.applied.hazard_rows`, over ``predict.hazard.levels``).
 
     artifacts : the stage-02 table (dataset, trajectory, stop, image, theta_deg, x_mm, method, n_inliers, ...)
     """
@@ -200,6 +206,8 @@ def sweep(
     ]
     results = workers.map(partial(_predict_task, predict=predict, fit=fit, protocol=protocol), tasks,
                           desc="predictor sweep (dataset, PnP method)", progress=progress)  # fmt: skip
+    if hazard is not None:
+        results.append(hazard_rows(artifacts, hazard, protocol, predict.hazard.levels))
     return pd.concat(results, ignore_index=True)
 
 

@@ -24,7 +24,7 @@ from poseintegrity.prediction.metrics import (best_operating_point, operating_cu
 from poseintegrity.params.predict import PredictParams
 from poseintegrity.prediction.predictors import NO_FIT
 from poseintegrity.prediction.sweeps import (
-    CONSERVATIVE_HIGH, ERROR_PREDICTORS, FITTED_PREDICTORS, FREE_WIDTH_PREDICTORS, OPERATING_POINT_KEY,
+    CONSERVATIVE_HIGH, ERROR_PREDICTORS, FITTED_PREDICTORS, HAZARD_PREDICTORS, FREE_WIDTH_PREDICTORS, OPERATING_POINT_KEY,
     PAPER_COUNTERPART, PAPER_PREDICTORS, RELATIVE_PREDICTORS, attach_envelopes,
 )
 from poseintegrity.prediction.tails import tail_metrics
@@ -101,7 +101,8 @@ def fit_status_shares(table: pd.DataFrame) -> dict[str, dict]:
     theta_p rests on a fit of that status."""
     # a sweep row serves every tolerance, but the error predictors' rows were made for one (sweeps.py)
     once = ["predictor", "method", "trajectory", "dataset", "operating_point"]
-    table = table.assign(made_for=table["tolerance"].where(table["predictor"].isin(ERROR_PREDICTORS), ""))
+    made_for_one = table["predictor"].isin((*ERROR_PREDICTORS, *HAZARD_PREDICTORS))
+    table = table.assign(made_for=table["tolerance"].where(made_for_one, ""))
     table = table.drop_duplicates([*once, "made_for"])
     shares = {}
     for predictor in FITTED_PREDICTORS:
@@ -146,7 +147,7 @@ def table_metrics(table: pd.DataFrame, curves: pd.DataFrame, predict: PredictPar
     static_mean = float(np.mean([get("static", "arc", t)[0] for t in tolerances]))
     limits = ceiling(table, best, protocol.pnp_method, tolerances)
     predictors = (*PAPER_PREDICTORS, "long_range_lower", *RELATIVE_PREDICTORS, *FREE_WIDTH_PREDICTORS,
-                  *ERROR_PREDICTORS)
+                  *ERROR_PREDICTORS, *HAZARD_PREDICTORS)
     draws = predict.intervals
 
     def spread(predictors: tuple[str, ...], method: str, trajectory: str, tolerances: list[str]) -> dict:
@@ -167,7 +168,7 @@ def table_metrics(table: pd.DataFrame, curves: pd.DataFrame, predict: PredictPar
                                 "ceiling_share": ceiling_share(spl, limits[tolerance]), "gain": spl - static,
                                 "relative_gain": relative_improvement(spl, static),
                                 "interval": arcs[tolerance].get(predictor, {})}
-            if predictor in (*PAPER_PREDICTORS, *ERROR_PREDICTORS):
+            if predictor in (*PAPER_PREDICTORS, *ERROR_PREDICTORS, *HAZARD_PREDICTORS):
                 entry[tolerance]["decided_by"] = deciding_datasets(table, predictor, protocol.pnp_method, "arc",
                                                                    tolerance, point)
             if point_key != "best_n_t":

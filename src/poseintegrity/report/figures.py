@@ -182,3 +182,29 @@ def population_figure(judged: pd.DataFrame, predictors: list[str]) -> plt.Figure
                  f"below -1 drawn at -1)", y=1.0)
     fig.tight_layout()
     return fig
+
+
+def hazard_figure(reliability: pd.DataFrame, importance: pd.DataFrame, top: int = 8) -> plt.Figure:
+    """The failure hazard on held-out worlds (issue 50), a row per tolerance: the reliability diagram of the next-step
+    hazard beside the one-column hazards (the predicted error alone, n_i alone; marker area: rows in the bin), and
+    the ``top`` evidence columns by permutation importance (mean rise of the Brier score, bars over the worlds' spread).
+    reliability : population.hazard.reliability_table; importance : its ``importance`` table."""
+    tolerances = sorted(reliability["tolerance"].unique())
+    fig, axes = plt.subplots(len(tolerances), 2, figsize=(11, 4.2 * len(tolerances)), squeeze=False)
+    for row, tolerance in zip(axes, tolerances):
+        shown = reliability[(reliability["tolerance"] == tolerance) & (reliability["predictor"] == "hazard_next_step")]
+        for (label, part), color in zip(shown.groupby("hazard_of", sort=False), sns.color_palette("deep")):
+            part = part[part["n"] > 0]
+            row[0].plot(part["mean_hazard"], part["failure_rate"], "-", color=color, alpha=0.7)
+            row[0].scatter(part["mean_hazard"], part["failure_rate"], s=8 + 60 * part["n"] / max(part["n"].max(), 1),
+                           color=color, label=label.replace("_", " "))
+        row[0].plot([0, 1], [0, 1], ":", color="grey")
+        row[0].set(xlabel="predicted hazard of the next stop", ylabel="share of those stops that failed",
+                   title=f"{tolerance}: calibration on held-out worlds", xlim=(0, 1), ylim=(0, 1))
+        row[0].legend(fontsize=8)
+        ranked = importance[(importance["tolerance"] == tolerance) & (importance["predictor"] == "hazard_next_step")]
+        ranked = ranked.groupby("feature")["importance"].agg(["mean", "std"]).sort_values("mean").tail(top)
+        row[1].barh(ranked.index, ranked["mean"], xerr=ranked["std"], color=sns.color_palette("deep")[0])
+        row[1].set(xlabel="rise of the Brier score when shuffled", title=f"{tolerance}: what the next-step hazard reads")
+    fig.tight_layout()
+    return fig
