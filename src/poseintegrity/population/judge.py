@@ -43,7 +43,9 @@ from poseintegrity.prediction.transfer import DECIMALS
 # Tables I-III chose (sweeps.combined_rows), a hindsight no transferred point removes (on the first run of 12 worlds
 # its share and its zero-incursion worlds were the same at every kind of point at 4 mm / 10 deg: 14 %, 100 %)
 JUDGED = ("static", "long_range", "mlp", "next_step", "error_long_range", "error_next_step",
-          "error_next_step_observed")
+          "error_next_step_observed", "hazard_next_step", "hazard_long_range")
+# ours (issue 50): the hazard predictors' rows of a world come from models trained without it (population/hazard.py),
+# and their ``others`` point is the h chosen on the training worlds' held-out curves (:func:`judge_population`)
 KEYS = ["predictor", "tolerance"]
 
 
@@ -168,15 +170,22 @@ def paired(judged: pd.DataFrame, point: str = "own") -> dict:
 
 
 def judge_population(worlds: dict[str, tuple[pd.DataFrame, pd.DataFrame]], main_curves: pd.DataFrame,
-                     zero_incursion_worlds: float, method: str, tolerances: list[str]) -> pd.DataFrame:
+                     zero_incursion_worlds: float, method: str, tolerances: list[str],
+                     held_out_points: pd.DataFrame | None = None) -> pd.DataFrame:
     """:func:`judge_world` of every world (column ``world``) at its own points, at the main world's (``main_curves``:
     its :func:`arc_curves`) and at the points chosen on the other worlds (:func:`chosen_on`, column ``feasible`` of
-    that choice). worlds : name -> (prediction table, :func:`arc_curves`)."""
+    that choice). worlds : name -> (prediction table, :func:`arc_curves`). held_out_points : (world, predictor,
+    tolerance, operating_point, feasible) rows that replace the others' point of a predictor whose rows on the other
+    worlds were made knowing this one (the hazard's: chosen on models fitted without it)."""
     main = best_table(main_curves).rename(columns={"best_operating_point": "operating_point"})[[*KEYS,
                                                                                                 "operating_point"]]
     judged = []
     for name, (table, curves) in worlds.items():
         others = chosen_on({w: c for w, (_, c) in worlds.items() if w != name}, zero_incursion_worlds)
+        if held_out_points is not None and len(held_out_points):
+            own = held_out_points[held_out_points["world"] == name][[*KEYS, "operating_point", "feasible"]]
+            others = pd.concat([others.merge(own[KEYS], on=KEYS, how="left", indicator=True).query(
+                "_merge == 'left_only'").drop(columns="_merge"), own], ignore_index=True)
         rows = judge_world(table, curves, {"main": main, "others": others}, method, tolerances)
         feasible = others.assign(point="others")[[*KEYS, "point", "feasible"]]
         judged.append(rows.merge(feasible, on=[*KEYS, "point"], how="left").assign(world=name))
@@ -230,3 +239,28 @@ def population_metrics(judged: pd.DataFrame, chosen: pd.DataFrame, applied: dict
         "ground_truth": (realism or {}) | {"r11_passed_worlds": sum(bool(r.get("r11_passed")) for r in
                                                                     (realism or {}).values())},
     }
+
+
+SEEN_BY = ("hazard_next_step", "hazard_long_range", "error_next_step", "error_next_step_observed", "error_long_range",
+           "next_step", "long_range")  # the predictors whose failures-seen-ahead are counted (issue 50)
+
+
+def seen_ahead(judged: pd.DataFrame, tables: dict[str, pd.DataFrame], modes: pd.DataFrame) -> dict:
+    """Per tolerance, predictor and failure mode (population.hazard.failure_modes): of the held-out arcs that failed
+    by that mode, how many the predictor stopped before (theta_p <= theta_a: it saw the failure a stop ahead) at its
+    ``others`` point (chosen without the arc's world). tables : world -> its prediction table (the hazard's rows
+    among them); judged : :func:`judge_population`. ``<tolerance>.<predictor>.<mode>: {seen, arcs}``."""
+    result: dict = {}
+    points = judged[(judged["point"] == "others") & judged["predictor"].isin(SEEN_BY)]
+    for row in points.dropna(subset=["operating_point"]).itertuples(index=False):
+        table = tables[row.world]
+        at = table[(table["predictor"] == row.predictor) & (table["tolerance"] == row.tolerance)
+                   & (table["trajectory"] == "arc") & np.isclose(table["operating_point"], row.operating_point)]
+        failed = modes[(modes["world"] == row.world) & (modes["tolerance"] == row.tolerance)]
+        scored = failed.merge(at[["dataset", "incursion"]], on="dataset", how="left")
+        for mode, group in scored.groupby("mode"):
+            entry = result.setdefault(row.tolerance, {}).setdefault(row.predictor, {}).setdefault(
+                mode, {"seen": 0, "arcs": 0})
+            entry["seen"] += int((group["incursion"] == 0).sum())
+            entry["arcs"] += len(group)
+    return result
