@@ -44,9 +44,8 @@ from poseintegrity.localization.pnp import MIN_CORRESPONDENCES, PnPResult, solve
 from poseintegrity.params.extract import ConsensusParams, ExtractParams
 from poseintegrity.poses import pose_errors, pose_from_rvec_tvec
 from poseintegrity.seeding import keyed_rng
+from poseintegrity.tables import CONSENSUS_COLUMNS, STOP_SPREAD_COLUMNS
 
-CONSENSUS_COLUMNS = ("consensus_t_mm", "consensus_r_deg", "consensus_elsewhere", "consensus_rerun_t_mm")
-STOP_SPREAD_COLUMNS = ("stop_spread_t_mm", "stop_spread_r_deg")
 STOP_KEYS = ["dataset", "method", "stop"]
 MIN_RESAMPLES = 4  # an RMS of fewer solved resamples says little
 CONSENSUS_CACHE_VERSION = 1  # bump when the cached content, its layout or what computes it changes
