@@ -168,15 +168,17 @@ class FrameTask:
     @property
     def pnp_path(self) -> Path:
         """The cache of the frame's PnP results (:mod:`frame_pnp`), beside its evidence."""
-        return self._beside_evidence(".pnp.npz")
+        return beside_evidence(self.evidence_path, ".pnp.npz")
 
     @property
     def consensus_path(self) -> Path:
         """The cache of the frame's consensus columns (:mod:`consensus`), beside its evidence."""
-        return self._beside_evidence(".consensus.npz")
+        return beside_evidence(self.evidence_path, ".consensus.npz")
 
-    def _beside_evidence(self, suffix: str) -> Path:
-        return self.evidence_path.with_name(self.evidence_path.name.removesuffix(".evidence.npz") + suffix)
+
+def beside_evidence(evidence_path: Path, suffix: str) -> Path:
+    """A per-frame cache file beside the frame's evidence: ``<image>.evidence.npz`` -> ``<image><suffix>``."""
+    return evidence_path.with_name(evidence_path.name.removesuffix(".evidence.npz") + suffix)
 
 
 def dataset_model(dataset: Dataset, params: ExtractParams, cache_dir: Path) -> tuple[TargetModel, BoardPose]:
