@@ -96,7 +96,8 @@ def check_artifacts(table: pd.DataFrame, name: str = "the artifacts table", *,
     """An artifacts table (stage 02 / 05), checked: ``columns`` present, rows, one row per (dataset, stop, image,
     method), stop and image integers >= 0, a known trajectory, theta_deg / x_mm finite, n_inliers a count >= 0 (or NaN: a missing count, which the predictors flag),
     E_t_mm / E_r_deg >= 0 or NaN (no pose, no board), the consensus columns, where present, >= 0 or NaN
-    (:data:`CONSENSUS_COLUMNS`, :data:`STOP_SPREAD_COLUMNS`), every dataset of ``datasets`` present. Returns it unchanged."""
+    (:data:`CONSENSUS_COLUMNS`, :data:`STOP_SPREAD_COLUMNS`), every dataset of ``datasets`` present. Returns it
+    unchanged."""
     _structure(table, name, columns, ARTIFACT_KEYS)
     for column in ("stop", "image"):
         _numeric(table, name, column, ARTIFACT_KEYS, integer=True, low=0)

@@ -371,8 +371,8 @@ def extract_datasets(
     (:func:`~poseintegrity.localization.consensus.stop_spread`).
 
     consensus : compute the consensus columns of every method (:mod:`consensus`; NaN otherwise). Stage 02 does, for
-    ``protocol.pnp_method``, at ~3 ms (bootstrap) + ~18 ms (3 USAC re-runs) per frame; stage 05 does not: its five
-    classic methods would cost ~50 ms more per frame, twice its PnP, for columns no figure of it reads."""
+    ``protocol.pnp_method``, at ~2 ms (bootstrap) + ~15 ms (3 USAC re-runs) per frame; stage 05 does not: its five
+    classic methods would cost ~50 ms more per frame, about three times its PnP, for columns no figure of it reads."""
     cache_dirs = [_cache_root(dataset.data_dir, params) / dataset.name for dataset in datasets]
     models = workers.map(store_model, [ModelTask(d, c, params) for d, c in zip(datasets, cache_dirs)],
                          desc="target models M_t", progress=progress)
