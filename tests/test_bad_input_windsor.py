@@ -155,6 +155,8 @@ def _envelopes() -> pd.DataFrame:
     (lambda t: t.drop(columns="E_t_mm"), r"lacks columns \['E_t_mm'\]"),
     (lambda t: t.assign(stop=t.stop.astype(float)), "column stop must hold integers"),
     (lambda t: t.assign(E_t_mm=-t.E_t_mm), "below 0 E_t_mm"),
+    (lambda t: t.assign(consensus_t_mm=-1.0), "below 0 consensus_t_mm"),  # checked where present (stage 02's)
+    (lambda t: t.assign(stop_spread_r_deg=np.inf), "non-finite stop_spread_r_deg"),
     (lambda t: t.assign(x_mm=t.x_mm.astype(object).where(t.index != 3, "20.0 mm")),
      r"column x_mm must hold numbers, got dtype object: '20.0 mm' in dataset arc_00 \(stop 1, image 1"),
 ])

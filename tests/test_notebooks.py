@@ -121,6 +121,9 @@ def test_stage_02_flags_the_spoiled_frames_and_writes_tables_metrics_and_figures
     assert (posed.covariance_status.isin(["ok", "too_few_points", "degenerate_points"])).all()
     assert (posed.loc[posed.covariance_status == "ok", ["sigma_t_pred_mm", "sigma_r_pred_deg"]] > 0).all().all()
     assert (table.loc[table.n_inliers == 0, "covariance_status"] == "no_pose").all()  # PnP gave no pose
+    consensus = ["consensus_t_mm", "consensus_r_deg", "consensus_elsewhere", "consensus_rerun_t_mm"]  # issue 50
+    assert (posed[consensus[:3] + ["stop_spread_t_mm", "stop_spread_r_deg"]] >= 0).any().all()
+    assert table.loc[table.n_inliers == 0, consensus].isna().all().all()
     calibration = found["error_prediction"]["main"][TINY.protocol.tolerance_names[0]]
     assert 0 <= calibration["within_1sigma_t"] <= calibration["within_2sigma_t"] <= 1
     assert calibration["n_frames"] > 0 and calibration["pixel_noise_px"] > 0
@@ -153,6 +156,7 @@ def test_stage_05_writes_one_row_per_frame_and_method_with_stage_02s_evidence(pi
         pd.testing.assert_frame_equal(variant.loc[flagged, same_frames], usac.loc[flagged, same_frames])
         pd.testing.assert_frame_equal(variant[same_frames[:3] + same_frames[5:]], usac[same_frames[:3] + same_frames[5:]])
     assert ((table["reason"] != "") == (table["status"] != "ok")).all()  # classic RANSAC says why too
+    assert table[["consensus_t_mm", "consensus_elsewhere"]].isna().all().all()  # stage 02's method alone
     found = metrics(reports, "pnp.json")
     assert set(found["methods"]) == {TINY.protocol.pnp_method, *methods}
     assert found["iteration_caps"] == {"epnp": 672, "sqpnp": 672}  # w = 0.4, p = 0.999, samples of 5

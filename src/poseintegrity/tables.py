@@ -29,6 +29,10 @@ TRAJECTORIES = ("arc", "line")
 ARTIFACT_KEYS = ("dataset", "stop", "image", "method")
 ARTIFACT_COLUMNS = ("world", "dataset", "trajectory", "stop", "image", "theta_deg", "x_mm", "method", "status",
                     "n_inliers", "E_t_mm", "E_r_deg")
+# stage 02's evidence without ground truth (localization/consensus.py, which names them from here): not required
+# (older tables lack them), checked where present
+CONSENSUS_COLUMNS = ("consensus_t_mm", "consensus_r_deg", "consensus_elsewhere", "consensus_rerun_t_mm")
+STOP_SPREAD_COLUMNS = ("stop_spread_t_mm", "stop_spread_r_deg")
 ENVELOPE_KEYS = ("dataset", "trajectory", "method", "tolerance")  # and "rule" when the table has one
 ENVELOPE_COLUMNS = ("world", "dataset", "trajectory", "method", "tolerance", "theta_a", "censored")
 NOT_MEASURED = "not_measured"  # an envelope row's status when its theta_a could not be read (localization.envelope)
@@ -91,14 +95,16 @@ def check_artifacts(table: pd.DataFrame, name: str = "the artifacts table", *,
                     columns: Iterable[str] = ARTIFACT_COLUMNS, datasets: Iterable[str] | None = None) -> pd.DataFrame:
     """An artifacts table (stage 02 / 05), checked: ``columns`` present, rows, one row per (dataset, stop, image,
     method), stop and image integers >= 0, a known trajectory, theta_deg / x_mm finite, n_inliers a count >= 0 (or NaN: a missing count, which the predictors flag),
-    E_t_mm / E_r_deg >= 0 or NaN (no pose, no board), every dataset of ``datasets`` present. Returns it unchanged."""
+    E_t_mm / E_r_deg >= 0 or NaN (no pose, no board), the consensus columns, where present, >= 0 or NaN
+    (:data:`CONSENSUS_COLUMNS`, :data:`STOP_SPREAD_COLUMNS`), every dataset of ``datasets`` present. Returns it
+    unchanged."""
     _structure(table, name, columns, ARTIFACT_KEYS)
     for column in ("stop", "image"):
         _numeric(table, name, column, ARTIFACT_KEYS, integer=True, low=0)
     for column in ("theta_deg", "x_mm"):
         _numeric(table, name, column, ARTIFACT_KEYS)
     _numeric(table, name, "n_inliers", ARTIFACT_KEYS, low=0, nan=True)  # NaN: a missing count, flagged downstream
-    for column in ("E_t_mm", "E_r_deg"):
+    for column in ("E_t_mm", "E_r_deg", *CONSENSUS_COLUMNS, *STOP_SPREAD_COLUMNS):
         _numeric(table, name, column, ARTIFACT_KEYS, low=0, nan=True)
     if "trajectory" in table.columns and (unknown := sorted(set(table["trajectory"].astype(str)) - set(TRAJECTORIES))):
         raise TableError(f"{name}: unknown trajectory type(s) {unknown} in column trajectory, expected one of "

@@ -33,7 +33,8 @@ def test_one_row_per_frame_and_method_with_the_schema(table):
     assert len(table) == (4 * 2 + 2 * 2) * len(METHODS)
     for column in ["dataset", "trajectory", "stop", "image", "theta_deg", "x_mm", "method", "n_inliers", "n_matches",
                    "inlier_ratio", "reproj_error_px", "inlier_spread_px", "E_t_mm", "E_r_deg", "E_t_exact_mm",
-                   "E_r_exact_deg", "status", "reason", "board_status", "world"]:
+                   "E_r_exact_deg", "status", "reason", "board_status", "world", "consensus_t_mm", "consensus_r_deg",
+                   "consensus_elsewhere", "consensus_rerun_t_mm", "stop_spread_t_mm", "stop_spread_r_deg"]:
         assert column in table.columns
     assert set(table["trajectory"]) == {"arc", "line"}
     assert (table["reason"] == "").all()  # nothing flagged in good datasets
@@ -72,6 +73,7 @@ def test_features_evidence_and_model_are_cached_per_image(table, synthetic_data_
     assert len(list((cache / "images").glob("s*_i*[0-9].npz"))) == 8  # SIFT
     assert len(list((cache / "images").glob("*.evidence.npz"))) == 8  # matches to M_t and the ArUco pose
     assert len(list((cache / "images").glob("*.pnp.npz"))) == 8  # every method's PnP result
+    assert len(list((cache / "images").glob("*.consensus.npz"))) == 8  # every method's consensus columns
     assert sorted(p.name for p in (cache / "model").glob("*.npz")) == ["0.npz", "1.npz", "M_t.npz"]
 
 
@@ -80,6 +82,7 @@ def test_a_second_run_reuses_every_frame_evidence_and_gives_the_same_rows(
     """Stage 05 on stage 02's frames: no decoding, SIFT, matching or board detection again; a rerun with the same
     methods and settings (after an edit of the package or of ``parallel``) no PnP either; the same values."""
     import poseintegrity.localization.evidence as evidence
+    import poseintegrity.localization.consensus as consensus
     import poseintegrity.localization.frame_pnp as frame_pnp
 
     def never(*args, **kwargs):
@@ -88,9 +91,34 @@ def test_a_second_run_reuses_every_frame_evidence_and_gives_the_same_rows(
     for name in ("decode_gray", "cached_features", "correspondences", "board_pose"):
         monkeypatch.setattr(evidence, name, never)
     monkeypatch.setattr(frame_pnp, "solve_methods", never)
+    monkeypatch.setattr(consensus, "_computed", never)
     params = extract_params.model_copy(update=dict(datasets=["arc_a", "line_a"]))
     again = E.extract_all(synthetic_data_dir, params, METHODS, workers, progress=False)
     assert parquet_bytes(again) == parquet_bytes(table)
+
+
+def test_consensus_columns_of_posed_frames(table):
+    posed = table[table.status == "ok"]
+    assert len(posed) == len(table)
+    assert (posed[["consensus_t_mm", "consensus_r_deg", "stop_spread_t_mm", "stop_spread_r_deg"]] >= 0).all().all()
+    assert posed.consensus_elsewhere.between(0, 1).all()
+    near = posed[(posed.dataset == "arc_a") & (posed.stop == 0)]  # a well-posed view: a few tenths of a mm at most
+    assert (near.consensus_t_mm < 1.0).all() and (near.consensus_elsewhere == 0).all()
+
+
+def test_stop_spread_is_the_same_on_every_row_of_a_stop(table):
+    per_stop = table.groupby(["dataset", "method", "stop"])[["stop_spread_t_mm", "stop_spread_r_deg"]]
+    assert (per_stop.nunique(dropna=False) == 1).all().all()
+
+
+def test_without_consensus_its_columns_are_nan_and_the_rest_unchanged(table, synthetic_data_dir, extract_params,
+                                                                      workers):
+    params = extract_params.model_copy(update=dict(datasets=["line_a"]))
+    bare = E.extract_all(synthetic_data_dir, params, METHODS, workers, progress=False, consensus=False)
+    columns = ["consensus_t_mm", "consensus_r_deg", "consensus_elsewhere", "consensus_rerun_t_mm"]
+    assert bare[columns].isna().all().all()
+    expected = table[table.dataset == "line_a"].reset_index(drop=True)
+    assert parquet_bytes(bare.drop(columns=columns)) == parquet_bytes(expected.drop(columns=columns))
 
 
 def test_runs_repeat_exactly(table, synthetic_data_dir, extract_params, workers, tmp_path):
@@ -124,6 +152,10 @@ def test_bad_frames_give_flagged_rows_not_crashes(synthetic_data_dir, extract_pa
     assert set(E.usable(rows)["image"]) == {0, 1, 2}
     assert (rows.loc[rows.status != "ok", "reason"] != "").all()  # every row without a pose says why
     assert "SIFT found no keypoints" in blank.reason and "matches, a pose needs 4" in few_blobs.reason
+    consensus = ["consensus_t_mm", "consensus_r_deg", "consensus_elsewhere", "consensus_rerun_t_mm"]
+    assert rows.loc[rows.T_cam_board_est.map(lambda T: np.isnan(T).all()), consensus].isna().all().all()
+    assert np.isfinite(no_board[consensus].astype(float)).all()  # a pose without ground truth: its evidence is
+    assert no_board.stop_spread_t_mm >= 0  # what needs none (the stop's 2 posed images: its own and no_truth's)
 
 
 def test_unknown_dataset_in_params_is_named(synthetic_data_dir, extract_params, workers):

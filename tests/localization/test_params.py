@@ -7,7 +7,7 @@ import pytest
 
 from params_cases import refusal
 from poseintegrity.config import ParamsError, parse_params
-from poseintegrity.params.extract import ClaheParams, ExtractParams, RealismParams, SiftParams
+from poseintegrity.params.extract import ClaheParams, ConsensusParams, ExtractParams, RealismParams, SiftParams
 
 
 def test_tiny_section_validates_beside_the_paper_protocol(tiny_params):
@@ -16,7 +16,7 @@ def test_tiny_section_validates_beside_the_paper_protocol(tiny_params):
     assert tiny_params.protocol.pnp_method not in tiny_params.extract.pnp_methods
 
 
-@pytest.mark.parametrize("schema", [ExtractParams, ClaheParams, SiftParams, RealismParams])
+@pytest.mark.parametrize("schema", [ExtractParams, ClaheParams, SiftParams, RealismParams, ConsensusParams])
 def test_no_field_has_a_default_that_could_disagree_with_params_yaml(schema):
     assert [name for name, field in schema.model_fields.items() if not field.is_required()] == []
 
@@ -66,6 +66,16 @@ BAD_VALUES = [
     ("extract.sift.sigma", -1.0, "extract.sift.sigma"),
     ("extract.sift.sigma", float("inf"), "extract.sift.sigma"),
     ("extract.realism.max_nfev", 5, "extract.realism.max_nfev"),
+    ("extract.consensus.n_bootstrap", -1, "extract.consensus.n_bootstrap"),
+    ("extract.consensus.n_bootstrap", 2.0, "extract.consensus.n_bootstrap"),  # a count
+    ("extract.consensus.n_bootstrap", 10**6, "extract.consensus.n_bootstrap"),
+    ("extract.consensus.n_reruns", -1, "extract.consensus.n_reruns"),
+    ("extract.consensus.n_reruns", True, "extract.consensus.n_reruns"),
+    ("extract.consensus.elsewhere_mm", 0.0, "extract.consensus.elsewhere_mm"),  # every re-run would be elsewhere
+    ("extract.consensus.elsewhere_mm", float("nan"), "extract.consensus.elsewhere_mm"),
+    ("extract.consensus.elsewhere_deg", -1.5, "extract.consensus.elsewhere_deg"),
+    ("extract.consensus.elsewhere_deg", 180.0, "extract.consensus.elsewhere_deg"),
+    ("extract.consensus.n_boot", 16, "extract.consensus.n_boot"),
 ]
 
 

@@ -10,7 +10,9 @@ workers of the ``parallel`` section (:class:`~poseintegrity.parallel.Workers`):
 2. per frame (one task, results in frame order): its evidence (:mod:`evidence`: image check, CLAHE + SIFT, ratio-test
    matches to M_t, the board's checked pose; cached, so stage 05 reuses stage 02's), then PnP-RANSAC per method
    (:mod:`frame_pnp`: cached per frame, the classic RANSAC shared by EPnP, SQPnP and iterative) ->
-   artifacts (III-C) and E_t/E_r against the ground truth, the board pose of the frame (IV-C): ``E_t_mm``,
+   artifacts (III-C), the evidence that needs no ground truth (:mod:`consensus`: the inliers' bootstrap and RANSAC
+   re-runs per frame and method, cached per frame; per stop the spread of its images' poses, once a dataset's rows
+   are gathered) and E_t/E_r against the ground truth, the board pose of the frame (IV-C): ``E_t_mm``,
    ``E_r_deg`` (NaN without a pose, and without a trusted board pose: ``board_status`` other than "ok", e.g.
    ``bad_ground_truth`` with its ``board_reason``; such a frame keeps its localization status and n_i, it is only
    not judged); the same against a board pose refused by the trust rule's limits alone, which judges looser
@@ -49,6 +51,7 @@ from poseintegrity.localization.dataset import Dataset, DatasetError, load_datas
 from poseintegrity.localization.evidence import FrameEvidence, frame_evidence, model_digest
 from poseintegrity.localization.features import cached_features, read_gray, write_npz
 from poseintegrity.localization.frame_artifacts import frame_artifacts
+from poseintegrity.localization.consensus import CONSENSUS_COLUMNS, frame_consensus, stop_spread
 from poseintegrity.localization.frame_pnp import frame_pnp
 from poseintegrity.localization.kinematic_consistency import kinematic_errors, reported_pose
 from poseintegrity.localization.ground_truth import (
@@ -63,6 +66,7 @@ from poseintegrity.parallel import Workers
 
 FRAME_COLUMNS = ["world", "dataset", "trajectory", "stop", "image", "theta_deg", "x_mm"]
 DATA_FLAGS = ("bad_image", "bad_pose")  # statuses of rows whose frame (not its localization) is at fault
+NO_CONSENSUS = dict.fromkeys(CONSENSUS_COLUMNS, np.nan)  # the consensus columns of a row without a pose
 
 
 def usable(table: pd.DataFrame) -> pd.DataFrame:
@@ -159,11 +163,22 @@ class FrameTask:
     T_cam0_board_exact: np.ndarray | None = None  # model image 0's exact board pose (rendered data: R11)
     T_base_board_robot: np.ndarray | None = None  # where the model view placed the board, in the robot's base frame
     handover_boards: tuple[dict[str, Any], ...] = ()  # meta.json's: boards that judge a frame its own board cannot
+    consensus: bool = True  # compute the consensus columns (else NaN): see extract_datasets
 
     @property
     def pnp_path(self) -> Path:
         """The cache of the frame's PnP results (:mod:`frame_pnp`), beside its evidence."""
-        return self.evidence_path.with_name(self.evidence_path.name.removesuffix(".evidence.npz") + ".pnp.npz")
+        return beside_evidence(self.evidence_path, ".pnp.npz")
+
+    @property
+    def consensus_path(self) -> Path:
+        """The cache of the frame's consensus columns (:mod:`consensus`), beside its evidence."""
+        return beside_evidence(self.evidence_path, ".consensus.npz")
+
+
+def beside_evidence(evidence_path: Path, suffix: str) -> Path:
+    """A per-frame cache file beside the frame's evidence: ``<image>.evidence.npz`` -> ``<image><suffix>``."""
+    return evidence_path.with_name(evidence_path.name.removesuffix(".evidence.npz") + suffix)
 
 
 def dataset_model(dataset: Dataset, params: ExtractParams, cache_dir: Path) -> tuple[TargetModel, BoardPose]:
@@ -259,6 +274,9 @@ def frame_rows(task: FrameTask) -> tuple[list[dict[str, Any]], tuple[BoardPose, 
     results = {} if evidence.image_problem else frame_pnp(  # cached per frame; the classic RANSAC shared
         task.pnp_path, evidence.object_points, evidence.image_points, task.camera.K, model.digest, task.methods, caps,
         task.params, seed)
+    consensus = {} if evidence.image_problem or not task.consensus else frame_consensus(  # cached per frame
+        task.consensus_path, evidence.object_points, evidence.image_points, task.camera.K, model.digest, results, caps,
+        task.params, seed)
     rows = []
     for method in task.methods:
         if evidence.image_problem:
@@ -277,6 +295,7 @@ def frame_rows(task: FrameTask) -> tuple[list[dict[str, Any]], tuple[BoardPose, 
                | dict(method=method, status=status or pnp_status, reason=reason or pnp_reason, model_size=model.size,
                       model_pixel_noise_px=model.pixel_noise_px)
                | artifacts
+               | consensus.get(method, NO_CONSENSUS)
                | dict(E_t_exact_mm=E_t_exact_mm, E_r_exact_deg=E_r_exact_deg, E_t_kinematic_mm=E_t_kinematic_mm,
                       E_r_kinematic_deg=E_r_kinematic_deg, T_cam_board_est=T_est.ravel().tolist()))
         rows.append(row | judged(row, evidence.board, task))
@@ -344,10 +363,16 @@ def handed_over_rows(tasks: list[FrameTask], results: list[tuple[list[dict[str, 
 
 
 def extract_datasets(
-    datasets: list[Dataset], params: ExtractParams, methods: list[str], workers: Workers, progress: bool = True
+    datasets: list[Dataset], params: ExtractParams, methods: list[str], workers: Workers, progress: bool = True,
+    consensus: bool = True,
 ) -> pd.DataFrame:
     """Artifact rows (one per frame and method, datasets in the given order, frames by stop and image) of checked
-    datasets: M_t per dataset, then every frame, on ``workers``."""
+    datasets: M_t per dataset, then every frame, on ``workers``; then each stop's spread of poses
+    (:func:`~poseintegrity.localization.consensus.stop_spread`).
+
+    consensus : compute the consensus columns of every method (:mod:`consensus`; NaN otherwise). Stage 02 does, for
+    ``protocol.pnp_method``, at ~2 ms (bootstrap) + ~15 ms (3 USAC re-runs) per frame; stage 05 does not: its five
+    classic methods would cost ~50 ms more per frame, about three times its PnP, for columns no figure of it reads."""
     cache_dirs = [_cache_root(dataset.data_dir, params) / dataset.name for dataset in datasets]
     models = workers.map(store_model, [ModelTask(d, c, params) for d, c in zip(datasets, cache_dirs)],
                          desc="target models M_t", progress=progress)
@@ -356,7 +381,7 @@ def extract_datasets(
             frame, dataset.path(frame["file"]), cache_dir / Path(frame["file"]).with_suffix(".npz"),
             cache_dir / Path(frame["file"]).with_suffix(".evidence.npz"), model, dataset.meta.get("board"),
             dataset.camera, tuple(methods), params, dataset.meta.get("ground_truth", "board"), exact_model_pose(dataset),
-            robot_board_pose(dataset, model), tuple(dataset.meta.get("handover_boards") or ()),
+            robot_board_pose(dataset, model), tuple(dataset.meta.get("handover_boards") or ()), consensus,
         )
         for dataset, cache_dir, model in zip(datasets, cache_dirs, models)
         for frame in dataset.frames.assign(world=dataset.meta["world"], trajectory=dataset.meta["trajectory"])
@@ -367,7 +392,8 @@ def extract_datasets(
     for dataset in datasets:
         mine = [k for k, task in enumerate(tasks) if task.frame["dataset"] == dataset.name]
         rows += handed_over_rows([tasks[k] for k in mine], [results[k] for k in mine], params)
-    return pd.DataFrame(rows)
+    table = pd.DataFrame(rows)
+    return table.join(stop_spread(table)) if rows else table
 
 
 def robot_board_pose(dataset: Dataset, model: StoredModel) -> np.ndarray | None:
@@ -394,14 +420,15 @@ def _cache_root(data_dir: Path, params: ExtractParams) -> Path:
 
 def extract_dataset(
     data_dir: str | Path, folder: str | Path, params: ExtractParams, methods: list[str], workers: Workers,
-    progress: bool = True,
+    progress: bool = True, consensus: bool = True,
 ) -> pd.DataFrame:
     """Artifact rows (one per frame and method) of the dataset in ``data_dir/folder`` (checked on read)."""
-    return extract_datasets([load_dataset(data_dir, folder)], params, methods, workers, progress)
+    return extract_datasets([load_dataset(data_dir, folder)], params, methods, workers, progress, consensus)
 
 
 def extract_all(
-    data_dir: str | Path, params: ExtractParams, methods: list[str], workers: Workers, progress: bool = True
+    data_dir: str | Path, params: ExtractParams, methods: list[str], workers: Workers, progress: bool = True,
+    consensus: bool = True,
 ) -> pd.DataFrame:
     """Artifact rows of every dataset of ``data_dir/datasets/index.parquet`` (or of ``params.datasets``), in index
     order. Every dataset is checked before any work (:mod:`~poseintegrity.localization.dataset`)."""
@@ -413,4 +440,4 @@ def extract_all(
                                f"known: {sorted(index['dataset'])}")
         index = index[index["dataset"].isin(params.datasets)]
     datasets = [load_dataset(data_dir, row.path, row.dataset) for row in index.itertuples()]
-    return extract_datasets(datasets, params, methods, workers, progress)
+    return extract_datasets(datasets, params, methods, workers, progress, consensus)

@@ -11,6 +11,8 @@ import hashlib
 import json
 import os
 import tempfile
+import zipfile
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -133,6 +135,16 @@ def cached_features(
     features = detect_features(decode_gray(data, image_path) if image is None else image, clahe, sift)
     write_npz(cache_path, key=key, points=features.points, descriptors=features.descriptors.astype(np.uint8))
     return features
+
+
+def read_npz(path: Path, names: Sequence[str]) -> tuple[np.ndarray, ...] | None:
+    """The arrays ``names`` of an .npz cache entry, in that order; None when the file is missing, truncated, not an
+    .npz or lacks one of them (the caller recomputes the entry)."""
+    try:
+        with np.load(path) as stored:
+            return tuple(stored[name] for name in names)
+    except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile):
+        return None
 
 
 def write_npz(path: Path, **arrays) -> None:

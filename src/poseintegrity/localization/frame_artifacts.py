@@ -23,6 +23,9 @@ of RANSAC's threshold ((c) there):
 - ``sigma_t_unconditioned_mm``, ``sigma_r_unconditioned_deg``: the same without the inlier test's conditioning (the
   plain first-order propagation), reported beside it
 - ``covariance_status``: "ok", or why there is no prediction ("no_pose", "too_few_points", "degenerate_points")
+
+Evidence about the pose that needs no ground truth (issue 50), beside these in stage 02's rows: ``consensus_*`` and
+``stop_spread_*``, :mod:`consensus`.
 """
 
 from __future__ import annotations

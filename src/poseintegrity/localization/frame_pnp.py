@@ -17,14 +17,13 @@ from __future__ import annotations
 
 import hashlib
 import json
-import zipfile
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 import cv2
 import numpy as np
 
-from poseintegrity.localization.features import write_npz
+from poseintegrity.localization.features import read_npz, write_npz
 from poseintegrity.params.extract import ExtractParams
 from poseintegrity.localization.pnp import PnPResult, solve_methods
 
@@ -53,11 +52,9 @@ def pnp_key(
 def _stored(path: Path) -> dict[str, tuple[str, PnPResult]]:
     """The entries of a cache file: method -> (its key, its result); {} when the file is missing, truncated, not an
     .npz or of another layout."""
-    try:
-        with np.load(path) as stored:
-            methods, keys, T, n_reported, status, reason, counts, inliers = (stored[name] for name in FIELDS)
-    except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile):
+    if (arrays := read_npz(path, FIELDS)) is None:
         return {}
+    methods, keys, T, n_reported, status, reason, counts, inliers = arrays
     m = len(methods)
     if (methods.ndim != 1 or T.shape != (m, 4, 4) or inliers.ndim != 1 or counts.sum() != len(inliers)
             or any(len(a) != m for a in (keys, n_reported, status, reason, counts))):

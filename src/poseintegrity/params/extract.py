@@ -62,6 +62,21 @@ class GroundTruthParams(Section):
     max_sigma_r_deg: float = Field(gt=0, le=90, description="the same for the rotation")
 
 
+class ConsensusParams(Section):
+    """Per-frame evidence about a pose that needs no ground truth (issue 50,
+    :mod:`poseintegrity.localization.consensus`): how its inliers' bootstrap and RANSAC re-runs with other seeds
+    agree with it. A count of 0 turns its part off (its columns NaN)."""
+
+    n_bootstrap: int = Field(ge=0, le=1000, description="resamples of a frame's inliers, each re-solved from its pose: "
+                                                        "consensus_t_mm / consensus_r_deg are their RMS deviation "
+                                                        "(1000 solves are ~0.2 s per frame and method)")
+    n_reruns: int = Field(ge=0, le=100, description="RANSAC re-runs with other seeds: consensus_elsewhere is the "
+                                                    "share landing elsewhere (100 USAC re-runs are ~0.6 s per frame)")
+    elsewhere_mm: float = Field(gt=0, le=100, description="a re-run's pose is elsewhere beyond this translation "
+                                                          "from the frame's")
+    elsewhere_deg: float = Field(gt=0, le=90, description="... or beyond this rotation")
+
+
 class ExtractParams(Section):
     """Target localization pipeline, artifact extraction and actual envelopes (stages 02 and 05)."""
 
@@ -91,6 +106,7 @@ class ExtractParams(Section):
         min_length=1, description="dataset ids to process (names of index.parquet); null: every dataset")
     realism: RealismParams
     ground_truth: GroundTruthParams
+    consensus: ConsensusParams
 
     @model_validator(mode="after")
     def _check(self, info: ValidationInfo) -> ExtractParams:
