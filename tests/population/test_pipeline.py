@@ -58,7 +58,7 @@ def test_a_world_added_runs_that_world_alone(population):
     _, _, _, _, added = population
     ran = re.findall(r"Running stage '([^']+)'", added)
     assert sorted(ran) == ["population/dvc.yaml:extract@w03", "population/dvc.yaml:generate@w03",
-                           "population/dvc.yaml:judge", "population/dvc.yaml:predict@w03"]
+                           "population/dvc.yaml:hazard", "population/dvc.yaml:judge", "population/dvc.yaml:predict@w03"]
 
 
 def test_the_population_s_metrics_judge_every_predictor_on_every_world(population):
@@ -72,6 +72,10 @@ def test_the_population_s_metrics_judge_every_predictor_on_every_world(populatio
             assert 0.0 <= entry[predictor]["others"]["zero_incursion_worlds"] <= 1.0
     assert set(metrics["applied"]) == {"main", "validation"}  # the population's points on the paper-scale worlds
     assert (work / "reports" / "figures" / "08_population.png").stat().st_size > 10_000
+    hazard = json.loads((work / "reports" / "metrics" / "hazard.json").read_text())
+    assert hazard == {"trained": False, "note": hazard["note"]} and "at least 4 worlds" in hazard["note"]
+    model = json.loads((work / "data" / "hazard" / "model.json").read_text())
+    assert model["tolerances"] == {} and model["note"] == hazard["note"]  # stage 04 runs no hazard rows on it
     world = yaml.safe_load((work / "data" / "population" / "w03" / "params.yaml").read_text())
     assert world["extends"] == "../../../params.yaml" and world["generate"]["scenes"][0]["name"] == "w03_s1"
 

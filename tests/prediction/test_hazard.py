@@ -150,3 +150,12 @@ def load_protocol() -> dict:
     from repository import ROOT
 
     return yaml.safe_load((ROOT / "params.yaml").read_text())["protocol"]
+
+
+def test_a_population_too_small_to_hold_a_world_out_trains_nothing_and_says_why():
+    from poseintegrity.population.hazard import train_population
+
+    protocol = ProtocolParams.model_validate(load_protocol())
+    worlds = {f"w{i}": (arc_frames("main", f"w{i}_a", [100, 80, 60, 40, 20]), pd.DataFrame()) for i in range(3)}
+    with pytest.raises(HazardFitError, match="at least 4 worlds in population.worlds .* got 3"):
+        train_population(worlds, protocol, np.array([0.1]), 1.0, 2, 1, 0, 0.9, progress=False)

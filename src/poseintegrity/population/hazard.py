@@ -26,7 +26,7 @@ from poseintegrity.localization.envelope import headline
 from poseintegrity.parallel import Progress
 from poseintegrity.population.judge import chosen_on
 from poseintegrity.prediction.hazard.applied import LONG_RANGE, NEXT_STEP, HazardSet, hazard_rows
-from poseintegrity.prediction.hazard.model import HazardModel, brier_score, fit_hazard, reliability
+from poseintegrity.prediction.hazard.model import HazardFitError, HazardModel, brier_score, fit_hazard, reliability
 from poseintegrity.prediction.hazard.risk_sets import LONG_RANGE as LONG_RANGE_COLUMNS
 from poseintegrity.prediction.hazard.risk_sets import long_range_rows, next_step_rows
 from poseintegrity.prediction.hazard.stop_evidence import EVIDENCE, stop_evidence
@@ -39,6 +39,7 @@ FEATURES = {NEXT_STEP: EVIDENCE, LONG_RANGE: LONG_RANGE_COLUMNS}
 ONE_COLUMN = {"error_alone": ("predicted_error",), "inliers_alone": ("log_inliers",)}  # the Brier comparisons
 CLIFF_INLIERS = 8.0  # a stop's mean n_i below this: the count fell off its cliff (issue 38: val_2_arc090 8.3 -> 6.0)
 MODES = ("no_pose", "cliff", "accelerating_bias")
+MIN_WORLDS = 4  # a held-out world, one held out within its training worlds, two to fit and calibrate on
 
 
 class World:
@@ -138,12 +139,16 @@ def train_population(worlds: dict[str, tuple[pd.DataFrame, pd.DataFrame]], proto
                      zero_incursion_worlds: float, progress: bool = True) -> dict:
     """Steps 1-4 for every world and tolerance, then the models of every world (module docstring).
 
-    worlds : name -> (stage 02's artifacts table, its envelopes table), at least 3 worlds (2 to train a held-out
-    world's models on, each calibrated on the other); progress : print a progress line now and then.
+    worlds : name -> (stage 02's artifacts table, its envelopes table), at least MIN_WORLDS; progress : print a
+    progress line now and then.
     Returns {"predictions", "chosen", "risk", "importance", "modes": DataFrames; "hazard": the :class:`HazardSet` of
     every world}. ArgumentError (:class:`~poseintegrity.prediction.hazard.model.HazardFitError`) when a model cannot be
     fitted (too few worlds, no failure among their rows).
     """
+    if len(worlds) < MIN_WORLDS:
+        raise HazardFitError(f"the hazard needs at least {MIN_WORLDS} worlds in population.worlds (one held out, one "
+                             f"more held out inside its training worlds to choose h, two left to fit and calibrate "
+                             f"on), got {len(worlds)}")
     predictions, chosen, risk, importances, modes = [], [], [], [], []
     models_all, chosen_all = {}, {}
     lines = Progress(len(worlds) * len(protocol.tolerances), "hazard, each world held out once", enabled=progress)
