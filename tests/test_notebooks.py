@@ -28,6 +28,7 @@ from poseintegrity.localization.envelope_causes import CAUSES
 from poseintegrity.localization.summaries import FAILURE_STATUSES
 from poseintegrity.prediction import (ERROR_PREDICTORS, FITTED_PREDICTORS, FREE_WIDTH_PREDICTORS, NO_FIT,
                                       PAPER_PREDICTORS)
+from poseintegrity.prediction.hazard.applied import HAZARD_PREDICTORS
 from poseintegrity.report.claims import TITLE
 from project_copy import project_copy, stage_06_project
 from repository import ROOT
@@ -76,7 +77,7 @@ def metrics(reports, name):
     return json.loads((reports / "metrics" / name).read_text())
 
 
-POPULATION_NOTEBOOKS = ["08_population"]  # needs a population's worlds: tests/population/test_pipeline.py runs it
+POPULATION_NOTEBOOKS = ["08_population", "09_hazard"]  # need a population's worlds: tests/population runs them
 
 
 def test_order_covers_every_notebook():
@@ -201,6 +202,10 @@ def test_stage_04_scores_every_predictor_on_both_worlds_and_draws_every_figure(p
             gap = limit["mean_theta_a"] - limit["static_spl"]
             assert share == pytest.approx((spl - limit["static_spl"]) / gap if gap > 0 else np.nan, nan_ok=True)
     assert {"k", "incursions", "envelope_share"} <= set(found["live"]["error_next_step"])
+    # issue 50: the committed hazard models (trained on the population, not on these datasets) ran on both worlds
+    assert set(found["hazard"]["worlds"]) == {"main", "validation"} and found["hazard"]["trained_on_arcs"] > 0
+    for predictor in HAZARD_PREDICTORS:
+        assert set(protocol.tolerance_names) <= set(found[predictor])
     made = pd.read_parquet(data / "predictions" / "predictions.parquet").predictor
     assert (made == "error_next_step_observed").any()  # the robot's log reached stage 04
     assert {"straight_line", "pnp", "loso", "live", "fit_status", "tails", "envelope_rules",
@@ -222,7 +227,8 @@ def test_stage_04_scores_every_predictor_on_both_worlds_and_draws_every_figure(p
     table = table[table.world == "main"]  # predictors.json: the main world (validation.json the other)
     for predictor in FITTED_PREDICTORS:  # a row per tolerance swept (the error predictors'), or one for all
         rows = table[(table.predictor == predictor) & ((table.tolerance == protocol.tolerance_names[0])
-                                                       | table.predictor.isin(ERROR_PREDICTORS))]
+                                                       | table.predictor.isin((*ERROR_PREDICTORS,
+                                                                                *HAZARD_PREDICTORS)))]
         assert found["fit_status"][predictor]["n_rows"] == len(rows)
         share = found["fit_status"][predictor][NO_FIT]  # null: no rows (error_combined without a Table III n_t)
         assert (np.nan if share is None else share) == pytest.approx((rows.fit_status == NO_FIT).mean(), nan_ok=True)

@@ -100,3 +100,16 @@ def test_the_population_s_notebook_runs_as_it_is_in_jupyterlab(population):
     with NotebookServer(work) as server:
         server.run("notebooks/08_population.ipynb")
     assert written.read_text() == before  # the same bytes as its stage's run
+
+
+def test_the_hazard_notebook_runs_as_it_is_in_jupyterlab(population):
+    """Notebook 09 opened in JupyterLab and run as it is: the same files as its stage (here, with 3 tiny worlds, the
+    flagged model file and metrics that say why nothing was trained)."""
+    work = population[0]
+    written = [work / "reports" / "metrics" / "hazard.json", work / "data" / "hazard" / "model.json"]
+    before = [path.read_text() for path in written]
+    for path in written:
+        path.unlink()
+    with NotebookServer(work) as server:
+        server.run("notebooks/09_hazard.ipynb")
+    assert [path.read_text() for path in written] == before

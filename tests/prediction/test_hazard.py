@@ -54,8 +54,8 @@ def test_the_risk_set_ends_at_the_failing_stop_and_a_censored_arc_never_fails():
     rows = next_step_rows(evidence, envelopes, k=4)
     # stops 3 (6.75 deg) and 4 (9.0 deg) are at risk (theta_a > theta_i); stop 5 (11.25) is the first past theta_a
     assert list(rows["stop"]) == [3, 4] and list(rows["failed"]) == [0, 1]
-    ahead = long_range_rows(evidence, envelopes, k=4)
-    assert list(ahead["theta_deg"]) == [9.0, 11.25] and list(ahead["failed"]) == [0, 1]
+    ahead = long_range_rows(evidence, envelopes, k=4)  # from stop 1 on, the sampled stops among them
+    assert list(ahead["theta_deg"]) == list(THETA[1:6]) and list(ahead["failed"]) == [0, 0, 0, 0, 1]
     assert (ahead["ahead_deg"] == ahead["theta_deg"] - THETA[3]).all() and list(ahead.columns[:len(LONG_RANGE)]) \
         == list(LONG_RANGE)
     censored = envelopes.assign(theta_a=THETA[-1], censored=True)
@@ -116,9 +116,11 @@ def test_the_stopping_rules_stop_where_the_hazard_first_reaches_h():
     hazard_next = np.array([0.9, 0.9, 0.1, 0.3, 0.2, np.nan])  # stops 0-1 sampled (k = 3): read from stop 2 on
     found = stop_on_next_hazard(theta, hazard_next, 3, np.array([0.05, 0.25, 0.5]))
     assert list(found.theta_p) == [4.0, 6.0, 10.0] and list(found.status) == ["stopped", "stopped", "end_of_path"]
-    ahead = np.array([0.1, 0.2, 0.5])  # stops 3, 4, 5: failed by 0.1, 0.28, 0.64
+    ahead = np.array([0.0, 0.0, 0.1, 0.2, 0.5])  # stops 1-5: failed by 0, 0, 0.1, 0.28, 0.64
     found = stop_on_failure_probability(theta, ahead, 3, np.array([0.05, 0.2, 0.5, 0.9]))
     assert list(found.theta_p) == [4.0, 6.0, 8.0, 10.0] and list(found.status) == ["root"] * 3 + ["censored"]
+    early = stop_on_failure_probability(theta, np.array([0.6, 0.0, 0.0, 0.0, 0.0]), 3, np.array([0.5]))
+    assert early.theta_p[0] == 0.0  # as the paper's long range, the end may lie among the sampled stops
     assert np.isnan(stop_on_next_hazard(theta[:2], hazard_next[:2], 3, np.array([0.1])).theta_p).all()
 
 

@@ -114,11 +114,9 @@ def hazard_rows(artifacts: pd.DataFrame, hazard: HazardSet, protocol: ProtocolPa
         for dataset, arc in evidence.groupby("dataset", sort=True):
             theta = arc["theta_deg"].to_numpy()
             step = stop_on_next_hazard(theta, arc["hazard_next"].to_numpy(), k, levels)
-            if len(theta) > k:
-                ahead = stop_on_failure_probability(theta, ahead_model.predict(long_range_features(arc.iloc[k - 1],
-                                                                                       theta[k:])), k, levels)
-            else:
-                ahead = stop_on_failure_probability(theta, np.empty(0), k, levels)
+            sampled = len(theta) >= max(k, 2)
+            hazards = ahead_model.predict(long_range_features(arc.iloc[k - 1], theta[1:])) if sampled else None
+            ahead = stop_on_failure_probability(theta, hazards, k, levels)
             for predictor, found in ((NEXT_STEP, step), (LONG_RANGE, ahead)):
                 tables.append(pd.DataFrame({
                     "predictor": predictor, "model": MODEL, "method": method, "trajectory": "arc",

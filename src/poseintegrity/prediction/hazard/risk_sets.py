@@ -7,8 +7,11 @@ the risk set up to and including the stop where it fails, and leaves it then; an
 failed-frame rule (the ground truth: used to label the training worlds' rows, never read by a prediction).
 
     next_step_rows   at every stop i from the k-th on: the evidence of stop i, and whether stop i + 1 fails
-    long_range_rows  for every stop j after the k sampled ones: the evidence of the k-th stop, how far ahead j lies
-                     (``ahead_deg``), and whether stop j fails
+    long_range_rows  for every stop j after the first: the evidence of the k-th (last sampled) stop, how far ahead
+                     of it j lies (``ahead_deg``, negative for a sampled stop), and whether stop j fails. The sampled
+                     stops are in it as the paper's long range predictor's fit is: it may put the envelope's end
+                     among them (theta_p from theta_1, III-E), and on the population 2 of 12 worlds have an arc that
+                     fails there at 2 mm / 3 deg (w01: 3.9 deg, w07: 6.7 deg, before the 4th stop's 6.75)
 """
 
 from __future__ import annotations
@@ -54,17 +57,17 @@ def long_range_features(sampled: pd.DataFrame, theta: np.ndarray) -> pd.DataFram
 
 
 def long_range_rows(evidence: pd.DataFrame, envelopes: pd.DataFrame, k: int) -> pd.DataFrame:
-    """One row per arc and stop j >= k (0-based) at risk (theta_a > theta_{j-1}): the LONG_RANGE columns from the
+    """One row per arc and stop j >= 1 (0-based) at risk (theta_a > theta_{j-1}): the LONG_RANGE columns from the
     k-th stop's evidence, world, dataset, ``theta_deg`` (of stop j) and ``failed`` (stop j fails: theta_a <=
     theta_j). An arc with fewer than k stops gives none."""
     table = _with_envelopes(evidence, envelopes).sort_values(KEYS, kind="stable")
     rows = []
     for (world, dataset), arc in table.groupby(["world", "dataset"], sort=True):
-        if len(arc) <= k:
+        if len(arc) < max(k, 2):
             continue
         theta = arc["theta_deg"].to_numpy()
         theta_a = float(arc["theta_a"].iloc[0]) if not bool(arc["censored"].iloc[0]) else np.inf
-        at_risk = np.flatnonzero(theta_a > theta[k - 1:-1]) + k  # stops j whose previous stop had not failed
+        at_risk = np.flatnonzero(theta_a > theta[:-1]) + 1  # stops j whose previous stop had not failed
         features = long_range_features(arc.iloc[k - 1], theta[at_risk])
         rows.append(features.assign(world=world, dataset=dataset, theta_deg=theta[at_risk],
                                     failed=(theta_a <= theta[at_risk]).astype(int)))
