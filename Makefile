@@ -53,8 +53,13 @@ repro: $(VENV)/.installed $(PATH_HOOK) $(KERNEL_CONFIG) ## run the paper-scale p
 
 # The population of rendered worlds (issue 49, population/dvc.yaml): not on `make repro`'s path. Its pipeline needs the
 # main world's operating points (it runs stages 01-05 of dvc.yaml first where they are stale); then `dvc repro` brings
-# the summary up to date (stage 07 reads the population through population/dvc.lock).
+# the summary up to date (stage 07 reads the population through population/dvc.lock) and runs stage 04 with the hazard
+# models the population trained (issue 50, read through the same lock); the population's judge then reads the main
+# world's hazard rows, and the last `dvc repro` gives the summary its result (each run re-runs only what changed: its
+# stage 04 re-runs for the judge's new lock and writes the same bytes, and a third round would run nothing).
 population: $(VENV)/.installed $(PATH_HOOK) $(KERNEL_CONFIG) ## render every world of params.yaml's population, judge the predictors on them, then the summary
+	$(BIN)/dvc repro population/dvc.yaml
+	$(BIN)/dvc repro
 	$(BIN)/dvc repro population/dvc.yaml
 	$(BIN)/dvc repro
 	@$(BIN)/python -m poseintegrity.timing reports/metrics/timing

@@ -7,7 +7,8 @@ evidence read from stage 02's cache as the stage does:
 1. CPU-seconds of the loop of the code at ``--reference`` (extracted with git archive: one ``solvePnPRansac`` per
    method) and of this tree (EPnP, SQPnP and iterative sharing one RANSAC, localization/pnp.py), each in fresh
    processes, run alternately ``--rounds`` times with this tree's PnP cache emptied before each of its runs; the
-   ratio of the medians, and whether the rows of the two codes are identical (parquet bytes, every column).
+   ratio of the medians, and whether the rows of the two codes are identical (every column of the reference's; the
+   reference runs on params.yaml without the keys it did not know, ``REFERENCE_UNKNOWN``).
 2. This tree again with the PnP cache its last run left (localization/frame_pnp.py): a rerun whose keys did not
    change, against the same reference; its rows against the reference's.
 
@@ -32,12 +33,15 @@ import tempfile
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
+import yaml
 
 ROOT = Path(__file__).resolve().parents[1]
 REFERENCE_COMMIT = "a1220b7"  # stage 05 before the shared RANSAC and the PnP cache
+REFERENCE_UNKNOWN = (("extract", "consensus"),)  # params keys added since (issue 50), which its schema refuses
 
 LOOP = """
-import dataclasses, json, sys, time
+import dataclasses, inspect, json, sys, time
 from pathlib import Path
 import cv2
 import numpy as np
@@ -66,7 +70,9 @@ class Timed:  # the Workers interface of extract_datasets, in this process, timi
         return results
 
 
-table = E.extract_datasets(datasets, params, list(params.pnp_methods), Timed(), progress=False)
+# stage 05 computes no consensus (issue 50): the code that has the switch runs as the stage does
+stage_05 = {"consensus": False} if "consensus" in inspect.signature(E.extract_datasets).parameters else {}
+table = E.extract_datasets(datasets, params, list(params.pnp_methods), Timed(), progress=False, **stage_05)
 table.to_parquet(out + ".parquet", index=False)
 Path(out + ".json").write_text(json.dumps({"seconds": Timed.seconds, "frames": int(len(chosen)),
                                            "datasets": len(datasets), "rows": len(table)}))
@@ -86,7 +92,21 @@ def run_loop(src: Path, params: Path, data_dir: Path, features: Path, frames: in
     subprocess.run([sys.executable, "-c", LOOP, str(params), str(data_dir), str(features), str(frames), str(out)],
                    env=env, check=True)
     result = json.loads(out.with_suffix(".json").read_text())
-    return result | {"rows_bytes": out.with_suffix(".parquet").read_bytes()}
+    return result | {"table": pd.read_parquet(out.with_suffix(".parquet"))}
+
+
+def reference_params(params: Path, into: Path) -> Path:
+    """``params`` without the keys of REFERENCE_UNKNOWN, written to ``into``."""
+    values = yaml.safe_load(params.read_text())
+    for section, key in REFERENCE_UNKNOWN:
+        values.get(section, {}).pop(key, None)
+    into.write_text(yaml.safe_dump(values, sort_keys=False))
+    return into
+
+
+def same_rows(table: pd.DataFrame, reference: pd.DataFrame) -> bool:
+    """Whether ``table`` holds the reference's rows exactly, in every column the reference has."""
+    return set(reference.columns) <= set(table.columns) and table[list(reference.columns)].equals(reference)
 
 
 def main() -> None:
@@ -108,6 +128,8 @@ def main() -> None:
         (folder / "reference").mkdir()
         subprocess.run(["tar", "-x", "-C", str(folder / "reference")], input=archive, check=True)
         sources = {"reference": folder / "reference" / "src", "this tree": ROOT / "src"}
+        params = {"reference": reference_params(args.params, folder / "reference_params.yaml"),
+                  "this tree": args.params}
         features = folder / "features"
         seed_features(args.data_dir.resolve(), features_dir, features)
         run_loop(sources["this tree"], args.params, args.data_dir, features, args.frames, folder / "warm")
@@ -116,7 +138,7 @@ def main() -> None:
             for pnp in features.rglob("*.pnp.npz"):
                 pnp.unlink()
             for name in ("reference", "this tree"):
-                runs[name].append(run_loop(sources[name], args.params, args.data_dir, features, args.frames,
+                runs[name].append(run_loop(sources[name], params[name], args.data_dir, features, args.frames,
                                            folder / name.replace(" ", "_")))
             runs["this tree, cached"].append(run_loop(sources["this tree"], args.params, args.data_dir, features,
                                                       args.frames, folder / "cached"))
@@ -128,7 +150,7 @@ def main() -> None:
     for name, name_runs in runs.items():
         seconds = float(np.median([run["seconds"]["frame_rows"] for run in name_runs]))
         models = float(np.median([run["seconds"]["store_model"] for run in name_runs]))
-        differing = sum(run["rows_bytes"] != first["rows_bytes"] for run in name_runs)
+        differing = sum(not same_rows(run["table"], first["table"]) for run in name_runs)
         print(f"  {name:18s} {seconds:8.2f} s ({1e3 * seconds / first['frames']:6.1f} ms a frame; M_t of the datasets "
               f"{models:5.2f} s)  ratio to {args.reference}: {seconds / reference:5.3f}  rows identical to "
               f"{args.reference}'s: {len(name_runs) - differing} of {len(name_runs)} runs")

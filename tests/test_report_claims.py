@@ -200,6 +200,14 @@ def expectations(m: dict) -> dict[str, tuple[list[list], list, str]]:
                                                    get(m, s, f"{predictor}.{t}.best_k"), share(s, predictor, t),
                                                    *ends(get(m, s, f"{predictor}.{t}"), "ceiling_share"))]
                  for s, _ in WORLDS], [], "-")
+    hazard = m["predictors"].get("hazard", {})
+    for predictor in ("hazard_next_step", "hazard_long_range") if hazard.get("trained_on_arcs") else ():
+        cells = []
+        for world in ("main", "validation"):
+            entries = [hazard["worlds"][world][t][predictor] for t in TOLERANCES]
+            cells.append([x for e in entries if "share" in e
+                          for x in (e["share"], *(e["share_interval"]), e["incursion_rate"])])
+        out[f"ours: {predictor.replace('_', ' ')}"] = (cells, [], "-")
     lines = [get(m, s, "straight_line") for s, _ in WORLDS]
     grades = [2 if line["long_range_max_mean_spl_zero_incursion"] is None else grade(line.get("interval", {}).get("gain"))
               for line in lines]

@@ -161,3 +161,20 @@ def test_a_population_too_small_to_hold_a_world_out_trains_nothing_and_says_why(
     worlds = {f"w{i}": (arc_frames("main", f"w{i}_a", [100, 80, 60, 40, 20]), pd.DataFrame()) for i in range(3)}
     with pytest.raises(HazardFitError, match="at least 4 worlds in population.worlds .* got 3"):
         train_population(worlds, protocol, np.array([0.1]), 1.0, 2, 1, 0, 0.9, progress=False)
+
+
+def test_each_failed_arc_is_given_the_mode_its_failing_stop_shows():
+    from poseintegrity.population.hazard import World, failure_modes
+
+    protocol = ProtocolParams.model_validate(load_protocol())
+    frames = pd.concat([arc_frames("main", "cliff", [100, 90, 80, 70, 60, 5, 5, 5]),
+                        arc_frames("main", "lost", [100, 90, 80, 70, 60, 0, 0, 0]),
+                        arc_frames("main", "bias", [100] * 8), arc_frames("main", "never", [100] * 8)])
+    name = protocol.tolerance_names[0]
+    envelopes = pd.DataFrame({"world": "main", "dataset": ["cliff", "lost", "bias", "never"], "trajectory": "arc",
+                              "method": "usac_magsac", "tolerance": name, "theta_a": [10.0, 10.0, 12.0, THETA[-1]],
+                              "censored": [False, False, False, True]})
+    world = World("w9", frames, envelopes, protocol.tolerances[0], name, protocol)
+    modes = failure_modes(world, protocol.envelope.max_failed_fraction).set_index("dataset")
+    assert modes["mode"].to_dict() == {"cliff": "cliff", "lost": "no_pose", "bias": "accelerating_bias"}
+    assert modes.loc["bias", "failed_stop"] == 6 and modes.loc["bias", "stop_before"] == 5  # 12 deg: after 11.25

@@ -230,10 +230,12 @@ def failure_mode_counts(modes: pd.DataFrame) -> pd.DataFrame:
 def hazard_metrics(trained: dict, brier: pd.DataFrame, note: str = "") -> dict:
     """hazard.json: per tolerance and predictor the held-out Brier scores (:func:`brier_table`), the evidence ranked by
     permutation importance (mean over the held-out worlds), the h chosen on the training worlds of each held-out world
-    (and whether one qualified) and on all of them; per tolerance the arcs that failed by each mode."""
+    (and whether one qualified) and on all of them, and the held-out arcs it let past theta_a there
+    (:func:`incursions`); per tolerance the arcs that failed by each mode."""
     result: dict = {"trained": True, "note": note, "n_worlds": int(trained["chosen"]["world"].nunique()),
                     "trained_on_arcs": len(trained["hazard"].trained_on), "tolerances": {}}
     ranked = trained["importance"].groupby(["tolerance", "predictor", "feature"])["importance"].mean()
+    over = incursions(trained)
     for (tolerance, predictor), entry in brier.set_index(["tolerance", "predictor"]).iterrows():
         order = ranked.loc[tolerance, predictor].sort_values(ascending=False)
         chosen = trained["chosen"]
@@ -242,7 +244,32 @@ def hazard_metrics(trained: dict, brier: pd.DataFrame, note: str = "") -> dict:
             "brier": entry.to_dict(), "importance": {str(k): float(v) for k, v in order.items()},
             "h_per_held_out_world": {str(r.world): {"h": float(r.operating_point), "qualified": bool(r.feasible)}
                                      for r in folds.itertuples(index=False)},
-            "h_all_worlds": trained["hazard"].chosen.get((tolerance, predictor))}
+            "h_all_worlds": trained["hazard"].chosen.get((tolerance, predictor)),
+            "incursions": over[(over["tolerance"] == tolerance) & (over["predictor"] == predictor)].drop(
+                columns=["tolerance", "predictor"]).to_dict("records")}
     for tolerance, counts in failure_mode_counts(trained["modes"]).iterrows():
         result["tolerances"].setdefault(tolerance, {})["failure_modes"] = {k: int(v) for k, v in counts.items()}
     return result
+
+
+SHOWN_EVIDENCE = ("log_inliers", "predicted_error", "kinematic_error", "stop_spread", "bootstrap_spread",
+                  "rerun_elsewhere")  # what incursions() shows of the stop before theta_a
+
+
+def incursions(trained: dict) -> pd.DataFrame:
+    """Every held-out arc a hazard predictor let past theta_a at the h chosen on its world's training worlds: world,
+    tolerance, predictor, dataset, h, theta_p, theta_a, its failure mode, and at the stop before theta_a (the last
+    stop the next-step hazard judged) that hazard and the evidence of :data:`SHOWN_EVIDENCE`."""
+    chosen = trained["chosen"][trained["chosen"]["feasible"]].rename(columns={"operating_point": "h"})
+    rows = trained["predictions"].assign(h=trained["predictions"]["operating_point"].round(DECIMALS))
+    at = rows.merge(chosen.assign(h=chosen["h"].round(DECIMALS))[["world", "tolerance", "predictor", "h"]],
+                    on=["world", "tolerance", "predictor", "h"])
+    over = at[at["incursion"] == 1][["world", "tolerance", "predictor", "dataset", "h", "theta_p", "theta_a"]]
+    risk = trained["risk"]
+    before = risk[(risk["predictor"] == NEXT_STEP) & (risk["failed"] == 1)]
+    before = before[["world", "tolerance", "dataset", "stop", "hazard", *SHOWN_EVIDENCE]].rename(
+        columns={"stop": "stop_before", "hazard": "hazard_before"})
+    modes = trained["modes"][["world", "tolerance", "dataset", "mode"]]
+    return over.merge(modes, on=["world", "tolerance", "dataset"], how="left").merge(
+        before, on=["world", "tolerance", "dataset"], how="left").sort_values(
+        ["tolerance", "predictor", "world", "dataset"]).reset_index(drop=True)

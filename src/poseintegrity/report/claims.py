@@ -42,9 +42,11 @@ RULE = ("**Verdict**, one per claim, the weakest world deciding, read from the 9
 SPL, SHARE, RATE = "{:.1f}", "{:.0%}", "{:.2%}"
 NAMES = {"static": "static", "long_range": "long range", "next_step": "next step", "mlp": "MLP",
          "error_long_range": "error long range", "error_next_step": "error next step",
-         "error_next_step_observed": "observed error next step", "error_combined": "error combined"}
+         "error_next_step_observed": "observed error next step", "error_combined": "error combined",
+         "hazard_next_step": "hazard next step", "hazard_long_range": "hazard long range"}
 TABLES = {"long_range": "Tables I, III", "next_step": "Tables II, III"}
 OURS = ("error_long_range", "error_next_step", "error_next_step_observed", "error_combined")  # issue 38: k, not n_t
+HAZARD = ("hazard_next_step", "hazard_long_range")  # issue 50: h, chosen on the population
 PNP_VARIANTS = {"epnp": "EPnP", "p3p": "P3P", "ap3p": "AP3P"}  # the paper's three (V-A, Fig. 6)
 POSE_METHODS = {"usac_magsac": "USAC", **PNP_VARIANTS}
 
@@ -260,6 +262,24 @@ def _ours_row(read: Reader, worlds: list[World], predictor: str, links: dict[str
                f"its operating point is the safety factor k, chosen on {worlds[0].name}", links["predictors"])
 
 
+def _hazard_row(read: Reader, worlds: list[World], predictor: str, links: dict[str, str]) -> Row:
+    """Issue 50's hazard predictors at the h chosen on the population (predictors.json ``hazard``), applied unchanged
+    to each world: its share of the ceiling [interval over its scenes] and R_i; no claim of the paper's."""
+    cells = []
+    for world in worlds:
+        at = f"hazard.worlds.{world.name}"
+        if read.value("predictors", at) is MISSING:
+            cells.append(absent(read.metrics, "predictors"))
+            continue
+        cells.append(" · ".join(
+            "no h qualified" if read.value("predictors", f"{at}.{t}.{predictor}.share") is MISSING else
+            f"{read.text('predictors', f'{at}.{t}.{predictor}.share', SHARE)} "
+            f"{read.interval('predictors', f'{at}.{t}.{predictor}.share_interval', SHARE)}, R_i "
+            f"{read.text('predictors', f'{at}.{t}.{predictor}.incursion_rate', '{:.2f}')}" for t in paper.TOLERANCES))
+    return Row(f"ours: {NAMES[predictor]}, share of ceiling, 2 mm/3 deg · 4 mm/10 deg (issue 50)", "-", cells, "-",
+               "its operating point h was chosen on the population's worlds, not on these", links["predictors"])
+
+
 def _lines_row(read: Reader, worlds: list[World], links: dict[str, str]) -> Row:
     """Fig. 7: long range over static on the straight lines (V-A); a world's lines resampled one by one."""
     margin = paper.WINDSOR_IMPROVEMENTS["straight_line_vs_static"]
@@ -401,6 +421,8 @@ def claim_rows(metrics: dict[str, dict], worlds: list[World], links: dict[str, s
     rows.append(_mlp_row(read, worlds, links))
     rows += [_ours_row(read, worlds, predictor, links) for predictor in OURS
              if any(read.value(world.stage, predictor) is not MISSING for world in worlds)]
+    if read.value("predictors", "hazard.trained_on_arcs") not in (MISSING, 0):
+        rows += [_hazard_row(read, worlds, predictor, links) for predictor in HAZARD]
     rows += [_lines_row(read, worlds, links), _pnp_row(read, worlds, links), _live_row(read, worlds, links),
              _markers_row(read, worlds, 4, links), _markers_row(read, worlds, 3, links),
              _accuracy_row(read, worlds, links)]
@@ -408,7 +430,9 @@ def claim_rows(metrics: dict[str, dict], worlds: list[World], links: dict[str, s
 
 
 POPULATION_ROWS = ("static", "long_range", "next_step", "mlp", "error_long_range", "error_next_step",
-                   "error_next_step_observed")  # the summary's lines of the population (issue 49)
+                   "error_next_step_observed", "hazard_next_step", "hazard_long_range")
+# the summary's lines of the population (issue 49; the hazard's, issue 50: its others' point is the h chosen on the
+# training worlds' held-out curves, population/hazard.py)
 
 
 def population_lines(metrics: dict[str, dict]) -> list[str]:
