@@ -22,11 +22,12 @@ DVC = Path(sys.executable).parent / "dvc"  # the venv's dvc, as `.venv/bin/dvc r
 
 
 def project_copy(folder: Path) -> Path:
-    """``folder`` made a DVC project: the repository's dvc.yaml, .dvcignore, population/ pipeline, notebooks and src, and
-    tests/params_tiny.yaml as its params.yaml (:func:`write_params` changes it); its DVC cache is its own
+    """``folder`` made a DVC project: the repository's dvc.yaml, .dvcignore, population/ pipeline and its hazard models,
+    notebooks and src, and tests/params_tiny.yaml as its params.yaml (:func:`write_params` changes it); its DVC cache is its own
     (.dvc/cache)."""
     folder.mkdir(parents=True, exist_ok=True)
-    for name in ("dvc.yaml", ".dvcignore", "population/dvc.yaml", "population/dvc.lock"):  # stage 07 reads the lock
+    # stage 07 reads the population's lock; stage 04 applies the hazard models the population trained (in git)
+    for name in ("dvc.yaml", ".dvcignore", "population/dvc.yaml", "population/dvc.lock", "data/hazard/model.json"):
         (folder / name).parent.mkdir(parents=True, exist_ok=True)
         shutil.copy(ROOT / name, folder / name)
     for name in ("notebooks", "src"):
