@@ -249,7 +249,9 @@ def seen_ahead(judged: pd.DataFrame, tables: dict[str, pd.DataFrame], modes: pd.
     """Per tolerance, predictor and failure mode (population.hazard.failure_modes): of the held-out arcs that failed
     by that mode, how many the predictor stopped before (theta_p <= theta_a: it saw the failure a stop ahead) at its
     ``others`` point (chosen without the arc's world). tables : world -> its prediction table (the hazard's rows
-    among them); judged : :func:`judge_population`. ``<tolerance>.<predictor>.<mode>: {seen, arcs}``."""
+    among them); judged : :func:`judge_population`. ``<tolerance>.<predictor>.<mode>: {seen, arcs, envelope_used}``,
+    envelope_used the mean SPL / theta_a over those arcs: at a conservative point every predictor sees nearly every
+    failure coming, and what tells them apart is how much of the envelope it kept."""
     result: dict = {}
     points = judged[(judged["point"] == "others") & judged["predictor"].isin(SEEN_BY)]
     for row in points.dropna(subset=["operating_point"]).itertuples(index=False):
@@ -257,10 +259,15 @@ def seen_ahead(judged: pd.DataFrame, tables: dict[str, pd.DataFrame], modes: pd.
         at = table[(table["predictor"] == row.predictor) & (table["tolerance"] == row.tolerance)
                    & (table["trajectory"] == "arc") & np.isclose(table["operating_point"], row.operating_point)]
         failed = modes[(modes["world"] == row.world) & (modes["tolerance"] == row.tolerance)]
-        scored = failed.merge(at[["dataset", "incursion"]], on="dataset", how="left")
+        scored = failed.merge(at[["dataset", "incursion", "spl"]], on="dataset", how="left")
         for mode, group in scored.groupby("mode"):
             entry = result.setdefault(row.tolerance, {}).setdefault(row.predictor, {}).setdefault(
-                mode, {"seen": 0, "arcs": 0})
+                mode, {"seen": 0, "arcs": 0, "used": []})
             entry["seen"] += int((group["incursion"] == 0).sum())
             entry["arcs"] += len(group)
+            entry["used"] += list(group["spl"] / group["theta_a"])
+    for by_predictor in result.values():
+        for by_mode in by_predictor.values():
+            for entry in by_mode.values():
+                entry["envelope_used"] = float(np.nanmean(entry.pop("used"))) if entry["arcs"] else None
     return result
