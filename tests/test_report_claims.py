@@ -57,11 +57,12 @@ def before_issue_49(metrics: dict) -> dict:
 
 
 def before_issue_38(metrics: dict) -> dict:
-    """The metrics as a run before issue 38 wrote them: no ceiling, no shares, no error predictors (no intervals)."""
+    """The metrics as a run before issue 38 wrote them: no ceiling, no shares, no error predictors (no intervals), and
+    none of what came later (issue 50's hazard)."""
     metrics = before_issue_49(metrics)
     for stage in ("predictors", "validation"):
         table = metrics[stage]
-        for key in ("ceiling", *OURS):
+        for key in ("ceiling", *OURS, "hazard", "hazard_next_step", "hazard_long_range"):
             table.pop(key, None)
         for entry in table.values():
             for value in entry.values() if isinstance(entry, dict) else ():

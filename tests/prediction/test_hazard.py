@@ -178,3 +178,17 @@ def test_each_failed_arc_is_given_the_mode_its_failing_stop_shows():
     modes = failure_modes(world, protocol.envelope.max_failed_fraction).set_index("dataset")
     assert modes["mode"].to_dict() == {"cliff": "cliff", "lost": "no_pose", "bias": "accelerating_bias"}
     assert modes.loc["bias", "failed_stop"] == 6 and modes.loc["bias", "stop_before"] == 5  # 12 deg: after 11.25
+
+
+def test_the_brier_comparison_resamples_worlds_and_says_which_hazard_is_better():
+    from poseintegrity.population.hazard import brier_table
+
+    rows = synthetic_rows(8, 300, 6)
+    risk = rows.assign(tolerance="2mm_3deg", predictor="hazard_next_step", hazard=rows["p_true"],
+                       error_alone=rows["failed"].mean(), inliers_alone=rows["p_true"])
+    table = brier_table(risk, 500, 0.9, np.random.default_rng(0)).iloc[0]
+    assert table["hazard"] == pytest.approx(np.mean((rows["p_true"] - rows["failed"]) ** 2))
+    assert table["error_alone"] == pytest.approx(table["base_rate"])
+    low, high = table["error_alone_minus_hazard"]
+    assert 0 < low < table["error_alone"] - table["hazard"] < high  # the true law beats knowing the base rate alone
+    assert table["inliers_alone_minus_hazard"] == [0.0, 0.0]  # the same hazard: no difference in any draw

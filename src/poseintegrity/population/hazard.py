@@ -33,6 +33,7 @@ from poseintegrity.prediction.hazard.stop_evidence import EVIDENCE, stop_evidenc
 from poseintegrity.prediction.metrics import operating_curves, with_metrics
 from poseintegrity.prediction.transfer import DECIMALS
 from poseintegrity.protocol import ProtocolParams
+from poseintegrity.resampling import cluster_weights, percentile_interval
 from poseintegrity.seeding import keyed_rng
 
 FEATURES = {NEXT_STEP: EVIDENCE, LONG_RANGE: LONG_RANGE_COLUMNS}
@@ -188,17 +189,26 @@ def train_population(worlds: dict[str, tuple[pd.DataFrame, pd.DataFrame]], proto
             "modes": pd.concat(modes, ignore_index=True), "hazard": HazardSet(trained, models_all, chosen_all)}
 
 
-def brier_table(risk: pd.DataFrame) -> pd.DataFrame:
+def brier_table(risk: pd.DataFrame, n_draws: int, level: float, rng: np.random.Generator) -> pd.DataFrame:
     """Per tolerance and predictor, the held-out Brier score of the hazard, of the one-column hazards (next step
-    only) and of the base rate (the training-free floor: the held-out rows' own failure share), and the rows."""
+    only) and of the base rate (the training-free floor: the held-out rows' own failure share), the rows, and for each
+    one-column hazard ``<label>_minus_hazard``: the interval of its Brier score minus the hazard's, the worlds
+    resampled with replacement (``n_draws`` draws, percentile interval at ``level``): above 0, the hazard is better."""
     rows = []
     for (tolerance, predictor), group in risk.groupby(["tolerance", "predictor"], sort=True):
         failed = group["failed"].to_numpy(float)
+        weights = cluster_weights(group["world"].to_numpy(), n_draws, rng)
+        hazard_error = (group["hazard"].to_numpy(float) - failed) ** 2
         entry = {"tolerance": tolerance, "predictor": predictor, "n_rows": len(group), "n_failed": int(failed.sum()),
                  "hazard": brier_score(group["hazard"], failed),
                  "base_rate": brier_score(np.full(len(group), failed.mean()), failed)}
-        entry |= {label: brier_score(group[label], failed) if label in group and group[label].notna().all()
-                  else float("nan") for label in ONE_COLUMN}
+        for label in ONE_COLUMN:
+            if label not in group or not group[label].notna().all():
+                entry[label], entry[f"{label}_minus_hazard"] = float("nan"), [None, None]
+                continue
+            entry[label] = brier_score(group[label], failed)
+            difference = (group[label].to_numpy(float) - failed) ** 2 - hazard_error
+            entry[f"{label}_minus_hazard"] = percentile_interval(weights @ difference / weights.sum(axis=1), level)
         rows.append(entry)
     return pd.DataFrame(rows)
 

@@ -277,7 +277,7 @@ def _hazard_row(read: Reader, worlds: list[World], predictor: str, links: dict[s
             f"{read.interval('predictors', f'{at}.{t}.{predictor}.share_interval', SHARE)}, R_i "
             f"{read.text('predictors', f'{at}.{t}.{predictor}.incursion_rate', '{:.2f}')}" for t in paper.TOLERANCES))
     return Row(f"ours: {NAMES[predictor]}, share of ceiling, 2 mm/3 deg · 4 mm/10 deg (issue 50)", "-", cells, "-",
-               "its operating point h was chosen on the population's worlds, not on these", links["predictors"])
+               "its operating point h was chosen on other rendered worlds, not on these", links["predictors"])
 
 
 def _lines_row(read: Reader, worlds: list[World], links: dict[str, str]) -> Row:
@@ -488,11 +488,12 @@ def claims_section(metrics: dict[str, dict]) -> list[str]:
              "Each claim of the two papers beside ours on each world, read from `reports/metrics/*.json`. The "
              "**ceiling** is the most any predictor can gain over static: the arcs' mean theta_a / smallest - 1 "
              "(issue 38; the paper's is at least its next step over static). A predictor's **share of the ceiling** "
-             "is (its SPL - static's) / (mean theta_a - static's): it compares predictors fairly across worlds.", "",
+             "is (its SPL - static's) / (mean theta_a - static's): it compares predictors fairly across worlds. "
+             f"Figures: {figures}.", "",
              RULE, "",
              "| claim (paper) | paper | " + " | ".join(f"ours: {world.name}" for world in worlds)
              + " | verdict | why |", "| --- | --- |" + " --- |" * len(worlds) + " --- | --- |"]
     lines += [f"| {row.claim} | {row.paper} | " + " | ".join(row.cells)
               + f" | {row.verdict} | [{row.why}]({row.link}) |" for row in rows]
     population = population_lines(metrics)
-    return [*lines, "", f"Figures: {figures}.", "", *population, *([""] if population else [])]
+    return [*lines, "", *population, *([""] if population else [])]
