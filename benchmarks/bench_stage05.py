@@ -1,14 +1,16 @@
-"""Stage 05's cost, the code at a reference commit against this tree, measured in the same run (issue 33).
+"""Stage 05's cost, the code at a reference commit against this tree, measured in the same run (issues 33 and 50).
 
 Stage 05's frame loop (``extract_datasets`` -> ``frame_rows`` of every frame, its classic methods of params.yaml)
 on frames spread evenly over every dataset of ``--data-dir``, one process, OpenCV on one thread as in a worker, the
 evidence read from stage 02's cache as the stage does:
 
-1. CPU-seconds of the loop of the code at ``--reference`` (extracted with git archive: one ``solvePnPRansac`` per
-   method) and of this tree (EPnP, SQPnP and iterative sharing one RANSAC, localization/pnp.py), each in fresh
-   processes, run alternately ``--rounds`` times with this tree's PnP cache emptied before each of its runs; the
+1. CPU-seconds of the loop of the code at ``--reference`` (extracted with git archive; issue 33 measured a1220b7,
+   one ``solvePnPRansac`` per method, against EPnP, SQPnP and iterative sharing one RANSAC: 0.43, docs/references.md)
+   and of this tree, each in fresh
+   processes, run alternately ``--rounds`` times with the PnP cache emptied before each of their runs; the
    ratio of the medians, and whether the rows of the two codes are identical (every column of the reference's; the
-   reference runs on params.yaml without the keys it did not know, ``REFERENCE_UNKNOWN``).
+   reference runs on params.yaml without the keys its own params.yaml did not have, which its schema refuses:
+   ``extract.ground_truth`` of issue 39, ``extract.consensus`` of issue 50).
 2. This tree again with the PnP cache its last run left (localization/frame_pnp.py): a rerun whose keys did not
    change, against the same reference; its rows against the reference's.
 
@@ -16,7 +18,7 @@ Both codes read and write a temporary features folder (``extract.features_dir``)
 and M_t caches of the chosen frames found under ``<data-dir>/<features_dir>``: the data folder is never written.
 A warm-up run of this tree first fills whatever is missing there (SIFT of frames stage 02 did not cache).
 
-    .venv/bin/python benchmarks/bench_stage05.py [--data-dir data] [--frames 200] [--reference a1220b7] [--rounds 3]
+    .venv/bin/python benchmarks/bench_stage05.py [--data-dir data] [--frames 200] [--reference 4ec2cf1] [--rounds 3]
 
 from the repository root, with MALLOC_MMAP_THRESHOLD_=33554432 MALLOC_TRIM_THRESHOLD_=1073741824 as the stages run.
 """
@@ -37,8 +39,10 @@ import pandas as pd
 import yaml
 
 ROOT = Path(__file__).resolve().parents[1]
-REFERENCE_COMMIT = "a1220b7"  # stage 05 before the shared RANSAC and the PnP cache
-REFERENCE_UNKNOWN = (("extract", "consensus"),)  # params keys added since (issue 50), which its schema refuses
+# stage 05 before issue 50's evidence (consensus, stop spread), which stage 05 does not compute: the ratio must be ~1.
+# The first reference, a1220b7 (before the shared RANSAC and the PnP cache, issue 33), cannot read the datasets
+# written since issue 39 (the boards' meta.json).
+REFERENCE_COMMIT = "4ec2cf1"
 
 LOOP = """
 import dataclasses, inspect, json, sys, time
@@ -95,11 +99,14 @@ def run_loop(src: Path, params: Path, data_dir: Path, features: Path, frames: in
     return result | {"table": pd.read_parquet(out.with_suffix(".parquet"))}
 
 
-def reference_params(params: Path, into: Path) -> Path:
-    """``params`` without the keys of REFERENCE_UNKNOWN, written to ``into``."""
+def reference_params(params: Path, commit: str, into: Path) -> Path:
+    """``params`` without the keys the params.yaml of ``commit`` did not have (its schema refuses them), to ``into``."""
     values = yaml.safe_load(params.read_text())
-    for section, key in REFERENCE_UNKNOWN:
-        values.get(section, {}).pop(key, None)
+    known = yaml.safe_load(subprocess.run(["git", "-C", str(ROOT), "show", f"{commit}:params.yaml"], check=True,
+                                          capture_output=True, text=True).stdout)
+    for section, entries in values.items():
+        if isinstance(entries, dict) and isinstance(known.get(section), dict):
+            values[section] = {key: value for key, value in entries.items() if key in known[section]}
     into.write_text(yaml.safe_dump(values, sort_keys=False))
     return into
 
@@ -128,16 +135,16 @@ def main() -> None:
         (folder / "reference").mkdir()
         subprocess.run(["tar", "-x", "-C", str(folder / "reference")], input=archive, check=True)
         sources = {"reference": folder / "reference" / "src", "this tree": ROOT / "src"}
-        params = {"reference": reference_params(args.params, folder / "reference_params.yaml"),
+        params = {"reference": reference_params(args.params, args.reference, folder / "reference_params.yaml"),
                   "this tree": args.params}
         features = folder / "features"
         seed_features(args.data_dir.resolve(), features_dir, features)
         run_loop(sources["this tree"], args.params, args.data_dir, features, args.frames, folder / "warm")
         runs = {"reference": [], "this tree": [], "this tree, cached": []}
         for _ in range(args.rounds):
-            for pnp in features.rglob("*.pnp.npz"):
-                pnp.unlink()
             for name in ("reference", "this tree"):
+                for pnp in features.rglob("*.pnp.npz"):  # each computes its PnP: a reference with the same cache
+                    pnp.unlink()                        # would leave this tree nothing to compute
                 runs[name].append(run_loop(sources[name], params[name], args.data_dir, features, args.frames,
                                            folder / name.replace(" ", "_")))
             runs["this tree, cached"].append(run_loop(sources["this tree"], args.params, args.data_dir, features,
