@@ -148,3 +148,9 @@ def test_a_robot_log_is_what_the_robot_observes_and_calibrates_the_error_predict
     np.testing.assert_allclose(jpeg.E_t_kinematic_mm, jpeg.E_t_mm, rtol=1e-6, atol=1e-6)
     made = pd.read_parquet(copy / "data" / "predictions" / "predictions.parquet")
     assert set(made.loc[made.predictor == "error_next_step_observed", "dataset"]) == {"arc_b", "arc_poses_jpeg"}
+    # issue 50: the hazard models trained on the population run on every recorded arc, robot log or not (a column
+    # the recording lacks is filled with the training median)
+    arcs = made[(made.trajectory == "arc") & (made.method == made.loc[made.predictor == "next_step", "method"].iloc[0])]
+    for predictor in ("hazard_next_step", "hazard_long_range"):
+        assert set(arcs.loc[arcs.predictor == predictor, "dataset"]) == set(arcs.loc[arcs.predictor == "static",
+                                                                                    "dataset"])
