@@ -192,3 +192,43 @@ def test_the_brier_comparison_resamples_worlds_and_says_which_hazard_is_better()
     low, high = table["error_alone_minus_hazard"]
     assert 0 < low < table["error_alone"] - table["hazard"] < high  # the true law beats knowing the base rate alone
     assert table["inliers_alone_minus_hazard"] == [0.0, 0.0]  # the same hazard: no difference in any draw
+
+
+def synthetic_world(name: str, seed: int) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """A world of 6 arcs whose counts fall at their own rates, each arc failing where its count drops below 30."""
+    rng = np.random.default_rng(seed)
+    protocol = ProtocolParams.model_validate(load_protocol())
+    frames, envelopes = [], []
+    for arc in range(6):
+        rate = rng.uniform(0.1, 0.5)
+        counts = [float(np.round(120 * np.exp(-rate * stop))) for stop in range(8)]
+        frames.append(arc_frames("main", f"{name}_a{arc}", counts))
+        failing = next((stop for stop, count in enumerate(counts) if count < 30), None)
+        for tolerance in protocol.tolerance_names:
+            envelopes.append({"world": "main", "dataset": f"{name}_a{arc}", "trajectory": "arc",
+                              "method": "usac_magsac", "tolerance": tolerance, "rule": "fail_fraction",
+                              "theta_a": THETA[-1] if failing is None else THETA[failing] - 1.0,
+                              "censored": failing is None, "status": "ok", "reason": ""})
+    return pd.concat(frames, ignore_index=True), pd.DataFrame(envelopes)
+
+
+def test_every_world_is_predicted_by_models_fitted_without_it():
+    from poseintegrity.population.hazard import FEATURES, train_population, world_tables
+
+    protocol = ProtocolParams.model_validate(load_protocol())
+    worlds = {f"w{i}": world_tables(*synthetic_world(f"w{i}", i), protocol) for i in range(5)}
+    levels = np.array([0.01, 0.05, 0.2, 0.5])
+    trained = train_population(worlds, protocol, levels, 1.0, 2, 2, 0, 0.6, progress=False)
+    assert set(trained["predictions"]["world"]) == set(worlds) and set(trained["chosen"]["world"]) == set(worlds)
+    assert len(trained["hazard"].trained_on) == 30 and len(trained["hazard"].models) == 2 * len(protocol.tolerances)
+    # world w0's rows are those of models fitted on w1-w4 alone (recomputed here): nothing of w0 went into them
+    from poseintegrity.population.hazard import World, fit_models, predicted
+
+    name, tolerance = protocol.tolerance_names[0], protocol.tolerances[0]
+    population = [World(w, *tables, tolerance, name, protocol) for w, tables in worlds.items()]
+    models = fit_models(population[1:], 1.0, 2)
+    expected = predicted(population[0], models, protocol, name, levels)
+    found = trained["predictions"]
+    found = found[(found["world"] == "w0") & (found["tolerance"] == name)].reset_index(drop=True)
+    pd.testing.assert_frame_equal(found, expected.reset_index(drop=True))
+    assert set(models) == set(FEATURES)

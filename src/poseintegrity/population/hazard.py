@@ -63,7 +63,8 @@ def _fit(worlds: list[World], predictor: str, features: tuple[str, ...], C: floa
     return fit_hazard(rows, features, C, folds)
 
 
-def _models(worlds: list[World], C: float, folds: int) -> dict[str, HazardModel]:
+def fit_models(worlds: list[World], C: float, folds: int) -> dict[str, HazardModel]:
+    """Both predictors' hazard models fitted on the risk sets of ``worlds`` (:data:`FEATURES`)."""
     return {predictor: _fit(worlds, predictor, features, C, folds) for predictor, features in FEATURES.items()}
 
 
@@ -87,7 +88,7 @@ def choose_h(training: list[World], protocol: ProtocolParams, tolerance_name: st
     """Step 1: (predictor, tolerance, operating_point, feasible) chosen on ``training``'s held-out curves."""
     curves = {}
     for held in training:
-        models = _models([w for w in training if w is not held], C, folds)
+        models = fit_models([w for w in training if w is not held], C, folds)
         curves[held.name] = curves_of(predicted(held, models, protocol, tolerance_name, levels))
     return chosen_on(curves, zero_incursion_worlds)
 
@@ -159,7 +160,7 @@ def train_population(worlds: dict[str, tuple[pd.DataFrame, pd.DataFrame]], proto
             training = [w for w in population if w is not held]
             points = choose_h(training, protocol, name, levels, C, folds, zero_incursion_worlds)
             chosen.append(points.assign(world=held.name))
-            models = _models(training, C, folds)
+            models = fit_models(training, C, folds)
             predictions.append(predicted(held, models, protocol, name, levels))
             for predictor, model in models.items():
                 rows = held.rows[predictor]
@@ -179,7 +180,7 @@ def train_population(worlds: dict[str, tuple[pd.DataFrame, pd.DataFrame]], proto
         held_out = held_out[held_out["tolerance"] == name]
         all_points = chosen_on({w.name: curves_of(held_out[held_out["world"] == w.name]) for w in population},
                                zero_incursion_worlds)
-        for predictor, model in _models(population, C, folds).items():
+        for predictor, model in fit_models(population, C, folds).items():
             models_all[name, predictor] = model
             point = all_points[(all_points["predictor"] == predictor) & all_points["feasible"]]["operating_point"]
             chosen_all[name, predictor] = float(point.iloc[0]) if len(point) else float("nan")

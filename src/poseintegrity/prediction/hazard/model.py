@@ -25,6 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
+from scipy.special import expit
 from sklearn.exceptions import ConvergenceWarning
 from sklearn.linear_model import LogisticRegression
 from sklearn.model_selection import GroupKFold
@@ -68,7 +69,7 @@ class HazardModel:
 
     def predict(self, rows: pd.DataFrame) -> np.ndarray:
         """(n,) calibrated hazards in (0, 1) (step 4)."""
-        return 1.0 / (1.0 + np.exp(-(self.slope_a * self.logit(rows) + self.offset_c)))
+        return expit(self.slope_a * self.logit(rows) + self.offset_c)
 
     def to_dict(self) -> dict:
         return {"features": list(self.features), **{name: float(getattr(self, name)) for name in SCALARS},
