@@ -19,13 +19,15 @@ the held-out curves of step 2 (the file ``predict.hazard.model``).
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 import pandas as pd
 
 from poseintegrity.localization.envelope import headline
 from poseintegrity.parallel import Progress
-from poseintegrity.population.judge import chosen_on
-from poseintegrity.prediction.hazard.applied import LONG_RANGE, NEXT_STEP, HazardSet, hazard_rows
+from poseintegrity.population.judge import arc_curves, chosen_on
+from poseintegrity.prediction.hazard.applied import LONG_RANGE, NEXT_STEP, HazardSet, arc_rows
 from poseintegrity.prediction.hazard.model import HazardFitError, HazardModel, brier_score, fit_hazard, reliability
 from poseintegrity.prediction.hazard.risk_sets import LONG_RANGE as LONG_RANGE_COLUMNS
 from poseintegrity.prediction.hazard.risk_sets import long_range_rows, next_step_rows
@@ -68,28 +70,36 @@ def fit_models(worlds: list[World], C: float, folds: int) -> dict[str, HazardMod
     return {predictor: _fit(worlds, predictor, features, C, folds) for predictor, features in FEATURES.items()}
 
 
+def models_without(population: list[World], C: float, folds: int) -> Callable[..., dict[str, HazardModel]]:
+    """models_without(*names): :func:`fit_models` on the worlds of ``population`` other than ``names``, each set of
+    names fitted once (h chosen for world A holds world B out, and for world B world A: the same models)."""
+    fitted: dict[frozenset, dict[str, HazardModel]] = {}
+
+    def without(*names: str) -> dict[str, HazardModel]:
+        key = frozenset(names)
+        if key not in fitted:
+            fitted[key] = fit_models([w for w in population if w.name not in key], C, folds)
+        return fitted[key]
+
+    return without
+
+
 def predicted(world: World, models: dict[str, HazardModel], protocol: ProtocolParams, tolerance_name: str,
               levels: np.ndarray) -> pd.DataFrame:
     """``world``'s hazard rows at every h (stage 04's rows with world, theta_a, censored, spl, incursion)."""
-    hazard = HazardSet((), {(tolerance_name, p): m for p, m in models.items()}, {})
-    rows = hazard_rows(world.artifacts, hazard, protocol, levels)
+    rows = arc_rows(world.evidence, models, protocol, tolerance_name, levels)
     scored = rows.merge(world.envelopes[["dataset", "world", "theta_a", "censored"]], on="dataset", how="inner")
     return with_metrics(scored[scored["theta_a"].notna()])
 
 
-def curves_of(table: pd.DataFrame) -> pd.DataFrame:
-    """The SPL / R_i curves of hazard rows, operating points rounded as the judge's (population.judge.arc_curves)."""
-    curves = operating_curves(table.assign(tolerance=table["tolerance"]))
-    return curves.assign(operating_point=curves["operating_point"].round(DECIMALS))
-
-
-def choose_h(training: list[World], protocol: ProtocolParams, tolerance_name: str, levels: np.ndarray, C: float,
-             folds: int, zero_incursion_worlds: float) -> pd.DataFrame:
-    """Step 1: (predictor, tolerance, operating_point, feasible) chosen on ``training``'s held-out curves."""
-    curves = {}
-    for held in training:
-        models = fit_models([w for w in training if w is not held], C, folds)
-        curves[held.name] = curves_of(predicted(held, models, protocol, tolerance_name, levels))
+def choose_h(held: World, population: list[World], without: Callable[..., dict[str, HazardModel]],
+             protocol: ProtocolParams, tolerance_name: str, levels: np.ndarray,
+             zero_incursion_worlds: float) -> pd.DataFrame:
+    """Step 1 for ``held``: (predictor, tolerance, operating_point, feasible) chosen on the curves of the other
+    worlds, each predicted by models fitted without it and without ``held`` (``without``: :func:`models_without`)."""
+    curves = {other.name: arc_curves(operating_curves(predicted(other, without(held.name, other.name), protocol,
+                                                                tolerance_name, levels)), protocol.pnp_method)
+              for other in population if other is not held}
     return chosen_on(curves, zero_incursion_worlds)
 
 
@@ -156,11 +166,12 @@ def train_population(worlds: dict[str, tuple[pd.DataFrame, pd.DataFrame]], proto
     lines = Progress(len(worlds) * len(protocol.tolerances), "hazard, each world held out once", enabled=progress)
     for tolerance, name in zip(protocol.tolerances, protocol.tolerance_names):
         population = [World(w, *tables, tolerance, name, protocol) for w, tables in worlds.items()]
+        without = models_without(population, C, folds)
         for held in population:
             training = [w for w in population if w is not held]
-            points = choose_h(training, protocol, name, levels, C, folds, zero_incursion_worlds)
+            points = choose_h(held, population, without, protocol, name, levels, zero_incursion_worlds)
             chosen.append(points.assign(world=held.name))
-            models = fit_models(training, C, folds)
+            models = without(held.name)
             predictions.append(predicted(held, models, protocol, name, levels))
             for predictor, model in models.items():
                 rows = held.rows[predictor]
@@ -178,9 +189,9 @@ def train_population(worlds: dict[str, tuple[pd.DataFrame, pd.DataFrame]], proto
             lines.update()
         held_out = pd.concat(predictions, ignore_index=True)
         held_out = held_out[held_out["tolerance"] == name]
-        all_points = chosen_on({w.name: curves_of(held_out[held_out["world"] == w.name]) for w in population},
-                               zero_incursion_worlds)
-        for predictor, model in fit_models(population, C, folds).items():
+        all_points = chosen_on({w.name: arc_curves(operating_curves(held_out[held_out["world"] == w.name]),
+                                                   protocol.pnp_method) for w in population}, zero_incursion_worlds)
+        for predictor, model in without().items():
             models_all[name, predictor] = model
             point = all_points[(all_points["predictor"] == predictor) & all_points["feasible"]]["operating_point"]
             chosen_all[name, predictor] = float(point.iloc[0]) if len(point) else float("nan")

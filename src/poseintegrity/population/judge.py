@@ -184,8 +184,7 @@ def judge_population(worlds: dict[str, tuple[pd.DataFrame, pd.DataFrame]], main_
         others = chosen_on({w: c for w, (_, c) in worlds.items() if w != name}, zero_incursion_worlds)
         if held_out_points is not None and len(held_out_points):
             own = held_out_points[held_out_points["world"] == name][[*KEYS, "operating_point", "feasible"]]
-            others = pd.concat([others.merge(own[KEYS], on=KEYS, how="left", indicator=True).query(
-                "_merge == 'left_only'").drop(columns="_merge"), own], ignore_index=True)
+            others = pd.concat([others, own], ignore_index=True).drop_duplicates(KEYS, keep="last")
         rows = judge_world(table, curves, {"main": main, "others": others}, method, tolerances)
         feasible = others.assign(point="others")[[*KEYS, "point", "feasible"]]
         judged.append(rows.merge(feasible, on=[*KEYS, "point"], how="left").assign(world=name))

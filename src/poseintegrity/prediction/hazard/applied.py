@@ -101,25 +101,31 @@ def hazard_rows(artifacts: pd.DataFrame, hazard: HazardSet, protocol: ProtocolPa
     """theta_p of both hazard predictors on every arc of ``protocol.pnp_method`` in ``artifacts`` (stage 02's
     table), per tolerance and h in ``levels`` (T,): rows of stage 04's sweep (:data:`~poseintegrity.prediction.
     sweeps.COLUMNS`). A tolerance the file has no model for gets no rows, nor a dataset it was trained on."""
-    k, method, tables = protocol.stops_sampled("arc"), protocol.pnp_method, []
     artifacts = artifacts[~artifacts["dataset"].isin(hazard.trained_on)]
+    tables = []
     for tolerance, name in zip(protocol.tolerances, protocol.tolerance_names):
-        next_model, ahead_model = hazard.models.get((name, NEXT_STEP)), hazard.models.get((name, LONG_RANGE))
-        if next_model is None or ahead_model is None:
-            continue
-        evidence = stop_evidence(artifacts, method, tolerance)
-        if evidence.empty:
-            continue
-        evidence = evidence.assign(hazard_next=next_model.predict(evidence))
-        for dataset, arc in evidence.groupby("dataset", sort=True):
-            theta = arc["theta_deg"].to_numpy()
-            step = stop_on_next_hazard(theta, arc["hazard_next"].to_numpy(), k, levels)
-            sampled = len(theta) >= max(k, 2)
-            hazards = ahead_model.predict(long_range_features(arc.iloc[k - 1], theta[1:])) if sampled else None
-            ahead = stop_on_failure_probability(theta, hazards, k, levels)
-            for predictor, found in ((NEXT_STEP, step), (LONG_RANGE, ahead)):
-                tables.append(pd.DataFrame({
-                    "predictor": predictor, "model": MODEL, "method": method, "trajectory": "arc",
-                    "dataset": dataset, "operating_point": levels, "theta_p": found.theta_p, "status": found.status,
-                    "fit_status": "ok", "reason": "", "tolerance": name}))
+        models = {predictor: hazard.models.get((name, predictor)) for predictor in HAZARD_PREDICTORS}
+        if None not in models.values():
+            tables.append(arc_rows(stop_evidence(artifacts, protocol.pnp_method, tolerance), models, protocol, name,
+                                   levels))
+    return pd.concat(tables, ignore_index=True) if tables else pd.DataFrame()
+
+
+def arc_rows(evidence: pd.DataFrame, models: dict[str, HazardModel], protocol: ProtocolParams, tolerance_name: str,
+             levels: np.ndarray) -> pd.DataFrame:
+    """The rows of :func:`hazard_rows` for one tolerance, from its stop evidence (:func:`~.stop_evidence.
+    stop_evidence`) and its model per predictor."""
+    k, tables = protocol.stops_sampled("arc"), []
+    evidence = evidence.assign(hazard_next=models[NEXT_STEP].predict(evidence))
+    for dataset, arc in evidence.groupby("dataset", sort=True):
+        theta = arc["theta_deg"].to_numpy()
+        step = stop_on_next_hazard(theta, arc["hazard_next"].to_numpy(), k, levels)
+        sampled = len(theta) >= max(k, 2)
+        hazards = models[LONG_RANGE].predict(long_range_features(arc.iloc[k - 1], theta[1:])) if sampled else None
+        ahead = stop_on_failure_probability(theta, hazards, k, levels)
+        for predictor, found in ((NEXT_STEP, step), (LONG_RANGE, ahead)):
+            tables.append(pd.DataFrame({
+                "predictor": predictor, "model": MODEL, "method": protocol.pnp_method, "trajectory": "arc",
+                "dataset": dataset, "operating_point": levels, "theta_p": found.theta_p, "status": found.status,
+                "fit_status": "ok", "reason": "", "tolerance": tolerance_name}))
     return pd.concat(tables, ignore_index=True) if tables else pd.DataFrame()

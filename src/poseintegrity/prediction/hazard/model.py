@@ -38,6 +38,12 @@ MAX_ITERATIONS = 10_000  # lbfgs on standardized columns converges in tens; a mo
 PLATT_C = 1e6  # the calibration's two parameters fitted all but unpenalized
 
 
+def columns(rows: pd.DataFrame, features: tuple[str, ...]) -> np.ndarray:
+    """(n, F) float: the ``features`` columns of ``rows``, NaN for one ``rows`` lacks (step 1 fills it)."""
+    return np.column_stack([rows[name].to_numpy(float) if name in rows.columns else np.full(len(rows), np.nan)
+                            for name in features]) if len(rows) else np.empty((0, len(features)))
+
+
 class HazardFitError(ArgumentError):
     """A hazard model cannot be fitted on these rows (one class only, too few worlds, no convergence)."""
 
@@ -58,8 +64,7 @@ class HazardModel:
 
     def design(self, rows: pd.DataFrame) -> np.ndarray:
         """Steps 1-2: (n, F) standardized columns; a column ``rows`` lacks counts as missing (filled)."""
-        X = np.column_stack([rows[name].to_numpy(float) if name in rows.columns else np.full(len(rows), np.nan)
-                             for name in self.features]) if len(rows) else np.empty((0, len(self.features)))
+        X = columns(rows, self.features)
         X = np.where(np.isfinite(X), X, self.fill)
         return (X - self.mean) / self.scale
 
@@ -106,8 +111,7 @@ def _regression(X: np.ndarray, y: np.ndarray, C: float) -> LogisticRegression:
 
 def _standardized(rows: pd.DataFrame, features: tuple[str, ...]) -> tuple[np.ndarray, ...]:
     """Steps 1-2 fitted: (X standardized, fill, mean, scale)."""
-    X = np.column_stack([rows[name].to_numpy(float) if name in rows.columns else np.full(len(rows), np.nan)
-                         for name in features])
+    X = columns(rows, features)
     finite = np.isfinite(X)
     fill = np.array([np.median(X[finite[:, j], j]) if finite[:, j].any() else 0.0 for j in range(X.shape[1])])
     X = np.where(finite, X, fill)
