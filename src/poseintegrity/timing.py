@@ -13,13 +13,13 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import os
 import sys
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
 from poseintegrity.errors import PoseIntegrityError
 from poseintegrity.parallel import describe_backend
+from poseintegrity.staging import write_text_atomically
 
 
 class TimingFileError(PoseIntegrityError):
@@ -45,9 +45,7 @@ class StageTiming:
 
     def write(self, path: Path) -> None:
         """Write ``path`` atomically: an interrupted write leaves no file that looks complete."""
-        partial = path.with_name(path.name + ".partial")
-        partial.write_text(json.dumps(asdict(self), indent=1) + "\n")
-        os.replace(partial, path)
+        write_text_atomically(path, json.dumps(asdict(self), indent=1) + "\n")
 
     @classmethod
     def read(cls, path: Path) -> StageTiming:

@@ -7,6 +7,7 @@ import pytest
 from scipy.stats import spearmanr
 
 import loc_synthetic as synthetic
+from poseintegrity import cache_entry as C
 from poseintegrity.localization import extract as E
 from poseintegrity.localization.dataset import DatasetError, load_dataset
 from poseintegrity.poses import pose_errors
@@ -95,6 +96,40 @@ def test_a_second_run_reuses_every_frame_evidence_and_gives_the_same_rows(
     params = extract_params.model_copy(update=dict(datasets=["arc_a", "line_a"]))
     again = E.extract_all(synthetic_data_dir, params, METHODS, workers, progress=False)
     assert parquet_bytes(again) == parquet_bytes(table)
+
+
+def test_damaged_cache_files_are_recomputed_said_so_and_none_survives(
+        table, synthetic_data_dir, extract_params, workers, tmp_path, capsys):
+    """A cut SIFT file behind whole evidence (which alone would not read it), bits flipped in another frame's PnP
+    results and in a third's evidence, a stale consensus file and a killed writer's staging file: the rerun names the
+    dataset, how many files it recomputed and why, gives the same rows, and leaves every cache file as a clean run
+    wrote it."""
+    shutil.copytree(synthetic_data_dir / "datasets" / "line_a", tmp_path / "datasets" / "line_a")
+    shutil.copytree(synthetic_data_dir / extract_params.features_dir / "line_a",
+                    tmp_path / extract_params.features_dir / "line_a")
+    images = tmp_path / extract_params.features_dir / "line_a" / "images"
+    clean = {path.name: path.read_bytes() for path in images.iterdir()}
+    frames = sorted(name.removesuffix(".evidence.npz") for name in clean if name.endswith(".evidence.npz"))
+    assert len(frames) >= 4
+    cut, flipped, flipped_evidence = (images / f"{frames[0]}.npz", images / f"{frames[1]}.pnp.npz",
+                                      images / f"{frames[2]}.evidence.npz")
+    cut.write_bytes(clean[cut.name][:len(clean[cut.name]) // 2])
+    for path in (flipped, flipped_evidence):
+        data = bytearray(clean[path.name])
+        data[len(data) // 3: len(data) // 3 + 64] = bytes(b ^ 0x5A for b in data[len(data) // 3: len(data) // 3 + 64])
+        path.write_bytes(data)
+    old_format = images / f"{frames[3]}.consensus.npz"
+    old_format.write_bytes(clean[old_format.name][:-C.TRAILER])  # a whole .npz of the format before trailers
+    (images / ".s00_i01.npz.a1b2.partial").write_bytes(b"PK half")
+    again = E.extract_dataset(tmp_path, "datasets/line_a", extract_params, METHODS, workers)
+    assert parquet_bytes(again) == parquet_bytes(table[table.dataset == "line_a"].reset_index(drop=True))
+    said = [line for line in capsys.readouterr().out.splitlines() if line.startswith("cache of")]
+    n_checked = 3 + 4 * len(again.drop_duplicates(["stop", "image"]))  # M_t and its 2 SIFT files; 4 files per frame
+    assert said == [f"cache of line_a: 4 of {n_checked} cache files recomputed (3 damaged: cut short or altered, "
+                    f"1 stale: other inputs, params, code or file format); 1 unfinished write(s) of a stopped run removed",
+                    f"cache of 1 dataset(s): 4 of {n_checked} cache files recomputed (3 damaged: cut short or altered, "
+                    f"1 stale: other inputs, params, code or file format)"]
+    assert {path.name: path.read_bytes() for path in images.iterdir()} == clean  # every file whole, as written clean
 
 
 def test_consensus_columns_of_posed_frames(table):

@@ -2,12 +2,11 @@
 result, the same results as computing them, what a changed key reaches recomputed, damaged files recomputed, writes
 atomic. The end-to-end rerun of stages 02/05 on it: tests/localization/test_extract.py."""
 
-import cv2
 import numpy as np
 import pytest
 
 from poseintegrity.localization import frame_pnp as FP
-from poseintegrity.localization.features import write_npz
+from poseintegrity import cache_entry
 from poseintegrity.localization.pnp import solve_checked
 from pnp_scenes import K, scene
 
@@ -103,7 +102,7 @@ def test_changed_correspondences_camera_or_library_recompute(tmp_path, frame, ex
     K_other[0, 2] += 1e-9
     FP.frame_pnp(path, X, moved, K_other, "m" * 40, METHODS, CAPS, extract_params, 4)
     assert computed[2:] == [METHODS]
-    monkeypatch.setattr(cv2, "__version__", cv2.__version__ + "-other")
+    monkeypatch.setattr(cache_entry, "provenance", lambda: "another OpenCV")  # other code computes it
     solve(path, (X, moved), extract_params)
     assert computed[3:] == [METHODS]
 
@@ -117,9 +116,8 @@ def test_a_damaged_file_is_recomputed_not_an_error(tmp_path, frame, extract_para
     elif damage == "not an npz":
         path.write_text("not an npz")
     elif damage == "foreign arrays":  # the right keys beside a pose array of another shape
-        with np.load(path) as stored:
-            arrays = {name: stored[name] for name in stored.files}
-        write_npz(path, **arrays | {"T_cam_model": arrays["T_cam_model"][:, :3]})
+        arrays = cache_entry.read_entry(path, FP.FILE_KEY)
+        cache_entry.write_entry(path, FP.FILE_KEY, arrays | {"T_cam_model": arrays["T_cam_model"][:, :3]})
     else:
         path.write_bytes(b"")
     again = solve(path, frame, extract_params)

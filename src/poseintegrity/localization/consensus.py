@@ -25,8 +25,9 @@ All of them are NaN where the frame has no pose. Stage 02 computes them for the 
 re-runs); stage 05 leaves them NaN (:func:`~poseintegrity.localization.extract.extract_datasets`, ``consensus``).
 The per-frame columns are cached beside the frame's PnP results (``<image>.consensus.npz``, the layout of
 :mod:`frame_pnp`), under a key hashing the PnP result's own key (the correspondences, K, M_t, the method and its
-settings, the frame's seed, OpenCV and numpy), the pose, its inliers, the re-run seeds and the ``extract.consensus``
-settings: a re-run of the stage after an unrelated change reads them.
+settings, the frame's seed), the pose, its inliers, the re-run seeds and the ``extract.consensus`` settings, in a file
+keyed by what computes them (:mod:`poseintegrity.cache_entry`): a re-run of the stage after an unrelated change
+reads them.
 """
 
 from __future__ import annotations
@@ -41,8 +42,8 @@ import numpy as np
 import pandas as pd
 from scipy.spatial.transform import Rotation
 
-from poseintegrity.localization.features import read_npz, write_npz
-from poseintegrity.localization.frame_pnp import pnp_key
+from poseintegrity.cache_entry import Miss, read_entry, write_entry
+from poseintegrity.localization.frame_pnp import pnp_key, stale_entries
 from poseintegrity.localization.pnp import MIN_CORRESPONDENCES, PnPResult, solve_methods
 from poseintegrity.params.extract import ConsensusParams, ExtractParams
 from poseintegrity.poses import pose_errors, pose_from_rvec_tvec
@@ -51,7 +52,8 @@ from poseintegrity.tables import CONSENSUS_COLUMNS, STOP_SPREAD_COLUMNS
 
 STOP_KEYS = ["dataset", "method", "stop"]
 MIN_RESAMPLES = 4  # an RMS of fewer solved resamples says little
-CONSENSUS_CACHE_VERSION = 1  # bump when the cached content, its layout or what computes it changes
+CONSENSUS_CACHE_VERSION = 2  # bump when the cached content or its layout changes (2: OpenCV and numpy in the file key)
+FILE_KEY = f"consensus columns, layout {CONSENSUS_CACHE_VERSION}"  # each method's entry carries its own key
 FIELDS = ("methods", "keys", "values")  # values: (m, 4) float64, CONSENSUS_COLUMNS per method
 
 
@@ -121,21 +123,22 @@ def frame_consensus(
     keys = {method: consensus_key(pnp_key(method, object_points, image_points, K, digest, params,
                                           max_iterations[method], seed), result, seeds, params.consensus)
             for method, result in results.items()}
-    stored = _stored(path) if path.exists() else {}
+    stored = _stored(path)
     missing = [method for method in results if stored.get(method, ("",))[0] != keys[method]]
     if missing:
+        stale_entries(stored, missing)
         computed = _computed(object_points, image_points, K, {m: results[m] for m in missing}, max_iterations,
                              params, seed, seeds)
         stored |= {method: (keys[method], values) for method, values in computed.items()}  # the others stay
-        write_npz(path, methods=np.array(list(stored), dtype=str),
-                  keys=np.array([key for key, _ in stored.values()], dtype=str),
-                  values=np.array([values for _, values in stored.values()], dtype=np.float64).reshape(-1, 4))
+        write_entry(path, FILE_KEY, dict(
+            methods=np.array(list(stored), dtype=str), keys=np.array([key for key, _ in stored.values()], dtype=str),
+            values=np.array([values for _, values in stored.values()], dtype=np.float64).reshape(-1, 4)))
     return {method: dict(zip(CONSENSUS_COLUMNS, map(float, stored[method][1]))) for method in results}
 
 
 def consensus_key(pnp_key_: str, result: PnPResult, seeds: Sequence[int], settings: ConsensusParams) -> str:
     """Hash of everything a method's consensus columns depend on: its PnP result's key (:func:`frame_pnp.pnp_key`:
-    the correspondences, K, M_t, the method and its settings, the frame's seed, OpenCV and numpy), the result's pose
+    the correspondences, K, M_t, the method and its settings, the frame's seed), the result's pose
     and inliers, the re-run seeds and the ``extract.consensus`` settings."""
     header = [CONSENSUS_CACHE_VERSION, pnp_key_, list(seeds), settings.n_bootstrap, settings.n_reruns,
               settings.elsewhere_mm, settings.elsewhere_deg]
@@ -146,9 +149,10 @@ def consensus_key(pnp_key_: str, result: PnPResult, seeds: Sequence[int], settin
 
 def _stored(path: Path) -> dict[str, tuple[str, np.ndarray]]:
     """The entries of a cache file: method -> (its key, its (4,) values); {} when the file is damaged or foreign."""
-    if (arrays := read_npz(path, FIELDS)) is None:
+    stored = read_entry(path, FILE_KEY)
+    if isinstance(stored, Miss) or any(field not in stored for field in FIELDS):
         return {}
-    methods, keys, values = arrays
+    methods, keys, values = (stored[field] for field in FIELDS)
     if methods.ndim != 1 or keys.shape != methods.shape or values.shape != (len(methods), 4):
         return {}
     return {method: (str(keys[i]), values[i]) for i, method in enumerate(methods.tolist())}

@@ -9,8 +9,9 @@ small ``.npz`` per frame (``<features_dir>/<dataset>/images/<image>.evidence.npz
 PnP methods on the same frames, reads them back instead of decoding the image, loading its descriptors,
 matching them and detecting the board again. The entry's key hashes everything the evidence depends on (image
 bytes, CLAHE/SIFT settings, the ratio, M_t itself, the board, the camera), so an entry is used only when
-recomputing it would give the same arrays; a frame image that fails its check is never cached (it is checked,
-and flagged, again).
+recomputing it would give the same arrays, and only when whole (:mod:`poseintegrity.cache_entry`); a frame image
+that fails its check is never cached (it is checked, and flagged, again). The frame's SIFT cache file is checked
+too when its evidence is read back, and computed again if it is not whole: no damaged cache file is left behind.
 """
 
 from __future__ import annotations
@@ -23,9 +24,10 @@ from typing import Any
 
 import numpy as np
 
+from poseintegrity.cache_entry import Miss, read_entry, write_entry
 from poseintegrity.lens import Camera
 from poseintegrity.localization.features import (
-    ImageReadError, cached_features, decode_gray, features_key, read_image_bytes, write_npz,
+    ImageReadError, cached_features, decode_gray, features_key, read_image_bytes, stored_features,
 )
 from poseintegrity.localization.ground_truth import BoardPose, ImageMarkers, board_from_dict, board_pose, no_pose
 from poseintegrity.localization.matching import match_ratio_test
@@ -92,16 +94,13 @@ def correspondences(features, model: TargetModel, ratio: float, camera: Camera) 
 
 
 def _load(path: Path, key: str) -> FrameEvidence | None:
-    try:
-        with np.load(path) as stored:
-            if str(stored["key"]) != key:
-                return None
-            return FrameEvidence("", stored["object_points"], stored["model_index"].astype(np.intp),
-                                 stored["image_points"], int(stored["n_keypoints"]), _stored_pose(stored, "board"),
-                                 tuple(_stored_pose(stored, f"handover{k}", k + 1)
-                                       for k in range(int(stored["n_handover"]))))
-    except (OSError, ValueError, KeyError):
-        return None  # missing, truncated or foreign: recomputed
+    """The evidence stored at ``path`` when the file is whole and its key is ``key``, else None (recomputed)."""
+    stored = read_entry(path, key)
+    if isinstance(stored, Miss):
+        return None
+    return FrameEvidence("", stored["object_points"], stored["model_index"].astype(np.intp), stored["image_points"],
+                         int(stored["n_keypoints"]), _stored_pose(stored, "board"),
+                         tuple(_stored_pose(stored, f"handover{k}", k + 1) for k in range(int(stored["n_handover"]))))
 
 
 def _pose_arrays(prefix: str, pose: BoardPose) -> dict[str, Any]:
@@ -134,7 +133,9 @@ def frame_evidence(
     data = read_image_bytes(image_path)
     features_key_ = features_key(data, params.clahe, params.sift)
     key = evidence_key(features_key_, digest, params, board, camera, handover_boards)
-    if evidence_path.exists() and (cached := _load(evidence_path, key)) is not None:
+    if (cached := _load(evidence_path, key)) is not None:
+        if isinstance(read_entry(features_path, features_key_), Miss):  # not whole: computed again, none left damaged
+            stored_features(image_path, features_path, features_key_, params.clahe, params.sift, data)
         return cached
     try:
         image = decode_gray(data, name, (camera.width, camera.height))
@@ -148,7 +149,8 @@ def frame_evidence(
              else no_pose("no_board", "recorded poses are the ground truth"))  # no board: recorded poses instead
     handover = tuple(replace(board_pose(image, board_from_dict(other), camera, params.ground_truth, markers),
                              board=k + 1) for k, other in enumerate(handover_boards))
-    write_npz(evidence_path, key=key, object_points=object_points, model_index=model_index, image_points=image_points,
-              n_keypoints=features.n_keypoints, n_handover=len(handover), **_pose_arrays("board", truth),
-              **{k: v for n, pose in enumerate(handover) for k, v in _pose_arrays(f"handover{n}", pose).items()})
+    write_entry(evidence_path, key, dict(
+        object_points=object_points, model_index=model_index, image_points=image_points,
+        n_keypoints=features.n_keypoints, n_handover=len(handover), **_pose_arrays("board", truth),
+        **{k: v for n, pose in enumerate(handover) for k, v in _pose_arrays(f"handover{n}", pose).items()}))
     return FrameEvidence("", object_points, model_index, image_points, features.n_keypoints, truth, handover)

@@ -27,6 +27,10 @@ workers of the ``parallel`` section (:class:`~poseintegrity.parallel.Workers`):
    frames' poses of frames.parquet are the ground truth of E_t/E_r (as well as of the ``_exact`` columns), and the
    board columns say ``no_board``.
 
+Every cache file (SIFT features, evidence, PnP results, consensus columns, M_t) is used only when it proves it is
+whole and current (:mod:`poseintegrity.cache_entry`), and computed again otherwise; the unfinished writes of a killed
+run are removed first. The stage prints one line per dataset where it computed a file (how many, and why) and a total.
+
 A frame whose image is unusable gives rows with status ``bad_image``, one whose exact pose in frames.parquet is not a
 finite rigid transform rows with status ``bad_pose`` (a damaged file: no error is reported); a frame without a pose
 gives its PnP status; a recorded frame whose pose is not known (None in frames.parquet, board ground truth) is not
@@ -37,19 +41,21 @@ envelopes and summaries.
 
 from __future__ import annotations
 
+from collections import Counter
 from dataclasses import dataclass, replace
-from functools import lru_cache
+from functools import lru_cache, partial
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pandas as pd
 
+from poseintegrity.cache_entry import Miss, describe, read_entry, read_whole, tallied, write_entry
 from poseintegrity.lens import Camera
 from poseintegrity.seeding import keyed_rng
 from poseintegrity.localization.dataset import Dataset, DatasetError, load_dataset, load_index, pose_problem
 from poseintegrity.localization.evidence import FrameEvidence, frame_evidence, model_digest
-from poseintegrity.localization.features import cached_features, read_gray, write_npz
+from poseintegrity.localization.features import cached_features, read_gray
 from poseintegrity.localization.frame_artifacts import frame_artifacts
 from poseintegrity.localization.consensus import CONSENSUS_COLUMNS, frame_consensus, stop_spread
 from poseintegrity.localization.frame_pnp import frame_pnp
@@ -63,6 +69,7 @@ from poseintegrity.ransac import minimal_sample_size, ransac_iterations
 from poseintegrity.poses import NAN_POSE, pose_errors
 from poseintegrity.localization.target_model import TargetModel, build_target_model
 from poseintegrity.parallel import Workers
+from poseintegrity.staging import remove_staging_files
 
 FRAME_COLUMNS = ["world", "dataset", "trajectory", "stop", "image", "theta_deg", "x_mm"]
 DATA_FLAGS = ("bad_image", "bad_pose")  # statuses of rows whose frame (not its localization) is at fault
@@ -226,14 +233,10 @@ def store_model(task: ModelTask) -> StoredModel:
     """Build M_t of a dataset (a worker task) and store it for the frame tasks (unless stored already)."""
     model, anchor = dataset_model(task.dataset, task.params, task.cache_dir)
     digest = model_digest(model)
-    try:  # the covariances do not enter the digest (no evidence depends on them): compared themselves
-        with np.load(task.path) as stored:
-            current = str(stored["digest"]) == digest and np.array_equal(stored["covariances"], model.covariances)
-    except (OSError, ValueError, KeyError):
-        current = False
-    if not current:
-        write_npz(task.path, digest=digest, points=model.points, descriptors=model.descriptors,
-                  covariances=model.covariances, pixel_noise_px=model.pixel_noise_px)
+    stored = read_entry(task.path, digest)  # the covariances do not enter the digest (no evidence depends on them)
+    if isinstance(stored, Miss) or not np.array_equal(stored["covariances"], model.covariances):
+        write_entry(task.path, digest, dict(points=model.points, descriptors=model.descriptors,
+                                            covariances=model.covariances, pixel_noise_px=model.pixel_noise_px))
     return StoredModel(task.path, digest, model.size, anchor, model.pixel_noise_px,
                        handover_anchors(task.dataset, task.params))
 
@@ -241,11 +244,11 @@ def store_model(task: ModelTask) -> StoredModel:
 @lru_cache(maxsize=4)
 def load_model(path: Path, digest: str) -> TargetModel:
     """M_t stored by :func:`store_model`, loaded once per worker process (``digest``: the one expected)."""
-    with np.load(path) as stored:
-        if str(stored["digest"]) != digest:
-            raise DatasetError(f"target model {path} was replaced while this stage ran (another run on the same data?)")
-        return TargetModel(stored["points"], stored["descriptors"], stored["covariances"],
-                           float(stored["pixel_noise_px"]))
+    stored = read_whole(path, digest)  # checked (and counted) by store_model
+    if isinstance(stored, Miss):
+        raise DatasetError(f"target model {path} is {stored.reason} since this stage stored it (another run on the "
+                           f"same data?): re-run the stage")
+    return TargetModel(stored["points"], stored["descriptors"], stored["covariances"], float(stored["pixel_noise_px"]))
 
 
 def frame_rows(task: FrameTask) -> tuple[list[dict[str, Any]], tuple[BoardPose, ...]]:
@@ -374,8 +377,10 @@ def extract_datasets(
     ``protocol.pnp_method``, at ~2 ms (bootstrap) + ~15 ms (3 USAC re-runs) per frame; stage 05 does not: its five
     classic methods would cost ~50 ms more per frame, about three times its PnP, for columns no figure of it reads."""
     cache_dirs = [_cache_root(dataset.data_dir, params) / dataset.name for dataset in datasets]
-    models = workers.map(store_model, [ModelTask(d, c, params) for d, c in zip(datasets, cache_dirs)],
+    unfinished = {dataset.name: remove_staging_files(cache_dir) for dataset, cache_dir in zip(datasets, cache_dirs)}
+    stored = workers.map(partial(tallied, store_model), [ModelTask(d, c, params) for d, c in zip(datasets, cache_dirs)],
                          desc="target models M_t", progress=progress)
+    models = [model for model, _ in stored]
     tasks = [
         FrameTask(
             frame, dataset.path(frame["file"]), cache_dir / Path(frame["file"]).with_suffix(".npz"),
@@ -387,13 +392,30 @@ def extract_datasets(
         for frame in dataset.frames.assign(world=dataset.meta["world"], trajectory=dataset.meta["trajectory"])
             .to_dict("records")
     ]
-    results = workers.map(frame_rows, tasks, desc=f"frames of {len(datasets)} dataset(s)", progress=progress)
+    counted = workers.map(partial(tallied, frame_rows), tasks, desc=f"frames of {len(datasets)} dataset(s)",
+                          progress=progress)
+    results = [result for result, _ in counted]
+    tallies = {dataset.name: tally for dataset, (_, tally) in zip(datasets, stored)}
+    for task, (_, tally) in zip(tasks, counted):
+        tallies[task.frame["dataset"]] += tally
+    if progress:
+        print(cache_report(tallies, unfinished), flush=True)
     rows = []
     for dataset in datasets:
         mine = [k for k, task in enumerate(tasks) if task.frame["dataset"] == dataset.name]
         rows += handed_over_rows([tasks[k] for k in mine], [results[k] for k in mine], params)
     table = pd.DataFrame(rows)
     return table.join(stop_spread(table)) if rows else table
+
+
+def cache_report(tallies: dict[str, Counter], unfinished: dict[str, int]) -> str:
+    """The lines a stage prints about its cache files (:mod:`poseintegrity.cache_entry`): one per dataset where any
+    file was computed (or a killed run's unfinished write removed), then the total."""
+    lines = [f"cache of {name}: {describe(tally)}" + (f"; {unfinished[name]} unfinished write(s) of a stopped run "
+                                                      f"removed" if unfinished[name] else "")
+             for name, tally in tallies.items()
+             if unfinished[name] or set(tally) - {"checked"}]
+    return "\n".join([*lines, f"cache of {len(tallies)} dataset(s): {describe(sum(tallies.values(), Counter()))}"])
 
 
 def robot_board_pose(dataset: Dataset, model: StoredModel) -> np.ndarray | None:

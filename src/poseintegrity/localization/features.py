@@ -1,24 +1,21 @@
 """CLAHE + SIFT keypoint features (paper IV-C), computed once per image and cached on disk.
 
-The cache holds one ``.npz`` per image. Its key hashes the image bytes together with the CLAHE and SIFT
-settings, so a re-rendered image or a changed setting recomputes the features, while re-runs with other
-matching or RANSAC settings (and every PnP method of stage 05) reuse them.
+The cache holds one file per image (:mod:`poseintegrity.cache_entry`: whole or recomputed). Its key hashes the image
+bytes together with the CLAHE and SIFT settings, so a re-rendered image or a changed setting recomputes the features,
+while re-runs with other matching or RANSAC settings (and every PnP method of stage 05) reuse them.
 """
 
 from __future__ import annotations
 
 import hashlib
 import json
-import os
-import tempfile
-import zipfile
-from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
 import cv2
 import numpy as np
 
+from poseintegrity.cache_entry import Miss, read_entry, write_entry
 from poseintegrity.defaults import published
 from poseintegrity.grayscale import as_gray8
 from poseintegrity.localization.dataset import DatasetError
@@ -117,45 +114,26 @@ def cached_features(
     image_path: str | Path, cache_path: str | Path, clahe: ClaheParams, sift: SiftParams, data: bytes | None = None,
     image: np.ndarray | None = None,
 ) -> Features:
-    """Features of ``image_path``, read from ``cache_path`` (.npz) when its key matches, else computed and stored.
+    """Features of ``image_path``, read from ``cache_path`` when it is whole and its key matches, else computed and
+    stored (:mod:`poseintegrity.cache_entry`).
 
     ``data``: the file's bytes if already read; ``image``: the decoded image if already decoded (and checked).
     Raises :class:`ImageReadError` naming the file if the image is missing or unreadable.
     """
     data = read_image_bytes(image_path) if data is None else data
     key = features_key(data, clahe, sift)
-    cache_path = Path(cache_path)
-    if cache_path.exists():
-        try:
-            with np.load(cache_path) as stored:
-                if str(stored["key"]) == key:
-                    return Features(stored["points"], stored["descriptors"].astype(np.float32))
-        except (OSError, ValueError, KeyError):
-            pass  # a truncated or foreign file is simply recomputed
+    stored = read_entry(Path(cache_path), key)
+    if not isinstance(stored, Miss):
+        return Features(stored["points"], stored["descriptors"].astype(np.float32))
+    return stored_features(image_path, cache_path, key, clahe, sift, data, image)
+
+
+def stored_features(
+    image_path: str | Path, cache_path: str | Path, key: str, clahe: ClaheParams, sift: SiftParams, data: bytes,
+    image: np.ndarray | None = None,
+) -> Features:
+    """Compute the features of ``image_path`` (its bytes ``data``, decoded ``image`` if given) and store them at
+    ``cache_path`` under ``key`` (:func:`features_key`)."""
     features = detect_features(decode_gray(data, image_path) if image is None else image, clahe, sift)
-    write_npz(cache_path, key=key, points=features.points, descriptors=features.descriptors.astype(np.uint8))
+    write_entry(Path(cache_path), key, {"points": features.points, "descriptors": features.descriptors.astype(np.uint8)})
     return features
-
-
-def read_npz(path: Path, names: Sequence[str]) -> tuple[np.ndarray, ...] | None:
-    """The arrays ``names`` of an .npz cache entry, in that order; None when the file is missing, truncated, not an
-    .npz or lacks one of them (the caller recomputes the entry)."""
-    try:
-        with np.load(path) as stored:
-            return tuple(stored[name] for name in names)
-    except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile):
-        return None
-
-
-def write_npz(path: Path, **arrays) -> None:
-    """Write an .npz cache entry by write-then-rename: parallel workers and interrupted runs never leave a
-    half-written entry."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    handle, tmp_path = tempfile.mkstemp(dir=path.parent, suffix=".npz")
-    try:
-        with os.fdopen(handle, "wb") as stream:
-            np.savez(stream, **arrays)
-        os.replace(tmp_path, path)
-    except BaseException:  # an error or an interrupt: no staging file is left behind
-        Path(tmp_path).unlink(missing_ok=True)
-        raise

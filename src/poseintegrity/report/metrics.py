@@ -8,11 +8,11 @@ metrics file that looks complete.
 from __future__ import annotations
 
 import json
-import os
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+from poseintegrity.staging import write_text_atomically
 
 
 def json_ready(value: Any) -> Any:
@@ -31,11 +31,9 @@ def json_ready(value: Any) -> Any:
 
 
 def write_metrics(path: str | Path, metrics: dict[str, Any]) -> None:
-    """Write ``metrics`` (nested dicts / lists of numbers, strings, bools) as indented, key-sorted JSON."""
-    path = Path(path)
-    partial = path.with_name(path.name + ".partial")
-    partial.write_text(json.dumps(json_ready(metrics), indent=2, sort_keys=True, allow_nan=False) + "\n")
-    os.replace(partial, path)
+    """Write ``metrics`` (nested dicts / lists of numbers, strings, bools) as indented, key-sorted JSON, atomically
+    (its folder made if missing; a full disk: :class:`~poseintegrity.staging.DiskFullError` naming the file)."""
+    write_text_atomically(path, json.dumps(json_ready(metrics), indent=2, sort_keys=True, allow_nan=False) + "\n")
 
 
 def metrics_differences(before: Any, after: Any, skip: frozenset[str] = frozenset(), rtol: float = 0.0, path: str = "") -> list[str]:

@@ -45,7 +45,7 @@ from poseintegrity.lens import Camera, write_camera_yaml
 from poseintegrity.parallel import Workers
 from poseintegrity.poses import inverse
 from poseintegrity.protocol import ProtocolParams
-from poseintegrity.staging import partial_folder
+from poseintegrity.staging import full_disk_named, partial_folder
 from poseintegrity.scenes import catalog, optics, renderer, trajectories
 from poseintegrity.scenes.acquisition import Route, image_motion, image_pose, model_motion, rotation_maps, visits
 from poseintegrity.scenes.board_placement import PlacementError
@@ -534,21 +534,23 @@ def generate(params: GenerateParams, protocol: ProtocolParams, root: Path, worke
     and each world's plan (its calibration and robot accuracy)."""
     worlds = plan_worlds(params, protocol, workers, progress)
     root = Path(root)
-    root.mkdir(parents=True, exist_ok=True)
-    (root / "index.parquet").unlink(missing_ok=True)
-    rows = []
-    for w in worlds.values():
-        write_calibration(Path(calibration_dir) / w.name, w.calibration, w.params, CAMERA_NAME, IMAGE_PNG_FLAGS)
-        for plan in w.plans:
-            tmp = _partial(root, plan.dataset)
-            shutil.rmtree(tmp, ignore_errors=True)
-            (tmp / "model").mkdir(parents=True)
-            (tmp / "images").mkdir()
-        shots = plan_shots(w.params, w.plans, w.trips, w.routes, {key: s.plan for key, s in w.scenes.items()})
-        workers.map(partial(take_shot, w.params, protocol, root), shots,
-                    desc=f"camera poses of {len(w.plans)} datasets ({w.name} world)", progress=progress)
-        rows += [finish_dataset(w.params, root, plan, trip, route, w.scenes[plan.scene_index, plan.trajectory],
-                                w.calibration.calibration.camera) for plan, trip, route in zip(w.plans, w.trips, w.routes)]
-    index = pd.DataFrame(rows)
-    index.to_parquet(root / "index.parquet", index=False)
+    with full_disk_named(root):  # a full disk, in a worker or here: one line naming the datasets' folder
+        root.mkdir(parents=True, exist_ok=True)
+        (root / "index.parquet").unlink(missing_ok=True)
+        rows = []
+        for w in worlds.values():
+            write_calibration(Path(calibration_dir) / w.name, w.calibration, w.params, CAMERA_NAME, IMAGE_PNG_FLAGS)
+            for plan in w.plans:
+                tmp = _partial(root, plan.dataset)
+                shutil.rmtree(tmp, ignore_errors=True)
+                (tmp / "model").mkdir(parents=True)
+                (tmp / "images").mkdir()
+            shots = plan_shots(w.params, w.plans, w.trips, w.routes, {key: s.plan for key, s in w.scenes.items()})
+            workers.map(partial(take_shot, w.params, protocol, root), shots,
+                        desc=f"camera poses of {len(w.plans)} datasets ({w.name} world)", progress=progress)
+            rows += [finish_dataset(w.params, root, plan, trip, route, w.scenes[plan.scene_index, plan.trajectory],
+                                    w.calibration.calibration.camera)
+                     for plan, trip, route in zip(w.plans, w.trips, w.routes)]
+        index = pd.DataFrame(rows)
+        index.to_parquet(root / "index.parquet", index=False)
     return index, worlds

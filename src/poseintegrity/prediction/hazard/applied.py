@@ -26,6 +26,7 @@ from poseintegrity.prediction.hazard.risk_sets import long_range_features
 from poseintegrity.prediction.hazard.stop_evidence import stop_evidence
 from poseintegrity.prediction.hazard.stopping import stop_on_failure_probability, stop_on_next_hazard
 from poseintegrity.protocol import ProtocolParams
+from poseintegrity.staging import write_text_atomically
 
 NEXT_STEP, LONG_RANGE = "hazard_next_step", "hazard_long_range"
 HAZARD_PREDICTORS = (NEXT_STEP, LONG_RANGE)
@@ -67,11 +68,7 @@ class HazardSet:
 
 def write_hazard(path: str | Path, hazard: HazardSet) -> None:
     """The file of ``hazard`` (JSON), written to a temporary name and renamed: never half a file."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    partial = path.with_name(path.name + ".partial")
-    partial.write_text(json.dumps(hazard.to_dict(), indent=1, sort_keys=True) + "\n")
-    partial.replace(path)
+    write_text_atomically(path, json.dumps(hazard.to_dict(), indent=1, sort_keys=True) + "\n")
 
 
 def hazard_models(path: str | Path) -> HazardSet | None:
