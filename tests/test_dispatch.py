@@ -79,6 +79,9 @@ def test_libraries_loaded_above_the_ceiling_are_named():
                               SKX_CPU)
     assert found == ["OpenBLAS (libopenblas.so) runs its SkylakeX kernels", "numpy dispatches X86_V4",
                      "OpenCV dispatches AVX512-SKX", "torch dispatches AVX512"]
+    with_ipp = SimpleNamespace(getCPUFeaturesLine=lambda: "SSE SSE2 *AVX2 *AVX512-SKX?",
+                               ipp=SimpleNamespace(useIPP=lambda: True, getIppVersion=lambda: "ippIP AVX2 (l9)"))
+    assert unpinned_dispatch({"cv2": with_ipp}, {}, SKX_CPU) == ["OpenCV runs Intel IPP (ippIP AVX2 (l9))"]
     capped = SimpleNamespace(getCPUFeaturesLine=lambda: "SSE SSE2 *SSE4.1 *AVX *AVX2 *AVX512-SKX?")
     assert unpinned_dispatch({"cv2": capped}, {}, SKX_CPU) == []
     assert unpinned_dispatch({}, {"libopenblas.so": "Sandybridge"}, AVX_CPU) == []  # no Haswell kernels to pin to
@@ -117,6 +120,15 @@ def test_sift_moves_with_the_dispatch_level_unpinned_and_not_pinned():
     assert _hash(SIFT_HASH, pinned | avx2) == _hash(SIFT_HASH, pinned | avx)
 
 
+@pytest.mark.skipif("avx512f" not in dispatch.cpu_flags(), reason="IPP's AVX-512 level needs an AVX-512 CPU")
+def test_sift_moves_with_opencvs_ipp_level_unpinned_and_not_pinned():
+    """OpenCV's Intel IPP dispatches by itself (OPENCV_CPU_DISABLE does not reach it): its AVX2 and AVX-512 code
+    give other SIFT angles and descriptors; pinned, IPP is off whatever the user asks."""
+    native, pinned = {"POSEINTEGRITY_CPU_DISPATCH": "native"}, {"POSEINTEGRITY_CPU_DISPATCH": "pinned"}
+    assert _hash(SIFT_HASH, native | {"OPENCV_IPP": "avx2"}) != _hash(SIFT_HASH, native | {"OPENCV_IPP": ""})
+    assert _hash(SIFT_HASH, pinned | {"OPENCV_IPP": "avx2"}) == _hash(SIFT_HASH, pinned | {"OPENCV_IPP": ""})
+
+
 @pytest.mark.skipif(not dispatch.OPENBLAS_NEEDS <= dispatch.cpu_flags(), reason="Haswell's kernels need AVX2 + FMA")
 def test_a_matrix_product_moves_with_openblas_kernels_unpinned_and_not_pinned():
     """Sandybridge's kernels (AVX, no FMA) run on every AVX2 CPU: left to the user's OPENBLAS_CORETYPE, the product
@@ -125,6 +137,44 @@ def test_a_matrix_product_moves_with_openblas_kernels_unpinned_and_not_pinned():
     haswell = _hash(DGEMM_HASH, native | {"OPENBLAS_CORETYPE": "Haswell"})
     assert _hash(DGEMM_HASH, native | {"OPENBLAS_CORETYPE": "Sandybridge"}) != haswell
     assert _hash(DGEMM_HASH, pinned | {"OPENBLAS_CORETYPE": "Sandybridge"}) == haswell
+
+
+NUMBA_ASM = """
+import poseintegrity
+import numpy as np
+from numba import njit
+
+@njit(fastmath=True)
+def sum_of_squares(x):
+    total = 0.0
+    for v in x:
+        total += v * v
+    return total
+
+sum_of_squares(np.ones(3))
+print(sum_of_squares.inspect_asm(sum_of_squares.signatures[0]))
+"""
+
+
+@pytest.mark.skipif("avx512f" not in dispatch.cpu_flags(), reason="needs an AVX-512 CPU to show numba's host features")
+def test_numba_compiles_for_haswell_not_for_the_host(tmp_path):
+    """NUMBA_CPU_NAME=haswell alone still let numba add the host's features: a fastmath loop became AVX-512 (zmm)
+    code on an AVX-512 CPU and another summation width than on an AVX2 one. Pinned, it is AVX2 (ymm) code; native,
+    the host's."""
+    cache = {"NUMBA_CACHE_DIR": str(tmp_path)}
+    pinned = _hash(NUMBA_ASM, cache | {"POSEINTEGRITY_CPU_DISPATCH": "pinned"})
+    assert "ymm" in pinned and "zmm" not in pinned
+    env = {k: v for k, v in os.environ.items() if not k.startswith("NUMBA_CPU")}
+    native = subprocess.run([sys.executable, "-c", NUMBA_ASM], env=env | cache | {"POSEINTEGRITY_CPU_DISPATCH": "native"},
+                            capture_output=True, text=True, check=True).stdout
+    assert "zmm" in native
+
+
+def test_numba_loaded_for_the_host_is_named():
+    config = SimpleNamespace(CPU_NAME="haswell", CPU_FEATURES=None)
+    assert unpinned_dispatch({"numba.core.config": config}, {}, SKX_CPU) == ["numba compiles for this machine's CPU"]
+    assert unpinned_dispatch({"numba.core.config": SimpleNamespace(CPU_NAME="haswell", CPU_FEATURES="")}, {},
+                             SKX_CPU) == []
 
 
 @pytest.mark.pipeline  # a notebook's kernel

@@ -5,7 +5,9 @@ choose their kernels by the CPU they run on. Kernels of another width round diff
 another polynomial for exp or sin, a fused multiply-add or not), so a CPU with AVX-512 gave other SIFT keypoints than
 an AVX2 one and moved theta_a by up to 1.4 % (issue 32), and OpenBLAS's SkylakeX kernels gave other stage-01 data and
 730 other metric values than its Haswell ones (issue 40). Every x86-64 CPU of the last decade has AVX2; dispatching
-no higher, and running OpenBLAS's Haswell kernels (AVX2 + FMA), gives the same numbers on all of them.
+no higher, and running OpenBLAS's Haswell kernels (AVX2 + FMA), gives the same numbers on all of them. OpenCV's Intel
+IPP dispatches by itself, and its magnitude starts from an approximate reciprocal square root that differs between
+Intel and AMD CPUs: it is switched off (``OPENCV_IPP``), so SIFT runs OpenCV's own pinned kernels.
 
 Each library reads its setting from the environment once, when it loads, so :func:`pin_dispatch` sets it in
 ``os.environ`` before anything is imported: ``import poseintegrity`` does so first, the stage runner's kernel and
@@ -18,14 +20,16 @@ numbers). For a process that does not start by importing poseintegrity (a Dask w
 own, so that running it does not run again what ``import poseintegrity`` has imported).
 
 Sources (docs/references.md, "CPU dispatch"): OpenCV's ``OPENCV_CPU_DISABLE`` (core/src/system.cpp), numpy's
-``NPY_DISABLE_CPU_FEATURES`` (numpy 2.4 groups), OpenBLAS's ``OPENBLAS_CORETYPE`` (DYNAMIC_ARCH builds), ATen's
+``NPY_DISABLE_CPU_FEATURES`` (numpy 2.4 groups), OpenCV's ``OPENCV_IPP`` (its Intel IPP, which dispatches on its own),
+OpenBLAS's ``OPENBLAS_CORETYPE`` (DYNAMIC_ARCH builds), ATen's
 ``ATEN_CPU_CAPABILITY``, MKL's conditional numerical reproducibility ``MKL_CBWR``, oneDNN's ``ONEDNN_MAX_CPU_ISA``
-and numba's ``NUMBA_CPU_NAME``.
+and numba's ``NUMBA_CPU_NAME`` with ``NUMBA_CPU_FEATURES``.
 """
 
 from __future__ import annotations
 
 import ctypes
+import hashlib
 import os
 import sys
 import warnings
@@ -47,7 +51,20 @@ FIXED = {
     "MKL_CBWR": "AVX2,STRICT",  # torch's BLAS (MKL): AVX2 code paths, run-to-run identical
     "ONEDNN_MAX_CPU_ISA": "AVX2",  # torch's oneDNN primitives
     "NUMBA_CPU_NAME": "haswell",  # numba compiles for the first AVX2 core, not for the host
+    # ... with that core's features: without this numba adds the host's own (AVX-512 on an AVX-512 CPU: zmm code in
+    # every fastmath kernel, another summation width), whatever NUMBA_CPU_NAME says (numba/core/codegen.py,
+    # _get_host_cpu_features; "" is the value numba's config gives the generic CPU for the same purpose)
+    "NUMBA_CPU_FEATURES": "",
+    # Intel IPP inside OpenCV: OPENCV_CPU_DISABLE does not reach it, so it ran its AVX-512 code (k0) on an AVX-512 CPU
+    # and its AVX2 code (l9) elsewhere, and its magnitude (which SIFT's orientations and descriptors use) starts from
+    # vrsqrtps, an approximate instruction whose results differ between Intel and AMD: SIFT descriptors +-1 and
+    # other angles in 142 of 645 frames between the two levels on one CPU (traced under qemu, docs/references.md,
+    # "CPU dispatch"). Without IPP, OpenCV runs its own kernels, pinned above; SIFT costs ~7 % more CPU.
+    "OPENCV_IPP": "disabled",
 }
+# OpenCV logs "IPP was disabled by OPENCV_IPP" at WARNING level when it loads, in every process; its log level is
+# raised to ERROR unless the user set one (pin_dispatch)
+OPENCV_LOG = ("OPENCV_LOG_LEVEL", "ERROR")
 # numpy's and scipy's OpenBLAS (scipy-openblas, built with DYNAMIC_ARCH: one kernel set per CPU family, chosen at
 # load) run the kernel set named here instead of their CPU's. Haswell's needs AVX2 and FMA (every AVX2 CPU has both);
 # on a CPU without them no kernel set is pinned.
@@ -88,7 +105,17 @@ def pin_dispatch(environ: MutableMapping[str, str] = os.environ) -> dict[str, tu
     pinned = pinned_environment(cpu_flags())
     replaced = {name: (environ[name], value) for name, value in pinned.items() if environ.get(name, value) != value}
     environ.update(pinned)
+    environ.setdefault(*OPENCV_LOG)
     return replaced
+
+
+def kernel_level(environ: Mapping[str, str] = os.environ) -> str:
+    """The level the compiled kernels of this process dispatch to: ``"AVX2, OpenCV without IPP"`` where pinned (the
+    same on every x86-64 machine), else ``"native "`` and a digest of the CPU's flags (machine-dependent). Part of every cache
+    entry's key (:mod:`poseintegrity.cache_entry`): an entry computed by other kernels is computed again."""
+    if environ.get(SWITCH, "pinned") != "native":
+        return f"{CEILING}, OpenCV without IPP"
+    return "native " + hashlib.sha1(" ".join(sorted(cpu_flags())).encode()).hexdigest()[:12]
 
 
 def openblas_cores() -> dict[str, str]:
@@ -135,6 +162,12 @@ def unpinned_dispatch(modules: Mapping[str, object] = sys.modules, openblas: Map
         on = sorted(enabled & OPENCV_ABOVE_CEILING.keys())
         if on:
             found.append(f"OpenCV dispatches {', '.join(on)}")
+        if hasattr(cv2, "ipp") and cv2.ipp.useIPP():
+            found.append(f"OpenCV runs Intel IPP ({cv2.ipp.getIppVersion()})")
+    numba_config = modules.get("numba.core.config")
+    if numba_config is not None and (getattr(numba_config, "CPU_NAME", None), getattr(numba_config, "CPU_FEATURES", None)) \
+            != (FIXED["NUMBA_CPU_NAME"], FIXED["NUMBA_CPU_FEATURES"]):
+        found.append("numba compiles for this machine's CPU")
     torch = modules.get("torch")
     if torch is not None and hasattr(torch, "backends"):
         capability = torch.backends.cpu.get_cpu_capability()

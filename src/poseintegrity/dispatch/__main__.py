@@ -3,12 +3,14 @@ that does not start by importing poseintegrity (README, "Running on a Dask clust
 
 import sys
 
-from poseintegrity.dispatch import cpu_flags, pinned_environment
+from poseintegrity.dispatch import OPENCV_LOG, cpu_flags, pinned_environment
 
 
 def main() -> int:
     for name, value in sorted(pinned_environment(cpu_flags()).items()):
         print(f"export {name}='{value}'")
+    name, value = OPENCV_LOG
+    print(f'export {name}="${{{name}:-{value}}}"')  # the user's own level stays
     return 0
 
 
