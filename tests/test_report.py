@@ -49,7 +49,7 @@ def test_values_nulls_and_missing_stages_are_told_apart():
         "predictors": {"long_range": {"2mm_3deg": {"max_mean_spl_zero_incursion": None},
                                       "4mm_10deg": {"max_mean_spl_zero_incursion": 14.25}}},
     }
-    text = render_summary(metrics, [])
+    text = render_summary(metrics)
     assert "| viewing-angle datasets | 21 | 21 (7 scenes x 3 azimuths) | - |" in text
     assert "| disk (GB) | 1.473 | - | <= 3 |" in text
     # each tolerance beside the paper's value for that tolerance (Table I), not the mean of both
@@ -60,20 +60,30 @@ def test_values_nulls_and_missing_stages_are_told_apart():
 
 def test_the_summary_points_nowhere_outside_the_repository():
     summary = ROOT / "reports" / "summary.md"
-    assert "docs/references.md" in render_summary({}, [])
-    assert outside_references(render_summary({}, []), summary.parent) == []
+    assert "docs/references.md" in render_summary({})
+    assert outside_references(render_summary({}), summary.parent) == []
 
 
-def test_stage_wall_times_say_where_the_tasks_ran():
+def test_stage_wall_times_say_where_the_tasks_ran_and_stay_out_of_the_summary():
+    """Wall times and speed-ups are on the machine-dependent page, each bar passed or failed; the summary only links
+    it, so that it holds no number that changes with the machine."""
+    from poseintegrity.report.timing_page import render_timing
     from poseintegrity.timing import StageTiming
 
-    timings = [StageTiming("01_generate_datasets", 101.4, "local", 2, None, "2026-11-23T10:02:03"),
+    timings = [StageTiming("01_generate_datasets", 501.4, "local", 2, None, "2026-11-23T10:02:03"),
                StageTiming("02_extract_artifacts", 250.0, "dask", 8, "tcp://10.0.0.5:8786", "2026-11-23T10:06:13")]
-    text = render_summary({}, timings)
-    assert "| 01_generate_datasets | 101 | local, n_jobs 2 | 2026-11-23 10:02 |" in text
-    assert "| 02_extract_artifacts | 250 | dask at tcp://10.0.0.5:8786, n_jobs 8 | 2026-11-23 10:06 |" in text
-    assert "| total (without this report) | 351 | | |" in text
-    assert "No stage timing yet" in render_summary({}, [])
+    speed = {"speedup_vs_filterpy": 12.3, "speedup_vs_pykalman": 40.0, "filter_step_ms": {"srukf": 0.05},
+             "subroutine_ms": {"Contour detection": 1.25}}
+    text = render_timing(timings, {"06_marker_tracking": speed}, "AMD EPYC, 2 logical cores (x86_64)")
+    assert ("| 01_generate_datasets | 501 | local, n_jobs 2 | 2026-11-23 10:02 | <= 480 s, rendering every world on 2 "
+            "cores: fail |") in text
+    assert "| 02_extract_artifacts | 250 | dask at tcp://10.0.0.5:8786, n_jobs 8 | 2026-11-23 10:06 |  |" in text
+    assert "| total (without the report) | 751 | | | |" in text and "AMD EPYC, 2 logical cores" in text
+    assert "| SR-UKF step speed-up over filterpy's UKF | 12.3x | >= 10x: pass |" in text
+    assert "| Contour detection (ms) | 1.250 | |" in text
+    assert "No stage timing yet" in render_timing([], {}, "x") and "has not written its timings" in render_timing([], {}, "x")
+    summary = render_summary({"tracking": {"rms_mm": {"ukf": 1.1}}})
+    assert "[timing.md](timing.md)" in summary and "wall time (s)" not in summary and "| SR-UKF step speed-up" not in summary
 
 
 def test_metrics_file_is_valid_json_with_null_for_nan(tmp_path):
@@ -104,7 +114,7 @@ def test_fit_statuses_have_a_row_per_model_and_predictor():
             for s in FIT_STATUSES} <= keys
     metrics = {"fits": {"fit_status": {"emg": {"ok": 0.975, "at_bound": 0.025, "non_physical": 0.0, "fallback": 0.0}}},
                "predictors": {"fit_status": {"next_step": {"non_physical": 0.125}}, "live": {"n_flagged_fits": 2}}}
-    text = render_summary(metrics, [])
+    text = render_summary(metrics)
     assert "| EMG (eq. 1): share of fits ok | 97.5% | - | >= 0.99 |" in text
     assert "| ... at a bound | 2.5% | - | - |" in text
     assert "| ... non-physical | 12.5% | - | - |" in text  # next step's rows
@@ -120,7 +130,7 @@ def test_free_width_rows_and_tail_counts_stand_beside_the_papers_rows():
                                   "relative_improvement_vs_long_range": 0.125},
         "tails": {"long_range": {"2mm_3deg": {"n_overshooting": 2, "datasets": ["scene_1_arc00", "scene_4_arc17"]}},
                   "long_range_free_width": {"2mm_3deg": {"n_overshooting": 0, "datasets": []}}}}}
-    text = render_summary(metrics, [])
+    text = render_summary(metrics)
     assert "| long range (EMG, eq. 1), 2 mm/3 deg: max mean SPL at zero incursion (deg) | 11 | 12.3 | - |" in text
     assert ("| ours: long range on the free-width EMG, 2 mm/3 deg: max mean SPL at zero incursion (deg) | 12.5 | - | - |"
             in text)
@@ -147,10 +157,10 @@ def test_each_headline_names_the_arcs_that_decide_it_and_how_they_end():
                       "worlds": {"validation": {"envelope_causes": [cause | dict(dataset="v_arc270", cause="estimate",
                                                                                   truth_shift=0.1)]}}},
     }
-    summary = render_summary(metrics, [])
+    summary = render_summary(metrics)
     assert ("| main | 2mm_3deg | long_range | 16.08 | 18 | a_arc090 | 17.77 | 24.50 | translation | resolution | "
             "0.332 | 38.3 |") in summary
     assert "| main | 2mm_3deg | static | 14.50 | 14.5 | none | - |" in summary
     assert ("| validation | 2mm_3deg | next_step | 12.45 | 33 | v_arc270 | 17.77 | 24.50 | translation | "
             "estimate |") in summary
-    assert "Which arcs decide" not in render_summary({"predictors": {"static": {"2mm_3deg": {}}}}, [])
+    assert "Which arcs decide" not in render_summary({"predictors": {"static": {"2mm_3deg": {}}}})

@@ -253,7 +253,7 @@ def expectations(m: dict) -> dict[str, tuple[list[list], list, str]]:
 @pytest.mark.parametrize("fixture", FIXTURES)
 def test_every_number_of_the_first_section_is_the_metrics_value_and_every_verdict_follows_the_rule(fixture):
     metrics = FIXTURES[fixture]
-    rows = table(render_summary(metrics, []))
+    rows = table(render_summary(metrics))
     expected = expectations(metrics)
     assert len(rows) == len(expected)  # a row per claim, and issue 38's where the metrics hold them
     for claim, (cells, why, word) in expected.items():
@@ -268,15 +268,15 @@ def test_every_number_of_the_first_section_is_the_metrics_value_and_every_verdic
 
 
 def test_a_run_without_the_ceiling_says_so():
-    rows = table(render_summary(OLD, []))
+    rows = table(render_summary(OLD))
     assert rows[next(c for c in rows if c.startswith("ceiling"))][1:3] == ["not measured", "not measured"]
     assert all("ceiling share not measured" in cell for claim, row in rows.items()
                if claim.startswith(("long range over", "next step over", "MLP")) for cell in row[1:3])
     assert not any(claim.startswith("ours") for claim in rows)  # issue 38's predictors: rows only once measured
-    text = render_summary(OLD, [])
+    text = render_summary(OLD)
     assert "(this run's stage 04 wrote no ceiling)" in text and "figures/04_ceiling.png)" not in text
     assert "![why each envelope ends, per world and tolerance](figures/02_envelope_causes.png)" in text
-    assert "![SPL vs R_i" in render_summary(FIXTURES["issue 38"], [])  # inline once stage 04 draws it
+    assert "![SPL vs R_i" in render_summary(FIXTURES["issue 38"])  # inline once stage 04 draws it
 
 
 def test_the_rule_word_for_word():
@@ -296,31 +296,31 @@ def test_a_planted_table_whose_verdict_the_interval_flips():
         entry = metrics[stage]["long_range"]["2mm_3deg"]
         entry["max_mean_spl_zero_incursion"], entry["gain"] = 20.0, 7.0
         entry["interval"] = dict(entry.get("interval", {}), gain=[0.4, 9.0])
-    row = next(cells for claim, cells in table(render_summary(metrics, [])).items()
+    row = next(cells for claim, cells in table(render_summary(metrics)).items()
                if claim.startswith("long range over static, 2 mm/3 deg"))
     assert row[-2] == "reproduced"
     metrics["validation"]["long_range"]["2mm_3deg"]["interval"]["gain"] = [-0.4, 9.0]  # one world's interval holds zero
-    row = next(cells for claim, cells in table(render_summary(metrics, [])).items()
+    row = next(cells for claim, cells in table(render_summary(metrics)).items()
                if claim.startswith("long range over static, 2 mm/3 deg"))
     assert row[-2] == "undecided"
     metrics["validation"]["long_range"]["2mm_3deg"]["interval"]["gain"] = [-3.0, -0.5]  # below zero
-    row = next(cells for claim, cells in table(render_summary(metrics, [])).items()
+    row = next(cells for claim, cells in table(render_summary(metrics)).items()
                if claim.startswith("long range over static, 2 mm/3 deg"))
     assert row[-2] == "not reproduced"
 
 
 def test_nothing_run_is_not_run_and_no_world_is_not_applicable():
-    rows = table(render_summary({}, []))
+    rows = table(render_summary({}))
     assert rows and all(row[-2] in ("not applicable", "-") for row in rows.values())
     assert rows[next(c for c in rows if c.startswith("long range over"))][1] == "not run"
-    no_lines = table(render_summary({"predictors": {"straight_line": {"tolerance": "2mm_3deg"}}}, []))  # no lines
+    no_lines = table(render_summary({"predictors": {"straight_line": {"tolerance": "2mm_3deg"}}}))  # no lines
     assert no_lines[next(c for c in no_lines if c.startswith("straight"))][-2] == "not applicable"
 
 
 @pytest.mark.parametrize("metrics", [COMMITTED, FIXTURES["issue 38"], RECORDED],
                          ids=["rendered", "issue 38", "recorded"])
 def test_the_first_section_is_one_screen_before_any_stage_table(metrics):
-    summary = render_summary(metrics, [])
+    summary = render_summary(metrics)
     lines = section(summary)
     assert len(lines) <= 40
     first_table = summary.index("| figure | ours | paper | target |")
@@ -365,7 +365,7 @@ def test_the_headline_file_holds_the_headline_of_each_world():
 @pytest.mark.parametrize("metrics", [COMMITTED, RECORDED], ids=["rendered", "recorded"])
 def test_every_link_of_the_first_section_leads_to_a_heading_below_it(metrics):
     """GitHub's heading links: lower case, punctuation dropped, spaces as hyphens."""
-    summary = render_summary(metrics, [])
+    summary = render_summary(metrics)
     headings = {"#" + re.sub(r"[^\w\- ]", "", line.lstrip("#").strip().lower()).replace(" ", "-")
                 for line in summary.splitlines() if line.startswith("## ")}
     links = set(re.findall(r"\]\((#[^)]+)\)", "\n".join(section(summary))))
@@ -385,7 +385,7 @@ def test_the_population_has_a_line_per_predictor_on_the_first_screen():
                  "error_next_step vs long_range": {"wins": 11, "losses": 1, "ties": 0, "sign_test_p": 0.0063},
                  "long_range vs mlp": {"wins": 10, "losses": 2, "ties": 0, "sign_test_p": 0.039}} for t in TOLERANCES}
     metrics = copy.deepcopy(COMMITTED) | {"population": {"n_worlds": 12, "across": across, "paired": {"own": pairs}}}
-    lines = section(render_summary(metrics, []))
+    lines = section(render_summary(metrics))
     assert any(line.startswith("**On a population of 12 rendered worlds**") for line in lines)
     rows = {line.split(" | ")[0].strip("| "): line.strip("|").split(" | ")[1:] for line in lines
             if line.startswith("| ") and "own point" not in line and "---" not in line}
@@ -396,4 +396,4 @@ def test_the_population_has_a_line_per_predictor_on_the_first_screen():
     assert "long range" in rows and "error long range" not in rows  # a line per predictor the population holds
     assert len(lines) <= 40
     unrun = {stage: entry for stage, entry in COMMITTED.items() if stage != "population"}
-    assert not any("population" in line for line in section(render_summary(unrun, [])))  # not run: no lines
+    assert not any("population" in line for line in section(render_summary(unrun)))  # not run: no lines

@@ -23,7 +23,7 @@ RECORDED = {
 
 
 def test_the_summary_of_recorded_data_says_what_was_measured_on_each_dataset():
-    text = render_summary(RECORDED, [])
+    text = render_summary(RECORDED)
     section = text.split("## Your recorded data: what was measured", 1)[1].split("\n## ", 1)[0]
     assert "Recorded datasets from `/data/mine`" in section and "`lab_a` (1 datasets), `lab_b` (1 datasets)" in section
     assert ("| lab_a | knee_01 | arc | 40 | 20 | 88 deg | 75% | 144 | 31.2 deg | >= 88 deg (censored: no failure up "
@@ -43,10 +43,10 @@ def test_the_summary_of_recorded_data_says_what_was_measured_on_each_dataset():
 def test_one_world_says_nothing_was_held_out_and_the_rendered_summary_is_unchanged():
     one = RECORDED | {"validation": {"world": None, "chosen_on": "lab_a",
                                      "note": "one world only (lab_a): no second world to apply its operating points to"}}
-    text = render_summary(one, [])
+    text = render_summary(one)
     assert text.count("one world only (lab_a)") == 2  # in the section on the data and as stage 04's held-out part
     assert "No straight lines in this world: Fig. 7 has nothing to show." in text  # lab_a: one arc
-    rendered = render_summary({"generate": {"disk_gb": 1.4731}}, [])
+    rendered = render_summary({"generate": {"disk_gb": 1.4731}})
     assert "Your recorded data" not in rendered and "| disk (GB) | 1.473 | - | <= 3 |" in rendered
 
 

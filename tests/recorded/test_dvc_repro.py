@@ -103,7 +103,7 @@ def test_the_summary_says_what_was_measured_and_judges_no_rendered_world(recorde
             if cell.startswith("ours: ")} == worlds
     headline = json.loads((copy / "reports/metrics/headline.json").read_text())
     assert set(headline) - {"tracking"} <= worlds and "a_markers4" in headline["tracking"]
-    headlines = summary.split("## Stage wall times")[0]  # the tables "figure | ours | paper | target"
+    headlines = summary.split("## Machine-dependent figures")[0]  # the tables "figure | ours | paper | target"
     rows = [line.split("|") for line in headlines.splitlines() if line.startswith("| ") and line.count("|") == 5]
     assert rows and all(cells[4].strip() in ("-", "---", "target") for cells in rows)  # no rendered-world target
     artifacts = json.loads((copy / "reports/metrics/artifacts.json").read_text())

@@ -450,7 +450,6 @@ HEADLINES: list[Headline] = [
     Headline("generate", "board.min_in_view", "... share of the board in view at its worst pose, smallest over scenes",
              fmt="{:.0%}", section="ground_truth"),
     Headline("generate", "disk_gb", "disk (GB)", "-", "<= 3"),
-    Headline("generate", "wall_time_s", "stage wall time (s), both worlds", "-", "<= 480 (main world)"),
     Headline("artifacts", "realism.min_abs_spearman", "weakest decay over arcs: min of -Spearman(theta, mean n_i)",
              "n_i 'decays' with viewing angle", ">= 0.8"),
     Headline("artifacts", "realism.min_abs_spearman_to_failure",
@@ -563,6 +562,4 @@ HEADLINES: list[Headline] = [
     Headline("tracking", "ten_metre_jump.ok_while_off", "frames reported ok while > 0.1 m off after a 10 m jump", "-", "0"),
     Headline("tracking", "failed_downdates", "failed Cholesky downdates",
              f"16 in 25 000 ({BLACK['failed_downdate_share']:.2%})"),
-    Headline("tracking", "speedup_vs_filterpy", "SR-UKF step speed-up over filterpy", "-", ">= 10"),
-    Headline("tracking", "speedup_vs_pykalman", "SR-UKF step speed-up over pykalman's SR-UKF"),
 ]

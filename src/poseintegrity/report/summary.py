@@ -3,7 +3,9 @@
 It opens with one screen (:func:`~poseintegrity.report.claims.claims_section`): each claim, ours per world, each
 predictor's share of the ceiling, a verdict and why. The sections below follow the questions a reader asks next
 (:data:`~poseintegrity.report.headlines.SECTIONS`): the predictors, the envelopes and why they end, the fits, the PnP
-variants, the tracking, the rendered world's realism, the ground truth, timings and machine. Each stage writes
+variants, the tracking, the rendered world's realism, the ground truth; then a link to the machine-dependent figures
+(wall times, speed-ups: :mod:`~poseintegrity.report.timing_page`), which the summary never holds, so that two runs
+write the same summary on any machine. Each stage writes
 ``reports/metrics/<stage>.json``; :data:`~poseintegrity.report.headlines.HEADLINES` says which keys are headline
 figures, what the papers reported for them and the project's target where there is one. A stage that has not run
 yet shows "not run", a key its metrics lack "not measured", rather than a stale or invented number.
@@ -14,14 +16,13 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from poseintegrity.parallel import describe_backend
 from poseintegrity.report.claims import claims_section
 from poseintegrity.report.deciding import deciding_section
 from poseintegrity.report.headline_file import HEADLINE_FILE
 from poseintegrity.report.headlines import HEADLINES, SECTIONS, section_heading
 from poseintegrity.report.lookup import MISSING, absent, lookup
 from poseintegrity.report.recorded import recorded_section, recorded_source
-from poseintegrity.timing import StageTiming
+from poseintegrity.report.timing_page import TIMING_PAGE
 
 
 def read_metrics(metrics_dir: Path) -> dict[str, dict]:
@@ -41,18 +42,6 @@ def _fmt(value, fmt: str = "{:.4g}", missing: str = "not run") -> str:
     if isinstance(value, list):
         return ", ".join(str(item) for item in value) or "none"
     return str(value)
-
-
-def timing_table(timings: list[StageTiming]) -> list[str]:
-    """Markdown lines: each stage's wall time in the run that wrote its metrics, where its tasks ran, the total."""
-    if not timings:
-        return ["No stage timing yet (`reports/metrics/timing/` is written by `python -m poseintegrity.stage`).", ""]
-    lines = ["| stage | wall time (s) | tasks ran on | finished |", "| --- | --- | --- | --- |"]
-    for t in timings:
-        where = describe_backend(t.backend, t.address, t.n_jobs)
-        lines.append(f"| {t.stage} | {t.wall_time_s:.0f} | {where} | {t.finished_at.replace('T', ' ')[:16]} |")
-    lines.append(f"| total (without this report) | {sum(t.wall_time_s for t in timings):.0f} | | |")
-    return [*lines, ""]
 
 
 def figure(path: str, text: str) -> list[str]:
@@ -102,10 +91,10 @@ EXTRAS = {"predictors": _predictor_figures, "envelopes": _envelope_figures, "rea
           "ground_truth": board_warnings}  # what a section shows below its table
 
 
-def render_summary(metrics: dict[str, dict], timings: list[StageTiming]) -> str:
+def render_summary(metrics: dict[str, dict]) -> str:
     """Markdown: the first screen (report/claims.py), then one table per section, ours beside the paper's and the
     target, with the figures, the arcs that decide each headline (report/deciding.py) and the board warnings; then
-    the machine and the stage wall times.
+    what holds on another machine, and where the machine-dependent figures are.
 
     On recorded data (:func:`~poseintegrity.report.recorded.recorded_source`) the section on the user's datasets
     follows the first screen and replaces stage 01's rendered-world rows; no target is shown (the rendered world's
@@ -136,10 +125,14 @@ def render_summary(metrics: dict[str, dict], timings: list[StageTiming]) -> str:
             lines.append(f"| {h.label} | {shown} | {h.paper} | {'-' if recorded else h.target} |")
         lines.append("")
         lines += EXTRAS[section](metrics) if section in EXTRAS else []
-    lines += ["## Same numbers on another machine", "", MACHINE_NOTE, "", "## Stage wall times", "", *timing_table(timings)]
+    lines += ["## Same numbers on another machine", "", MACHINE_NOTE, "", "## Machine-dependent figures", "",
+              f"Stage wall times and the tracking filter's speed-ups change with the machine and its load: they are on "
+              f"[{TIMING_PAGE}]({TIMING_PAGE}), not here.", ""]
     return "\n".join(lines)
 
 
 # What README "Same numbers on any x86-64 machine" measured of the figures above
-MACHINE_NOTE = ("OpenCV, numpy, torch and numba run capped at AVX2 on every x86-64 machine (`poseintegrity/dispatch`), "
-                "so SIFT and every figure that follows from it are the same on an AVX-512 machine.")
+MACHINE_NOTE = ("OpenCV, numpy, OpenBLAS, torch and numba run capped at AVX2 on every x86-64 machine "
+                "(`poseintegrity/dispatch`), so SIFT and every figure that follows from it are the same on an AVX-512 "
+                "machine, and a stage run again with the same params writes the same bytes into every data and metrics "
+                "file.")

@@ -41,12 +41,16 @@ class Study:
     """Everything section III reports, on our simulation (see :func:`run_study`).
 
     tables : per-frame / per-event results to write as parquet (bit-identical for one seed);
-    timing : Table I-like timings (ms, machine-dependent); metrics : the tracking.json content.
+    metrics : the tracking.json content (the same for one seed, on any machine);
+    timing : Table I-like timings (ms); speed : the SR-UKF's step times (ms) and its speed-ups over filterpy and
+    pykalman, with the timing table's means (``subroutine_ms``): machine-dependent, so never in a metrics file
+    (notebook 06 writes them under ``reports/metrics/timing/subroutines/``).
     """
 
     tables: dict[str, pd.DataFrame]
     timing: pd.DataFrame
     metrics: dict
+    speed: dict
 
 
 def call(task: Callable[[], object]) -> object:
@@ -114,11 +118,12 @@ def run_study(params: TrackParams, recording_folder: Path, workers: Workers) -> 
         "ten_metre_jump": ten_metre_jump(sim, params),
         "recording_replay": replay_metrics,
         "pykalman_time_update_max_diff": pykalman_time_update(geometry, params.filter, experiment_rng(params, "pykalman")),
-        "speedup_vs_filterpy": speed["speedup_vs_filterpy"],
-        "speedup_vs_pykalman": speed["speedup_vs_pykalman"],
-        "filter_step_ms": {k: v for k, v in speed.items() if not k.startswith("speedup")},
         "paper": BLACK_RESULTS,
     }
     tables = {**tables, "sigma_sweep": noise_against_lag(no_filter, params, runs), "success": success, **success_frames,
               "sigmas_motion_a": sigmas, "small_blobs": blobs, "multi_tool": multi_tool, "replay_poses": replay}
-    return Study(tables=tables, timing=timing_table(sim, params), metrics=metrics)
+    timing = timing_table(sim, params)
+    speed = {"speedup_vs_filterpy": speed["speedup_vs_filterpy"], "speedup_vs_pykalman": speed["speedup_vs_pykalman"],
+             "filter_step_ms": {k: v for k, v in speed.items() if not k.startswith("speedup")},
+             "subroutine_ms": dict(zip(timing.subroutine, timing.time_ms))}
+    return Study(tables=tables, timing=timing, metrics=metrics, speed=speed)

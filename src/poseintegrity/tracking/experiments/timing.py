@@ -18,11 +18,6 @@ from poseintegrity.tracking.filter.tracker import MarkerTracker
 from poseintegrity.tracking.experiments.filter_runs import experiment_rng
 
 
-TIMING_METRICS = frozenset({"filter_step_ms", "speedup_vs_filterpy", "speedup_vs_pykalman", "timing_ms"})
-
-
-"""The keys of tracking.json that are timings (machine-dependent): everything else is the same for one seed."""
-
 
 def _mean_time_ms(fn, repeats: int) -> float:
     fn()

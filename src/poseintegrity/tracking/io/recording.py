@@ -10,8 +10,9 @@ Folder layout:
 - ``lut_x.npy`` and ``lut_y.npy``: the depth camera's per-pixel unit-plane lookup table as two (H, W) arrays
   (Research Mode's MapImagePointToCameraUnitPlane: pixel (u, v) -> (x, y) on z = 1);
 - optional ``gyro.csv``: columns ``t_s, wx, wy, wz`` (rad/s, body frame of the tool carrying the gyro);
-- ``manifest.json``, written last: a run id, the number of frames, the size of every file of the folder and the
-  SHA-256 of frames.csv and gyro.csv.  :func:`read_recording` checks it, so a folder that mixes the frames of
+- ``manifest.json``, written last: the number of frames, the size of every file of the folder, the SHA-256 of
+  frames.csv and gyro.csv, and a recording id derived from them (the same recording, the same id and the same bytes:
+  no time or random id inside).  :func:`read_recording` checks it, so a folder that mixes the frames of
   two recordings, or whose writing was interrupted, is refused.  A recording from another recorder is sealed,
   once checked by eye, with :func:`write_manifest`.
 Points are expressed in the camera frame (T_world_cam = identity).
@@ -121,20 +122,22 @@ def _folder_files(folder: Path) -> dict[str, int]:
     return {p.relative_to(folder).as_posix(): p.stat().st_size for p in sorted(folder.rglob("*")) if p.is_file() and p.name != MANIFEST}
 
 
-def write_manifest(folder: str | Path, run_id: str | None = None) -> dict:
-    """Seal a recording folder: write manifest.json (run id, frame count, every file's size, SHA-256 of
-    frames.csv and gyro.csv) through a temporary file and a rename, so it is complete or absent.
+def write_manifest(folder: str | Path) -> dict:
+    """Seal a recording folder: write manifest.json (frame count, every file's size, SHA-256 of frames.csv and
+    gyro.csv, and the recording id: the SHA-256 of those, first 16 hex digits) through a temporary file and a
+    rename, so it is complete or absent.
     :class:`RecordingWriter` calls it last; call it on a recording from another recorder once it is checked."""
     folder = Path(folder)
     frames_csv = folder / "frames.csv"
     if not frames_csv.is_file():
         raise RecordingError(f"{folder}: cannot seal a recording without frames.csv")
     n_frames = max(sum(1 for line in frames_csv.read_bytes().splitlines() if line.strip()) - 1, 0)
-    manifest = {
-        "format": MANIFEST_FORMAT, "run_id": run_id or uuid.uuid4().hex, "n_frames": n_frames,
-        "files": _folder_files(folder),
+    content = {
+        "n_frames": n_frames, "files": _folder_files(folder),
         "sha256": {name: _sha256(folder / name) for name in ("frames.csv", "gyro.csv") if (folder / name).is_file()},
     }
+    recording_id = hashlib.sha256(json.dumps(content, sort_keys=True).encode()).hexdigest()[:16]
+    manifest = {"format": MANIFEST_FORMAT, "recording_id": recording_id, **content}
     tmp = folder / (MANIFEST + ".tmp")
     tmp.write_text(json.dumps(manifest, indent=1), encoding="utf-8")
     os.replace(tmp, folder / MANIFEST)
@@ -170,7 +173,8 @@ def check_manifest(folder: Path, n_frames: int) -> dict:
     if expected_frames != n_frames:
         problems.append(f"the manifest counts {expected_frames} frames, frames.csv has {n_frames}")
     if problems:
-        raise RecordingError(f"{folder}: does not match its {MANIFEST} (run {manifest.get('run_id')!r}): " + "; ".join(problems))
+        recording = manifest.get("recording_id", manifest.get("run_id"))  # run_id: a manifest of before ids were derived
+        raise RecordingError(f"{folder}: does not match its {MANIFEST} (recording {recording!r}): " + "; ".join(problems))
     return manifest
 
 
@@ -253,9 +257,9 @@ class RecordingWriter:
             self.lut = check_array("lut", lut, shape=(None, None, 2))
         except ArgumentError as error:
             raise RecordingError(f"{self.folder}: {error}") from None
-        self.run_id = uuid.uuid4().hex
+        self.writer_id = uuid.uuid4().hex  # names this writer's staging folder only, never a file of the recording
         self.folder.parent.mkdir(parents=True, exist_ok=True)
-        self.staging = self.folder.parent / f".{self.folder.name}.writing-{self.run_id}"
+        self.staging = self.folder.parent / f".{self.folder.name}.writing-{self.writer_id}"
         (self.staging / "ir").mkdir(parents=True)
         (self.staging / "depth").mkdir()
         np.save(self.staging / "lut_x.npy", self.lut[..., 0])
@@ -304,8 +308,8 @@ class RecordingWriter:
             table.to_csv(self.staging / "gyro.csv", index=False, float_format="%.17g")
         for name, table in (tables or {}).items():
             table.to_csv(self.staging / name, index=False, float_format="%.17g")
-        write_manifest(self.staging, self.run_id)
-        old = self.folder.parent / f".{self.folder.name}.old-{self.run_id}"
+        write_manifest(self.staging)
+        old = self.folder.parent / f".{self.folder.name}.old-{self.writer_id}"
         if self.folder.exists():
             os.replace(self.folder, old)  # an empty folder, or the recording overwrite=True replaces
         os.replace(self.staging, self.folder)
