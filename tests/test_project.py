@@ -12,7 +12,7 @@ from poseintegrity.stage import notebook_parameter
 from repository import ROOT
 
 NOTEBOOKS = sorted((ROOT / "notebooks").glob("*.ipynb"))
-FIRST_LINE = "params_path, data_dir, reports_dir = project_paths(params_path, data_dir, reports_dir)"
+FIRST_LINE = "params_path, data_dir, reports_dir = stage_paths(params_path, data_dir, reports_dir)"
 
 
 @pytest.fixture

@@ -5,7 +5,8 @@ The stage runner (``dvc repro``, papermill) starts a notebook's kernel in the pr
 ``jupyter nbconvert --execute`` start it in the notebook's own folder, ``notebooks/``. The root is the nearest folder
 holding ``dvc.yaml`` at or above the kernel's folder (the notebook's folder, or the root itself), so a notebook opened
 either way reads and writes the files ``dvc repro`` does. Every pipeline notebook's first cell after its parameters
-calls :func:`project_paths`.
+calls :func:`stage_paths`, which also takes its data folder's lock (:mod:`poseintegrity.workspace_lock`): a notebook
+never writes the files a running ``dvc repro`` writes, nor the other way round.
 """
 
 from __future__ import annotations
@@ -14,6 +15,7 @@ import os
 from pathlib import Path
 
 from poseintegrity.errors import ArgumentError, PoseIntegrityError
+from poseintegrity.workspace_lock import kernel_lock
 
 MARKER = "dvc.yaml"  # the file that makes a folder the project's root
 
@@ -48,3 +50,14 @@ def project_paths(*paths: str | os.PathLike, start: str | Path | None = None) ->
         return paths
     root = project_root(start)
     return tuple(root / path for path in paths)
+
+
+def stage_paths(params_path: str | os.PathLike, data_dir: str | os.PathLike, reports_dir: str | os.PathLike,
+                start: str | Path | None = None) -> tuple[Path, Path, Path]:
+    """A pipeline notebook's three parameters as absolute paths (:func:`project_paths`), with ``data_dir``'s lock
+    shared by this kernel for the rest of its life (:func:`~poseintegrity.workspace_lock.kernel_lock`; nothing to
+    take when the stage runner started it): :class:`~poseintegrity.workspace_lock.WorkspaceBusy` naming the folder
+    while a stage runs on it."""
+    params_path, data_dir, reports_dir = project_paths(params_path, data_dir, reports_dir, start=start)
+    kernel_lock(data_dir)
+    return params_path, data_dir, reports_dir

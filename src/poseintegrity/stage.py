@@ -8,9 +8,12 @@ writes ``<reports>/notebooks/<name>.ipynb`` and ``.html`` and ``<reports>/metric
 (:class:`poseintegrity.timing.StageTiming`). While the notebook runs, everything it prints (the progress lines of
 :mod:`poseintegrity.parallel`, tqdm bars) reaches this terminal as it comes, with one line per cell.
 
-Before any work, the notebook must exist, the ``parallel`` section is validated and a Dask scheduler at
-``parallel.address`` must answer: each fails naming the file or key in one line on stderr, exit status 2, no
-traceback (a failing cell exits with status 1 and the cell's error). The stage's previous outputs are deleted first and the notebook executes into
+Before any work, the notebook must exist, the ``parallel`` section is validated, a Dask scheduler at
+``parallel.address`` must answer and the data folder's lock must be free (no notebook kernel open on it, no other
+stage on it: :mod:`poseintegrity.workspace_lock`; the runner holds it until the stage ends): each fails naming the
+file, key or folder in one line on stderr, exit status 2, no traceback (a failing cell exits with status 1 and the
+cell's error; a full disk, in a cell or in the runner, with one line naming the file or folder and the free space
+left, no traceback). The stage's previous outputs are deleted first and the notebook executes into
 ``<name>.partial.ipynb``, renamed when the HTML is written; the timing file comes last. So an interrupted or
 failed stage leaves nothing that looks complete (the partial notebook shows how far it got).
 """
@@ -38,7 +41,9 @@ from tqdm import tqdm  # noqa: E402
 from poseintegrity.config import ParamsError, load_section  # noqa: E402
 from poseintegrity.parallel import worker_count  # noqa: E402
 from poseintegrity.project import ProjectError, project_root  # noqa: E402
+from poseintegrity.staging import FULL, DiskFullError, disk_full  # noqa: E402
 from poseintegrity.timing import StageTiming, usage_error  # noqa: E402
+from poseintegrity.workspace_lock import WorkspaceBusy, runner_lock  # noqa: E402
 
 KERNEL = "python3"  # the kernelspec `make install` writes into .venv's share/jupyter (kernel_search_path)
 
@@ -127,15 +132,24 @@ def run_stage(notebook: Path, params_path: Path, data_dir: Path, reports_dir: Pa
 
     The wall time runs from ``started`` (epoch s; default: now; the command line passes its process's start, so
     that its own imports count) to the written HTML. Raises ParamsError or ConnectionError before any work, and
-    papermill.PapermillExecutionError when a cell fails."""
+    papermill.PapermillExecutionError when a cell fails, WorkspaceBusy before any work when the data folder's lock
+    is held."""
     start = time.time() if started is None else started
     name = notebook.stem
     kernel_search_path()
     parallel = load_section(params_path, "parallel")
     n_jobs = worker_count(parallel)
+    with runner_lock(data_dir, name):
+        return _run_locked(notebook, params_path, data_dir, reports_dir, start, parallel, n_jobs)
+
+
+def _run_locked(notebook: Path, params_path: Path, data_dir: Path, reports_dir: Path, start: float, parallel,
+                n_jobs: int) -> StageTiming:
+    """:func:`run_stage` once the data folder's lock is held."""
     import papermill
     from nbconvert import HTMLExporter
 
+    name = notebook.stem
     outputs = StageOutputs(reports_dir, name)
     for path in (outputs.notebook, outputs.html, outputs.timing):
         path.unlink(missing_ok=True)
@@ -187,6 +201,17 @@ def _execution_error() -> type[Exception]:
     return PapermillExecutionError
 
 
+def disk_full_in_cell(error, data_dir: Path) -> str | None:
+    """The one line to show for a cell that failed on a full disk (papermill's ``error``: its ``ename``,
+    ``evalue``): our writers' :class:`DiskFullError` names the file; any other ENOSPC (a table or figure written
+    by a library) names the data folder and its free space. None for any other error."""
+    if error.ename == "DiskFullError":
+        return error.evalue
+    if "[Errno 28]" in error.evalue or "No space left on device" in error.evalue:
+        return str(disk_full(data_dir))
+    return None
+
+
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("notebook", type=Path, help="source notebook, e.g. notebooks/02_extract_artifacts.ipynb")
@@ -204,9 +229,17 @@ def main(argv: list[str] | None = None) -> None:
     try:
         record = run_stage(args.notebook, args.params, args.data, args.reports,
                            started=process_start_epoch())
-    except (ParamsError, ConnectionError) as error:
+    except (ParamsError, ConnectionError, WorkspaceBusy) as error:
         sys.exit(usage_error(f"{name}: {error}"))
+    except DiskFullError as error:  # the runner's own writes: the notebook, its HTML, the timing file
+        sys.exit(f"{name} stopped, the disk is full: {error}")
+    except OSError as error:
+        if error.errno not in FULL:
+            raise
+        sys.exit(f"{name} stopped, the disk is full: {disk_full(error.filename or partial, error)}")
     except _execution_error() as error:  # run_stage imported papermill before any cell ran
+        if (full := disk_full_in_cell(error, args.data)) is not None:
+            sys.exit(f"{name} stopped, the disk is full: {full}; the notebook as far as it ran: {partial}")
         sys.exit(f"{error}\n{name} failed; the notebook as far as it ran: {partial}")
     except KeyboardInterrupt:
         sys.exit(f"{name} interrupted; the notebook as far as it ran: {partial}")
