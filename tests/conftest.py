@@ -43,13 +43,13 @@ os.environ.setdefault("MPLBACKEND", "Agg")
 ROOT = Path(__file__).resolve().parents[1]
 TINY_PARAMS = ROOT / "tests" / "params_tiny.yaml"
 
-# The longest modules first, each given whole to one worker (pyproject.toml: --dist loadscope, in this order): stage
-# 06's project, which the recorded run copies and the chain's report reads (run_once), on one worker while the
-# pipeline chain starts on the other; then the recorded `dvc repro` run. The predictor sweep (run_once) next: made at
-# the start, it is ready when test_model_choice.py asks for it, where the worker that asked second sat idle for
-# 2.5 s of the fast tier while the other made it.
-LONGEST_FIRST = ("tests/tracking/test_notebook_06.py", "tests/test_notebooks.py", "tests/recorded/test_dvc_repro.py",
-                 "tests/test_stage.py", "tests/prediction/test_sweeps.py")
+# The longest modules first, each given whole to one worker (pyproject.toml: --dist loadscope, in this order): the
+# fault battery (~10 min of `dvc repro` runs) on one worker; on the other, stage 06's project, which the recorded run
+# copies and the chain's report reads (run_once), then the pipeline chain and the recorded `dvc repro` run. The
+# predictor sweep (run_once) next: made at the start, it is ready when test_model_choice.py asks for it, where the
+# worker that asked second sat idle for 2.5 s of the fast tier while the other made it.
+LONGEST_FIRST = ("tests/test_faults.py", "tests/tracking/test_notebook_06.py", "tests/test_notebooks.py",
+                 "tests/recorded/test_dvc_repro.py", "tests/test_stage.py", "tests/prediction/test_sweeps.py")
 
 
 def pytest_collectstart(collector):
