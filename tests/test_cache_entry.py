@@ -99,17 +99,35 @@ def test_misses_are_counted_per_block_and_described(tmp_path):
     assert result == C.Miss("missing") and counted == {"checked": 1, "missing": 1}
 
 
-def test_an_interrupted_write_keeps_the_old_file_and_leaves_no_staging_file(tmp_path, monkeypatch):
-    path = written(tmp_path)
-    before = path.read_bytes()
+class CutShort(io.RawIOBase):
+    """A file whose writer is interrupted (Ctrl-C, a killed worker's exception) halfway through its first write."""
 
-    def interrupted(stream, **arrays):
-        stream.write(b"PK partial")
+    def __init__(self, stream):
+        self.stream = stream
+
+    def writable(self):
+        return True
+
+    def write(self, data):
+        self.stream.write(data[: len(data) // 2])
+        self.stream.flush()
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(np, "savez", interrupted)
+    def close(self):
+        self.stream.close()
+        super().close()
+
+
+def test_an_interrupted_write_keeps_the_old_file_and_leaves_no_staging_file(tmp_path, monkeypatch):
+    """Interrupted halfway through writing the staging file: the old entry stays, whole, and the staging file goes;
+    the writer leaves a partial file only when its process is killed (removed by the next run: below)."""
+    path = written(tmp_path)
+    before = path.read_bytes()
+    fdopen = os.fdopen
+    monkeypatch.setattr(staging.os, "fdopen", lambda handle, mode: CutShort(fdopen(handle, mode)))
     with pytest.raises(KeyboardInterrupt):
         C.write_entry(path, "k2", ARRAYS)
+    monkeypatch.undo()
     assert path.read_bytes() == before and sorted(p.name for p in tmp_path.iterdir()) == ["entry.npz"]
 
 

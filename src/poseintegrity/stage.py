@@ -39,7 +39,7 @@ import psutil  # noqa: E402
 from tqdm import tqdm  # noqa: E402
 
 from poseintegrity.config import ParamsError, load_section  # noqa: E402
-from poseintegrity.parallel import worker_count  # noqa: E402
+from poseintegrity.parallel import ParallelParams, worker_count  # noqa: E402
 from poseintegrity.project import ProjectError, project_root  # noqa: E402
 from poseintegrity.staging import FULL, DiskFullError, disk_full  # noqa: E402
 from poseintegrity.timing import StageTiming, usage_error  # noqa: E402
@@ -143,8 +143,8 @@ def run_stage(notebook: Path, params_path: Path, data_dir: Path, reports_dir: Pa
         return _run_locked(notebook, params_path, data_dir, reports_dir, start, parallel, n_jobs)
 
 
-def _run_locked(notebook: Path, params_path: Path, data_dir: Path, reports_dir: Path, start: float, parallel,
-                n_jobs: int) -> StageTiming:
+def _run_locked(notebook: Path, params_path: Path, data_dir: Path, reports_dir: Path, start: float,
+                parallel: ParallelParams, n_jobs: int) -> StageTiming:
     """:func:`run_stage` once the data folder's lock is held."""
     import papermill
     from nbconvert import HTMLExporter

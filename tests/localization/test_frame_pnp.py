@@ -125,18 +125,3 @@ def test_a_damaged_file_is_recomputed_not_an_error(tmp_path, frame, extract_para
     assert computed[1:] == [METHODS]
     assert_same(solve(path, frame, extract_params), first)  # rewritten whole
     assert len(computed) == 2
-
-
-def test_an_interrupted_write_leaves_the_old_file_and_no_staging(tmp_path, frame, extract_params, monkeypatch):
-    path = tmp_path / "f.pnp.npz"
-    solve(path, frame, extract_params, methods=("epnp",))
-    before = path.read_bytes()
-
-    def interrupted(stream, **arrays):
-        stream.write(b"PK partial")
-        raise KeyboardInterrupt
-
-    monkeypatch.setattr(np, "savez", interrupted)
-    with pytest.raises(KeyboardInterrupt):
-        solve(path, frame, extract_params)
-    assert path.read_bytes() == before and [p.name for p in tmp_path.iterdir()] == [path.name]
