@@ -119,6 +119,9 @@ def test_sigkill_at_seeded_moments_then_a_rerun_equals_a_clean_run(clean, tmp_pa
         os.killpg(started.pid, signal.SIGKILL)
         started.wait()
         output, _, _ = run([str(DVC), "repro", STAGES], project)
+        print(f"SIGKILL after {delay:.1f} s; the rerun ran:", *[line for line in output.splitlines()
+                                                              if line.startswith(("Running stage", "cache of"))],
+              sep="\n  ")
         assert_as_clean(project, clean)
 
 
@@ -139,6 +142,8 @@ def test_damaged_cache_files_are_recomputed_and_said_so(clean, tmp_path):
     for path in (images / f"{frames[1]}.pnp.npz", images / f"{frames[2]}.evidence.npz"):
         path.write_bytes(damage(path.read_bytes()))
     output, _, _ = run([str(DVC), "repro", STAGES], project)
+    print("damaged caches, the rerun said:", *[line for line in output.splitlines() if line.startswith("cache of")],
+          sep="\n  ")
     assert (f"cache of {images.parent.name}: 3 of " in output
             and "cache files recomputed (3 damaged: cut short or altered)" in output), output[-3000:]
     # the PnP file lost stage 05's entries with its damage: stage 02 rewrote its own (DVC ignores *.pnp.npz, so
@@ -191,6 +196,7 @@ def test_a_full_disk_stops_in_one_line_and_a_rerun_with_space_equals_a_clean_run
     assert (out / "full.rc").read_text().strip() != "0", full[-3000:]
     assert "Traceback" not in full, full[-3000:]
     said = [line for line in full.splitlines() if "the disk is full" in line]
+    print("full disk, the run said:", *said, sep="\n  ")
     assert len(said) == 1 and "free there" in said[0] and str(tmp_path / "mount") in said[0], full[-3000:]
     assert (out / "again.rc").read_text().strip() == "0", (out / "again.log").read_text()[-3000:]
     assert_as_clean(out / "project", clean, same_caches=False)  # stage 05's PnP entries: added by its next run
@@ -224,6 +230,8 @@ def test_runs_side_by_side_are_refused_at_once_and_the_first_run_is_untouched(cl
     assert "Unable to acquire lock" in said or re.search(rf"is being blocked by:\s+\(PID {first.pid}\)", said), said
     notebook = subprocess.run([sys.executable, "-c", NOTEBOOK_KERNEL, str(project / "data")], capture_output=True,
                               text=True, env=environment(), check=True)
+    print("side by side, the second dvc repro said:", said.strip(), "a notebook said:", notebook.stdout.strip(),
+          sep="\n  ")
     assert "a stage of `dvc repro`" in notebook.stdout and "python -m poseintegrity.stage" in notebook.stdout
     rest = first.stdout.read()
     assert first.wait() == 0, "".join(lines) + rest
