@@ -59,7 +59,8 @@ FIXED = {
     # and its AVX2 code (l9) elsewhere, and its magnitude (which SIFT's orientations and descriptors use) starts from
     # vrsqrtps, an approximate instruction whose results differ between Intel and AMD: SIFT descriptors +-1 and
     # other angles in 142 of 645 frames between the two levels on one CPU (traced under qemu, docs/references.md,
-    # "CPU dispatch"). Without IPP, OpenCV runs its own kernels, pinned above; SIFT costs ~7 % more CPU.
+    # "CPU dispatch"). Without IPP, OpenCV runs its own kernels, pinned above, at no measurable cost
+    # (benchmarks/bench_dispatch.py).
     "OPENCV_IPP": "disabled",
 }
 # OpenCV logs "IPP was disabled by OPENCV_IPP" at WARNING level when it loads, in every process; its log level is
