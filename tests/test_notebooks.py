@@ -96,7 +96,7 @@ def test_every_stage_writes_its_metrics_and_the_report_summarises_them(pipeline)
     assert "| RMS position error, no filter (mm) | not run |" not in summary  # stage 06's metrics reached it
     timing = (reports / "timing.md").read_text()  # the machine-dependent figures, on their own page
     assert "| 06_marker_tracking |" in timing and "SR-UKF step speed-up over filterpy" in timing
-    assert "wall time" not in summary and "[timing.md](timing.md)" in summary
+    assert "| wall time (s) |" not in summary and "[timing.md](timing.md)" in summary
 
 
 def test_stage_02_flags_the_spoiled_frames_and_writes_tables_metrics_and_figures(pipeline):
