@@ -11,8 +11,8 @@ output (dvc.lock), and every cache file's bytes. Then, each in a copy of it:
   which files it recomputed and why, and no damaged file survives;
 - a full disk (a small tmpfs in a mount namespace of its own): one line naming the file and the free space, no
   traceback; with space back, a plain ``dvc repro``;
-- a second ``dvc repro`` while one runs (refused at once by DVC's locks: the repository's, or the read-write lock
-  on the files the first run uses), and a notebook kernel opening the same data folder meanwhile (refused by ours);
+- a notebook kernel opening the data folder while a stage runs on it (refused by ours), and the same ``dvc repro``
+  run again meanwhile (refused at once by DVC's read-write lock on the files the first run uses);
 - two experiments queued (``dvc exp run --queue``) and run by two queue workers at once, against the same two run
   one by one.
 """
@@ -213,26 +213,30 @@ NOTEBOOK_KERNEL = textwrap.dedent("""
 
 
 def test_runs_side_by_side_are_refused_at_once_and_the_first_run_is_untouched(clean, tmp_path):
-    """While `dvc repro -f` runs stage 02: a second `dvc repro` is refused at once by DVC's lock, and a notebook
-    kernel opening the same data folder by ours (stage_paths); the first run then ends as a clean run."""
+    """While `dvc repro -f 02_extract_artifacts` runs stage 02: a notebook kernel opening the same data folder is
+    refused by ours (stage_paths), and the same command run again is refused at once by DVC's lock on the files the
+    first run uses (stage 01's outputs, stage 02's inputs); the first run then ends as a clean run. (A second run whose
+    stages share no file with the running one is not refused by DVC: its stage runner then waits for the data
+    folder's lock, workspace_lock, so that no two stages on one data folder ever run at once.)"""
     project = copy_of(clean, tmp_path / "side")
-    first = subprocess.Popen([str(DVC), "repro", "-f", "02_extract_artifacts"], cwd=project, env=environment(),
-                             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    command = [str(DVC), "repro", "-f", "02_extract_artifacts"]
+    first = subprocess.Popen(command, cwd=project, env=environment(), stdout=subprocess.PIPE,
+                             stderr=subprocess.STDOUT, text=True)
     lines = []
     for line in first.stdout:  # until stage 02's kernel runs its cells: the runner holds the data folder
         lines.append(line)
         if line.startswith("[02_extract_artifacts") and " cell " in line:
             break
-    start = time.monotonic()
-    second = subprocess.run([str(DVC), "repro"], cwd=project, env=environment(), capture_output=True, text=True)
-    assert second.returncode != 0 and time.monotonic() - start < 30
-    said = second.stdout + second.stderr  # DVC's lock on the repository, or on the files the first run uses
-    assert "Unable to acquire lock" in said or re.search(rf"is being blocked by:\s+\(PID {first.pid}\)", said), said
     notebook = subprocess.run([sys.executable, "-c", NOTEBOOK_KERNEL, str(project / "data")], capture_output=True,
                               text=True, env=environment(), check=True)
-    print("side by side, the second dvc repro said:", said.strip(), "a notebook said:", notebook.stdout.strip(),
+    start = time.monotonic()
+    second = subprocess.run(command, cwd=project, env=environment(), capture_output=True, text=True)
+    said = second.stdout + second.stderr  # DVC's lock on the repository, or on the files the first run uses
+    print("side by side, a notebook said:", notebook.stdout.strip(), "the second dvc repro said:", said.strip(),
           sep="\n  ")
     assert "a stage of `dvc repro`" in notebook.stdout and "python -m poseintegrity.stage" in notebook.stdout
+    assert second.returncode != 0 and time.monotonic() - start < 30, said
+    assert "Unable to acquire lock" in said or re.search(rf"is being blocked by:\s+\(PID {first.pid}\)", said), said
     rest = first.stdout.read()
     assert first.wait() == 0, "".join(lines) + rest
     assert_as_clean(project, clean)
