@@ -55,12 +55,18 @@ def stage_06_project(folder: Path) -> None:
     run([str(DVC), "repro", "06_marker_tracking"], folder)
 
 
+def environment() -> dict[str, str]:
+    """The environment a command of the tests runs in: a user's PATH (:data:`FOREIGN_PATH`), none of the Makefile's or
+    pytest's settings."""
+    env = {key: value for key, value in os.environ.items()
+           if key not in ("JUPYTER_PATH", "VIRTUAL_ENV") and not key.startswith(("MALLOC_", "PYTEST", "COV_"))}
+    return env | {"PATH": FOREIGN_PATH}
+
+
 def run(argv: list[str], cwd: Path) -> tuple[str, float, float]:
     """(output, wall time s, CPU time s of the command and every process it waited for) of ``argv`` run in ``cwd``
     with the foreign PATH and none of the Makefile's settings; AssertionError with the output when it fails."""
-    env = {key: value for key, value in os.environ.items()
-           if key not in ("JUPYTER_PATH", "VIRTUAL_ENV") and not key.startswith(("MALLOC_", "PYTEST", "COV_"))}
-    env["PATH"] = FOREIGN_PATH
+    env = environment()
     start, before = time.perf_counter(), resource.getrusage(resource.RUSAGE_CHILDREN)
     done = subprocess.run(argv, cwd=cwd, env=env, capture_output=True, text=True)
     after = resource.getrusage(resource.RUSAGE_CHILDREN)

@@ -35,18 +35,11 @@ import pytest
 import yaml
 
 from poseintegrity.cache_entry import MAGIC, TRAILER, Miss, read_whole
-from project_copy import DVC, FOREIGN_PATH, project_copy, run
+from project_copy import DVC, environment, project_copy, run
 
 pytestmark = pytest.mark.pipeline
 STAGES = "05_pnp_variants"  # with the stages before it: 01 (renders) and 02 (every cache)
 RUN_RECORDS = ("reports/notebooks/", "reports/metrics/timing/")  # hold times by nature: not compared
-
-
-def environment() -> dict[str, str]:
-    """The environment :func:`project_copy.run` gives a command (a user's PATH, none of pytest's settings)."""
-    env = {key: value for key, value in os.environ.items()
-           if key not in ("JUPYTER_PATH", "VIRTUAL_ENV") and not key.startswith(("MALLOC_", "PYTEST", "COV_"))}
-    return env | {"PATH": FOREIGN_PATH}
 
 
 def locked_outputs(project: Path) -> dict[str, str]:

@@ -103,7 +103,7 @@ def count(reason: str) -> None:
 
 
 def read_entry(path: Path, key: str) -> dict[str, np.ndarray] | Miss:
-    """The arrays of the cache file ``path`` (without the two of the format) when it is whole and was computed
+    """The arrays of the cache file ``path`` (without its ``__key__``) when it is whole and was computed
     from ``key`` (:func:`stamped`); else a :class:`Miss` naming why, counted (:func:`counting`)."""
     found = read_whole(Path(path), key)
     count("checked")
