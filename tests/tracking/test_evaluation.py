@@ -8,6 +8,7 @@ from poseintegrity.tracking.experiments.filter_runs import (
     FilterRun,
     accuracy_runs,
     agreement_runs,
+    pace_runs,
     experiment_rng,
     filter_agreement,
     study_filter_runs,
@@ -115,8 +116,10 @@ def test_each_filter_run_is_made_once_and_shared_by_the_experiments_that_need_it
     assert sweep_runs(params)[1.0] == accuracy_runs(params)["ukf"]  # the sweep at scale 1 is the accuracy run
     sr, _ = agreement_runs(params)[f"alpha_{params.filter.alpha:g}"]
     assert sr == accuracy_runs(params)["ukf_gyro"] and isinstance(sr, FilterRun)
-    # 5 sigma variants on motion (a), ukf and ukf_gyro, 2 new sweep scales, and 3 new agreement runs
-    assert len(runs) == 5 + 2 + 2 + 3
+    assert set(pace_runs(params).values()) <= set(runs) and {run.recording for run in pace_runs(params).values()} == {"pace"}
+    # 5 sigma variants on motion (a), the published sigmas and ours at the paper's pace, ukf and ukf_gyro, 2 new sweep
+    # scales, and 3 new agreement runs
+    assert len(runs) == 5 + 2 + 2 + 2 + 3
 
 
 def test_small_blob_sweep_and_two_tools_and_jump_on_tiny_params():

@@ -5,7 +5,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from poseintegrity.tracking.experiments.intervals import block_weights, rate_interval, rms_interval
+from poseintegrity.tracking.experiments.filter_runs import experiment_rng
+from poseintegrity.tracking.experiments.intervals import block_weights, lag_interval, mean_rate_interval, rate_interval, rms_interval
+from poseintegrity.tracking.experiments.lag import block_lag_sums, filter_lag_ms, lag_from_ncc, ncc_from_sums, normalized_lag_ms
 from tracking.track_section import TRACK
 
 
@@ -41,3 +43,50 @@ def test_failures_in_one_block_widen_the_interval_as_that_block_is_drawn_or_not(
     low, high = rms_interval(per_axis, "axis_mm", TRACK, "errors")
     point = (np.sqrt(np.mean(np.where(correct, 1.0, 25.0))) + 2.0) / 3  # the mean of the three per-axis RMS
     assert 1.0 <= low < point < high
+
+
+def test_the_mean_rates_interval_is_the_mean_of_recordings_resampled_by_the_same_blocks():
+    """Against the resampling done by hand: each draw's blocks (the draws cluster_weights makes from the experiment's
+    generator) gather every recording's frames of those seconds; each recording's share, then their mean."""
+    params = TRACK.model_copy(update={"evaluation": TRACK.evaluation.model_copy(update={"interval_draws": 300})})
+    rng = np.random.default_rng(5)
+    tables = [_frames(n, correct=rng.random(n) < p) for n, p in ((400, 0.9), (400, 0.7), (330, 0.95))]  # 4, 4 and 3 blocks
+    low, high = mean_rate_interval(tables, params, "mean test")
+    blocks = [np.floor(df.t.to_numpy() / params.evaluation.interval_block_s) for df in tables]
+    names = np.unique(np.concatenate(blocks))
+    drawn = experiment_rng(params, "interval mean test").integers(0, len(names), size=(300, len(names)))
+    means = []
+    for draw in drawn:
+        shares = []
+        for df, block in zip(tables, blocks):
+            picked = np.concatenate([df.correct.to_numpy()[block == names[k]] for k in draw])
+            shares.append(picked.mean())
+        means.append(np.mean(shares))
+    assert [low, high] == pytest.approx(list(np.quantile(means, [0.05, 0.95], method="inverted_cdf")), rel=1e-12)
+    assert low < np.mean([df.correct.mean() for df in tables]) < high
+
+
+def test_block_sums_give_the_lag_and_correlation_of_the_whole_recording():
+    rng = np.random.default_rng(6)
+    t = np.arange(0.0, 23.0, 0.001)
+    signal = np.convolve(rng.standard_normal(len(t)), np.ones(300) / 300, mode="same")
+    delayed = np.interp(t - 0.120, t, signal) + 0.002 * rng.standard_normal(len(t))
+    sums = block_lag_sums(signal, delayed, np.floor(t / 5.0).astype(int), 300)
+    ncc = ncc_from_sums(sums.sum(axis=0))
+    for lag in (0, 77, 120, 299):  # Pearson's correlation of a[:L - lag] and b[lag:], computed directly
+        assert ncc[lag] == pytest.approx(np.corrcoef(signal[: len(t) - lag], delayed[lag:])[0, 1], rel=1e-9)
+    assert lag_from_ncc(ncc) == normalized_lag_ms(t, signal, t, delayed, 300) == 120
+
+
+def test_the_lag_interval_holds_a_known_lag():
+    rng = np.random.default_rng(7)
+    t = np.arange(0.0, 40.0, 0.046)
+    truth = np.cumsum(rng.standard_normal((len(t), 3)), axis=0)  # mm, a random walk per axis
+    no_filter = pd.DataFrame({"t": t, "correct": True, **{c: truth[:, i] for i, c in enumerate(("x_mm", "y_mm", "z_mm"))}})
+    t_fine = np.arange(0.0, 40.0, 0.0025)
+    filtered = pd.DataFrame({"t": t_fine, **{c: np.interp(t_fine - 0.150, t, truth[:, i]) for i, c in enumerate(("x_mm", "y_mm", "z_mm"))}})
+    assert filter_lag_ms(no_filter, filtered, 400) == pytest.approx(150, abs=3)
+    params = TRACK.model_copy(update={"evaluation": TRACK.evaluation.model_copy(update={"interval_draws": 200, "lag_max_ms": 400})})
+    low, high = lag_interval(no_filter, filtered, params, "lag test")
+    assert 140 <= low <= filter_lag_ms(no_filter, filtered, 400) <= high <= 160
+    assert lag_interval(no_filter, filtered.assign(x_mm=np.nan, y_mm=np.nan, z_mm=np.nan), params, "none") == [None, None]

@@ -217,6 +217,16 @@ class HandMotionParams(Section):
     occlusion_s: Seconds  # duration of a brief occlusion, s (uniform)
 
 
+class PaceParams(Section):
+    """Motion (c), the paper's pace: the accuracy recording's motion (``motion``) slowed to the pace the paper's
+    own numbers allow (params.yaml derives it from the published lag and errors):
+    :func:`~poseintegrity.tracking.simulation.pace.paced_motion` sets the OU angular velocity and linear acceleration
+    spreads so that the truth's per-axis RMS rates, averaged over the three axes, are these."""
+
+    euler_rate_rms: float = Field(gt=0, le=ANGULAR_MAX)  # rad/s, RMS rate of each Unity Euler angle (mean over the three)
+    velocity_rms: float = Field(gt=0, le=100)  # m/s, RMS velocity along each position axis (mean over x, y, z); 100 m/s is no hand
+
+
 class EvaluationParams(Section):
     """Section III on our simulation."""
 
@@ -254,6 +264,7 @@ class TrackParams(Section):
     filter: FilterParams
     motion: MotionParams
     hand: HandMotionParams
+    pace: PaceParams
     evaluation: EvaluationParams
 
     @model_validator(mode="after")

@@ -16,6 +16,7 @@ Sub-packages (paper section -> module):
                   loop                  :mod:`.filter.tracker` (+ innovation gate, ours), :mod:`.filter.multi_tool`
     simulation/   II-B  sensor frames   :mod:`.simulation.frames` (AHAT-like IR + depth synthesis, ours)
                   II-F  motion          :mod:`.simulation.motion` (motion (a) paper-like and (b) stress),
+                                        :mod:`.simulation.pace` (motion (c), the paper's pace, from its lag and errors),
                                         :mod:`.simulation.simulate` (a simulated recording through the pipeline)
                   II-F  errors          :mod:`.simulation.errors` (the paper's per-axis / Euler RMS beside norm /
                                         geodesic)
@@ -24,6 +25,7 @@ Sub-packages (paper section -> module):
                                         and hl2ss -> a recording folder), :mod:`.io.tool_files`
     experiments/  III   results         stage 06's experiments, one module each: :mod:`.experiments.accuracy`
                                         (III-A/B, occlusion), :mod:`.experiments.success` (III-C),
+                                        :mod:`.experiments.paper_pace` (III-A at the paper's pace),
                                         :mod:`.experiments.filter_runs`, :mod:`.experiments.lag`,
                                         :mod:`.experiments.timing` (Table I), :mod:`.experiments.robustness` (ours),
                                         :mod:`.experiments.small_blobs` (ours: 8-20 px markers),

@@ -1,6 +1,6 @@
 """The filter runs of section III, each made once over the recordings that need it (:class:`FilterRun`): accuracy
 with and without the gyro, the SR-UKF against the plain UKF, the process-noise sweep, the published sigmas against
-ours. Each experiment draws from its own generator, ``keyed_rng(params.seed, name)``."""
+ours on motion (a) and at the paper's pace. Each experiment draws from its own generator, ``keyed_rng(params.seed, name)``."""
 
 from __future__ import annotations
 
@@ -28,7 +28,8 @@ def experiment_rng(params: TrackParams, name: str) -> np.random.Generator:
 class FilterRun:
     """One run of the tracker over a recording (:func:`~poseintegrity.tracking.simulation.simulate.run_filter`).
 
-    recording : "accuracy" (the accuracy recording) or "hand" (motion (a), 4 markers); settings : the filter's
+    recording : "accuracy" (the accuracy recording), "hand" (motion (a), 4 markers) or "pace" (motion (c), the
+    paper's pace); settings : the filter's
     constants; filter_cls : the filter (SR-UKF of Alg. 5, or the plain UKF it is checked against).  Equal runs
     are equal keys: two experiments that need the same run share one.
     """
@@ -83,9 +84,16 @@ def sigma_runs(params: TrackParams) -> dict[str, FilterRun]:
     return {name: FilterRun("hand", False, settings) for name, settings in sigma_variants(params).items()}
 
 
+def pace_runs(params: TrackParams) -> dict[str, FilterRun]:
+    """The runs of motion (c), the paper's pace (:mod:`~.paper_pace`), UKF without gyro as the paper's accuracy
+    figures: the published sigmas (the claim's row) and ours."""
+    variants = sigma_variants(params)
+    return {name: FilterRun("pace", False, variants[name]) for name in ("published", "ours")}
+
+
 def study_filter_runs(params: TrackParams) -> list[FilterRun]:
     """Every distinct filter run of the study, the long motion (a) runs first (they set the critical path)."""
-    runs = [*sigma_runs(params).values(), *accuracy_runs(params).values(), *sweep_runs(params).values()]
+    runs = [*sigma_runs(params).values(), *pace_runs(params).values(), *accuracy_runs(params).values(), *sweep_runs(params).values()]
     runs += [run for pair in agreement_runs(params).values() for run in pair]
     return list(dict.fromkeys(runs))
 
