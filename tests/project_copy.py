@@ -23,8 +23,8 @@ DVC = Path(sys.executable).parent / "dvc"  # the venv's dvc, as `.venv/bin/dvc r
 
 def project_copy(folder: Path) -> Path:
     """``folder`` made a DVC project: the repository's dvc.yaml, .dvcignore, population/ pipeline and its hazard models,
-    notebooks and src, and tests/params_tiny.yaml as its params.yaml (:func:`write_params` changes it); its DVC cache is its own
-    (.dvc/cache)."""
+    notebooks and src, the plot templates (.dvc/plots), and tests/params_tiny.yaml as its params.yaml
+    (:func:`write_params` changes it); its DVC cache is its own (.dvc/cache)."""
     folder.mkdir(parents=True, exist_ok=True)
     # stage 07 reads the population's lock; stage 04 applies the hazard models the population trained (in git)
     for name in ("dvc.yaml", ".dvcignore", "population/dvc.yaml", "population/dvc.lock", "data/hazard/model.json"):
@@ -34,6 +34,7 @@ def project_copy(folder: Path) -> Path:
         shutil.copytree(ROOT / name, folder / name, ignore=shutil.ignore_patterns("__pycache__", "*.egg-info"))
     (folder / ".dvc").mkdir()  # what `dvc init --no-scm` writes, without a dvc start
     (folder / ".dvc" / "config").write_text("[core]\n    no_scm = True\n")
+    shutil.copytree(ROOT / ".dvc" / "plots", folder / ".dvc" / "plots")  # the templates of dvc.yaml's data plots
     return write_params(folder, {})
 
 

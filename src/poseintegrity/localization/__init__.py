@@ -5,7 +5,8 @@ target_model (M_t, III-B) -> evidence (a frame's checked image, matches and ArUc
 (PnP-RANSAC: USAC and classic variants, the classic iteration budget from poseintegrity.ransac; frame_pnp runs a frame's methods,
 cached) -> poseintegrity.poses (E_t, E_r)
 against the exact pose and the ground_truth (ArUco board) -> frame_artifacts (n_i and friends), realism checks ->
-envelope (theta_a, IV-E). extract runs it over datasets on the workers of poseintegrity.parallel.
+envelope (theta_a, IV-E). extract runs it over datasets on the workers of poseintegrity.parallel; envelope_figures
+draws stage 02's figures of how each envelope ends and of how well the predicted error is calibrated.
 """
 
 import lazy_loader

@@ -3,7 +3,6 @@
     best_table        per predictor, PnP method, trajectory and tolerance: max mean SPL at zero incursion and its
                       operating point (Tables I-III)
     deciding_datasets the datasets that hold an operating point where it is (they incur at the next bolder one)
-    live_trials       the simulated live trials (V-C): next-step supervision at one fixed n_t vs the static baseline
     table_metrics     one world's Tables I-III, Figs. 6-7, fit statuses and tails (the validation world's figures)
     headline_metrics  the keys of ``reports/metrics/predictors.json`` (the main world: table_metrics, LOSO, live)
     rule_metrics      Tables I-III under each failed-frame rule of theta_a
@@ -18,6 +17,7 @@ from poseintegrity.artifact_models import FIT_STATUSES
 from poseintegrity.artifact_models.fitted import OK
 from poseintegrity.prediction.ceiling import ceiling, ceiling_share
 from poseintegrity.prediction.intervals import INTERVAL_METHOD, live_intervals, world_intervals
+from poseintegrity.prediction.live_trials import heldout_interval
 from poseintegrity.prediction.loso import loso_summary
 from poseintegrity.prediction.metrics import (best_operating_point, operating_curves, relative_improvement,
                                                with_metrics)
@@ -61,38 +61,6 @@ def deciding_datasets(table: pd.DataFrame, predictor: str, method: str, trajecto
         return []
     nearest = incurring["operating_point"].max() if high else incurring["operating_point"].min()
     return sorted(incurring.loc[incurring["operating_point"] == nearest, "dataset"].unique().tolist())
-
-
-def live_trials(table: pd.DataFrame, best: pd.DataFrame, predict: PredictParams, protocol: ProtocolParams,
-                predictor: str = "next_step", operating_point: float | None = None) -> pd.DataFrame:
-    """The simulated live trials (V-C): next-step at n_t = live_n_t vs the static baseline at its best size; for
-    ``predictor`` "error_next_step" (ours) at the safety factor ``operating_point``.
-
-    best : :func:`best_table`; the static baseline runs at its largest zero-incursion size on the arcs of
-    ``protocol.pnp_method`` at ``predict.live_tolerance`` (the paper's comparison; NaN rows if it has none).
-    One row per arc dataset of ``protocol.pnp_method`` at ``predict.live_tolerance``: theta_a, the stop angle and
-    its incursion, the share of the actual envelope used (SPL / theta_a), the status of the fits the robot went by,
-    and the same for the static baseline.
-    """
-    rows = table[
-        (table["trajectory"] == "arc") & (table["method"] == protocol.pnp_method)
-        & (table["tolerance"] == predict.live_tolerance)
-    ]  # fmt: skip
-    static_best = best[(best["predictor"] == "static") & (best["trajectory"] == "arc")
-                       & (best["method"] == protocol.pnp_method) & (best["tolerance"] == predict.live_tolerance)]
-    static_size = float(static_best["best_operating_point"].iloc[0]) if len(static_best) else np.nan  # fmt: skip
-    point = predict.live_n_t if operating_point is None else operating_point
-    ours = rows[(rows["predictor"] == predictor) & np.isclose(rows["operating_point"], point)]
-    static = rows[(rows["predictor"] == "static") & np.isclose(rows["operating_point"], static_size)]
-    merged = ours.merge(static[["dataset", "spl", "incursion"]], on="dataset", how="left", suffixes=("", "_static"))
-    return pd.DataFrame(
-        {
-            "dataset": merged["dataset"], "theta_a": merged["theta_a"], "stop_angle": merged["theta_p"],
-            "incursion": merged["incursion"], "share": merged["spl"] / merged["theta_a"],
-            "fit_status": merged["fit_status"], "static_size": static_size,
-            "static_incursion": merged["incursion_static"], "static_share": merged["spl_static"] / merged["theta_a"],
-        }
-    )  # fmt: skip
 
 
 def fit_status_shares(table: pd.DataFrame) -> dict[str, dict]:
@@ -217,13 +185,17 @@ def table_metrics(table: pd.DataFrame, curves: pd.DataFrame, predict: PredictPar
 def headline_metrics(
     table: pd.DataFrame, curves: pd.DataFrame, loso: pd.DataFrame, live: pd.DataFrame, predict: PredictParams,
     protocol: ProtocolParams, error_live: pd.DataFrame | None = None, error_live_k: float = np.nan,
+    heldout_live: pd.DataFrame | None = None,
 ) -> dict:
     """The content of ``reports/metrics/predictors.json``, of the main world: :func:`table_metrics`, and
     loso.<predictor>.<tolerance>.{heldout_incursion_rate, heldout_mean_spl, ceiling_share, ...} at the first target
     rate (the held-out mean SPL's share of the world's ceiling); live.{n_t, incursions, n_trials, envelope_share,
     n_flagged_fits, static_*} (V-C), and live.error_next_step.{k, incursions, n_trials, envelope_share,
-    n_flagged_fits} for ``error_live`` (:func:`live_trials` of "error_next_step" at ``error_live_k``, ours); each with
-    ``interval``, the live trials resampled by scene (:func:`.intervals.live_intervals`, ours)."""
+    n_flagged_fits} for ``error_live`` (:func:`~.live_trials.live_trials` of "error_next_step" at ``error_live_k``,
+    ours); each with ``interval``, the live trials resampled by scene (:func:`.intervals.live_intervals`, ours); and
+    live.heldout.{n_t, static_size (per scene), n_trials, incursions, envelope_share, static_envelope_share,
+    static_incursions, n_flagged_fits, interval} for ``heldout_live`` (:func:`~.live_trials.heldout_live_trials`,
+    every operating point chosen on the other scenes; ours)."""
     metrics = table_metrics(table, curves, predict, protocol)
     metrics["loso"] = loso_summary(loso, predict.loso_target_rates[0])
     for entry in metrics["loso"].values():
@@ -246,6 +218,15 @@ def headline_metrics(
     if error_live is not None:
         metrics["live"]["error_next_step"] = {"k": float(error_live_k), **_live_figures(error_live),
                                               "interval": live_spread("error_next_step", error_live_k)}
+    if heldout_live is not None and len(heldout_live):
+        by_scene = heldout_live.drop_duplicates("scene").set_index("scene")
+        metrics["live"]["heldout"] = {
+            "n_t": by_scene["n_t"].astype(float).to_dict(), "static_size": by_scene["static_size"].astype(float).to_dict(),
+            **_live_figures(heldout_live), "static_incursions": float(heldout_live["static_incursion"].sum()),
+            "static_envelope_share": float(heldout_live["static_share"].mean()),
+            "interval": heldout_interval(heldout_live, predict.intervals.n_draws, predict.intervals.level,
+                                         keyed_rng(predict.seed, "held-out live intervals")),
+        }  # fmt: skip
     return metrics
 
 

@@ -108,42 +108,6 @@ def tail_figure(tails: list[TailFit], n_t_max: int, n_cols: int = 3) -> plt.Figu
     return fig
 
 
-def band_figure(bands: pd.DataFrame, limits: dict[str, dict[str, dict]], level: float) -> plt.Figure:
-    """The SPL vs R_i figure with bands (issue 49), small multiples: a row per world and tolerance, a column per
-    predictor. Each panel: the predictor's max mean SPL at R_i <= r against r (:func:`~poseintegrity.prediction.
-    intervals.rate_bands`; at r = 0, the headline) and its band over scene-resampled draws, beside the static
-    baseline's (grey), the ceiling (mean theta_a, dashed) and the smallest theta_a (dotted), so that each panel reads
-    "by how much, if at all, does it beat one size for all". bands : rows of rate_bands with columns world and
-    tolerance; limits : world -> tolerance -> :func:`~poseintegrity.prediction.ceiling.ceiling` entry."""
-    panels = list(dict.fromkeys(zip(bands["world"], bands["tolerance"])))
-    predictors = [p for p in dict.fromkeys(bands["predictor"]) if p != "static"]
-    fig, axes = plt.subplots(len(panels), len(predictors), figsize=(2.5 * len(predictors), 2.4 * len(panels)),
-                             squeeze=False, sharex=True, sharey="row")
-    for row, (world, tolerance) in enumerate(panels):
-        entry, rows = limits[world][tolerance], bands[(bands["world"] == world) & (bands["tolerance"] == tolerance)]
-        static = rows[rows["predictor"] == "static"]
-        for col, predictor in enumerate(predictors):
-            ax, ours = axes[row, col], rows[rows["predictor"] == predictor]
-            for part, colour in ((static, "0.55"), (ours, "C0")):
-                ax.step(part["incursion_rate"], part["max_mean_spl"], where="post", color=colour, lw=1.5)
-                ax.fill_between(part["incursion_rate"], part["low"], part["high"], step="post", color=colour,
-                                alpha=0.2, lw=0)
-            ax.axhline(entry["mean_theta_a"], color="black", ls="--", lw=1)
-            ax.axhline(entry["min_theta_a"], color="black", ls=":", lw=1)
-            if row == 0:
-                ax.set_title(predictor.replace("_", " "), fontsize=9)
-            if col == 0:
-                ax.set_ylabel(f"{world}, {tolerance}\nmax mean SPL (deg)", fontsize=8)
-            if row == len(panels) - 1:
-                ax.set_xlabel("R_i <= r", fontsize=8)
-            ax.tick_params(labelsize=7)
-    fig.suptitle(f"Max mean SPL at R_i <= r (at r = 0: the headline), blue; static baseline, grey. Bands: {level:.0%} "
-                 f"of draws resampling the scenes, the operating point chosen again in each. Dashed: mean theta_a "
-                 f"(the ceiling); dotted: smallest theta_a", fontsize=9, y=1.0)
-    fig.tight_layout()
-    return fig
-
-
 POINT_KINDS = {"own": "its own point", "main": "the main world's point", "others": "the other worlds' point"}
 
 
