@@ -8,6 +8,7 @@ import pytest
 from poseintegrity import paper_results as paper
 from poseintegrity.report.headlines import HEADLINES, SECTIONS
 from poseintegrity.report.summary import render_summary
+from report_text import report_text
 from repository import ROOT, outside_references
 
 # Rows of Windsor et al.'s tables as printed (system, 2mm/3deg, 4mm/10deg, mean, relative improvement)
@@ -49,9 +50,9 @@ def test_values_nulls_and_missing_stages_are_told_apart():
         "predictors": {"long_range": {"2mm_3deg": {"max_mean_spl_zero_incursion": None},
                                       "4mm_10deg": {"max_mean_spl_zero_incursion": 14.25}}},
     }
-    text = render_summary(metrics)
+    text = report_text(metrics)
     assert "| viewing-angle datasets | 21 | 21 (7 scenes x 3 azimuths) | - |" in text
-    assert "| disk (GB) | 1.473 | - | <= 3 |" in text
+    assert "| disk (GB) | 1.473 | - | <= 3: pass |" in text
     # each tolerance beside the paper's value for that tolerance (Table I), not the mean of both
     assert "| long range (EMG, eq. 1), 2 mm/3 deg: max mean SPL at zero incursion (deg) | none | 12.3 | - |" in text
     assert "| long range (EMG, eq. 1), 4 mm/10 deg: max mean SPL at zero incursion (deg) | 14.25 | 13.5 | - |" in text
@@ -83,7 +84,7 @@ def test_stage_wall_times_say_where_the_tasks_ran_and_stay_out_of_the_summary():
     assert "| Contour detection (ms) | 1.250 | |" in text
     assert "No stage timing yet" in render_timing([], {}, "x") and "has not written its timings" in render_timing([], {}, "x")
     summary = render_summary({"tracking": {"rms_mm": {"ukf": 1.1}}})
-    assert "[timing.md](timing.md)" in summary and "wall time (s)" not in summary and "| SR-UKF step speed-up" not in summary
+    assert "](timing.md)" in summary and "wall time (s)" not in summary and "| SR-UKF step speed-up" not in summary
 
 
 def test_metrics_file_is_valid_json_with_null_for_nan(tmp_path):
@@ -114,8 +115,8 @@ def test_fit_statuses_have_a_row_per_model_and_predictor():
             for s in FIT_STATUSES} <= keys
     metrics = {"fits": {"fit_status": {"emg": {"ok": 0.975, "at_bound": 0.025, "non_physical": 0.0, "fallback": 0.0}}},
                "predictors": {"fit_status": {"next_step": {"non_physical": 0.125}}, "live": {"n_flagged_fits": 2}}}
-    text = render_summary(metrics)
-    assert "| EMG (eq. 1): share of fits ok | 97.5% | - | >= 0.99 |" in text
+    text = report_text(metrics)
+    assert "| EMG (eq. 1): share of fits ok | 97.5% | - | >= 99 %: fail |" in text
     assert "| ... at a bound | 2.5% | - | - |" in text
     assert "| ... non-physical | 12.5% | - | - |" in text  # next step's rows
     assert "| simulated live trials that went by a flagged fit | 2 | - | - |" in text
@@ -130,7 +131,7 @@ def test_free_width_rows_and_tail_counts_stand_beside_the_papers_rows():
                                   "relative_improvement_vs_long_range": 0.125},
         "tails": {"long_range": {"2mm_3deg": {"n_overshooting": 2, "datasets": ["scene_1_arc00", "scene_4_arc17"]}},
                   "long_range_free_width": {"2mm_3deg": {"n_overshooting": 0, "datasets": []}}}}}
-    text = render_summary(metrics)
+    text = report_text(metrics)
     assert "| long range (EMG, eq. 1), 2 mm/3 deg: max mean SPL at zero incursion (deg) | 11 | 12.3 | - |" in text
     assert ("| ours: long range on the free-width EMG, 2 mm/3 deg: max mean SPL at zero incursion (deg) | 12.5 | - | - |"
             in text)
@@ -157,10 +158,10 @@ def test_each_headline_names_the_arcs_that_decide_it_and_how_they_end():
                       "worlds": {"validation": {"envelope_causes": [cause | dict(dataset="v_arc270", cause="estimate",
                                                                                   truth_shift=0.1)]}}},
     }
-    summary = render_summary(metrics)
+    summary = report_text(metrics)
     assert ("| main | 2mm_3deg | long_range | 16.08 | 18 | a_arc090 | 17.77 | 24.50 | translation | resolution | "
             "0.332 | 38.3 |") in summary
     assert "| main | 2mm_3deg | static | 14.50 | 14.5 | none | - |" in summary
     assert ("| validation | 2mm_3deg | next_step | 12.45 | 33 | v_arc270 | 17.77 | 24.50 | translation | "
             "estimate |") in summary
-    assert "Which arcs decide" not in render_summary({"predictors": {"static": {"2mm_3deg": {}}}})
+    assert "Which arcs decide" not in report_text({"predictors": {"static": {"2mm_3deg": {}}}})

@@ -9,9 +9,12 @@ import re
 import pytest
 
 from poseintegrity import paper_results as paper
+from poseintegrity.report.beyond_papers import TITLE as BEYOND
 from poseintegrity.report.claims import RULE, TITLE, interval_grade
 from poseintegrity.report.headline_file import HEADLINE_FILE, headline_metrics
+from poseintegrity.report.stage_pages import render_pages
 from poseintegrity.report.summary import read_metrics, render_summary
+from report_text import report_text
 from repository import ROOT
 from test_report_recorded import RECORDED
 
@@ -76,9 +79,9 @@ FIXTURES = {"committed": COMMITTED, "before issue 49": before_issue_49(COMMITTED
             "issue 38": with_issue_38(OLD)}
 
 
-def section(summary: str) -> list[str]:
-    """The first section's lines, from its heading to the next heading."""
-    start = summary.index(f"## {TITLE}")
+def section(summary: str, title: str = TITLE) -> list[str]:
+    """A section's lines (the first section's by default), from its heading to the next heading."""
+    start = summary.index(f"## {title}")
     return summary[start:].split("\n## ", 1)[0].splitlines()
 
 
@@ -148,8 +151,7 @@ def ends(entry: dict, key: str) -> list:
 
 
 def expectations(m: dict) -> dict[str, tuple[list[list], list, str]]:
-    """claim -> (the values each world's cell shows, the values its why shows, its verdict), from the metrics."""
-    spl = paper.WINDSOR_SPL_ZERO_INCURSION
+    """claim -> (the values each world's cell shows, the values its caveat shows, its verdict), from the metrics."""
     out = {}
 
     def share(stage, predictor, t):
@@ -158,95 +160,92 @@ def expectations(m: dict) -> dict[str, tuple[list[list], list, str]]:
     def weakest(grades):
         return max(range(len(grades)), key=lambda i: (grades[i], -i))
 
-    ceiling = [[x for t in TOLERANCES for x in (get(m, s, f"ceiling.{t}.gain"), get(m, s, f"ceiling.{t}.n_arcs"))]
-               if "ceiling" in m[s] else [] for s, _ in WORLDS]
-    r6r7 = [get(m, "artifacts", f"{p}realism.{k}") for _, p in WORLDS
-            for k in ("min_theta_a_2mm3deg", "arc_theta_a_mean_over_min_2mm3deg")]
-    out["ceiling"] = (ceiling, r6r7, "-")
     for predictor, name in (("long_range", "long range"), ("next_step", "next step")):
         for t in TOLERANCES:
             entries = [get(m, s, f"{predictor}.{t}") for s, _ in WORLDS]
             statics = [get(m, s, f"static.{t}.max_mean_spl_zero_incursion") for s, _ in WORLDS]
-            cells = [[e["max_mean_spl_zero_incursion"], st, e.get("gain"), *ends(e, "gain"), e.get("relative_gain"),
+            cells = [[e.get("relative_gain"), *ends(e, "relative_gain"), e["max_mean_spl_zero_incursion"], st,
                       e["best_n_t"], share(s, predictor, t), *ends(e, "ceiling_share")]
                      for e, st, (s, _) in zip(entries, statics, WORLDS)]
             grades = [2 if e["max_mean_spl_zero_incursion"] is None else grade(e.get("interval", {}).get("gain"))
                       for e in entries]
             w = weakest(grades)
-            arcs, static_arcs = entries[w]["decided_by"], get(m, WORLDS[w][0], f"static.{t}.decided_by")
+            stage = WORLDS[w][0]
+            arcs, static_arcs = entries[w]["decided_by"], get(m, stage, f"static.{t}.decided_by")
             cause = next(c for c in get(m, "artifacts", f"{WORLDS[w][1]}envelope_causes")
                          if c["dataset"] == arcs[0] and c["tolerance"] == t)
-            out[f"{name} over static, {paper.TOLERANCE_LABELS[t]}"] = (
-                cells, [len(arcs), get(m, WORLDS[w][0], f"ceiling.{t}.n_arcs") if "ceiling" in m[WORLDS[w][0]] else None,
-                        entries[w]["best_n_t"], cause["theta_a"], len(static_arcs)], verdict(grades))
+            ceiling = m[stage].get("ceiling", {}).get(t, {})
+            out[f"{paper.TOLERANCE_LABELS[t]}: {name} over static"] = (
+                cells, [ceiling.get("gain"), len(arcs), ceiling.get("n_arcs"), entries[w]["best_n_t"],
+                        cause["theta_a"], len(static_arcs)], verdict(grades))
+    mlp = [[get(m, s, f"mlp.{t}") for t in TOLERANCES] for s, _ in WORLDS]
+    grades = [max(2 if e["max_mean_spl_zero_incursion"] is None else grade(e.get("interval", {}).get("gain"))
+                  for e in world) for world in mlp]
+    out["both tolerances: MLP over static"] = (
+        [[x for e in world for x in (e.get("relative_gain"), *ends(e, "relative_gain"))]
+         + [x for e in world for x in (e.get("ceiling_share"), *ends(e, "ceiling_share"))] for world in mlp],
+        [get(m, WORLDS[weakest(grades)][0], "fit_status.mlp.non_physical")], verdict(grades))
     pair = "long_range vs mlp"
     pairs = [[get(m, s, "intervals")[t]["pairs"][pair] if "intervals" in m[s] else {} for t in TOLERANCES]
              for s, _ in WORLDS]
     grades = [max(grade(p.get("difference")) for p in world) for world in pairs]
     w = weakest(grades)
-    out["MLP"] = ([[get(m, s, f"mlp.{t}.max_mean_spl_zero_incursion") for t in TOLERANCES]
-                   + [x for t in TOLERANCES for x in (share(s, "mlp", t), *ends(get(m, s, f"mlp.{t}"), "ceiling_share"))]
-                   + [get(m, s, "long_range.relative_improvement_vs_mlp")]
-                   + [x for p in world for x in (p.get("point"), *p.get("difference", []))]
-                   for (s, _), world in zip(WORLDS, pairs)],
-                  [get(m, WORLDS[w][0], "fit_status.mlp.non_physical")]
-                  + [x for t in TOLERANCES for x in (*(len(get(m, WORLDS[w][0], f"{p}.{t}.decided_by"))
-                                                       for p in ("long_range", "mlp")),
-                                                     get(m, WORLDS[w][0], f"ceiling.{t}.n_arcs")
-                                                     if "ceiling" in m[WORLDS[w][0]] else None)], verdict(grades))
-    for predictor in OURS:
-        if predictor in m["predictors"]:
-            out[f"ours: {OURS_NAMES.get(predictor, predictor.replace('_', ' '))}"] = (
-                [[x for t in TOLERANCES for x in (get(m, s, f"{predictor}.{t}.max_mean_spl_zero_incursion"),
-                                                   get(m, s, f"{predictor}.{t}.best_k"), share(s, predictor, t),
-                                                   *ends(get(m, s, f"{predictor}.{t}"), "ceiling_share"))]
-                 for s, _ in WORLDS], [], "-")
-    hazard = m["predictors"].get("hazard", {})
-    for predictor in ("hazard_next_step", "hazard_long_range") if hazard.get("trained_on_arcs") else ():
-        cells = []
-        for world in ("main", "validation"):
-            entries = [hazard["worlds"][world][t][predictor] for t in TOLERANCES]
-            cells.append([x for e in entries if "share" in e
-                          for x in (e["share"], *(e["share_interval"]), e["incursion_rate"])])
-        out[f"ours: {predictor.replace('_', ' ')}"] = (cells, [], "-")
+    out["both tolerances: long range over the MLP"] = (
+        [[get(m, s, "long_range.relative_improvement_vs_mlp")]
+         + [x for p in world for x in (p.get("point"), *p.get("difference", []))]
+         for (s, _), world in zip(WORLDS, pairs)],
+        [x for t in TOLERANCES for x in (*(len(get(m, WORLDS[w][0], f"{p}.{t}.decided_by")) for p in ("long_range", "mlp")),
+                                         m[WORLDS[w][0]].get("ceiling", {}).get(t, {}).get("n_arcs"))], verdict(grades))
     lines = [get(m, s, "straight_line") for s, _ in WORLDS]
     grades = [2 if line["long_range_max_mean_spl_zero_incursion"] is None else grade(line.get("interval", {}).get("gain"))
               for line in lines]
     r8 = f"{WORLDS[weakest(grades)][1]}realism.line_x_a_mean_over_min_2mm3deg"
-    out["straight lines"] = ([[line["relative_improvement"], line["long_range_max_mean_spl_zero_incursion"],
-                               line["static_max_mean_spl_zero_incursion"], *ends(line, "gain")] for line in lines],
-                             [lines[weakest(grades)].get("n_lines"), get(m, "artifacts", r8)], verdict(grades))
+    out["2 mm/3 deg: straight lines"] = (
+        [[line["relative_improvement"], *ends(line, "relative_gain"), line["long_range_max_mean_spl_zero_incursion"],
+          line["static_max_mean_spl_zero_incursion"]] for line in lines],
+        [lines[weakest(grades)].get("n_lines"), get(m, "artifacts", r8), 1.4], verdict(grades))
     variants = ("epnp", "p3p", "ap3p")
     pnp = [[get(m, s, f"pnp.{v}") for v in variants] for s, _ in WORLDS]
     grades = [max(2 if e["max_mean_spl_zero_incursion"] is None else grade(e.get("interval", {}).get("gain"))
                   for e in entries) for entries in pnp]
-    out["PnP variants"] = ([[x for e in entries
-                             for x in (e["max_mean_spl_zero_incursion"], e["static_max_mean_spl_zero_incursion"],
-                                       *ends(e, "gain"))]
-                            for entries in pnp],
-                           [get(m, "pnp", f"{WORLDS[weakest(grades)][1]}methods.{v}.failure_rate")
-                            for v in ("usac_magsac", *variants)], verdict(grades))
-    live = m["predictors"]["live"]  # the main world's only: validation.json has none
-    grades = [2 if live["incursions"] else grade(live.get("interval", {}).get("envelope_share_gain"))]
-    out["live trials"] = ([[live["n_t"], live["incursions"], live["n_trials"], live["envelope_share"],
-                            live["static_envelope_share"], *ends(live, "envelope_share_gain")], []],
-                          [m["predictors"]["next_step"][live["tolerance"]]["best_n_t"],
-                           len(m["predictors"]["static"][live["tolerance"]]["decided_by"]),
-                           m["predictors"]["ceiling"][live["tolerance"]]["n_arcs"] if "ceiling" in m["predictors"]
-                           else None], verdict(grades))
+    out["2 mm/3 deg: PnP variants"] = (
+        [[x for e in entries for x in (e["max_mean_spl_zero_incursion"], e["static_max_mean_spl_zero_incursion"],
+                                       *ends(e, "relative_gain"))] for entries in pnp],
+        [get(m, "pnp", f"{WORLDS[weakest(grades)][1]}methods.{v}.failure_rate") for v in ("usac_magsac", *variants)],
+        verdict(grades))
+    held = m["predictors"].get("live", {}).get("heldout")  # the main world's only: validation.json has none
+    if held:
+        grades = [2 if held["incursions"] else grade(held.get("interval", {}).get("envelope_share_gain"))]
+        out["4 mm/10 deg: live trials"] = (
+            [[held["envelope_share"], held["static_envelope_share"], *ends(held, "envelope_share_gain"),
+              held["incursions"], held["n_trials"], min(held["n_t"].values()), max(held["n_t"].values())], []],
+            [paper.WINDSOR_LIVE["n_t"]], verdict(grades))  # the caveat: the paper's n_t
+    else:
+        out["4 mm/10 deg: live trials"] = ([[], []], [], "not applicable")
     rates, black = m["tracking"]["success_rates"], paper.BLACK_RESULTS
     intervals = m["tracking"].get("intervals", {})
-    for n in (4, 3):
-        interval = intervals.get("success_rates", {}).get(f"a_markers{n}")
-        out[f"correct pose, {n} markers"] = ([[rates[f"a_markers{n}"], *(interval or [])], []], [rates[f"b_markers{n}"]],
-                                             verdict([level(interval, black["success_rate"][f"markers{n}"], True)]))
-    mm, deg = m["tracking"]["rms_axis_mm"], m["tracking"]["rms_euler_deg"]
-    mm_interval = intervals.get("rms_axis_mm", {}).get("ukf")
-    deg_interval = intervals.get("rms_euler_deg", {}).get("ukf")
-    out["accuracy"] = ([[mm["ukf"], *(mm_interval or []), deg["ukf"], *(deg_interval or [])], []],
-                       [mm["no_filter"], deg["no_filter"]],
-                       verdict([max(level(mm_interval, black["rms_mm"]["ukf"], False),
-                                    level(deg_interval, black["rms_deg"]["ukf"], False))]))
+    interval = intervals.get("success_rates", {}).get("a_markers4")
+    out["correct pose, 4 markers"] = ([[rates["a_markers4"], *(interval or [])], []], [rates["b_markers4"]],
+                                      verdict([level(interval, black["success_rate"]["markers4"], True)]))
+    if "a_markers3_mean" in rates:
+        interval = intervals.get("success_rates", {}).get("a_markers3_mean")
+        out["correct pose, 3 markers"] = (
+            [[rates["a_markers3_mean"], *(interval or []), rates["a_markers3_drop1"], rates["a_markers3"],
+              rates["a_markers3_drop3"], rates["a_markers3_drop4"]], []], [rates["b_markers3"]],
+            verdict([level(interval, black["success_rate"]["markers3"], True)]))
+    else:
+        out["correct pose, 3 markers"] = ([[], []], [], "not applicable")
+    pace = m["tracking"].get("paper_pace")
+    if pace:
+        published = pace["published"]
+        mm, deg = published["intervals"]["axis_mm"], published["intervals"]["euler_deg"]
+        out["accuracy with the UKF"] = (
+            [[published["axis_mm"], *mm, published["euler_deg"], *deg, published["lag_ms"],
+              *published["intervals"]["lag_ms"]], []],
+            [pace["pace"]["euler_rad_s"]["mean"], pace["pace"]["velocity_mm_s"]["mean"], published["euler_lag_ms"]],
+            verdict([max(level(mm, black["rms_mm"]["ukf"], False), level(deg, black["rms_deg"]["ukf"], False))]))
+    else:
+        out["accuracy with the UKF"] = ([[], []], [], "not applicable")
     return out
 
 
@@ -255,28 +254,56 @@ def test_every_number_of_the_first_section_is_the_metrics_value_and_every_verdic
     metrics = FIXTURES[fixture]
     rows = table(render_summary(metrics))
     expected = expectations(metrics)
-    assert len(rows) == len(expected)  # a row per claim, and issue 38's where the metrics hold them
-    for claim, (cells, why, word) in expected.items():
+    assert len(rows) == len(expected)  # a row per claim, a two-part claim two rows
+    for claim, (cells, caveat, word) in expected.items():
         found = [row for label, row in rows.items() if label.startswith(claim)]
         assert len(found) == 1, f"{claim}: {list(rows)}"
-        paper_cell, *ours, shown_verdict, shown_why = found[0]
+        paper_cell, *ours, shown_verdict, shown_caveat = found[0]
         assert shown_verdict == word, f"{claim}: {shown_verdict}, by the rule {word}"
         for world, (cell, values) in enumerate(zip(ours, cells)):
             assert_shows(cell, values, f"{claim}, world {world}")
-        assert_shows(shown_why, why, f"{claim}, why")
-        assert "](#" in shown_why  # it links to the section below that shows it
+        assert_shows(shown_caveat, caveat, f"{claim}, caveat")
+        assert "](stages/" in shown_caveat  # it links to the stage page that shows it
+
+
+def test_the_data_line_and_the_variants_show_the_metrics_values():
+    """What the data are (bars failed per world, the hardest arc, the ceiling) and our named variants of a claim."""
+    m = COMMITTED
+    lines = section(render_summary(m))
+    data = next(line for line in lines if line.startswith("**The data are rendered"))
+    realism = [get(m, "artifacts", f"{p}realism") for _, p in WORLDS]
+    assert_shows(data, [x for r in realism for x in (r["n_bars"] - r["n_bars_passed"], r["n_bars"])]
+                 + [realism[0]["min_theta_a_2mm3deg"], 7.0, m["predictors"]["ceiling"]["2mm_3deg"]["gain"], 0.99],
+                 "the data line")
+    variants = {row[0]: row[1:] for row in (line.strip("|").split(" | ") for line in lines
+                                            if line.startswith("| [") and "---" not in line)}
+    pace = next(cells for name, cells in variants.items() if "the paper's pace" in name)
+    ours, no_filter = m["tracking"]["paper_pace"]["ours"], m["tracking"]["paper_pace"]["no_filter"]
+    assert_shows(pace[1], [ours["axis_mm"], *ours["intervals"]["axis_mm"], ours["euler_deg"],
+                           *ours["intervals"]["euler_deg"], ours["lag_ms"], no_filter["axis_mm"], no_filter["euler_deg"]],
+                 "our sigmas at the paper's pace")
+    tracking = next(cells for name, cells in variants.items() if "motion (a)" in name)
+    t = m["tracking"]
+    assert_shows(tracking[1], [t["rms_axis_mm"]["ukf"], *t["intervals"]["rms_axis_mm"]["ukf"], t["rms_euler_deg"]["ukf"],
+                               *t["intervals"]["rms_euler_deg"]["ukf"], t["lag_ms"]["ukf"],
+                               t["sigmas_motion_a"]["published"]["axis_mm"], t["sigmas_motion_a"]["published"]["lag_ms"]],
+                 "our sigmas")
+    live = m["predictors"]["live"]
+    fixed = next(cells for name, cells in variants.items() if "paper's n_t" in name)
+    assert_shows(fixed[1], [live["envelope_share"], live["static_envelope_share"],
+                            *live["interval"]["envelope_share_gain"], live["incursions"], live["n_trials"]], "fixed n_t")
 
 
 def test_a_run_without_the_ceiling_says_so():
     rows = table(render_summary(OLD))
-    assert rows[next(c for c in rows if c.startswith("ceiling"))][1:3] == ["not measured", "not measured"]
     assert all("ceiling share not measured" in cell for claim, row in rows.items()
-               if claim.startswith(("long range over", "next step over", "MLP")) for cell in row[1:3])
-    assert not any(claim.startswith("ours") for claim in rows)  # issue 38's predictors: rows only once measured
-    text = render_summary(OLD)
-    assert "(this run's stage 04 wrote no ceiling)" in text and "figures/04_ceiling.png)" not in text
-    assert "![why each envelope ends, per world and tolerance](figures/02_envelope_causes.png)" in text
-    assert "![SPL vs R_i" in render_summary(FIXTURES["issue 38"])  # inline once stage 04 draws it
+               if claim.startswith(("2 mm/3 deg: long", "2 mm/3 deg: next", "4 mm", "both tolerances: MLP"))
+               and "live" not in claim for cell in row[1:3])
+    text = report_text(OLD)
+    assert "of ceiling, k " not in render_summary(OLD)  # our predictors: rows only once measured
+    assert "(this run's stage 04 wrote no ceiling)" in text and "04_ceiling.png)" not in text
+    assert "![why each envelope ends, per world and tolerance](../figures/02_envelope_causes.png)" in text
+    assert "![SPL vs R_i" in report_text(FIXTURES["issue 38"])  # on stage 04's page once it draws it
 
 
 def test_the_rule_word_for_word():
@@ -297,39 +324,40 @@ def test_a_planted_table_whose_verdict_the_interval_flips():
         entry["max_mean_spl_zero_incursion"], entry["gain"] = 20.0, 7.0
         entry["interval"] = dict(entry.get("interval", {}), gain=[0.4, 9.0])
     row = next(cells for claim, cells in table(render_summary(metrics)).items()
-               if claim.startswith("long range over static, 2 mm/3 deg"))
+               if claim.startswith("2 mm/3 deg: long range over static"))
     assert row[-2] == "reproduced"
     metrics["validation"]["long_range"]["2mm_3deg"]["interval"]["gain"] = [-0.4, 9.0]  # one world's interval holds zero
     row = next(cells for claim, cells in table(render_summary(metrics)).items()
-               if claim.startswith("long range over static, 2 mm/3 deg"))
+               if claim.startswith("2 mm/3 deg: long range over static"))
     assert row[-2] == "undecided"
     metrics["validation"]["long_range"]["2mm_3deg"]["interval"]["gain"] = [-3.0, -0.5]  # below zero
     row = next(cells for claim, cells in table(render_summary(metrics)).items()
-               if claim.startswith("long range over static, 2 mm/3 deg"))
+               if claim.startswith("2 mm/3 deg: long range over static"))
     assert row[-2] == "not reproduced"
 
 
 def test_nothing_run_is_not_run_and_no_world_is_not_applicable():
     rows = table(render_summary({}))
-    assert rows and all(row[-2] in ("not applicable", "-") for row in rows.values())
-    assert rows[next(c for c in rows if c.startswith("long range over"))][1] == "not run"
+    assert rows and all(row[-2] == "not applicable" for row in rows.values())
+    assert rows[next(c for c in rows if "long range over static" in c)][1] == "not run"
     no_lines = table(render_summary({"predictors": {"straight_line": {"tolerance": "2mm_3deg"}}}))  # no lines
-    assert no_lines[next(c for c in no_lines if c.startswith("straight"))][-2] == "not applicable"
+    assert no_lines[next(c for c in no_lines if "straight lines" in c)][-2] == "not applicable"
 
 
 @pytest.mark.parametrize("metrics", [COMMITTED, FIXTURES["issue 38"], RECORDED],
                          ids=["rendered", "issue 38", "recorded"])
-def test_the_first_section_is_one_screen_before_any_stage_table(metrics):
+def test_the_summary_is_200_lines_its_first_section_40(metrics):
     summary = render_summary(metrics)
+    assert len(summary.splitlines()) <= 200
     lines = section(summary)
     assert len(lines) <= 40
-    first_table = summary.index("| figure | ours | paper | target |")
-    assert summary.index(f"## {TITLE}") < first_table
     assert summary.index(f"## {TITLE}") < summary.find("## Your recorded data") or "Your recorded" not in summary
     header = next(line for line in lines if line.startswith("| claim"))
     worlds = [cell for cell in header.split(" | ") if cell.startswith("ours: ")]
     expected = ["ours: lab_a", "ours: lab_b"] if metrics is RECORDED else ["ours: main", "ours: validation"]
     assert worlds == expected
+    assert sum(line.startswith("- **") for line in lines) == 5  # the glossary
+    assert not re.search(r"[Ii]ssues? \d", report_text(metrics))  # no issue numbers for the reader
 
 
 def test_the_headline_file_holds_the_headline_of_each_world():
@@ -363,19 +391,27 @@ def test_the_headline_file_holds_the_headline_of_each_world():
 
 
 @pytest.mark.parametrize("metrics", [COMMITTED, RECORDED], ids=["rendered", "recorded"])
-def test_every_link_of_the_first_section_leads_to_a_heading_below_it(metrics):
-    """GitHub's heading links: lower case, punctuation dropped, spaces as hyphens."""
-    summary = render_summary(metrics)
-    headings = {"#" + re.sub(r"[^\w\- ]", "", line.lstrip("#").strip().lower()).replace(" ", "-")
-                for line in summary.splitlines() if line.startswith("## ")}
-    links = set(re.findall(r"\]\((#[^)]+)\)", "\n".join(section(summary))))
-    assert {"#the-rendered-worlds-realism" if metrics is COMMITTED else "#your-datasets-described",
-            "#envelopes-and-why-they-end", "#predictors", "#pnp-variants", "#tracking", "#fits"} == links
-    assert links <= headings
+def test_every_link_of_the_summary_leads_to_a_page_and_a_heading_on_it(metrics):
+    """GitHub's heading links: lower case, punctuation dropped, spaces as hyphens; every page the summary links is one
+    stage 07 writes, every figure one the stages draw."""
+    summary, pages = render_summary(metrics), render_pages(metrics)
+    for target in re.findall(r"\]\(([^)#]*)(#[^)]+)?\)", summary):
+        path, heading = target
+        if path.startswith("figures/"):
+            assert (ROOT / "reports" / path).exists(), path
+            continue
+        text = summary if path == "" else pages.get(path)
+        assert text is not None or path in ("timing.md",), path
+        if heading and text is not None:
+            headings = {"#" + re.sub(r"[^\w\- ]", "", line.lstrip("#").strip().lower()).replace(" ", "-")
+                        for line in text.splitlines() if line.startswith("#")}
+            assert heading in headings, (path, heading)
+    links = set(re.findall(r"\]\((stages/[^)#]+)", "\n".join(section(summary))))
+    assert len(links) >= 5  # the claims' caveats lead to the stage pages
 
 
-def test_the_population_has_a_line_per_predictor_on_the_first_screen():
-    """population.json (issue 49) on the first screen: per predictor and tolerance the median share with its 10-90 %
+def test_the_population_has_a_line_per_predictor_beyond_the_papers():
+    """population.json in the summary's section beyond the papers: per predictor and tolerance the median share with its 10-90 %
     range at its own and at the others' point, the zero-incursion share of worlds, and the paired wins against long
     range (a pair written the other way, "long_range vs mlp", read as the MLP's losses)."""
     across = {t: {p: {"own": {"median_share": 0.3 + i / 100, "share_10_90": [0.1, 0.5]},
@@ -385,7 +421,8 @@ def test_the_population_has_a_line_per_predictor_on_the_first_screen():
                  "error_next_step vs long_range": {"wins": 11, "losses": 1, "ties": 0, "sign_test_p": 0.0063},
                  "long_range vs mlp": {"wins": 10, "losses": 2, "ties": 0, "sign_test_p": 0.039}} for t in TOLERANCES}
     metrics = copy.deepcopy(COMMITTED) | {"population": {"n_worlds": 12, "across": across, "paired": {"own": pairs}}}
-    lines = section(render_summary(metrics))
+    lines = section(render_summary(metrics), BEYOND)
+    lines = lines[next(i for i, line in enumerate(lines) if line.startswith("**On a population")):]
     assert any(line.startswith("**On a population of 12 rendered worlds**") for line in lines)
     rows = {line.split(" | ")[0].strip("| "): line.strip("|").split(" | ")[1:] for line in lines
             if line.startswith("| ") and "own point" not in line and "---" not in line}
@@ -394,6 +431,26 @@ def test_the_population_has_a_line_per_predictor_on_the_first_screen():
     assert_shows(rows["next step"][0], [0.31, 0.1, 0.5], "next step, own point")
     assert_shows(rows["next step"][1], [0.2, 0.4, 0.75], "next step, others' point")  # the low end: none
     assert "long range" in rows and "error long range" not in rows  # a line per predictor the population holds
-    assert len(lines) <= 40
     unrun = {stage: entry for stage, entry in COMMITTED.items() if stage != "population"}
-    assert not any("population" in line for line in section(render_summary(unrun)))  # not run: no lines
+    assert "**On a population" not in render_summary(unrun)  # not run: no lines
+
+
+def test_our_predictors_beyond_the_papers_show_the_metrics_values():
+    """The section on our own predictors: per world and tolerance the share of the ceiling with its interval and k
+    (error predictors), or the share at the population's h with its interval and R_i (hazard predictors)."""
+    m = COMMITTED
+    lines = section(render_summary(m), BEYOND)
+    rows = {line.strip("|").split(" | ")[0].strip(): [c.strip() for c in line.strip("|").split(" | ")[1:]]
+            for line in lines[:next(i for i, line in enumerate(lines) if line.startswith("**On a population"))]
+            if line.startswith("| ") and "---" not in line and not line.startswith("| predictor")}
+    for predictor in OURS:
+        for (stage, _), cell in zip(WORLDS, rows[OURS_NAMES.get(predictor, predictor.replace("_", " "))]):
+            entries = [get(m, stage, f"{predictor}.{t}") for t in TOLERANCES]
+            assert_shows(cell, [x for e in entries for x in (e["ceiling_share"], *ends(e, "ceiling_share"), e["best_k"])],
+                         f"{predictor} on {stage}")
+    hazard = m["predictors"]["hazard"]["worlds"]
+    for predictor in ("hazard_next_step", "hazard_long_range"):
+        for world, cell in zip(("main", "validation"), rows[predictor.replace("_", " ")]):
+            entries = [hazard[world][t][predictor] for t in TOLERANCES]
+            assert_shows(cell, [x for e in entries if "share" in e
+                                for x in (e["share"], *e["share_interval"], e["incursion_rate"])], predictor)

@@ -3,6 +3,7 @@ reach, no rendered-world target is shown, rows of keys a stage that ran did not 
 called "not run"; and which world heads the metrics (poseintegrity.worlds)."""
 
 from poseintegrity.report.summary import render_summary
+from report_text import report_text
 from poseintegrity.worlds import world_order
 
 DATASET = {"world": "lab_a", "trajectory": "arc", "dataset": "knee_01", "n_frames": 40, "n_stops": 20,
@@ -33,6 +34,7 @@ def test_the_summary_of_recorded_data_says_what_was_measured_on_each_dataset():
     assert "| static baseline | 20.5; size 21 |" in section and "| long range (eq. 1) | 25; n_t 23 |" in section
     assert "Held-out world `lab_b`" in section and "| long range (eq. 1) | 0; 12.5 |" in section
     assert "No lines in `lab_a`: no line operating point to apply." in section
+    text = report_text(RECORDED)
     assert "## Stage 01 · rendered robot datasets" not in text  # replaced by the section above
     assert "| weakest decay over arcs: min of -Spearman(theta, mean n_i) | 0.9 | n_i 'decays' with viewing angle | - |" \
         in text  # its rendered-world target (>= 0.8) is not shown
@@ -43,11 +45,11 @@ def test_the_summary_of_recorded_data_says_what_was_measured_on_each_dataset():
 def test_one_world_says_nothing_was_held_out_and_the_rendered_summary_is_unchanged():
     one = RECORDED | {"validation": {"world": None, "chosen_on": "lab_a",
                                      "note": "one world only (lab_a): no second world to apply its operating points to"}}
-    text = render_summary(one)
+    text = report_text(one)
     assert text.count("one world only (lab_a)") == 2  # in the section on the data and as stage 04's held-out part
     assert "No straight lines in this world: Fig. 7 has nothing to show." in text  # lab_a: one arc
-    rendered = render_summary({"generate": {"disk_gb": 1.4731}})
-    assert "Your recorded data" not in rendered and "| disk (GB) | 1.473 | - | <= 3 |" in rendered
+    rendered = report_text({"generate": {"disk_gb": 1.4731}})
+    assert "Your recorded data" not in rendered and "| disk (GB) | 1.473 | - | <= 3: pass |" in rendered
 
 
 def test_main_heads_then_validation_then_the_others_by_name():

@@ -103,7 +103,7 @@ def test_the_summary_says_what_was_measured_and_judges_no_rendered_world(recorde
             if cell.startswith("ours: ")} == worlds
     headline = json.loads((copy / "reports/metrics/headline.json").read_text())
     assert set(headline) - {"tracking"} <= worlds and "a_markers4" in headline["tracking"]
-    headlines = summary.split("## Machine-dependent figures")[0]  # the tables "figure | ours | paper | target"
+    headlines = "\n".join(page.read_text() for page in (copy / "reports/stages").glob("*.md"))  # the stages' tables
     rows = [line.split("|") for line in headlines.splitlines() if line.startswith("| ") and line.count("|") == 5]
     assert rows and all(cells[4].strip() in ("-", "---", "target") for cells in rows)  # no rendered-world target
     artifacts = json.loads((copy / "reports/metrics/artifacts.json").read_text())
@@ -132,7 +132,7 @@ def test_both_kinds_of_ground_truth_are_measured_and_nothing_is_judged_as_a_worl
     assert recorded_worlds(data) == {"lab_a", "lab_b", "recorded"} and not (data / "calibration" / "recorded").exists()
     realism = json.loads((copy / "reports" / "metrics" / "artifacts.json").read_text())["realism"]
     assert "passed" not in realism and "recorded data" in realism["description_only"]  # described, not judged
-    assert "Realism bars: recorded data" in (copy / "reports" / "summary.md").read_text()
+    assert "Realism bars: recorded data" in (copy / "reports" / "stages" / "01_generate_datasets.md").read_text()
 
 
 def test_a_robot_log_is_what_the_robot_observes_and_calibrates_the_error_predictor(recorded_project):

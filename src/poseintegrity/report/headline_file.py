@@ -12,7 +12,8 @@ R11 (what the board's ground truth adds to E_t and E_r, 99th percentile); the tr
 from __future__ import annotations
 
 from poseintegrity import paper_results as paper
-from poseintegrity.report.claims import OURS, metric_worlds
+from poseintegrity.report.beyond_papers import ERROR as OURS
+from poseintegrity.report.claims import metric_worlds
 from poseintegrity.report.lookup import MISSING, lookup
 
 HEADLINE_FILE = "headline.json"

@@ -19,6 +19,8 @@ class Headline:
     target: str = "-"
     fmt: str = "{:.4g}"  # how a float is shown, e.g. "{:+.1%}" for a relative improvement
     section: str | None = None  # the SECTIONS entry it is shown in, when not its stage's (e.g. a world's bars)
+    judged_by: str | None = None  # the key of the stage's own pass/fail of the target (report/targets.py)
+    why: str = ""  # what the reader needs beside the target's pass or fail
 
     @property
     def shown_in(self) -> str:
@@ -76,7 +78,7 @@ def _fit_status_rows() -> list[Headline]:
         for status, label in FIT_STATUS_LABELS.items():
             rows.append(Headline("fits", f"fit_status.{model}.{status}",
                                  f"{name}: share of fits {label}" if status == "ok" else f"... {label}",
-                                 target=">= 0.99" if (model, status) == ("emg", "ok") else "-", fmt="{:.1%}"))
+                                 target=">= 99 %" if (model, status) == ("emg", "ok") else "-", fmt="{:.1%}"))
     return rows
 
 
@@ -167,7 +169,7 @@ def _ceiling_rows(stage: str) -> list[Headline]:
     for tolerance in paper.TOLERANCES:
         label, key = paper.TOLERANCE_LABELS[tolerance], f"ceiling.{tolerance}"
         rows += [
-            Headline(stage, f"{key}.gain", f"ceiling, {label}: the arcs' mean theta_a / smallest - 1 (issue 38)",
+            Headline(stage, f"{key}.gain", f"ceiling, {label}: the arcs' mean theta_a / smallest - 1",
                      f">= {spl['next_step'][tolerance] / spl['static'][tolerance] - 1:+.0%} (next step over static)",
                      fmt="{:+.1%}"),
             Headline(stage, f"{key}.n_arcs", "... arcs"),
@@ -221,7 +223,10 @@ def _calibration_rows(world: str) -> list[Headline]:
         label, key = paper.TOLERANCE_LABELS[tolerance], f"error_prediction.{world}.{tolerance}"
         rows += [
             Headline("artifacts", f"{key}.within_2sigma_t", f"predicted error, {world} world, frames before theta_a "
-                     f"({label}): measured E_t within 2 predicted sigma", target=">= 0.9 (else explained)",
+                     f"({label}): measured E_t within 2 predicted sigma", target=">= 90 %",
+                     why="the median measured / predicted E_t is near 1 (rows below), so the scale is right, but the "
+                     "tails are heavier than a Gaussian's; the error predictors' safety factor k (1.4-3.5, chosen at "
+                     "zero incursion) absorbs them",
                      fmt="{:.0%}", section="predictors"),
             Headline("artifacts", f"{key}.within_1sigma_t", "... within 1 sigma (a Gaussian: 61-68 %)", fmt="{:.0%}",
                      section="predictors"),
@@ -383,7 +388,7 @@ def _world_rows() -> list[Headline]:
     realism = "worlds.validation.realism"
     return [
         Headline("artifacts", f"{realism}.n_bars_passed", "validation world: realism bars passed (nothing tuned on "
-                 "them; R6 and R7 are comparisons, not bars)"),
+                 "them; R7 is a comparison, not a bar)"),
         Headline("artifacts", f"{realism}.n_bars", "... realism bars"),
         *_comparison_rows(realism, "validation world: "),
         *_truth_rows("artifacts", realism, "ground_truth", "validation"),
@@ -392,13 +397,15 @@ def _world_rows() -> list[Headline]:
 
 
 def _comparison_rows(realism: str, at: str = "") -> list[Headline]:
-    """R6 and R7 (artifacts.json ``<realism>``): the hardest arc and the arcs' spread beside the paper's lab, no bar.
-    A real handheld sequence gave 15.1 deg and 1.46, like our main world, a held-out rendered world 11.3 and 2.06
-    (issue 41): the spread belongs to the lab, not to the method; the ceiling share compares predictors across
-    worlds (report/claims.py)."""
+    """R6 and R7 (artifacts.json ``<realism>``): the hardest arc and the arcs' spread beside the paper's lab. R6 keeps
+    the bar of realism.passed.min_theta_a (an envelope short enough for static to be beaten); R7 is a comparison alone.
+    A real handheld sequence gave 15.1 deg and 1.46, like our main world, a held-out rendered world 11.3 and 2.06: the
+    spread belongs to the lab, not to the method; the ceiling share compares predictors across worlds
+    (report/claims.py)."""
     return [
-        Headline("artifacts", f"{realism}.min_theta_a_2mm3deg", f"{at}R6, a comparison with the paper's lab (no bar): "
-                 "smallest arc theta_a, 2 mm/3 deg (deg)", "7.0 (static baseline at zero incursion)"),
+        Headline("artifacts", f"{realism}.min_theta_a_2mm3deg", f"{at}R6: smallest arc theta_a, 2 mm/3 deg (deg)",
+                 "7.0 (static baseline at zero incursion)", "<= 12", judged_by=f"{realism}.passed.min_theta_a",
+                 why="static reaches about the smallest theta_a, so a larger one caps every predictor's gain"),
         Headline("artifacts", f"{realism}.arc_theta_a_mean_over_min_2mm3deg", f"{at}R7, a comparison (no bar): arcs' "
                  "mean theta_a / smallest, 2 mm/3 deg", ">= 2 (next step's 13.9-14.4 over static's 7.0)"),
     ]
@@ -424,6 +431,43 @@ def _exact_pose_rows(stage: str) -> list[Headline]:
 
 BLACK = paper.BLACK_RESULTS  # Black and Salcudean, section III
 
+
+def _removal_rows() -> list[Headline]:
+    """The 3-marker rate on motion (a) with each of the four markers removed and their mean (the claim's figure: the
+    paper does not say which it removed), each with its interval over 5-s blocks."""
+    removals = {"a_markers3_drop1": "m1", "a_markers3": "m2 (track.drop_marker)", "a_markers3_drop3": "m3",
+                "a_markers3_drop4": "m4", "a_markers3_mean": "mean of the four removals"}
+    rows = []
+    for key, name in removals.items():
+        rows += [Headline("tracking", f"success_rates.{key}", f"correct pose, 3 markers, motion (a), {name} removed"
+                          if "mean" not in name else f"correct pose, 3 markers, motion (a), {name}",
+                          f"{BLACK['success_rate']['markers3']:.2%}" if "mean" in name else "-", fmt="{:.2%}"),
+                 Headline("tracking", f"intervals.success_rates.{key}", "... its 90 % interval", fmt="{:.2%}")]
+    return rows
+
+
+def _pace_rows() -> list[Headline]:
+    """Motion (c), at the pace the paper's lag and errors imply (tracking.json ``paper_pace``): the truth's rates, and
+    per run the paper's two errors with their intervals, the position's lag and the orientation's."""
+    at = "paper_pace"
+    rows = [Headline("tracking", f"{at}.pace.euler_rad_s.mean", "motion (c), the paper's pace: the truth's RMS Euler "
+                     "rate, mean of the three angles (rad/s)", "0.132 (1.51 deg / 199.5 ms)"),
+            Headline("tracking", f"{at}.pace.velocity_mm_s.mean", "... its RMS velocity, mean of the three axes (mm/s)",
+                     "8.87 (1.77 mm / 199.5 ms)")]
+    for run, name, theirs in (("published", "published sigmas", True), ("ours", "our sigmas", False),
+                              ("no_filter", "no filter", False)):
+        rows += [Headline("tracking", f"{at}.{run}.axis_mm", f"motion (c), {name}: RMS position error per axis (mm)",
+                          f"{BLACK['rms_mm']['ukf']:g}" if theirs else "-"),
+                 Headline("tracking", f"{at}.{run}.intervals.axis_mm", "... its 90 % interval (mm)"),
+                 Headline("tracking", f"{at}.{run}.euler_deg", "... RMS Euler-angle error (deg)",
+                          f"{BLACK['rms_deg']['ukf']:g}" if theirs else "-"),
+                 Headline("tracking", f"{at}.{run}.intervals.euler_deg", "... its 90 % interval (deg)")]
+        if run != "no_filter":
+            rows += [Headline("tracking", f"{at}.{run}.lag_ms", "... lag of the position behind the no-filter chain "
+                              "(ms)", f"{BLACK['lag_ms']:g}" if theirs else "-"),
+                     Headline("tracking", f"{at}.{run}.euler_lag_ms", "... lag of the orientation (ms)")]
+    return rows
+
 HEADLINES: list[Headline] = [
     Headline("generate", "n_viewing_angle_datasets", "viewing-angle datasets", "21 (7 scenes x 3 azimuths)"),
     Headline("generate", "n_straight_line_datasets", "straight-line datasets", "4"),
@@ -433,7 +477,7 @@ HEADLINES: list[Headline] = [
     Headline("generate", "clahe_keypoint_gain_bone", "SIFT keypoints on bone targets, CLAHE / raw",
              "CLAHE used 'to improve feature detection on low texture bone phantoms'"),
     Headline("generate", "calibration.rms_px", "camera calibration (ChArUco, rendered): reprojection RMS (px)", "-",
-             "<= generate.calibration.max_rms_px"),
+             "<= 0.5 (generate.calibration.max_rms_px)"),
     Headline("generate", "calibration.fx_error_pct", "... its focal length error (%)"),
     Headline("generate", "calibration.principal_point_error_px", "... its principal point error (px)"),
     Headline("generate", "calibration.ray_error_px_max", "... largest ray error over the image (px)"),
@@ -451,49 +495,58 @@ HEADLINES: list[Headline] = [
              fmt="{:.0%}", section="ground_truth"),
     Headline("generate", "disk_gb", "disk (GB)", "-", "<= 3"),
     Headline("artifacts", "realism.min_abs_spearman", "weakest decay over arcs: min of -Spearman(theta, mean n_i)",
-             "n_i 'decays' with viewing angle", ">= 0.8"),
+             "n_i 'decays' with viewing angle", ">= 0.8",
+             judged_by="realism.passed.spearman"),
     Headline("artifacts", "realism.min_abs_spearman_to_failure",
              "... over the stops up to theta_a (4 mm/10 deg) only, a diagnostic: the floor after failure is noise"),
     Headline("artifacts", "realism.min_first_stop_mean_inliers", "smallest mean n_i at the first stop", "-",
-             ">= 50"),
+             ">= 50", judged_by="realism.passed.first_stop_inliers"),
     Headline("artifacts", "realism.error_ratio_low_vs_high_inliers",
-             "median E_t: frames with n_i < 15 over frames with n_i > 50", "error blows up at low n_i", ">= 3"),
+             "median E_t: frames with n_i < 15 over frames with n_i > 50", "error blows up at low n_i", ">= 3",
+             judged_by="realism.passed.error_ratio"),
     Headline("artifacts", "realism.n_uncensored_4mm10deg", "arcs whose envelope ends inside the arc, 4 mm/10 deg",
-             "-", ">= 18 of 21"),
+             "-", ">= 18 of 21 (in proportion to the arcs)", judged_by="realism.passed.uncensored"),
     Headline("artifacts", "realism.cv_theta_a_2mm3deg", "coefficient of variation of theta_a, 2 mm/3 deg", "-",
-             ">= 0.25"),
+             ">= 0.25", judged_by="realism.passed.cv_theta_a"),
     Headline("artifacts", "realism.median_inliers_at_theta_a_4mm10deg",
              "median mean n_i at theta_a, 4 mm/10 deg (failure by running out of inliers)",
-             "12-28 (n_t at zero incursion, Table III)", "<= 30; R4: 10-35"),
+             "12-28 (n_t at zero incursion, Table III)", "<= 30", judged_by="realism.passed.inliers_at_failure",
+             why="R4 asks 10-35 of it too (R4's row)"),
     Headline("artifacts", "realism.emg_rmse_ratio",
              "R1: EMG mean RMSE from 4 stops / best other least-squares base function's (arcs)",
-             "EMG lowest (Fig. 2)", "<= 1.10"),
+             "EMG lowest (Fig. 2)", "<= 1.10", judged_by="realism.passed.r1_emg_near_best"),
     Headline("artifacts", "realism.n_theta_a_2mm3deg_within_sampling",
              "R2: arcs failing at 2 mm/3 deg within the 4 sampled stops (<= 6.75 deg)",
-             "4 stops 'only drawn from within the localization envelope' (IV-A)", "0"),
+             "4 stops 'only drawn from within the localization envelope' (IV-A)",
+             "0, and the smallest theta_a <= 12 deg", judged_by="realism.passed.r2_envelopes_beyond_sampling",
+             why="R2 asks both: the 4 stops inside every envelope, and some envelope short enough to test it (R6)"),
     Headline("artifacts", "realism.median_theta_a_gap", "R3: median theta_a(4 mm/10 deg) - theta_a(2 mm/3 deg) (deg)",
-             "static 7.0 at both tolerances", "<= 4.5"),
+             "static 7.0 at both tolerances", "<= 4.5", judged_by="realism.passed.r3_abrupt_failure"),
     Headline("artifacts", "realism.median_inliers_at_theta_a_2mm3deg", "R4: median mean n_i at theta_a, 2 mm/3 deg",
-             "n_t 12-23 at zero incursion", "10-35"),
+             "n_t 12-23 at zero incursion", "10-35, and 10-35 at 4 mm/10 deg, and both rows below",
+             judged_by="realism.passed.r4_inliers_at_failure",
+             why="one bar: both tolerances' medians 10-35, both 90th percentiles <= 50"),
     Headline("artifacts", "realism.p90_inliers_at_theta_a_2mm3deg", "R4: 90th percentile of n_i at theta_a, "
              "2 mm/3 deg", "-", "<= 50"),
     Headline("artifacts", "realism.p90_inliers_at_theta_a_4mm10deg", "R4: 90th percentile of n_i at theta_a, "
              "4 mm/10 deg", "-", "<= 50"),
     Headline("artifacts", "realism.median_decay_ratio_arc", "R5: median mean n_i at the 4th stop / first stop, arcs",
-             "4 stops suffice to fit the decay", "<= 0.75"),
+             "4 stops suffice to fit the decay", "<= 0.75, and the lines' row below",
+             judged_by="realism.passed.r5_early_decay"),
     Headline("artifacts", "realism.median_decay_ratio_line", "R5: the same on straight lines",
-             "'begins to decay later' (V-A)", "> arcs"),
+             "'begins to decay later' (V-A)", "> the arcs' (R5's row)", judged_by="realism.passed.r5_early_decay"),
     *_comparison_rows("realism"),
     Headline("artifacts", "realism.line_x_a_mean_over_min_2mm3deg", "R8: lines' mean x_a / smallest, 2 mm/3 deg",
-             "+46.2 % for the line predictor", ">= 1.4"),
+             "+46.2 % for the line predictor", ">= 1.4", judged_by="realism.passed.r8_line_spread"),
     Headline("artifacts", "realism.median_E_t_mm_first_stops",
              "R9: median E_t vs the ArUco ground truth, frames with a pose, sampled stops (mm)",
-             "2 mm/3 deg 'the accuracy limit of our pose estimation pipeline'", "0.3-1.5"),
+             "2 mm/3 deg 'the accuracy limit of our pose estimation pipeline'", "0.3-1.5",
+             judged_by="realism.passed.r9_pipeline_accuracy"),
     Headline("artifacts", "realism.share_theta_a_on_stop_2mm3deg",
              "R10: uncensored arcs whose theta_a lies within 0.01 deg of a stop", "interpolated between stops (IV-E)",
-             "<= 0.5", fmt="{:.0%}"),
-    Headline("artifacts", "realism.n_bars_passed", "realism bars passed (of realism.n_bars, artifacts.json; R6 and R7 "
-             "are comparisons, not bars)"),
+             "<= 50 %", fmt="{:.0%}", judged_by="realism.passed.r10_interpolated"),
+    Headline("artifacts", "realism.n_bars_passed", "realism bars passed (each a row above with its target; R7 is a "
+             "comparison, not a bar)"),
     Headline("artifacts", "realism.n_bars", "... realism bars"),
     *_truth_rows("artifacts", "realism", "ground_truth"),
     *_cause_rows("artifacts", "", "envelopes"),
@@ -546,8 +599,8 @@ HEADLINES: list[Headline] = [
     Headline("tracking", "rms_deg.ukf_gyro", "RMS geodesic rotation error, UKF + gyro (deg; ours)"),
     Headline("tracking", "success_rates.a_markers4", "correct pose, 4 markers, motion (a) paper-like",
              f"{BLACK['success_rate']['markers4']:.2%}", fmt="{:.2%}"),
-    Headline("tracking", "success_rates.a_markers3", "correct pose, 3 markers, motion (a) paper-like",
-             f"{BLACK['success_rate']['markers3']:.2%}", fmt="{:.2%}"),
+    *_removal_rows(),
+    *_pace_rows(),
     Headline("tracking", "success_rates.b_markers4", "correct pose, 4 markers, motion (b) stress test", fmt="{:.2%}"),
     Headline("tracking", "success_rates.b_markers3", "correct pose, 3 markers, motion (b) stress test", fmt="{:.2%}"),
     Headline("tracking", "success_rates.b_markers4_no_split", "correct pose, 4 markers, motion (b), touching blobs not split", fmt="{:.2%}"),

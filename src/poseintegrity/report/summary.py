@@ -1,14 +1,11 @@
-"""``reports/summary.md``: what held of the papers' claims, then every stage's headline figures beside the papers'.
+"""``reports/summary.md``: what held of the two papers' claims, in at most 200 lines, and the links to the rest.
 
-It opens with one screen (:func:`~poseintegrity.report.claims.claims_section`): each claim, ours per world, each
-predictor's share of the ceiling, a verdict and why. The sections below follow the questions a reader asks next
-(:data:`~poseintegrity.report.headlines.SECTIONS`): the predictors, the envelopes and why they end, the fits, the PnP
-variants, the tracking, the rendered world's realism, the ground truth; then a link to the machine-dependent figures
-(wall times, speed-ups: :mod:`~poseintegrity.report.timing_page`), which the summary never holds, so that two runs
-write the same summary on any machine. Each stage writes
-``reports/metrics/<stage>.json``; :data:`~poseintegrity.report.headlines.HEADLINES` says which keys are headline
-figures, what the papers reported for them and the project's target where there is one. A stage that has not run
-yet shows "not run", a key its metrics lack "not measured", rather than a stale or invented number.
+It opens with one screen (:func:`~poseintegrity.report.claims.claims_section`): what the data are, five words, each
+claim judged as the paper measured it on each world, and our named variants. Then the papers' figures we reproduce,
+each group under the claims it shows; our own predictors and the population (report/beyond_papers.py); the targets
+that fail; and a link to each stage's page (:mod:`~poseintegrity.report.stage_pages`), which holds every headline
+figure beside the papers' and every target judged. Wall times and speed-ups are on their own page
+(:mod:`~poseintegrity.report.timing_page`), so that two runs write the same summary on any machine.
 """
 
 from __future__ import annotations
@@ -16,12 +13,13 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from poseintegrity.report.claims import claims_section
-from poseintegrity.report.deciding import deciding_section
+from poseintegrity.report.beyond_papers import beyond_section
+from poseintegrity.report.claims import claims_section, metric_worlds
 from poseintegrity.report.headline_file import HEADLINE_FILE
-from poseintegrity.report.headlines import HEADLINES, SECTIONS, section_heading
-from poseintegrity.report.lookup import MISSING, absent, lookup
+from poseintegrity.report.headlines import HEADLINES
+from poseintegrity.report.lookup import absent
 from poseintegrity.report.recorded import recorded_section, recorded_source
+from poseintegrity.report.stage_pages import PAGES, page_path, row_judgement, section_page, shown
 from poseintegrity.report.timing_page import TIMING_PAGE
 
 
@@ -32,102 +30,67 @@ def read_metrics(metrics_dir: Path) -> dict[str, dict]:
             if p.name != HEADLINE_FILE}
 
 
-def _fmt(value, fmt: str = "{:.4g}", missing: str = "not run") -> str:
-    if value is MISSING:
-        return missing
-    if value is None:
-        return "none"
-    if isinstance(value, float):
-        return fmt.format(value)
-    if isinstance(value, list):
-        return ", ".join(str(item) for item in value) or "none"
-    return str(value)
+# The papers' figures we reproduce, beside the claims they show: (heading, the stage whose metrics say it ran, its
+# figures as (path under reports/, what it shows))
+PAPER_FIGURES = [
+    ("Long range and next step over static (Windsor et al. Tables I-III, Figs. 5 and 8)", "predictors",
+     [("figures/04_fig5_long_range.png", "Fig. 5: mean SPL vs R_i of long range, the MLP and static"),
+      ("figures/04_fig8_next_step.png", "Fig. 8: mean SPL vs R_i of next step and static")]),
+    ("The MLP and the artifact model (Windsor et al. Table I, Fig. 2)", "fits",
+     [("figures/03_fig2_mean_rmse.png", "Fig. 2: mean RMSE of each artifact model from the first 4 stops")]),
+    ("Straight lines and PnP variants (Windsor et al. Figs. 7 and 6)", "predictors",
+     [("figures/04_fig7_straight_line.png", "Fig. 7: mean SPL vs R_i on the straight lines (mm)"),
+      ("figures/04_fig6_pnp.png", "Fig. 6: long range and static on each PnP variant")]),
+    ("Marker tracking (Black and Salcudean III, Figs. 5-9)", "tracking",
+     [("figures/06_errors.png", "Figs. 4-5: errors without and with the UKF against ground truth"),
+      ("figures/06_noise_vs_lag.png", "Figs. 6, 9: noise against lag as the sigmas scale"),
+      ("figures/06_success_rate.png", "Fig. 7: the share of frames with the correct pose"),
+      ("figures/06_occlusion.png", "Fig. 8: orientation through an occlusion, with and without the gyroscope")]),
+]
 
 
-def figure(path: str, text: str) -> list[str]:
-    """A figure inline: a Markdown image relative to ``reports/summary.md``."""
-    return [f"![{text}]({path})", ""]
-
-
-def _predictor_figures(metrics: dict[str, dict]) -> list[str]:
-    """The SPL-vs-R_i curves of every predictor per world with the ceiling drawn: stage 04 draws them with the
-    ceiling (issue 38), so a run whose predictors.json has none has no such figure."""
-    if lookup(metrics, "predictors", "ceiling") is MISSING:
-        return ["SPL vs R_i per predictor with the ceiling drawn (`figures/04_ceiling.png`): "
-                f"{absent(metrics, 'predictors')} (this run's stage 04 wrote no ceiling).", ""]
-    return figure("figures/04_ceiling.png", "SPL vs R_i of every predictor per world, the ceiling drawn")
-
-
-def _envelope_figures(metrics: dict[str, dict]) -> list[str]:
-    """Why each envelope ends (figure of stage 02), then the arcs that decide each headline."""
-    return [*figure("figures/02_envelope_causes.png", "why each envelope ends, per world and tolerance"),
-            *deciding_section(metrics)]
-
-
-def _realism_notes(metrics: dict[str, dict]) -> list[str]:
-    """On recorded data, why no bar is judged; for an artifacts.json of before R6 and R7 became comparisons, that its
-    count still holds them."""
-    described = lookup(metrics, "artifacts", "realism.description_only")
-    lines = [f"Realism bars: {described}.", ""] if isinstance(described, str) else []
-    if lookup(metrics, "artifacts", "realism.passed.r6_hardest_arc") is not MISSING:
-        lines += ["This artifacts.json was written before R6 and R7 became comparisons (issue 41): its count of bars "
-                  "passed still holds them (re-run stage 02).", ""]
+def figure_lines(metrics: dict[str, dict]) -> list[str]:
+    """The papers' figures, each group under the claims it shows; "not run" for a stage without metrics."""
+    lines = ["## The papers' figures, ours", ""]
+    for heading, stage, figures in PAPER_FIGURES:
+        lines += [f"### {heading}", ""]
+        if stage not in metrics:
+            lines += [f"{absent(metrics, stage)}.", ""]
+            continue
+        lines += [f"![{text}]({path})" for path, text in figures] + [""]
     return lines
 
 
-def board_warnings(metrics: dict[str, dict]) -> list[str]:
-    """The message stage 02 printed for each board that cannot judge the tolerance (artifacts.json
-    ``board_warnings``), each once."""
-    warnings = lookup(metrics, "artifacts", "board_warnings")
-    if warnings is MISSING:
-        return [f"Boards that cannot judge the tolerance: {absent(metrics, 'artifacts')}.", ""]
-    messages = list(dict.fromkeys(warning["message"] for warning in warnings))
-    if not messages:
-        return ["Boards that cannot judge the tolerance: none (every board is trusted in most of its frames).", ""]
-    return ["Boards that cannot judge the tolerance (stage 02's warnings):", "", *(f"- {m}" for m in messages), ""]
-
-
-EXTRAS = {"predictors": _predictor_figures, "envelopes": _envelope_figures, "realism": _realism_notes,
-          "ground_truth": board_warnings}  # what a section shows below its table
+def target_lines(metrics: dict[str, dict]) -> list[str]:
+    """How many of the report's targets pass, and each that fails, with its value and where it is explained."""
+    judged = [(h, row_judgement(metrics, h)) for h in HEADLINES if h.target != "-"]
+    failing = [h for h, passed in judged if passed is False]
+    passing = sum(passed is True for _, passed in judged)
+    lines = ["## Targets", "", f"Of {len(judged)} targets on the stage pages, {passing} pass, {len(failing)} fail and "
+             f"{len(judged) - passing - len(failing)} have no value yet. Those failing, each with its reason on its "
+             "page:", ""]
+    lines += [f"- [{h.label.lstrip('. ')}]({page_path(section_page(h.shown_in))}): {shown(metrics, h)} against "
+              f"{h.target}" for h in failing]
+    return [*lines, ""]
 
 
 def render_summary(metrics: dict[str, dict]) -> str:
-    """Markdown: the first screen (report/claims.py), then one table per section, ours beside the paper's and the
-    target, with the figures, the arcs that decide each headline (report/deciding.py) and the board warnings; then
-    what holds on another machine, and where the machine-dependent figures are.
-
-    On recorded data (:func:`~poseintegrity.report.recorded.recorded_source`) the section on the user's datasets
-    follows the first screen and replaces stage 01's rendered-world rows; no target is shown (the rendered world's
-    bars are not judged on recorded data) and a row whose key a stage that ran did not write (a rendered world's
-    name, say) is left out rather than shown as "not measured"."""
+    """Markdown: the first screen (report/claims.py), the section on recorded data when the run had any, the papers'
+    figures beside their claims, our own predictors, the targets that fail, and the links to each stage's page
+    (report/stage_pages.py) and to the machine-dependent figures, which the summary never holds, so that two runs
+    write the same summary on any machine."""
+    worlds = metric_worlds(metrics)
     recorded = recorded_source(metrics) is not None
-    lines = ["# Summary of the latest run", "",
-             "Generated by stage 07 from `reports/metrics/*.json`. Paper figures (per tolerance where the paper gives",
-             "them): Windsor et al., IEEE RA-L 9(5), 2024; Black and Salcudean, IEEE Transactions on Instrumentation and",
-             "Measurement, 2024, DOI 10.1109/TIM.2024.3398108 (see `docs/references.md`). \"none\": the stage ran and",
-             "found no such value (e.g. no threshold n_t <= 100 reaches zero incursions); \"not run\": no metrics yet.", "",
-             *claims_section(metrics), *recorded_section(metrics)]
-    for section in SECTIONS:
-        title, holds = section_heading(section, recorded)
-        lines += [f"## {title}", "", f"{holds}.", ""]
-        if recorded and "note" in metrics.get(section, {}):  # e.g. validation.json of one world: nothing held out
-            lines += [f"{metrics[section]['note']}.", ""]
-            continue
-        lines += ["| figure | ours | paper | target |", "| --- | --- | --- | --- |"]
-        skipped = False
-        for h in (h for h in HEADLINES if h.shown_in == section and not (recorded and h.stage == "generate")):
-            value = lookup(metrics, h.stage, h.key)
-            if recorded and h.stage in metrics and (value is MISSING or skipped and h.label.startswith("...")):
-                skipped = True  # and so is a "..." row that continues it
-                continue
-            skipped = False
-            shown = _fmt(value, h.fmt, absent(metrics, h.stage))
-            lines.append(f"| {h.label} | {shown} | {h.paper} | {'-' if recorded else h.target} |")
-        lines.append("")
-        lines += EXTRAS[section](metrics) if section in EXTRAS else []
-    lines += ["## Same numbers on another machine", "", MACHINE_NOTE, "", "## Machine-dependent figures", "",
-              f"Stage wall times and the tracking filter's speed-ups change with the machine and its load: they are on "
-              f"[{TIMING_PAGE}]({TIMING_PAGE}), not here.", ""]
+    lines = ["# What held of the two papers: the latest run", "",
+             "Generated by stage 07 from `reports/metrics/*.json`. The papers: Windsor et al., IEEE RA-L 9(5), 2024 "
+             "(localization envelopes); Black and Salcudean, IEEE TIM 2024, DOI 10.1109/TIM.2024.3398108 (marker "
+             "tracking); see `docs/references.md`. \"not run\": no metrics yet.", "",
+             *claims_section(metrics), *recorded_section(metrics), *figure_lines(metrics),
+             *beyond_section(metrics, worlds), *([] if recorded else target_lines(metrics)),
+             "## Every stage in detail", ""]
+    lines += [f"- [{title}]({page_path(page)})" for page, (title, _) in PAGES.items()]
+    lines += [f"- [Wall times and speed-ups]({TIMING_PAGE}): they change with the machine and its load, so they are "
+              "there, not here.", "", "## Same numbers on another machine", "", MACHINE_NOTE, ""]
     return "\n".join(lines)
 
 
