@@ -19,7 +19,8 @@ def population_lines(metrics: dict[str, dict], reports: str = "") -> list[str]:
     """The population's lines (``population.json``): per predictor and tolerance, the median share of the
     ceiling over the worlds with its 10-90 % range at the world's own operating point and at the point chosen on the
     other worlds, the share of worlds with zero incursion at that point, and the worlds in which it beats long range
-    with the sign test's p. No lines when the population has not run."""
+    with the sign test's p. No lines when the population has not run. reports : the path from the page to reports/
+    ("" from the summary, "../" from a stage page), for the figure's link."""
     read = Reader(metrics)
     if read.value("population", "n_worlds") is MISSING:
         return []
