@@ -213,15 +213,13 @@ def expectations(m: dict) -> dict[str, tuple[list[list], list, str]]:
                                        *ends(e, "relative_gain"))] for entries in pnp],
         [get(m, "pnp", f"{WORLDS[weakest(grades)][1]}methods.{v}.failure_rate") for v in ("usac_magsac", *variants)],
         verdict(grades))
-    held = m["predictors"].get("live", {}).get("heldout")  # the main world's only: validation.json has none
-    if held:
-        grades = [2 if held["incursions"] else grade(held.get("interval", {}).get("envelope_share_gain"))]
-        out["4 mm/10 deg: live trials"] = (
-            [[held["envelope_share"], held["static_envelope_share"], *ends(held, "envelope_share_gain"),
-              held["incursions"], held["n_trials"], min(held["n_t"].values()), max(held["n_t"].values())], []],
-            [paper.WINDSOR_LIVE["n_t"]], verdict(grades))  # the caveat: the paper's n_t
-    else:
-        out["4 mm/10 deg: live trials"] = ([[], []], [], "not applicable")
+    helds = [m[stage].get("live", {}).get("heldout") for stage, _ in WORLDS]  # each world's held-out trials
+    grades = [2 if held["incursions"] else grade(held.get("interval", {}).get("envelope_share_gain"))
+              for held in helds if held]
+    out["4 mm/10 deg: live trials"] = (
+        [[held["envelope_share"], held["static_envelope_share"], *ends(held, "envelope_share_gain"), held["incursions"],
+          held["n_trials"], min(held["n_t"].values()), max(held["n_t"].values())] if held else [] for held in helds],
+        [paper.WINDSOR_LIVE["n_t"]] if grades else [], verdict(grades))  # the caveat: the paper's n_t
     rates, black = m["tracking"]["success_rates"], paper.BLACK_RESULTS
     intervals = m["tracking"].get("intervals", {})
     interval = intervals.get("success_rates", {}).get("a_markers4")

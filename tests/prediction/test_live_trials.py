@@ -8,7 +8,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from poseintegrity.prediction import attach_envelopes, heldout_interval, heldout_live_trials, scene_of
+from poseintegrity.prediction import (attach_envelopes, heldout_interval, heldout_live_trials, heldout_metrics,
+                                      scene_of)
+from poseintegrity.seeding import keyed_rng
 
 
 @pytest.fixture(scope="module")
@@ -58,3 +60,15 @@ def test_the_interval_resamples_scenes_and_holds_the_pooled_gain(table, tiny_pre
 def test_one_scene_has_no_fold(table, tiny_predict, protocol):
     one = table[table.dataset.map(scene_of) == table.dataset.map(scene_of).iloc[0]]
     assert heldout_live_trials(one, tiny_predict, protocol).empty
+
+
+def test_the_metrics_of_the_held_out_trials_are_their_rows_summed(table, tiny_predict, protocol):
+    trials = heldout_live_trials(table, tiny_predict, protocol)
+    metrics = heldout_metrics(trials, tiny_predict)
+    assert metrics["n_trials"] == len(trials) and metrics["incursions"] == trials.incursion.sum()
+    assert metrics["envelope_share"] == pytest.approx(trials.share.mean())
+    assert metrics["static_envelope_share"] == pytest.approx(trials.static_share.mean())
+    assert metrics["n_t"] == {scene: float(n) for scene, n in trials.groupby("scene").n_t.first().items()}
+    rng = keyed_rng(tiny_predict.seed, "held-out live intervals")  # the same draws, so the same interval
+    assert metrics["interval"] == heldout_interval(trials, tiny_predict.intervals.n_draws, tiny_predict.intervals.level,
+                                                   rng)

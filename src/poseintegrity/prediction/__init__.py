@@ -41,7 +41,7 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "attach_envelopes", "combined_rows", "predict_dataset", "sweep", "with_pnp_variants",
         ],
         "tables": ["best_table", "fit_status_shares", "headline_metrics", "rule_metrics", "table_metrics"],
-        "live_trials": ["heldout_interval", "heldout_live_trials", "live_trials"],
+        "live_trials": ["heldout_interval", "heldout_live_trials", "heldout_metrics", "live_trials", "trial_figures"],
         "transfer": ["transfer", "transfer_metrics"],
         "uncertainty": ["Interval", "bootstrap_interval", "covariance_interval", "prediction_interval"],
     },

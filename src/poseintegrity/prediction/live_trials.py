@@ -8,6 +8,7 @@ where the predictor says the envelope ends, against the static baseline.
                          :mod:`.loso` chooses), then run on that scene's arcs
     heldout_interval     the held-out trials resampled by scene: the interval of the share of the envelope used over
                          static's
+    trial_figures, heldout_metrics   what predictors.json and validation.json hold of them
 
 A trial's share of the envelope is SPL / theta_a (the paper's "74.7 % of the actual envelope"); an incursion is a
 stop past theta_a (eq. 4).
@@ -18,10 +19,12 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from poseintegrity.artifact_models.fitted import OK
 from poseintegrity.params.predict import PredictParams
 from poseintegrity.prediction.loso import loso_folds, scene_of
 from poseintegrity.protocol import ProtocolParams
 from poseintegrity.resampling import cluster_weights, percentile_interval
+from poseintegrity.seeding import keyed_rng
 
 TRIAL_COLUMNS = ["dataset", "theta_a", "stop_angle", "incursion", "share", "fit_status", "static_size",
                  "static_incursion", "static_share"]
@@ -107,3 +110,22 @@ def heldout_interval(trials: pd.DataFrame, n_draws: int, level: float, rng: np.r
     with np.errstate(invalid="ignore", divide="ignore"):
         return {"envelope_share_gain": percentile_interval(ours - static, level),
                 "relative_gain": percentile_interval(ours / static - 1.0, level)}
+
+
+def trial_figures(trials: pd.DataFrame) -> dict:
+    """n_trials, incursions, envelope_share, n_flagged_fits of :func:`live_trials` (or held-out) rows."""
+    return {"n_trials": int(len(trials)), "incursions": float(trials["incursion"].sum()),
+            "envelope_share": float(trials["share"].mean()),
+            "n_flagged_fits": int((~trials["fit_status"].isin([OK])).sum())}
+
+
+def heldout_metrics(trials: pd.DataFrame, predict: PredictParams) -> dict:
+    """One world's held-out trials (:func:`heldout_live_trials`, not empty) as its metrics file holds them: n_t and
+    static_size per scene, :func:`trial_figures`, static's incursions and share, and ``interval``
+    (:func:`heldout_interval`, drawn from ``predict.intervals`` and ``predict.seed``)."""
+    by_scene = trials.drop_duplicates("scene").set_index("scene")
+    return {"n_t": by_scene["n_t"].astype(float).to_dict(), "static_size": by_scene["static_size"].astype(float).to_dict(),
+            **trial_figures(trials), "static_incursions": float(trials["static_incursion"].sum()),
+            "static_envelope_share": float(trials["static_share"].mean()),
+            "interval": heldout_interval(trials, predict.intervals.n_draws, predict.intervals.level,
+                                         keyed_rng(predict.seed, "held-out live intervals"))}

@@ -14,10 +14,9 @@ import numpy as np
 import pandas as pd
 
 from poseintegrity.artifact_models import FIT_STATUSES
-from poseintegrity.artifact_models.fitted import OK
 from poseintegrity.prediction.ceiling import ceiling, ceiling_share
 from poseintegrity.prediction.intervals import INTERVAL_METHOD, live_intervals, world_intervals
-from poseintegrity.prediction.live_trials import heldout_interval
+from poseintegrity.prediction.live_trials import heldout_metrics, trial_figures
 from poseintegrity.prediction.loso import loso_summary
 from poseintegrity.prediction.metrics import (best_operating_point, operating_curves, relative_improvement,
                                                with_metrics)
@@ -202,7 +201,7 @@ def headline_metrics(
         for tolerance, figures in entry.items():
             figures["ceiling_share"] = ceiling_share(figures["heldout_mean_spl"], metrics["ceiling"][tolerance])
     metrics["live"] = {
-        "n_t": predict.live_n_t, "tolerance": predict.live_tolerance, **_live_figures(live),
+        "n_t": predict.live_n_t, "tolerance": predict.live_tolerance, **trial_figures(live),
         "static_size": float(live["static_size"].iloc[0]) if len(live) else np.nan,
         "static_incursions": float(live["static_incursion"].sum()),
         "static_envelope_share": float(live["static_share"].mean()),
@@ -216,24 +215,11 @@ def headline_metrics(
 
     metrics["live"]["interval"] = live_spread("next_step", predict.live_n_t)
     if error_live is not None:
-        metrics["live"]["error_next_step"] = {"k": float(error_live_k), **_live_figures(error_live),
+        metrics["live"]["error_next_step"] = {"k": float(error_live_k), **trial_figures(error_live),
                                               "interval": live_spread("error_next_step", error_live_k)}
     if heldout_live is not None and len(heldout_live):
-        by_scene = heldout_live.drop_duplicates("scene").set_index("scene")
-        metrics["live"]["heldout"] = {
-            "n_t": by_scene["n_t"].astype(float).to_dict(), "static_size": by_scene["static_size"].astype(float).to_dict(),
-            **_live_figures(heldout_live), "static_incursions": float(heldout_live["static_incursion"].sum()),
-            "static_envelope_share": float(heldout_live["static_share"].mean()),
-            "interval": heldout_interval(heldout_live, predict.intervals.n_draws, predict.intervals.level,
-                                         keyed_rng(predict.seed, "held-out live intervals")),
-        }  # fmt: skip
+        metrics["live"]["heldout"] = heldout_metrics(heldout_live, predict)
     return metrics
-
-
-def _live_figures(live: pd.DataFrame) -> dict:
-    """n_trials, incursions, envelope_share, n_flagged_fits of :func:`live_trials` rows."""
-    return {"n_trials": int(len(live)), "incursions": float(live["incursion"].sum()),
-            "envelope_share": float(live["share"].mean()), "n_flagged_fits": int((~live["fit_status"].isin([OK])).sum())}
 
 
 def rule_metrics(theta_p: pd.DataFrame, envelopes: pd.DataFrame, protocol: ProtocolParams,
