@@ -254,6 +254,16 @@ def _pnp_row(read: Reader, worlds: list[World], links: dict[str, str]) -> Row:
                verdict(list(grades.values())), caveat, links["pnp"])
 
 
+def _trials(read: Reader, stage: str, at: str) -> str:
+    """Simulated live trials (``at``: a ``live`` block of ``stage``'s metrics) as the paper gives them: the share of
+    the envelope used against static's, the interval of the gain, the incursions of the trials."""
+    return (f"{read.text(stage, f'{at}.envelope_share', '{:.1%}')} vs "
+            f"{read.text(stage, f'{at}.static_envelope_share', '{:.1%}')}, gain "
+            f"{read.interval(stage, f'{at}.interval.envelope_share_gain', '{:+.1%}')}; "
+            f"incursions {read.text(stage, f'{at}.incursions', '{:g}')} of "
+            f"{read.text(stage, f'{at}.n_trials', '{:g}')}")
+
+
 def _live_row(read: Reader, worlds: list[World], links: dict[str, str]) -> Row:
     """Fig. 9, V-C: next step supervising the robot, no incursion and more of the envelope used than by static; judged
     on the held-out trials (``live.heldout``: each scene's n_t and static's size chosen on the other scenes)."""
@@ -261,18 +271,14 @@ def _live_row(read: Reader, worlds: list[World], links: dict[str, str]) -> Row:
     cells, grades = [], {}
     for i, world in enumerate(worlds):
         if read.value(world.stage, f"{held}.envelope_share") is MISSING:
-            cells.append("not measured" if world.stage in read.metrics else absent(read.metrics, world.stage))
+            cells.append(absent(read.metrics, world.stage))
             continue
         incursions = read.value(world.stage, f"{held}.incursions")
         grades[i] = 2 if incursions not in (0, 0.0) else interval_grade(
             read.value(world.stage, f"{held}.interval.envelope_share_gain"))
         n_t = read.value(world.stage, f"{held}.n_t")
         n_t = f"{min(n_t.values()):g}-{max(n_t.values()):g}" if isinstance(n_t, dict) and n_t else "-"
-        cells.append(f"{read.text(world.stage, f'{held}.envelope_share', '{:.1%}')} vs "
-                     f"{read.text(world.stage, f'{held}.static_envelope_share', '{:.1%}')}, gain "
-                     f"{read.interval(world.stage, f'{held}.interval.envelope_share_gain', '{:+.1%}')}; "
-                     f"incursions {read.text(world.stage, f'{held}.incursions', '{:g}')} of "
-                     f"{read.text(world.stage, f'{held}.n_trials', '{:g}')}, n_t {n_t} by scene")
+        cells.append(f"{_trials(read, world.stage, held)}, n_t {n_t} by scene")
     caveat = UNMEASURED
     if grades:
         world = worlds[_weakest(grades)]
@@ -324,6 +330,18 @@ def _markers_row(read: Reader, worlds: list[World], markers: int, links: dict[st
 PACE = "paper_pace"  # tracking.json: the accuracy recording at the pace the paper's lag and errors imply
 
 
+def _errors(read: Reader, mm: str, deg: str, lag: str, intervals: dict[str, str]) -> str:
+    """The tracking's RMS errors as the paper reports them (per axis, mm; Euler angles, deg) and the lag (ms), keys of
+    tracking.json, each with its interval where ``intervals`` names one (by "mm", "deg", "lag"), e.g.
+    "1.31 mm [1.25, 1.38] / 4.03 deg [3.36, 4.60], lag 82 ms"."""
+    def shown(name: str, key: str, fmt: str, unit: str) -> str:
+        return " ".join(filter(None, (f"{read.text('tracking', key, fmt)} {unit}",
+                                      read.interval("tracking", intervals.get(name, ""), fmt))))
+
+    return (f"{shown('mm', mm, '{:.2f}', 'mm')} / {shown('deg', deg, '{:.2f}', 'deg')}, "
+            f"lag {shown('lag', lag, '{:.0f}', 'ms')}")
+
+
 def _accuracy_row(read: Reader, worlds: list[World], links: dict[str, str]) -> Row:
     """Black and Salcudean III: RMS position (mm, per axis) and Euler-angle (deg) error with the UKF and the lag, with
     the published sigmas on a hand motion at the paper's pace (``paper_pace.published``)."""
@@ -333,13 +351,8 @@ def _accuracy_row(read: Reader, worlds: list[World], links: dict[str, str]) -> R
     measured = all(read.value("tracking", key) is not MISSING for key in keys)
     grades = [max(_level_grade(read, f"{at}.intervals.axis_mm", theirs["rms_mm"]["ukf"], False),
                   _level_grade(read, f"{at}.intervals.euler_deg", theirs["rms_deg"]["ukf"], False))] if measured else []
-    cell = (f"{read.text('tracking', keys[0], '{:.2f}')} mm "
-            f"{read.interval('tracking', f'{at}.intervals.axis_mm', '{:.2f}')}"
-            f" / {read.text('tracking', keys[1], '{:.2f}')} deg "
-            f"{read.interval('tracking', f'{at}.intervals.euler_deg', '{:.2f}')}, lag "
-            f"{read.text('tracking', f'{at}.lag_ms', '{:.0f}')} ms "
-            f"{read.interval('tracking', f'{at}.intervals.lag_ms', '{:.0f}')}"
-            .rstrip() if measured else absent(read.metrics, "tracking"))
+    cell = (_errors(read, *keys, f"{at}.lag_ms", {name: f"{at}.intervals.{figure}" for name, figure in (
+        ("mm", "axis_mm"), ("deg", "euler_deg"), ("lag", "lag_ms"))}) if measured else absent(read.metrics, "tracking"))
     caveat = (f"a hand at {read.text('tracking', f'{PACE}.pace.euler_rad_s.mean', '{:.3f}')} rad/s and "
               f"{read.text('tracking', f'{PACE}.pace.velocity_mm_s.mean', '{:.1f}')} mm/s per axis (RMS), the pace at "
               "which the paper's lag alone gives its errors; the orientation lags "
@@ -366,23 +379,15 @@ def variant_rows(metrics: dict[str, dict], links: dict[str, str]) -> list[tuple[
     link). The tracking with our sigmas at the paper's pace and on our motion (a); the live trials at the paper's fixed
     n_t."""
     read, live, black = Reader(metrics), paper.WINDSOR_LIVE, paper.BLACK_RESULTS
-    tracking = (f"{read.text('tracking', 'rms_axis_mm.ukf', '{:.2f}')} mm "
-                f"{read.interval('tracking', 'intervals.rms_axis_mm.ukf', '{:.2f}')} / "
-                f"{read.text('tracking', 'rms_euler_deg.ukf', '{:.2f}')} deg "
-                f"{read.interval('tracking', 'intervals.rms_euler_deg.ukf', '{:.2f}')}, lag "
-                f"{read.text('tracking', 'lag_ms.ukf', '{:.0f}')} ms; the published sigmas on it: "
+    tracking = (_errors(read, "rms_axis_mm.ukf", "rms_euler_deg.ukf", "lag_ms.ukf", {
+                    "mm": "intervals.rms_axis_mm.ukf", "deg": "intervals.rms_euler_deg.ukf"})
+                + "; the published sigmas on it: "
                 f"{read.text('tracking', 'sigmas_motion_a.published.axis_mm', '{:.1f}')} mm, lag "
                 f"{read.text('tracking', 'sigmas_motion_a.published.lag_ms', '{:.0f}')} ms")
-    fixed = (f"{read.text('predictors', 'live.envelope_share', '{:.1%}')} vs "
-             f"{read.text('predictors', 'live.static_envelope_share', '{:.1%}')}, gain "
-             f"{read.interval('predictors', 'live.interval.envelope_share_gain', '{:+.1%}')}; "
-             f"incursions {read.text('predictors', 'live.incursions', '{:g}')} of "
-             f"{read.text('predictors', 'live.n_trials', '{:g}')}")
-    pace = (f"{read.text('tracking', f'{PACE}.ours.axis_mm', '{:.2f}')} mm "
-            f"{read.interval('tracking', f'{PACE}.ours.intervals.axis_mm', '{:.2f}')} / "
-            f"{read.text('tracking', f'{PACE}.ours.euler_deg', '{:.2f}')} deg "
-            f"{read.interval('tracking', f'{PACE}.ours.intervals.euler_deg', '{:.2f}')}, lag "
-            f"{read.text('tracking', f'{PACE}.ours.lag_ms', '{:.0f}')} ms; no filter "
+    fixed = _trials(read, "predictors", "live")
+    ours = f"{PACE}.ours"
+    pace = (_errors(read, f"{ours}.axis_mm", f"{ours}.euler_deg", f"{ours}.lag_ms", {
+                "mm": f"{ours}.intervals.axis_mm", "deg": f"{ours}.intervals.euler_deg"}) + "; no filter "
             f"{read.text('tracking', f'{PACE}.no_filter.axis_mm', '{:.2f}')} mm / "
             f"{read.text('tracking', f'{PACE}.no_filter.euler_deg', '{:.2f}')} deg")
     return [("accuracy, our sigmas at the paper's pace",
