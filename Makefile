@@ -6,7 +6,7 @@ BIN := $(CURDIR)/$(VENV)/bin
 # venv-on-path.pth: this venv's bin first on PATH in every process of its Python, so that dvc.yaml's `python` is it
 PATH_HOOK := $(VENV)/lib/python3.11/site-packages/venv-on-path.pth
 # The venv's Jupyter kernels import poseintegrity before any cell runs (IPython reads <venv>/etc/ipython), so that a
-# notebook opened in JupyterLab runs the pinned kernels of poseintegrity/dispatch even if it imports numpy first.
+# notebook opened in JupyterLab runs the pinned kernels of poseintegrity/kernel_pin even if it imports numpy first.
 KERNEL_CONFIG := $(VENV)/etc/ipython/ipython_kernel_config.py
 export PATH := $(BIN):$(PATH)
 # Papermill's `-k python3` must resolve to this venv's kernel, never to one of the user's.
@@ -49,7 +49,7 @@ install: $(VENV)/.installed $(PATH_HOOK) $(KERNEL_CONFIG) ## create .venv and in
 
 repro: $(VENV)/.installed $(PATH_HOOK) $(KERNEL_CONFIG) ## run the paper-scale pipeline (dvc repro), then print each stage's wall time
 	$(BIN)/dvc repro
-	@$(BIN)/python -m poseintegrity.timing reports/metrics/timing
+	@$(BIN)/python -m poseintegrity.stage_timing reports/metrics/timing
 
 # The population of rendered worlds (issue 49, population/dvc.yaml): not on `make repro`'s path. Its pipeline needs the
 # main world's operating points (it runs stages 01-05 of dvc.yaml first where they are stale); then `dvc repro` brings
@@ -62,7 +62,7 @@ population: $(VENV)/.installed $(PATH_HOOK) $(KERNEL_CONFIG) ## render every wor
 	$(BIN)/dvc repro
 	$(BIN)/dvc repro population/dvc.yaml
 	$(BIN)/dvc repro
-	@$(BIN)/python -m poseintegrity.timing reports/metrics/timing
+	@$(BIN)/python -m poseintegrity.stage_timing reports/metrics/timing
 
 # pytest keeps each test module with its assertions rewritten in __pycache__, and Python our own modules, unless
 # PYTHONDONTWRITEBYTECODE is set (as on our machines): then every xdist worker rewrote all ~270 test modules on every

@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 
 import poseintegrity.cache_entry as C
-from poseintegrity.dispatch import kernel_level
-from poseintegrity import staging
-from poseintegrity.staging import DiskFullError, remove_staging_files
+from poseintegrity import atomic_write
+from poseintegrity.atomic_write import DiskFullError, remove_staging_files
+from poseintegrity.kernel_pin import kernel_level
 
 ARRAYS = {"points": np.arange(12, dtype=np.float32).reshape(6, 2), "name": np.array("usac_magsac"),
           "count": np.array(7)}
@@ -124,7 +124,7 @@ def test_an_interrupted_write_keeps_the_old_file_and_leaves_no_staging_file(tmp_
     path = written(tmp_path)
     before = path.read_bytes()
     fdopen = os.fdopen
-    monkeypatch.setattr(staging.os, "fdopen", lambda handle, mode: CutShort(fdopen(handle, mode)))
+    monkeypatch.setattr(atomic_write.os, "fdopen", lambda handle, mode: CutShort(fdopen(handle, mode)))
     with pytest.raises(KeyboardInterrupt):
         C.write_entry(path, "k2", ARRAYS)
     monkeypatch.undo()
@@ -145,7 +145,7 @@ class FullDisk(io.RawIOBase):
 
 
 def test_a_full_disk_names_the_file_and_the_free_space_and_leaves_nothing(tmp_path, monkeypatch):
-    monkeypatch.setattr(staging.os, "fdopen", FullDisk)
+    monkeypatch.setattr(atomic_write.os, "fdopen", FullDisk)
     path = tmp_path / "deep" / "entry.npz"
     with pytest.raises(DiskFullError) as raised:
         C.write_entry(path, "k1", ARRAYS)

@@ -12,8 +12,8 @@ from pathlib import Path
 import nbformat
 import pytest
 
-from poseintegrity.dispatch import cpu_flags, pinned_environment
-from poseintegrity.timing import StageTiming, summary
+from poseintegrity.kernel_pin import cpu_flags, pinned_environment
+from poseintegrity.stage_timing import StageTiming, summary
 
 PARAMETERS = 'params_path = "params.yaml"\ndata_dir = "data"\nreports_dir = "reports"'
 WORK = """\
@@ -21,7 +21,7 @@ import time
 from pathlib import Path
 from tqdm import tqdm
 from poseintegrity.config import load_section
-from poseintegrity.parallel import Workers
+from poseintegrity.workers import Workers
 
 with Workers(load_section(params_path, "parallel")) as workers:
     values = workers.map(abs, [-1, -2, -3], desc="values")"""
@@ -151,7 +151,7 @@ def test_summary_lists_stages_in_name_order_with_their_total(tmp_path):
 PINNED = """\
 import os
 import cv2
-from poseintegrity.dispatch import unpinned_dispatch
+from poseintegrity.kernel_pin import unpinned_dispatch
 with Workers(load_section(params_path, "parallel")) as workers:
     in_workers = workers.map(os.getenv, ["OPENCV_CPU_DISABLE", "NUMBA_CPU_NAME", "OPENBLAS_CORETYPE"])
 (Path(data_dir) / "pinned.txt").write_text(repr([os.getenv("OPENCV_CPU_DISABLE"), cv2.getCPUFeaturesLine(),

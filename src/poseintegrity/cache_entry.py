@@ -13,7 +13,7 @@ population world's) is one such file:
 
 :func:`read_entry` returns the arrays only when the file is whole and its key is the one asked for; otherwise a
 :class:`Miss` that says why, and the caller computes the entry again and writes it (:func:`write_entry`: a staging
-file renamed into place, :func:`poseintegrity.staging.write_atomically`). A file that cannot prove it is whole is
+file renamed into place, :func:`poseintegrity.atomic_write.write_atomically`). A file that cannot prove it is whole is
 never used. Every miss is counted in the :func:`counting` block around it, so that a stage can say per dataset how
 many files it recomputed and why (:func:`describe`).
 """
@@ -34,7 +34,7 @@ from typing import TypeVar
 
 import numpy as np
 
-from poseintegrity.staging import write_atomically
+from poseintegrity.atomic_write import write_atomically
 
 Task = TypeVar("Task")
 Result = TypeVar("Result")
@@ -59,12 +59,12 @@ class Miss:
 @cache
 def provenance() -> str:
     """What computes every cached value besides its inputs: OpenCV's, numpy's and scipy's versions and the level
-    their kernels dispatch to (:func:`poseintegrity.dispatch.kernel_level`: the same on every x86-64 machine when
+    their kernels dispatch to (:func:`poseintegrity.kernel_pin.kernel_level`: the same on every x86-64 machine when
     pinned). A cache entry made under another one is stale."""
     import cv2
     import scipy
 
-    from poseintegrity.dispatch import kernel_level
+    from poseintegrity.kernel_pin import kernel_level
 
     return json.dumps([cv2.__version__, np.__version__, scipy.__version__, kernel_level()])
 
@@ -149,7 +149,7 @@ def _whole_zip(data: bytes) -> bool:
 
 def write_entry(path: Path, key: str, arrays: Mapping[str, np.ndarray]) -> None:
     """Write the cache file ``path``: ``arrays`` with their key (:func:`stamped`) and the trailer, by a staging file
-    renamed into place (a full disk: :class:`~poseintegrity.staging.DiskFullError` naming ``path``). The bytes are
+    renamed into place (a full disk: :class:`~poseintegrity.atomic_write.DiskFullError` naming ``path``). The bytes are
     the same for the same arrays and key."""
     buffer = io.BytesIO()
     np.savez(buffer, **arrays, **{KEY: np.array(stamped(key))})

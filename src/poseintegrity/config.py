@@ -3,7 +3,7 @@
 Every stage of ``dvc.yaml`` owns one top-level section of ``params.yaml``; the schema of a section lives in the
 package :mod:`poseintegrity.params` (``poseintegrity.params.<section>``), beside the other sections' and below the
 code that uses it, and is collected here. The ``protocol``
-section holds the facts several stages share (:mod:`poseintegrity.protocol`); every other section is validated
+section holds the facts several stages share (:mod:`poseintegrity.params.protocol`); every other section is validated
 with it at hand, so that a rule across sections (a tolerance named in ``predict`` must be one of
 ``protocol.tolerances``) names its key too. A bad value raises :class:`ParamsError` whose message names the
 offending key, e.g. ``generate.scenes.2.targets.0``.
@@ -37,14 +37,14 @@ import yaml
 from pydantic import BaseModel, ConfigDict, ValidationError
 
 from poseintegrity.errors import PoseIntegrityError
-from poseintegrity.parallel import ParallelParams
 from poseintegrity.params.extract import ExtractParams
 from poseintegrity.params.fit import FitParams
 from poseintegrity.params.generate import GenerateParams
+from poseintegrity.params.parallel import ParallelParams
 from poseintegrity.params.population import PopulationParams
 from poseintegrity.params.predict import PredictParams
+from poseintegrity.params.protocol import ProtocolParams
 from poseintegrity.params.track import TrackParams
-from poseintegrity.protocol import ProtocolParams
 from poseintegrity.schema import KeyRule
 
 
@@ -228,6 +228,16 @@ def default_params() -> Params:
     every public function that takes a params section. Frozen, so one instance is shared safely."""
     raw, base_dir = read_raw(PACKAGED_PARAMS)
     return parse_params(raw, source=str(PACKAGED_PARAMS), base_dir=base_dir)
+
+
+def published(dotted: str) -> Any:
+    """The section or value of the packaged ``params.yaml`` at ``dotted`` (e.g. ``"track.detection"``): what a
+    public function that takes a params section (``detect_markers(ir, depth, lut, detection=None)``) uses when none
+    is given."""
+    value: Any = default_params()
+    for part in dotted.split("."):
+        value = getattr(value, part)
+    return value
 
 
 def load_section(path: str | Path, section: str) -> BaseModel:

@@ -9,45 +9,15 @@ in this form, docs/references.md "Robot"). Lengths in mm, angles in rad (params 
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 from scipy.optimize import least_squares
 from scipy.spatial.transform import Rotation
 
-N_JOINTS = 6
+from poseintegrity.denavit_hartenberg import DH, N_JOINTS
+
 ROTATION_WEIGHT_MM = 100.0  # IK residual: 1 rad of orientation weighs as 100 mm of position (1 mrad ~ 0.1 mm)
 IK_TOLERANCE_MM = 1e-9  # a converged IK solution reaches the pose to this (rotation residual scaled as above)
 IK_MAX_EVALUATIONS = 60  # from a seed on the solution's branch LM converges in ~10; more means another branch
-
-
-@dataclass(frozen=True)
-class DH:
-    """Standard DH parameters of a 6R arm, joint i = 1..6 at index i - 1.
-
-    a, d : (6,) float, mm; alpha, theta_offset : (6,) float, rad.
-    """
-
-    a: np.ndarray
-    d: np.ndarray
-    alpha: np.ndarray
-    theta_offset: np.ndarray
-
-    def perturbed(self, da: np.ndarray, dd: np.ndarray, dalpha: np.ndarray, dtheta: np.ndarray) -> "DH":
-        """These parameters plus the deviations (same shapes and units): a physical arm's actual kinematics."""
-        return DH(self.a + da, self.d + dd, self.alpha + dalpha, self.theta_offset + dtheta)
-
-    @property
-    def reach_mm(self) -> float:
-        """An upper bound of the distance from joint 2's axis to the flange: the sum of every link's lengths."""
-        return float(np.abs(self.a).sum() + np.abs(self.d[1:]).sum())
-
-
-# Universal Robots' published DH table of the UR5e (docs/references.md "Robot"): a, d in mm, alpha in deg.
-UR5E = DH(a=np.array([0.0, -425.0, -392.2, 0.0, 0.0, 0.0]),
-          d=np.array([162.5, 0.0, 0.0, 133.3, 99.7, 99.6]),
-          alpha=np.radians([90.0, 0.0, 0.0, 90.0, -90.0, 0.0]),
-          theta_offset=np.zeros(N_JOINTS))
 
 
 def link_transforms(dh: DH, q: np.ndarray) -> np.ndarray:

@@ -5,8 +5,8 @@ record its wall time::
                                   [--reports reports]
 
 writes ``<reports>/notebooks/<name>.ipynb`` and ``.html`` and ``<reports>/metrics/timing/<name>.json``
-(:class:`poseintegrity.timing.StageTiming`). While the notebook runs, everything it prints (the progress lines of
-:mod:`poseintegrity.parallel`, tqdm bars) reaches this terminal as it comes, with one line per cell.
+(:class:`poseintegrity.stage_timing.StageTiming`). While the notebook runs, everything it prints (the progress lines of
+:mod:`poseintegrity.workers`, tqdm bars) reaches this terminal as it comes, with one line per cell.
 
 Before any work, the notebook must exist, the ``parallel`` section is validated, a Dask scheduler at
 ``parallel.address`` must answer and the data folder's lock must be free (no notebook kernel open on it, no other
@@ -38,11 +38,12 @@ sys.modules.setdefault("rfc3987_syntax", None)
 import psutil  # noqa: E402
 from tqdm import tqdm  # noqa: E402
 
+from poseintegrity.atomic_write import FULL, DiskFullError, disk_full  # noqa: E402
 from poseintegrity.config import ParamsError, load_section  # noqa: E402
-from poseintegrity.parallel import ParallelParams, worker_count  # noqa: E402
+from poseintegrity.params.parallel import ParallelParams  # noqa: E402
 from poseintegrity.project import ProjectError, project_root  # noqa: E402
-from poseintegrity.staging import FULL, DiskFullError, disk_full  # noqa: E402
-from poseintegrity.timing import StageTiming, usage_error  # noqa: E402
+from poseintegrity.stage_timing import StageTiming, usage_error  # noqa: E402
+from poseintegrity.workers import worker_count  # noqa: E402
 from poseintegrity.workspace_lock import WorkspaceBusy, runner_lock  # noqa: E402
 
 KERNEL = "python3"  # the kernelspec `make install` writes into .venv's share/jupyter (kernel_search_path)

@@ -1,18 +1,19 @@
 """Schema of the camera side of the ``generate`` section (stage 01): the camera and its lens, the sensor, how a
-stop's images are captured, the calibration session and the printed boards (scenes/camera.py, scenes/optics.py,
-scenes/calibration_views.py, :mod:`poseintegrity.lens`). Every number bounded, its key named when refused."""
+stop's images are captured, the calibration session and its ChArUco card (scenes/camera.py, scenes/optics.py,
+scenes/calibration_views.py, :mod:`poseintegrity.lens`); the scenes' boards are in :mod:`.boards`. Every number
+bounded, its key named when refused."""
 
 from __future__ import annotations
 
-from typing import Annotated, Literal
+from typing import Annotated
 
-import cv2
 import numpy as np
-from pydantic import AfterValidator, Field, field_validator, model_validator
+from pydantic import Field, field_validator, model_validator
 
-from poseintegrity.boards import ArucoGrid, Board, Charuco, dictionary_size
+from poseintegrity.boards import dictionary_size
 from poseintegrity.lens import LensError, check_folding
-from poseintegrity.schema import FromList, KeyRule, Section, distinct, ordered_range
+from poseintegrity.params.boards import Dictionary
+from poseintegrity.schema import FromList, KeyRule, Section, ordered_range
 
 MIN_IMAGE_PX = 64  # the rendered image's shorter side: below it no target keeps enough pixels to be localized
 # Zhang's method takes the focal length from how the board's plane turns between views (views of parallel planes add
@@ -27,15 +28,6 @@ MAX_SENSOR_PX = 4096  # a side of the sensor: larger frames take GBs of z-buffer
 
 Radial = Annotated[float, Field(ge=-2, le=2)]  # k_i beyond +-2 describe a fisheye, which plumb_bob does not model
 Tangential = Annotated[float, Field(ge=-0.05, le=0.05)]  # a lens decentred enough for p_i = 0.05 is broken
-
-
-def _known_dictionary(name: str) -> str:
-    if not isinstance(getattr(cv2.aruco, name, None), int):
-        raise ValueError(f"OpenCV has no ArUco dictionary {name!r}")
-    return name
-
-
-Dictionary = Annotated[str, Field(pattern=r"^DICT_\w+$"), AfterValidator(_known_dictionary)]  # both boards' dictionary
 
 
 class CameraParams(Section):
@@ -101,20 +93,6 @@ class SensorParams(Section):
                                                      "1 + flicker x N(0, 1) would sometimes be <= 0: a black image)")
 
 
-class PrintedBoardParams(Section):
-    """Printed boards are not their drawings (both the calibration ChArUco and the scenes' ArUco ground-truth board):
-    a printer scales each axis a little, and a sheet is not flat. Drawn once per board and world; every stage that
-    uses a board assumes its drawing, as a lab does."""
-
-    scale_std: float = Field(ge=0, le=0.01, description="per axis: laser printers scale by ~0.1-0.3 %; 1 % would be "
-                                                        "seen with a ruler")
-    calibration_sag_std_mm: float = Field(ge=0, le=5, description="bow of the ChArUco card at its centre")
-    board_sag_std_mm: float = Field(ge=0, le=5, description="bow of the ground-truth board glued on its stand")
-    caliper_std_mm: float | None = Field(
-        ge=0, le=5, description="the lab measures the printed ground-truth board's width and height with calipers "
-        "(this error each) and uses the measured size; null: the drawing's size is used, unmeasured")
-
-
 class CharucoParams(Section):
     """The calibration board: a ChArUco board (cv2.aruco.CharucoBoard) printed on paper."""
 
@@ -134,77 +112,6 @@ class CharucoParams(Section):
             raise KeyRule("dictionary", f"{self.squares_x} x {self.squares_y} squares hold {n_markers} markers, "
                                         f"{self.dictionary} has {size}")
         return self
-
-
-class GroundTruthBoardParams(Section):
-    """The scenes' ground-truth board (IV-C: "an ArUco marker board [35]"; its size and layout are unpublished, ours
-    are chosen by measurement: docs/references.md, "Ground-truth boards"). ``aruco_grid`` needs markers_x, markers_y,
-    marker_length_mm and separation_mm; ``charuco`` squares_x, squares_y, square_mm and marker_mm (the other kind's
-    keys are refused). ``placement``: ``planned`` (per scene, a ChArUco board of one of ``sizes_mm`` on a post facing
-    the model camera, wholly in view, in focus and predicted within ``plan_sigma_t_mm`` at every stop of the
-    trajectories it serves, and up to ``max_boards`` of them: scenes/board_placement.py, issue 39),
-    ``facing_camera`` (one board of square_mm, most of it in view along every trajectory: the layout of issue 30) or
-    ``flat`` (lying on a pedestal beside the target, the layout before issue 30)."""
-
-    type: Literal["aruco_grid", "charuco"]
-    dictionary: Dictionary
-    markers_x: int | None = Field(None, ge=1, le=20)
-    markers_y: int | None = Field(None, ge=1, le=20)
-    marker_length_mm: float | None = Field(None, gt=0, le=200)
-    separation_mm: float | None = Field(None, ge=0, le=100)
-    squares_x: int | None = Field(None, ge=3, le=40)
-    squares_y: int | None = Field(None, ge=3, le=40)
-    square_mm: float | None = Field(None, gt=0, le=200)
-    marker_mm: float | None = Field(None, gt=0, le=200)
-    margin_mm: float = Field(ge=0, le=100, description="white paper around the pattern")
-    px_per_mm: float = Field(ge=2, le=32, description="texels per mm of the printed board's texture")
-    placement: Literal["planned", "facing_camera", "flat"]
-    sizes_mm: distinct(Annotated[float, Field(gt=0, le=200)]) | None = Field(
-        None, min_length=1, description="planned: the square sizes the lab may print the board at (marker_mm scales "
-                                        "with square_mm); the plan picks one per board")
-    max_boards: int | None = Field(
-        None, ge=1, le=2, description="planned: boards per scene at most (a second one where no place keeps one in "
-                                      "view on every trajectory)")
-    plan_sigma_t_mm: float | None = Field(
-        None, gt=0, le=100, description="planned: a board serves a trajectory when its pose is predicted within this "
-        "(RMS at the board origin, mm) at every stop; extract.ground_truth.max_sigma_t_mm is what stage 02 then trusts")
-
-    @model_validator(mode="after")
-    def _fields_of_its_type(self) -> "GroundTruthBoardParams":
-        mine = {"aruco_grid": ("markers_x", "markers_y", "marker_length_mm", "separation_mm"),
-                "charuco": ("squares_x", "squares_y", "square_mm", "marker_mm")}
-        for key in mine[self.type]:
-            if getattr(self, key) is None:
-                raise KeyRule(key, f"required by a {self.type} board")
-        for kind, keys in mine.items():
-            for key in keys:
-                if kind != self.type and getattr(self, key) is not None:
-                    raise KeyRule(key, f"a key of a {kind} board; this board is {self.type}")
-        if self.type == "charuco" and self.marker_mm >= self.square_mm:
-            raise KeyRule("marker_mm", f"a marker lies inside its square: must be < square_mm ({self.square_mm:g})")
-        planned = ("sizes_mm", "max_boards", "plan_sigma_t_mm")
-        for key in planned:
-            if (getattr(self, key) is None) == (self.placement == "planned"):
-                raise KeyRule(key, "required by placement planned" if self.placement == "planned" else
-                              f"a key of placement planned; this board's placement is {self.placement}")
-        if self.placement == "planned" and self.type != "charuco":
-            raise KeyRule("type", "placement planned plans ChArUco boards (their corners stay sharp under blur)")
-        n_markers, size = self.drawing().n_markers * (self.max_boards or 1), dictionary_size(self.dictionary)
-        if n_markers > size:
-            raise KeyRule("dictionary", f"the board(s) hold {n_markers} markers, {self.dictionary} has {size}")
-        return self
-
-    def drawing(self, scale: tuple[float, float] = (1.0, 1.0), square_mm: float | None = None,
-                first_id: int = 0) -> Board:
-        """The board as drawn (:mod:`poseintegrity.boards`), or as measured with ``scale`` (printed / drawn); a
-        ChArUco board printed with squares of ``square_mm`` (default: ``square_mm``; its markers scaled alike) and
-        ids from ``first_id``."""
-        if self.type == "charuco":
-            square = self.square_mm if square_mm is None else square_mm
-            return Charuco(self.dictionary, self.squares_x, self.squares_y, square,
-                           self.marker_mm * square / self.square_mm, first_id, scale)
-        return ArucoGrid(self.dictionary, self.markers_x, self.markers_y, self.marker_length_mm, self.separation_mm,
-                         0, scale)
 
 
 class CalibrationParams(Section):

@@ -11,8 +11,8 @@ from __future__ import annotations
 
 from pydantic import Field, ValidationInfo, model_validator
 
+from poseintegrity.params.protocol import PnPMethod
 from poseintegrity.ransac import minimal_sample_size, ransac_iterations
-from poseintegrity.protocol import PnPMethod
 from poseintegrity.schema import KeyRule, Section, Seed, distinct
 
 MAX_PIXELS = 20.0  # a reprojection bound beyond this accepts wrong poses at 968 x 608 px: a setting gone astray

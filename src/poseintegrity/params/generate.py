@@ -18,9 +18,8 @@ from pydantic import Field, ValidationError, ValidationInfo, field_validator, mo
 
 from poseintegrity.errors import ArgumentError
 from poseintegrity.mesh_file import check_mesh
-from poseintegrity.params.camera import (
-    CalibrationParams, CameraParams, CaptureParams, GroundTruthBoardParams, PrintedBoardParams, SensorParams,
-)
+from poseintegrity.params.boards import GroundTruthBoardParams, PrintedBoardParams
+from poseintegrity.params.camera import CalibrationParams, CameraParams, CaptureParams, SensorParams
 from poseintegrity.params.robot import RobotParams
 from poseintegrity.schema import FromList, KeyRule, ProjectPath, Section, Seed, distinct
 
@@ -330,6 +329,6 @@ class GenerateParams(Section):
         return {name: self.world(name) for name in WORLDS if name == "main" or self.validation is not None}
 
     def dataset_ids(self) -> list[str]:
-        """Every dataset, in the order of scenes/dataset.py plan_datasets: each scene's arcs, then the lines."""
+        """Every dataset, in the order of scenes/trips.py plan_datasets: each scene's arcs, then the lines."""
         return ([i for spec in self.scenes for i in self.arcs.dataset_ids(spec.name)]
                 + ([] if self.lines is None else self.lines.dataset_ids()))

@@ -67,7 +67,8 @@ class ErrorPredictorParams(Section):
     n_k: int = Field(ge=2, le=GRID, description="safety factors swept, k_min .. k_max in geometric steps")
     live_k: Annotated[float, Field(gt=0, le=1e3)] | None = Field(
         description="fixed k of the simulated live trials of error_next_step (as live_n_t of the paper's); null: the "
-                    "k of the main world's Table III at live_tolerance")
+                    "k of the main world's Table III at live_tolerance (prediction/live_trials.py, "
+                    "live_safety_factor)")
 
     @model_validator(mode="after")
     def _check(self) -> ErrorPredictorParams:
@@ -76,7 +77,7 @@ class ErrorPredictorParams(Section):
         return self
 
     @property
-    def factors(self) -> np.ndarray:
+    def safety_factors(self) -> np.ndarray:
         """The swept safety factors k : (n_k,) float, geometric from k_min to k_max (rounded to 1e-9, so that the
         grids of two worlds agree exactly)."""
         return np.round(np.geomspace(self.k_min, self.k_max, self.n_k), 9)

@@ -10,7 +10,7 @@ from typing import Annotated
 
 from pydantic import Field, field_validator
 
-from poseintegrity.kinematics import UR5E
+from poseintegrity.denavit_hartenberg import UR5E
 from poseintegrity.schema import FromList, Section, distinct
 
 

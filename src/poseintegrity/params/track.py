@@ -72,7 +72,7 @@ Seconds = ordered_range(gt=0, le=60)  # [low, high] s of a hand's turn or a fing
 PositiveList = Annotated[list[Annotated[float, Field(gt=0, le=1000)]], AfterValidator(_non_empty)]  # non-empty
 
 
-class CameraParams(Section):
+class AhatCameraParams(Section):
     """AHAT-like pinhole camera (docs/references.md: 512 x 512); the world frame is the camera frame shifted by origin_m."""
 
     width: int = Field(ge=16, le=IMAGE_MAX_PX)
@@ -257,7 +257,7 @@ class TrackParams(Section):
     seed: Seed
     markers_body: list[MarkerPoint]  # m, body frame (docs/references.md)
     drop_marker: int = Field(ge=0, le=100)  # the marker removed for the 3-marker variant (params.yaml says why); an index of markers_body
-    camera: CameraParams
+    camera: AhatCameraParams
     frames: FrameParams
     detection: DetectionParams
     matching: MatchingParams

@@ -25,7 +25,7 @@ from pydantic.fields import FieldInfo
 from poseintegrity.config import Params, ParamsError, load_params, parse_params
 from poseintegrity.schema import FromList, Section
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 # Numeric places allowed without both bounds, each with its reason. Empty: every number of params.yaml has both
 # (seeds through ``schema.Seed``: 0 <= seed < 2**63, what numpy's SeedSequence takes). Add a place here only with
@@ -110,7 +110,7 @@ def walk_model(model: type[BaseModel], places: list[Place], models: dict[type, N
         return
     models[model] = None
     for name, info in model.model_fields.items():
-        module = model.__module__.removeprefix("poseintegrity.")  # two models are named CameraParams
+        module = model.__module__.removeprefix("poseintegrity.")  # the place names its module too
         _walk(f"{module}.{model.__name__}.{name}", info.annotation, list(info.metadata), places, models)
 
 

@@ -1,11 +1,11 @@
 """One parallel layer, two backends: map a function over a list of tasks on local processes or a Dask cluster.
 
-The ``parallel`` section of ``params.yaml`` chooses the backend (:class:`ParallelParams`); the code that runs
+The ``parallel`` section of ``params.yaml`` chooses the backend (:class:`~poseintegrity.params.parallel.ParallelParams`); the code that runs
 tasks does not change::
 
     from functools import partial
     from poseintegrity.config import load_section
-    from poseintegrity.parallel import Workers
+    from poseintegrity.workers import Workers
 
     parallel = load_section("params.yaml", "parallel")
     with Workers(parallel) as workers:                    # connects (or starts a LocalCluster) before any work
@@ -31,54 +31,16 @@ import time
 from collections.abc import Callable, Sequence
 from functools import partial
 from pathlib import Path
-from typing import Literal, TypeVar
-from urllib.parse import urlsplit
+from typing import TypeVar
 
 import cv2
 import joblib
-from pydantic import Field, ValidationInfo, field_validator
 from tqdm import tqdm
 
-from poseintegrity.schema import Section, WorkerCount
+from poseintegrity.params.parallel import ParallelParams
 
 Task = TypeVar("Task")
 Result = TypeVar("Result")
-
-DASK_SCHEMES = ("tcp", "tls", "ws", "wss")
-
-
-class ParallelParams(Section):
-    """The ``parallel`` section of ``params.yaml``: where the per-frame and per-dataset tasks run."""
-
-    backend: Literal["local", "dask"] = Field(
-        "local", description="local: joblib (loky) worker processes on this machine; dask: a Dask cluster")
-    address: str | None = Field(
-        None, description="dask only: a scheduler address such as tcp://host:8786; null starts a LocalCluster "
-                          "of n_jobs single-threaded worker processes on this machine")
-    n_jobs: WorkerCount = Field(
-        2, description="worker processes of the local backend and of a LocalCluster (-1: all cores); "
-                       "a scheduler at `address` has the workers that joined it")
-
-    @field_validator("address")
-    @classmethod
-    def _valid_address(cls, address: str | None, info: ValidationInfo) -> str | None:
-        if address is None:
-            return None
-        if info.data.get("backend") != "dask":
-            raise ValueError("an address is only used with backend: dask (set backend: dask, or address: null)")
-        parts = urlsplit(address)
-        if parts.scheme not in DASK_SCHEMES or not parts.hostname or parts.path or _port(parts) is None:
-            raise ValueError(f"expected a Dask scheduler address such as tcp://host:8786 "
-                             f"(schemes {', '.join(DASK_SCHEMES)}), got {address!r}")
-        return address
-
-
-def _port(parts) -> int | None:
-    try:
-        return parts.port
-    except ValueError:  # not a number or out of range
-        return None
-
 
 def worker_count(params: ParallelParams, connect_timeout_s: float = 10.0) -> int:
     """How many tasks run at once: ``n_jobs`` (-1: the cores of this machine) for local processes and a

@@ -3,9 +3,9 @@
 import pytest
 
 from params_cases import refusal
-from poseintegrity.scenes import dataset
-from poseintegrity.scenes.optics import defocus_sigma_px
 from poseintegrity.params.generate import GenerateParams
+from poseintegrity.scenes import trips
+from poseintegrity.scenes.optics import defocus_sigma_px
 
 NO_LIGHT = {"ambient": 0.0, "ring": 0.0, "room": 0.0, "background": 0.5}
 
@@ -107,7 +107,7 @@ def test_every_key_is_set_by_params_yaml():
 
 def test_dataset_ids_are_the_plan_and_distinct(tiny_params):
     ids = tiny_params.generate.dataset_ids()
-    assert ids == [plan.dataset for plan in dataset.plan_datasets(tiny_params.generate)]
+    assert ids == [plan.dataset for plan in trips.plan_datasets(tiny_params.generate)]
     assert len(set(ids)) == len(ids)
 
 

@@ -1,4 +1,4 @@
-"""The CPU dispatch pin (poseintegrity.dispatch): every library capped at AVX2 and OpenBLAS on its Haswell kernels by
+"""The CPU dispatch pin (poseintegrity.kernel_pin): every library capped at AVX2 and OpenBLAS on its Haswell kernels by
 the package import, whatever the user's environment asks, in this process, in the stage runner's kernel, in the
 venv's Jupyter kernels and in a shell of the Dask recipe."""
 
@@ -11,8 +11,8 @@ from types import SimpleNamespace
 
 import pytest
 
-from poseintegrity import dispatch
-from poseintegrity.dispatch import openblas_cores, pin_dispatch, pinned_environment, unpinned_dispatch
+from poseintegrity import kernel_pin
+from poseintegrity.kernel_pin import openblas_cores, pin_dispatch, pinned_environment, unpinned_dispatch
 
 AVX_CPU = frozenset({"sse4_2", "avx"})
 AVX2_CPU = AVX_CPU | {"avx2", "fma"}
@@ -53,8 +53,8 @@ def test_the_pin_replaces_a_users_values_unless_switched_to_native():
     replaced = pin_dispatch(environ)
     assert environ["ATEN_CPU_CAPABILITY"] == "avx2" and environ["OPENCV_CPU_DISABLE"] != "AVX2"
     assert replaced["ATEN_CPU_CAPABILITY"] == ("default", "avx2") and "NUMBA_CPU_NAME" not in replaced  # the same
-    assert environ.items() >= pinned_environment(dispatch.cpu_flags()).items()
-    if dispatch.OPENBLAS_NEEDS <= dispatch.cpu_flags():
+    assert environ.items() >= pinned_environment(kernel_pin.cpu_flags()).items()
+    if kernel_pin.OPENBLAS_NEEDS <= kernel_pin.cpu_flags():
         assert replaced["OPENBLAS_CORETYPE"] == ("Prescott", "Haswell") and environ["OPENBLAS_CORETYPE"] == "Haswell"
     native = {"POSEINTEGRITY_CPU_DISPATCH": "native", "OPENCV_CPU_DISABLE": "AVX2"}
     assert pin_dispatch(native) == {} and native["OPENCV_CPU_DISABLE"] == "AVX2"
@@ -86,9 +86,9 @@ def test_libraries_loaded_above_the_ceiling_are_named():
     assert unpinned_dispatch({"cv2": capped}, {}, SKX_CPU) == []
     assert unpinned_dispatch({}, {"libopenblas.so": "Sandybridge"}, AVX_CPU) == []  # no Haswell kernels to pin to
     with pytest.warns(RuntimeWarning, match="OpenCV dispatches AVX512-SKX.*import poseintegrity first"):
-        dispatch.check_dispatch(modules={"cv2": cv2}, openblas={})
+        kernel_pin.check_dispatch(modules={"cv2": cv2}, openblas={})
     with pytest.warns(RuntimeWarning, match="OPENBLAS_CORETYPE='Haswell' in place of your 'Prescott'"):
-        dispatch.check_dispatch({"OPENBLAS_CORETYPE": ("Prescott", "Haswell")}, modules={})
+        kernel_pin.check_dispatch({"OPENBLAS_CORETYPE": ("Prescott", "Haswell")}, modules={})
 
 
 def test_this_process_is_pinned():
@@ -98,7 +98,7 @@ def test_this_process_is_pinned():
 
     assert unpinned_dispatch() == []
     assert os.environ["NUMBA_CPU_NAME"] == "haswell"
-    if dispatch.OPENBLAS_NEEDS <= dispatch.cpu_flags():
+    if kernel_pin.OPENBLAS_NEEDS <= kernel_pin.cpu_flags():
         assert set(openblas_cores().values()) == {"Haswell"}
     assert not np._core._multiarray_umath.__cpu_features__.get("X86_V4")
     assert torch.backends.cpu.get_cpu_capability() in ("AVX2", "DEFAULT", "NO AVX")
@@ -111,7 +111,7 @@ def _hash(script: str, env: dict[str, str]) -> str:
     return run.stdout.strip()
 
 
-@pytest.mark.skipif("avx2" not in dispatch.cpu_flags(), reason="the AVX2 path needs an AVX2 CPU")
+@pytest.mark.skipif("avx2" not in kernel_pin.cpu_flags(), reason="the AVX2 path needs an AVX2 CPU")
 def test_sift_moves_with_the_dispatch_level_unpinned_and_not_pinned():
     native = {"POSEINTEGRITY_CPU_DISPATCH": "native"}
     avx2, avx = {"OPENCV_CPU_DISABLE": ""}, {"OPENCV_CPU_DISABLE": "AVX2"}
@@ -120,7 +120,7 @@ def test_sift_moves_with_the_dispatch_level_unpinned_and_not_pinned():
     assert _hash(SIFT_HASH, pinned | avx2) == _hash(SIFT_HASH, pinned | avx)
 
 
-@pytest.mark.skipif("avx512f" not in dispatch.cpu_flags(), reason="IPP's AVX-512 level needs an AVX-512 CPU")
+@pytest.mark.skipif("avx512f" not in kernel_pin.cpu_flags(), reason="IPP's AVX-512 level needs an AVX-512 CPU")
 def test_sift_moves_with_opencvs_ipp_level_unpinned_and_not_pinned():
     """OpenCV's Intel IPP dispatches by itself (OPENCV_CPU_DISABLE does not reach it): its AVX2 and AVX-512 code
     give other SIFT angles and descriptors; pinned, IPP is off whatever the user asks."""
@@ -129,7 +129,7 @@ def test_sift_moves_with_opencvs_ipp_level_unpinned_and_not_pinned():
     assert _hash(SIFT_HASH, pinned | {"OPENCV_IPP": "avx2"}) == _hash(SIFT_HASH, pinned | {"OPENCV_IPP": ""})
 
 
-@pytest.mark.skipif(not dispatch.OPENBLAS_NEEDS <= dispatch.cpu_flags(), reason="Haswell's kernels need AVX2 + FMA")
+@pytest.mark.skipif(not kernel_pin.OPENBLAS_NEEDS <= kernel_pin.cpu_flags(), reason="Haswell's kernels need AVX2 + FMA")
 def test_a_matrix_product_moves_with_openblas_kernels_unpinned_and_not_pinned():
     """Sandybridge's kernels (AVX, no FMA) run on every AVX2 CPU: left to the user's OPENBLAS_CORETYPE, the product
     changes in its last bits; pinned, it is the Haswell kernels' whatever the user asks."""
@@ -156,7 +156,7 @@ print(sum_of_squares.inspect_asm(sum_of_squares.signatures[0]))
 """
 
 
-@pytest.mark.skipif("avx512f" not in dispatch.cpu_flags(), reason="needs an AVX-512 CPU to show numba's host features")
+@pytest.mark.skipif("avx512f" not in kernel_pin.cpu_flags(), reason="needs an AVX-512 CPU to show numba's host features")
 def test_numba_compiles_for_haswell_not_for_the_host(tmp_path):
     """NUMBA_CPU_NAME=haswell alone still let numba add the host's features: a fastmath loop became AVX-512 (zmm)
     code on an AVX-512 CPU and another summation width than on an AVX2 one. Pinned, it is AVX2 (ymm) code; native,
@@ -186,12 +186,12 @@ def test_a_jupyter_kernel_of_the_venv_is_pinned_before_its_first_cell(tmp_path):
     config = Path(sys.prefix) / "etc" / "ipython" / "ipython_kernel_config.py"
     assert "import poseintegrity" in config.read_text()
     env = {k: v for k, v in os.environ.items()
-           if k not in dispatch.FIXED and not k.startswith(("OPENCV_", "OPENBLAS_"))}
+           if k not in kernel_pin.FIXED and not k.startswith(("OPENCV_", "OPENBLAS_"))}
     env["JUPYTER_PATH"] = str(Path(sys.prefix) / "share" / "jupyter")
     manager, client = start_new_kernel(kernel_name="python3", env=env)
     try:
         out = []
-        client.execute_interactive("import numpy\nfrom poseintegrity.dispatch import unpinned_dispatch\n"
+        client.execute_interactive("import numpy\nfrom poseintegrity.kernel_pin import unpinned_dispatch\n"
                                    "print(unpinned_dispatch())", timeout=60,
                                    output_hook=lambda m: out.append(m["content"].get("text", "")))
     finally:
@@ -201,17 +201,17 @@ def test_a_jupyter_kernel_of_the_venv_is_pinned_before_its_first_cell(tmp_path):
 
 
 def test_the_dask_workers_recipe_pins_a_shell_that_never_imported_poseintegrity():
-    """README, "Running on a Dask cluster": eval "$(.venv/bin/python -m poseintegrity.dispatch)" before starting a
+    """README, "Running on a Dask cluster": eval "$(.venv/bin/python -m poseintegrity.kernel_pin)" before starting a
     worker exports the pinned environment."""
     venv_python = sys.executable
-    script = (f'eval "$({venv_python} -m poseintegrity.dispatch)" && '
+    script = (f'eval "$({venv_python} -m poseintegrity.kernel_pin)" && '
               f'{venv_python} -c "import os, cv2; print(os.environ[\'ATEN_CPU_CAPABILITY\'], '
               f'os.environ[\'NUMBA_CPU_NAME\'], repr(os.environ[\'OPENCV_CPU_DISABLE\']))"')
-    env = {k: v for k, v in os.environ.items() if k not in dispatch.FIXED and k != "OPENCV_CPU_DISABLE"}
+    env = {k: v for k, v in os.environ.items() if k not in kernel_pin.FIXED and k != "OPENCV_CPU_DISABLE"}
     run = subprocess.run(["bash", "-c", script], env=env, capture_output=True, text=True, check=True)
-    expected = pinned_environment(dispatch.cpu_flags())
+    expected = pinned_environment(kernel_pin.cpu_flags())
     assert run.stdout.split() == ["avx2", "haswell", repr(expected["OPENCV_CPU_DISABLE"])]
     assert run.stderr == ""  # runpy's RuntimeWarning ("found in sys.modules") no more
-    exports = subprocess.run([sys.executable, "-m", "poseintegrity.dispatch"], env=env, capture_output=True, text=True,
+    exports = subprocess.run([sys.executable, "-m", "poseintegrity.kernel_pin"], env=env, capture_output=True, text=True,
                              check=True).stdout
     assert all(f"export {name}='{value}'" in exports for name, value in expected.items())

@@ -1,9 +1,9 @@
-"""``python -m poseintegrity.dispatch``: this machine's pinned environment as shell ``export`` lines, for a process
+"""``python -m poseintegrity.kernel_pin``: this machine's pinned environment as shell ``export`` lines, for a process
 that does not start by importing poseintegrity (README, "Running on a Dask cluster")."""
 
 import sys
 
-from poseintegrity.dispatch import OPENCV_LOG, cpu_flags, pinned_environment
+from poseintegrity.kernel_pin import OPENCV_LOG, cpu_flags, pinned_environment
 
 
 def main() -> int:

@@ -10,9 +10,9 @@ import cloudpickle
 import numpy as np
 import pytest
 
-from poseintegrity import parallel
 from poseintegrity.config import ParamsError, parse_params
-from poseintegrity.parallel import ParallelParams, Progress, Workers, worker_count
+from poseintegrity.params.parallel import ParallelParams
+from poseintegrity.workers import Progress, Workers, _check_workers, in_worker_task, source_digest, worker_count
 
 # Worker processes cannot import this test module (pytest imports it from a path): send its functions by value,
 # as for functions defined in a notebook. The pipeline's functions live in poseintegrity, which workers import.
@@ -101,7 +101,7 @@ def test_tasks_run_with_one_opencv_thread_and_the_caller_keeps_its_own(request, 
 
 
 def task_location(_: int) -> bool:
-    return parallel.in_worker_task()
+    return in_worker_task()
 
 
 @pytest.mark.parametrize("backend", ["local", "dask"])
@@ -112,7 +112,7 @@ def test_tasks_know_whether_they_run_in_a_worker_process(request, backend):
         assert workers.map(task_location, range(3), progress=False) == [True, True, True]
     with Workers(ParallelParams(n_jobs=1)) as workers:
         assert workers.map(task_location, range(2), progress=False) == [False, False]
-    assert not parallel.in_worker_task()
+    assert not in_worker_task()
 
 
 def explode_on_three(value: int) -> int:
@@ -147,9 +147,9 @@ def test_unreachable_scheduler_fails_naming_the_key_before_any_work():
 def test_workers_running_other_code_are_refused_naming_the_key(cluster):
     """A worker from another checkout would compute other results, or hang a stage that it cannot unpickle."""
     with Workers(ParallelParams(backend="dask", address=cluster.scheduler_address)) as workers:
-        parallel._check_workers(workers._client, cluster.scheduler_address, parallel.source_digest())  # same code
+        _check_workers(workers._client, cluster.scheduler_address, source_digest())  # same code
         with pytest.raises(ConnectionError, match=r"parallel.address: workers \['tcp://127.0.0.1:\d+', 'tcp://"):
-            parallel._check_workers(workers._client, cluster.scheduler_address, "0" * 64)
+            _check_workers(workers._client, cluster.scheduler_address, "0" * 64)
 
 
 @pytest.mark.parametrize("section, key", [

@@ -16,7 +16,7 @@ any cell runs. Only this process and its children see it, never the machine's se
 of the caller's environment, :func:`check_dispatch` says so, once (the children inherit the pinned value).
 ``POSEINTEGRITY_CPU_DISPATCH=native`` leaves every library to its own choice (faster on AVX-512, machine-dependent
 numbers). For a process that does not start by importing poseintegrity (a Dask worker started by hand),
-``python -m poseintegrity.dispatch`` prints the settings as shell ``export`` lines (``__main__.py``: a module of its
+``python -m poseintegrity.kernel_pin`` prints the settings as shell ``export`` lines (``__main__.py``: a module of its
 own, so that running it does not run again what ``import poseintegrity`` has imported).
 
 Sources (docs/references.md, "CPU dispatch"): OpenCV's ``OPENCV_CPU_DISABLE`` (core/src/system.cpp), numpy's
@@ -194,5 +194,5 @@ def check_dispatch(replaced: Mapping[str, tuple[str, str]] = {}, modules: Mappin
     if found:
         warnings.warn(f"{'; '.join(found)}: loaded before poseintegrity, so not at the pinned {CEILING} level and "
                       f"its results may differ from other machines' in the last bits; import poseintegrity first, "
-                      f"or start Python with the environment of `python -m poseintegrity.dispatch`",
+                      f"or start Python with the environment of `python -m poseintegrity.kernel_pin`",
                       RuntimeWarning, stacklevel=3)

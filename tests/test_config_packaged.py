@@ -9,15 +9,15 @@ import numpy as np
 import pytest
 
 from poseintegrity.config import PACKAGED_PARAMS, default_params, load_params
-from poseintegrity.defaults import published
+from poseintegrity.config import published
 from poseintegrity.localization.features import detect_features
 from poseintegrity.localization.matching import match_ratio_test
-from poseintegrity.tracking.markers.correspondence import match_markers
-from poseintegrity.tracking.markers.detection import detect_markers
-from poseintegrity.tracking.simulation.frames import intrinsics, render_frame, unit_plane_lut
-from poseintegrity.tracking.markers.geometry import MARKER_DIAMETER_M
 from poseintegrity.tracking.filter.multi_tool import MultiToolTracker
 from poseintegrity.tracking.filter.tracker import MarkerTracker
+from poseintegrity.tracking.markers.correspondence import match_markers
+from poseintegrity.tracking.markers.detection import detect_markers
+from poseintegrity.tracking.markers.geometry import MARKER_DIAMETER_M
+from poseintegrity.tracking.simulation.frames import intrinsics, render_frame, unit_plane_lut
 
 from tracking.track_section import GEOMETRY
 

@@ -1,7 +1,7 @@
 """Stage wall times: one small JSON file per stage under ``reports/metrics/timing/`` (written by
 :mod:`poseintegrity.stage`), and the lines ``make repro`` ends with::
 
-    python -m poseintegrity.timing reports/metrics/timing
+    python -m poseintegrity.stage_timing reports/metrics/timing
 
     01_generate_datasets        412 s   local, n_jobs 2              finished 2025-11-23 14:02
     ...
@@ -17,9 +17,9 @@ import sys
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
+from poseintegrity.atomic_write import write_text_atomically
 from poseintegrity.errors import PoseIntegrityError
-from poseintegrity.parallel import describe_backend
-from poseintegrity.staging import write_text_atomically
+from poseintegrity.workers import describe_backend
 
 
 class TimingFileError(PoseIntegrityError):
