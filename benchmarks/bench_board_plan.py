@@ -2,7 +2,7 @@
 measured in the same run, on every session of params.yaml's worlds (main and validation: each scene's arcs, the
 lines).
 
-Each session is laid out once as stage 01 lays it out (scenes/dataset.laid_out, this tree's planner), which gives
+Each session is laid out once as stage 01 lays it out (scenes/world_checks.laid_out, this tree's planner), which gives
 plan_boards' arguments; then the reference's plan_boards (its board_plan.py read from git at ``--reference``,
 loaded as a module of its own) and this tree's are run alternately on them, ``--repeats`` times (this tree's kernels
 compiled and loaded first). Per session and in total: medians of wall seconds and of CPU-seconds (one process: on a
@@ -29,7 +29,7 @@ import poseintegrity  # noqa: F401 (first: pins the kernels' dispatch before num
 import numpy as np
 
 from poseintegrity.config import load_params
-from poseintegrity.scenes import board_plan, dataset
+from poseintegrity.scenes import board_plan, world_checks
 
 from git_reference import ROOT, module_at  # benchmarks/ (the scripts run from the repository root)
 
@@ -52,8 +52,8 @@ def sessions(everything) -> list[tuple[str, int, str, tuple, dict]]:
     try:
         out = []
         for world, params in everything.generate.worlds().items():
-            for index, session in dataset.sessions(params):
-                dataset.laid_out(params, everything.protocol, world, index, session)
+            for index, session in world_checks.sessions(params):
+                world_checks.laid_out(params, everything.protocol, world, index, session)
                 out.append((world, index, session, *calls[-1]))
         return out
     finally:

@@ -1,4 +1,4 @@
-"""What the kernel pin (poseintegrity.dispatch: every library capped at AVX2, OpenBLAS on its Haswell kernels) costs,
+"""What the kernel pin (poseintegrity.kernel_pin: every library capped at AVX2, OpenBLAS on its Haswell kernels) costs,
 on the two per-frame costs of the pipeline: rendering a stage-01 frame (the renderer's compiled kernels, the lens'
 blur, the sensor) and CLAHE + SIFT on it (stage 02). Each setting runs in a fresh process (the libraries read the
 setting when they load; the process imports poseintegrity before any of them), one thread, the settings interleaved
@@ -22,7 +22,7 @@ import os
 import subprocess
 import sys
 
-from poseintegrity.dispatch import FIXED, SWITCH  # before numpy, as everywhere (this process only starts the rows)
+from poseintegrity.kernel_pin import FIXED, SWITCH  # before numpy, as everywhere (this process only starts the rows)
 
 import numpy as np
 
@@ -40,17 +40,17 @@ import hashlib, json, sys, time
 import cv2
 import numpy as np
 from poseintegrity.config import load_params
-from poseintegrity.dispatch import openblas_cores
+from poseintegrity.kernel_pin import openblas_cores
 from poseintegrity.localization.features import detect_features
 from poseintegrity.poses import inverse
-from poseintegrity.scenes import dataset, optics, renderer, trajectories
+from poseintegrity.scenes import optics, renderer, trajectories, world_cache
 from poseintegrity.scenes.camera import true_camera
 from poseintegrity.seeding import keyed_rng
 
 cv2.setNumThreads(1)
 everything = load_params(sys.argv[1])
 params, protocol, extract = everything.generate, everything.protocol, everything.extract
-world = dataset.world(params, protocol, 0, "arc")
+world = world_cache.world(params, protocol, 0, "arc")
 spec = params.scenes[0]
 T_model = trajectories.model_pair(world.scene.aim, world.scene.view_dir, spec.distance_mm, params.model_baseline_mm)[0]
 stops = trajectories.arc(T_model, world.scene.aim, params.arcs.azimuths_deg[0], protocol.arc_span_deg, int(sys.argv[2]))

@@ -14,11 +14,11 @@ import time
 
 import cv2
 import numpy as np
-from timing import paired_medians  # benchmarks/timing.py
+from paired_timing import paired_medians  # benchmarks/paired_timing.py
 
 from poseintegrity.config import load_params
 from poseintegrity.poses import inverse
-from poseintegrity.scenes import dataset, optics, renderer, trajectories
+from poseintegrity.scenes import optics, renderer, shots, trajectories, world_cache
 from poseintegrity.scenes.acquisition import rotation_maps
 from poseintegrity.scenes.camera import Intrinsics, true_camera
 
@@ -57,7 +57,7 @@ def stop(world, T_cam_world, expose, png_flags) -> list[bytes]:
 
 
 def realistic_stop(world, T_cam_world, focus_mm) -> list[bytes]:
-    """One stop of today's stage 01 (scenes/dataset.take_shot without the writes): the lens' ideal canvas, depth of
+    """One stop of today's stage 01 (scenes/shots.take_shot without the writes): the lens' ideal canvas, depth of
     field per pixel, per image the ring-down warp and the lens distortion onto the sensor, expose, encode."""
     lens = true_camera(params.camera)
     K_canvas, width, height = lens.canvas
@@ -69,7 +69,7 @@ def realistic_stop(world, T_cam_world, focus_mm) -> list[bytes]:
         sensor = cv2.remap(irradiance, *rotation_maps(K_canvas, rotation, *lens.sensor_maps), cv2.INTER_LINEAR,
                            borderMode=cv2.BORDER_REPLICATE)
         images.append(cv2.imencode(".png", renderer.expose(sensor, params.sensor, np.random.default_rng([0, i])),
-                                   dataset.IMAGE_PNG_FLAGS)[1])
+                                   shots.IMAGE_PNG_FLAGS)[1])
     return images
 
 
@@ -83,7 +83,7 @@ def median_ms(fn, repeats: int) -> float:
 
 
 for scene_index in (0, 1, 2, 4):  # a scapula, the drilled scapula, a block, a scapula + block
-    world = dataset.world(params, scene_index)
+    world = world_cache.world(params, scene_index)
     spec = params.scenes[scene_index]
     T0 = trajectories.model_pair(world.scene.aim, world.scene.view_dir, spec.distance_mm, params.model_baseline_mm)[0]
     azimuth = params.arcs.azimuths_deg[min(1, len(params.arcs.azimuths_deg) - 1)]  # 90: down towards the table
@@ -105,16 +105,16 @@ for scene_index in (0, 1, 2, 4):  # a scapula, the drilled scapula, a block, a s
     print(f"  warpPerspective {warp_ms:6.2f} ms -> render + sensor = {full_ms / warp_ms:.0f} x a flat warp")
 
     reference = lambda: stop(world, T_cam_world, reference_expose, REFERENCE_PNG_FLAGS)  # noqa: E731
-    current = lambda: stop(world, T_cam_world, renderer.expose, dataset.IMAGE_PNG_FLAGS)  # noqa: E731
+    current = lambda: stop(world, T_cam_world, renderer.expose, shots.IMAGE_PNG_FLAGS)  # noqa: E731
     assert all((cv2.imdecode(a, cv2.IMREAD_UNCHANGED) == cv2.imdecode(b, cv2.IMREAD_UNCHANGED)).all()
                for a, b in zip(reference(), current())), "the pixels of a stop changed"
     sensor_ref, sensor_now = paired_medians(lambda: reference_expose(frame.radiance, params.sensor, rng),
                                             lambda: renderer.expose(frame.radiance, params.sensor, rng), 15)
     png_ref, png_now = paired_medians(lambda: cv2.imencode(".png", image, REFERENCE_PNG_FLAGS),
-                                      lambda: cv2.imencode(".png", image, dataset.IMAGE_PNG_FLAGS), 15)
+                                      lambda: cv2.imencode(".png", image, shots.IMAGE_PNG_FLAGS), 15)
     stop_ref, stop_now = paired_medians(reference, current, 5)
     size_ref, size_now = (len(cv2.imencode(".png", image, flags)[1])
-                          for flags in (REFERENCE_PNG_FLAGS, dataset.IMAGE_PNG_FLAGS))
+                          for flags in (REFERENCE_PNG_FLAGS, shots.IMAGE_PNG_FLAGS))
     print(f"  sensor {1000 * sensor_now:5.1f} ms vs numpy {1000 * sensor_ref:5.1f} ms: {sensor_ref / sensor_now:.2f} x")
     print(f"  PNG {1000 * png_now:5.1f} ms vs zlib level 3 {1000 * png_ref:5.1f} ms: {png_ref / png_now:.2f} x; "
           f"{size_now / 1e3:.0f} kB vs {size_ref / 1e3:.0f} kB")

@@ -3,7 +3,7 @@
 1. The ring-down warp maps of one exposure (scenes/acquisition.rotation_maps, ~5 900 a run) at the paper-scale
    resolution: the compiled pass against the numpy expressions it replaced (kept below), paired medians over
    exposures' rotations, and whether every map value is equal to the bit.
-2. Planning the worlds (calibration sessions, robot placement and drives): the tasks of scenes/dataset.plan_worlds
+2. Planning the worlds (calibration sessions, robot placement and drives): the tasks of scenes/world_plan.plan_worlds
    run one after the other in the notebook's process, as before, against this tree's run on two worker processes
    (started and warmed first, as the stage's rendering needs them anyway); wall times, and whether the plans are
    equal, value for value (routes, ring-downs, calibrations, robot accuracy).
@@ -21,14 +21,14 @@ from functools import partial
 import cv2
 import numpy as np
 from scipy.spatial.transform import Rotation
-from timing import paired_medians  # benchmarks/timing.py
+from paired_timing import paired_medians  # benchmarks/paired_timing.py
 
 from poseintegrity.config import load_params
-from poseintegrity.parallel import Workers
-from poseintegrity.scenes import dataset
+from poseintegrity.scenes import world_plan
 from poseintegrity.scenes.acquisition import rotation_maps
 from poseintegrity.scenes.calibration_views import render_view
 from poseintegrity.scenes.camera import true_camera
+from poseintegrity.workers import Workers
 
 
 def reference_rotation_maps(K, rotation, map_x, map_y):
@@ -98,7 +98,7 @@ def planning(everything, rounds: int) -> None:
             for _ in range(rounds):
                 traced_workers = Traced(workers)
                 start = time.perf_counter()
-                plans[n_jobs] = dataset.plan_worlds(params, protocol, traced_workers, progress=False)
+                plans[n_jobs] = world_plan.plan_worlds(params, protocol, traced_workers, progress=False)
                 seconds[n_jobs].append(time.perf_counter() - start)
                 traces[n_jobs] = traced_workers.traces
     old, new = np.median(seconds[1]), np.median(seconds[2])

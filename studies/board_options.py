@@ -36,9 +36,9 @@ from poseintegrity.lens import Camera
 from poseintegrity.localization.dataset import load_dataset, load_index
 from poseintegrity.localization.features import read_gray
 from poseintegrity.localization.ground_truth import board_pose, truth_error
-from poseintegrity.parallel import Workers
 from poseintegrity.poses import pose_errors
 from poseintegrity.scenes.dataset import generate
+from poseintegrity.workers import Workers
 
 CHARUCO = dict(type="charuco", dictionary="DICT_4X4_50", margin_mm=6.0, px_per_mm=8.0, placement="facing_camera")
 SIZES = [12.0, 15.0, 18.0, 21.0, 24.0]

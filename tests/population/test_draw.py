@@ -100,7 +100,7 @@ def test_a_scene_the_robot_cannot_serve_is_drawn_again_and_the_file_says_why(tmp
 def test_the_robot_check_refuses_a_scene_stage_01_would_refuse():
     """arc_problem is stage 01's own check (robot placement): a scene at 900 mm, far beyond a UR5e's reach, and the
     main world's own scenes, which stage 01 renders."""
-    from poseintegrity.scenes.dataset import arc_problem
+    from poseintegrity.scenes.world_checks import arc_problem
 
     far = PARAMS.generate.model_copy(update={"lines": None, "scenes": [PARAMS.generate.scenes[0].model_copy(
         update={"distance_mm": 900.0})]})

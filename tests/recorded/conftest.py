@@ -14,8 +14,8 @@ sys.path[:0] = [str(Path(__file__).parents[1] / "localization"), str(Path(__file
 import loc_synthetic as synthetic  # noqa: E402
 
 from poseintegrity.config import load_params  # noqa: E402
-from poseintegrity.parallel import Workers  # noqa: E402
 from poseintegrity.recorded.export import export_all  # noqa: E402
+from poseintegrity.workers import Workers  # noqa: E402
 from repository import ROOT  # noqa: E402
 
 TINY_PARAMS = ROOT / "tests" / "params_tiny.yaml"

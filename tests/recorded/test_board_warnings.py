@@ -10,11 +10,11 @@ import numpy as np
 import pytest
 
 from foreign_datasets import Folder, write_folder
-from poseintegrity.defaults import published
+from poseintegrity.config import published
 from poseintegrity.localization.board_warnings import board_warnings
+from poseintegrity.localization.envelope import envelopes, headline
 from poseintegrity.localization.extract import extract_dataset
 from poseintegrity.localization.summaries import dataset_summary
-from poseintegrity.localization.envelope import envelopes, headline
 from poseintegrity.recorded.materialize import materialize
 from repository import ROOT
 

@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 import yaml
 
+from poseintegrity.atomic_write import DestinationError
 from poseintegrity.lens import read_camera_yaml
 from poseintegrity.recorded.export import export_all
-from poseintegrity.staging import DestinationError
 from recorded_tools import bag_inputs, run, write_bag
 
 

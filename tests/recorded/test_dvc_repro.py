@@ -13,7 +13,7 @@ never the exporter), in three worlds:
 
 Every output dvc.yaml declares must exist, and the summary must say what was measured on the data without judging
 a rendered world. What a run of one world only writes (no held-out world, a first world of arcs only) is checked on
-the summary's side in tests/test_report_recorded.py. The run starts from the session's project copy in which stage
+the summary's side in tests/report/test_recorded.py. The run starts from the session's project copy in which stage
 06 (marker tracking, which reads no recording) is done (tests/project_copy.py, stage_06_project): DVC finds it
 unchanged and runs the other six stages. It prints its wall time and CPU seconds (`pytest -s`).
 """

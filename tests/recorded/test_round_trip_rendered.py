@@ -11,11 +11,11 @@ import pytest
 from poseintegrity.config import load_params
 from poseintegrity.localization.dataset import load_index
 from poseintegrity.localization.extract import extract_dataset
-from poseintegrity.parallel import Workers
 from poseintegrity.recorded.export import export_all
 from poseintegrity.recorded.materialize import materialize_source
 from poseintegrity.recorded.reader import problems, read_recorded
 from poseintegrity.scenes import dataset
+from poseintegrity.workers import Workers
 from recorded_tools import assert_rows_identical
 from repository import ROOT
 

@@ -1,24 +1,23 @@
 """How the lab plans a scene's ground-truth boards (scenes/board_plan.py, issue 39), checked against geometry and
-detection of our own: the board issue 30's rule stands leaves the image late in an arc, the plan's printed pattern
-stays wholly in view at every stop of the trajectories it serves (its white margin may leave it: OpenCV's detector
-finds every corner of a board whose margin the image cuts off), and rendered where the other left the view it is
-found whole and trusted; where one board cannot serve every trajectory the plan adds a second with marker ids of its
-own, apart from the first; the predicted uncertainty is OpenCV's, and the plan's margin on it is how far stage 02's
-own estimate scatters."""
+detection of our own: the board issue 30's rule stands leaves the image late in an arc, the plan's board keeps at
+least MIN_PLAN_CORNERS inner corners in view at every stop of the trajectories it serves, and rendered where the other
+left the view it is found whole and trusted; where one board cannot serve every trajectory the plan adds a second
+with marker ids of its own, apart from the first."""
 
 from __future__ import annotations
 
 import cv2
 import numpy as np
 import pytest
-from scipy.spatial.transform import Rotation
 
 from poseintegrity.config import load_params
 from poseintegrity.lens import Camera
-from poseintegrity.localization.ground_truth import board_pose, detect_board_points
-from poseintegrity.poses import inverse, pose_matrix
-from poseintegrity.scenes import board_placement, board_plan, catalog, dataset, optics, renderer, textures
+from poseintegrity.localization.ground_truth import board_pose
+from poseintegrity.poses import inverse
+from poseintegrity.scenes import board_criteria, optics, renderer, world_cache
 from poseintegrity.scenes.camera import true_camera
+from poseintegrity.scenes.scene_boards import SceneBoard
+from poseintegrity.scenes.trajectories import arc_trajectories
 from poseintegrity.seeding import keyed_rng
 from repository import ROOT
 
@@ -42,18 +41,18 @@ def world(params, scene_index: int, placement: str, azimuths: list[float], plan_
                       plan_sigma_t_mm=plan_sigma_t_mm or board["plan_sigma_t_mm"])
     generate = generate.model_copy(update={"board": type(generate.board).model_validate(board),
                                            "arcs": generate.arcs.model_copy(update={"azimuths_deg": azimuths})})
-    return generate, dataset.world(generate, params.protocol, scene_index, "arc")
+    return generate, world_cache.world(generate, params.protocol, scene_index, "arc")
 
 
 def stops(generate, protocol, scene, index):
     """Per arc of scene ``index`` its commanded T_world_cam: model image 0 and every stop."""
-    pair, arcs = board_placement.arc_trajectories(scene.aim, scene.view_dir, generate.scenes[index].distance_mm,
-                                                  generate.model_baseline_mm, generate.arcs.azimuths_deg,
-                                                  protocol.arc_span_deg, generate.arcs.n_stops)
+    pair, arcs = arc_trajectories(scene.aim, scene.view_dir, generate.scenes[index].distance_mm,
+                                  generate.model_baseline_mm, generate.arcs.azimuths_deg, protocol.arc_span_deg,
+                                  generate.arcs.n_stops)
     return [[pair[0], *arc] for arc in arcs]
 
 
-def paper(board: catalog.SceneBoard, margin: float) -> np.ndarray:
+def paper(board: SceneBoard, margin: float) -> np.ndarray:
     """The board's paper corners (4, 3), world mm (``margin`` 0: its printed pattern's)."""
     w, h = board.drawing.size_mm
     local = np.array([[-margin, -margin, 0], [w + margin, -margin, 0], [w + margin, h + margin, 0],
@@ -76,7 +75,7 @@ def _rvec_tvec(T: np.ndarray):
     return cv2.Rodrigues(T[:3, :3])[0], T[:3, 3]
 
 
-def rendered_board(generate, scene_world, T_world_cam: np.ndarray, focus_mm: float, board: catalog.SceneBoard):
+def rendered_board(generate, scene_world, T_world_cam: np.ndarray, focus_mm: float, board: SceneBoard):
     """The board's checked pose in the image taken at T_world_cam (no ring-down), with the true camera."""
     lens = true_camera(generate.camera)
     K_canvas, width, height = lens.canvas
@@ -87,7 +86,7 @@ def rendered_board(generate, scene_world, T_world_cam: np.ndarray, focus_mm: flo
     return board_pose(image, board.board, Camera(lens.K, lens.dist, lens.width, lens.height))
 
 
-def corners_in_view(board: catalog.SceneBoard, T_world_cam: np.ndarray, generate) -> int:
+def corners_in_view(board: SceneBoard, T_world_cam: np.ndarray, generate) -> int:
     """How many of the board's inner corners have all four of their squares inside the image of the pinhole of the
     true intrinsics (OpenCV's projectPoints): the corners a ChArUco detector can interpolate from their markers."""
     drawing = board.drawing
@@ -119,7 +118,7 @@ def test_a_board_that_would_leave_the_view_late_is_moved_and_judges_every_stop(p
     assert new.scene.plan.unserved == (0,) * len(AZIMUTHS)  # every stop served
     new_stops = stops(after, params.protocol, new.scene, index)
     for poses, b in zip(new_stops, new.scene.board_of):
-        assert min(corners_in_view(new.scene.boards[b], T, after) for T in poses) >= board_plan.MIN_PLAN_CORNERS
+        assert min(corners_in_view(new.scene.boards[b], T, after) for T in poses) >= board_criteria.MIN_PLAN_CORNERS
     missed = rendered_board(before, old, stops(before, params.protocol, old.scene, index)[arc][stop], focus, old_board)
     board = new.scene.board_for(arc)
     found = rendered_board(after, new, new_stops[arc][stop], focus, board)
@@ -131,7 +130,7 @@ def test_a_board_that_would_leave_the_view_late_is_moved_and_judges_every_stop(p
 def test_where_one_board_cannot_serve_every_arc_a_second_one_with_its_own_ids_stands_apart(params, monkeypatch):
     """Asked for every corner of a board in view (a stricter rule than the plan's), one board cannot serve scene_3's
     three arcs: the plan adds a second, with marker ids of its own, that never overlaps the first in the image."""
-    monkeypatch.setattr(board_plan, "MIN_PLAN_CORNERS", 24)
+    monkeypatch.setattr(board_criteria, "MIN_PLAN_CORNERS", 24)
     index = 2  # the main world's scene_3: a printed block at 320 mm, three arcs; a limit on sigma_t loose enough
     generate, built = world(params, index, "planned", params.generate.arcs.azimuths_deg, 0.3)  # that the view decides
     scene, plan = built.scene, built.scene.plan
@@ -148,88 +147,3 @@ def test_where_one_board_cannot_serve_every_arc_a_second_one_with_its_own_ids_st
         quads = [cv2.projectPoints(paper(board, 6.0), *_rvec_tvec(inverse(T)), camera.K, None)[0].reshape(-1, 2)
                  .astype(np.float32) for board in scene.boards]
         assert cv2.intersectConvexConvex(*quads)[0] == 0
-
-
-def test_the_predicted_uncertainty_is_opencvs_at_any_point_of_the_board():
-    """sigma_t of the plan (left-perturbed rotation, the translation of the point) against OpenCV's
-    projectPoints Jacobian (rvec, tvec), at the board origin and at a point 80 mm off it."""
-    K = np.array([[1024.0, 0.0, 484.0], [0.0, 1024.0, 304.0], [0.0, 0.0, 1.0]])
-    T = pose_matrix(Rotation.from_euler("xyz", [20.0, -30.0, 5.0], degrees=True).as_matrix(), [-40.0, 10.0, 350.0])
-    corners = np.array([[15.0 * (i + 1), 15.0 * (j + 1), 0.0] for j in range(4) for i in range(6)])
-    for point in (np.zeros(3), np.array([80.0, -20.0, 0.0])):
-        shifted = corners - point  # the same board with its origin at the point
-        _, jacobian = cv2.projectPoints(shifted, *_rvec_tvec(T @ pose_matrix(np.eye(3), point)), K, None)
-        expected = np.sqrt(np.trace(np.linalg.inv(jacobian[:, :6].T @ jacobian[:, :6])[3:, 3:]))
-        world = corners @ T[:3, :3].T + T[:3, 3]
-        got = board_plan._unit_sigma_t(world[None], (T[:3, :3] @ point + T[:3, 3])[None], np.eye(4), K)[0]
-        assert got == pytest.approx(expected, rel=1e-9)
-
-
-def test_a_board_partly_beyond_the_image_serves_while_half_its_corners_are_found(params):
-    """A 7 x 5 board facing a camera 300 mm away (K of f = 1024 px, squares of 51.2 px), its pattern's left edge 10 px
-    inside the image (its 6 mm white margin beyond the edge), then two and three squares and 10 px beyond it: the plan
-    counts 24, 12 and 8 inner corners found (a corner needs its four squares' markers) and serves the first two
-    (MIN_PLAN_CORNERS = 12); OpenCV's ChArUco detector, in synthetic images of the printed board so cut, finds all 24
-    corners, then at least the 12 the plan counts."""
-    generate = params.generate.world("main")
-    drawing = generate.board.drawing()
-    K, width, height, depth = np.array([[1024.0, 0.0, 484.0], [0.0, 1024.0, 304.0], [0.0, 0.0, 1.0]]), 968, 608, 300.0
-    pattern = np.array(drawing.size_mm, float)
-    margin = generate.board.margin_mm
-    square_px = drawing.square_mm * K[0, 0] / depth
-    px_per_mm = 8.0
-    texture = textures.board_texture(drawing, px_per_mm, margin)
-    scale = K[0, 0] / depth / px_per_mm
-    top = K[1, 2] - pattern[1] / 2 * K[1, 1] / depth
-    counted, served, found = [], [], []
-    for left_px in (10.0, -2 * square_px - 10.0, -3 * square_px - 10.0):
-        left_mm = (left_px - K[0, 2]) * depth / K[0, 0]
-        centre = np.array([[left_mm + pattern[0] / 2, 0.0, depth]])
-        axes = [np.array([v]) for v in np.eye(3)]  # x right, y down, z into the board: its print faces the camera
-        c = board_plan._Candidates(centre, *axes, pattern[None], np.array([drawing.square_mm]),
-                                   pattern[None] + 2 * margin)
-        cells = drawing.cv_board().getDictionary().markerSize + 2
-        judged = board_plan._judge(c, [np.eye(4)], [], (drawing.squares_x, drawing.squares_y), cells,
-                                   drawing.marker_mm / drawing.square_mm, K, width, height, depth, generate.camera,
-                                   generate.sensor.blur_sigma_px)
-        counted.append(int(board_plan._seen(
-            _lattice_in_image(left_px, square_px, drawing, K, width, height), (drawing.squares_x, drawing.squares_y)
-        ).sum()))
-        served.append(bool(judged.served[0, 0]))
-        # the printed board (with its margin) scaled to the camera's px per mm, cut by the image's left edge
-        shift = np.array([[scale, 0.0, left_px - margin * px_per_mm * scale],
-                          [0.0, scale, top - margin * px_per_mm * scale]])
-        image = cv2.warpAffine(texture, shift, (width, height), flags=cv2.INTER_AREA, borderValue=255)
-        if left_px > 0:
-            assert image[:, 0].min() > 150  # the image's edge cuts the white margin only
-        found.append(len(detect_board_points(image, drawing)[0]))
-    assert counted == [24, 12, 8] and served == [True, True, False]
-    assert found[0] == 24 and found[1] >= 12
-
-
-def _lattice_in_image(left_px: float, square_px: float, drawing, K, width: int, height: int) -> np.ndarray:
-    """(1, lattice) which corners of the squares of a board facing the camera, its left edge at ``left_px``, are in
-    the image (rows of board_plan._lattice)."""
-    u = left_px + square_px * np.arange(drawing.squares_x + 1)
-    v = K[1, 2] + square_px * (np.arange(drawing.squares_y + 1) - drawing.squares_y / 2)
-    uu, vv = np.meshgrid(u, v)
-    return ((uu >= 0) & (uu <= width - 1) & (vv >= 0) & (vv <= height - 1)).reshape(1, -1)
-
-
-def test_the_plans_margin_on_sigma_t_is_how_far_stage_02s_estimate_scatters():
-    """Stage 02 trusts a pose by its own sigma_t, s (J^T J)^-1 with s^2 = SSR / (2n - 6): over 4000 draws of Gaussian
-    noise on the 24 corners of a 7 x 5 board at 350 mm, fitted by OpenCV (IPPE, then LM as stage 02 does), the 95th
-    percentile of s / sigma is the plan's margin (the chi-square quantile) to within the draws' scatter."""
-    K = np.array([[1024.0, 0.0, 484.0], [0.0, 1024.0, 304.0], [0.0, 0.0, 1.0]])
-    T = pose_matrix(Rotation.from_euler("xyz", [25.0, -20.0, 5.0], degrees=True).as_matrix(), [-40.0, 10.0, 350.0])
-    corners = np.array([[15.0 * (i + 1), 15.0 * (j + 1), 0.0] for j in range(4) for i in range(6)])
-    exact, _ = cv2.projectPoints(corners, *_rvec_tvec(T), K, None)
-    rng, sigma_px, ratios = np.random.default_rng(39), 0.1, []
-    for _ in range(4000):
-        seen = exact.reshape(-1, 2) + sigma_px * rng.standard_normal((len(corners), 2))
-        _, rvec, tvec = cv2.solvePnP(corners, seen, K, None, flags=cv2.SOLVEPNP_IPPE)
-        rvec, tvec = cv2.solvePnPRefineLM(corners, seen, K, None, rvec, tvec)
-        residual = cv2.projectPoints(corners, rvec, tvec, K, None)[0].reshape(-1, 2) - seen
-        ratios.append(np.sqrt(np.sum(residual**2) / (2 * len(corners) - 6)) / sigma_px)
-    assert np.quantile(ratios, 0.95) == pytest.approx(board_plan.estimate_spread(len(corners)), abs=0.015)
-    assert board_plan.estimate_spread(len(corners)) == pytest.approx(1.176, abs=0.001)

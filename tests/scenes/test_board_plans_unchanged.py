@@ -1,6 +1,6 @@
 """The board planner made fast (issue 49) plans what it planned before: every session of params.yaml's worlds (main
 and validation: each scene's arcs, the lines' scene's lines), laid out as stage 01 lays it out
-(scenes/dataset.laid_out), gets the plan the planner of commit 3e10f65 made, to the bit: the same boards (square
+(scenes/world_checks.laid_out), gets the plan the planner of commit 3e10f65 made, to the bit: the same boards (square
 size, first marker id, T_world_board, post foot and top, share in view), their worst predicted sigma_t, each
 trajectory's board and its poses left unserved.
 
@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from poseintegrity.config import load_params
-from poseintegrity.scenes import dataset
+from poseintegrity.scenes import world_checks
 from repository import ROOT
 
 BEFORE = Path(__file__).with_name("board_plans_3e10f65.json")
@@ -28,12 +28,13 @@ def test_every_session_of_the_committed_worlds_is_planned_as_before():
     before = json.loads(BEFORE.read_text())["sessions"]
     worlds = everything.generate.worlds()
     assert [(s["world"], s["scene"], s["session"]) for s in before] == [
-        (world, index, session) for world, params in worlds.items() for index, session in dataset.sessions(params)]
+        (world, index, session) for world, params in worlds.items()
+        for index, session in world_checks.sessions(params)]
     differences = []
     for expected in before:
         where = f"{expected['world']} scene {expected['scene']} {expected['session']}s"
-        plan = dataset.laid_out(worlds[expected["world"]], everything.protocol, expected["world"], expected["scene"],
-                                expected["session"]).plan
+        plan = world_checks.laid_out(worlds[expected["world"]], everything.protocol, expected["world"],
+                                     expected["scene"], expected["session"]).plan
         got = {"board_of": list(plan.board_of), "unserved": list(plan.unserved), "boards": [
             {"square_mm": b.square_mm, "first_id": b.first_id, "T_world_board": b.placement.T_world_board.tolist(),
              "post_foot": b.placement.post_foot.tolist(), "post_top": b.placement.post_top.tolist(),

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from poseintegrity.config import load_params
-from poseintegrity.scenes import board_placement, board_plan, catalog, mesh
 from poseintegrity.params.generate import SceneSpec
+from poseintegrity.scenes import board_criteria, board_stand, catalog, mesh, printed_boards
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -57,7 +57,7 @@ def test_the_boards_face_the_model_camera_their_origin_the_corner_nearest_the_ta
     the target than the corner a half turn would put there (and than its centre); its printed side faces the model
     camera, tilted from facing it by at most 40 deg (board z against the camera's forward axis), and it stands on its
     post, whose top is behind its centre (never through the paper)."""
-    monkeypatch.setattr(board_plan, "MIN_PLAN_CORNERS", 24)
+    monkeypatch.setattr(board_criteria, "MIN_PLAN_CORNERS", 24)
     scene = catalog.build_scene(spec(targets), 3, planned(params.generate, sizes_mm, n_stops=10), protocol)
     assert len(scene.boards) == n_boards
     target = dict(scene.placed)[targets[0]].vertices.mean(axis=0)
@@ -76,7 +76,7 @@ def test_the_boards_face_the_model_camera_their_origin_the_corner_nearest_the_ta
         # its top behind the board's centre by more than its radius: it holds the board and never pierces the paper
         behind = top - centre[:3]
         assert np.linalg.norm(np.cross(behind, T[:3, 2])) == pytest.approx(0.0, abs=0.5)  # the mesh's facets
-        assert behind @ T[:3, 2] > board_placement.POST_RADIUS_MM
+        assert behind @ T[:3, 2] > board_stand.POST_RADIUS_MM
 
 
 def test_the_flat_placement_lays_the_board_beside_the_target_on_its_pedestal(generate, protocol):
@@ -92,15 +92,15 @@ def test_the_lab_measures_the_printed_board_with_calipers(generate, protocol):
     scene = catalog.build_scene(spec(["block_print"]), 0, generate, protocol)
     caliper = generate.printed_boards.caliper_std_mm
     for board in scene.boards:  # each printed board its own print and measurement
-        printed, _ = catalog.print_errors(generate, catalog.printed_name(generate, board.drawing),
-                                          generate.printed_boards.board_sag_std_mm)
+        printed, _ = printed_boards.print_errors(generate, printed_boards.printed_name(generate, board.drawing),
+                                                 generate.printed_boards.board_sag_std_mm)
         width, height = board.drawing.size_mm
         assert abs(board.board.scale[0] - printed[0]) * width < 5 * caliper
         assert abs(board.board.scale[1] - printed[1]) * height < 5 * caliper
         assert board.board.scale != (1.0, 1.0) and board.board.first_id == board.drawing.first_id
     unmeasured = generate.model_copy(update={"printed_boards": generate.printed_boards.model_copy(
         update={"caliper_std_mm": None})})
-    assert catalog.measured_board(unmeasured).scale == (1.0, 1.0)
+    assert printed_boards.measured_board(unmeasured).scale == (1.0, 1.0)
 
 
 def test_boxes_show_two_printed_sides_to_the_model_camera(generate, protocol):

@@ -3,22 +3,18 @@ count; another generate.seed gives another world), atomic writes."""
 
 import hashlib
 import json
-import os
-import subprocess
-import sys
-import textwrap
 
 import cv2
 import numpy as np
 import pandas as pd
 import pytest
 
-from poseintegrity.config import load_params
-from poseintegrity.parallel import Workers
-from poseintegrity.lens import read_camera_yaml
 from poseintegrity.boards import board_from_dict
-from poseintegrity.scenes import dataset, renderer
+from poseintegrity.config import load_params
+from poseintegrity.lens import read_camera_yaml
+from poseintegrity.scenes import dataset, renderer, trips
 from poseintegrity.scenes.camera import true_camera
+from poseintegrity.workers import Workers
 from repository import ROOT
 
 TINY = load_params(ROOT / "tests" / "params_tiny.yaml")  # params.yaml shrunk: the pipeline's configuration
@@ -49,7 +45,7 @@ def test_layout_and_index(tiny_root):
     params, root = tiny_root
     index = pd.read_parquet(root / "index.parquet")
     assert list(index["dataset"]) == [p.dataset for name, world in params.worlds().items()
-                                      for p in dataset.plan_datasets(world, name)]
+                                      for p in trips.plan_datasets(world, name)]
     assert set(index["trajectory"]) == {"arc", "line"} and set(index["world"]) == {"main", "validation"}
     for world in ("main", "validation"):
         calibration = root.parent / "calibration" / world
@@ -78,19 +74,6 @@ def test_images_of_a_stop_differ_only_by_noise(tiny_root):
     assert 0 < np.abs(a - b).mean() < 4.0
     c = cv2.imread(str(folder / "images/s02_i00.png"), cv2.IMREAD_GRAYSCALE).astype(float)
     assert np.abs(a - c).mean() > 2 * np.abs(a - b).mean()  # another stop is another view
-
-
-@pytest.mark.parametrize("flags", ["IMAGE_PNG_FLAGS", "MASK_PNG_FLAGS"])
-def test_png_files_hold_exactly_the_pixels_exposed(tmp_path, flags):
-    """The encoder settings are lossless on a noisy camera image and a flat mask, whatever they compress."""
-    folder = dataset._partial(tmp_path, "d")
-    folder.mkdir()
-    noisy = renderer.expose(np.full((64, 96), 0.6, np.float32), TINY.generate.sensor, np.random.default_rng(0))
-    mask = np.zeros((64, 96), np.uint8)
-    mask[10:40, 20:70] = 255
-    for name, image in (("noisy.png", noisy), ("mask.png", mask)):
-        dataset._write_png(tmp_path, ("d",), name, image, getattr(dataset, flags))
-        assert (cv2.imread(str(folder / name), cv2.IMREAD_UNCHANGED) == image).all()
 
 
 @pytest.mark.pipeline  # tiny_root: stage 01 on the tiny parameters
@@ -125,36 +108,6 @@ def test_rerun_reproduces_every_file_byte_for_byte_on_two_workers(tiny_root, tmp
     params, root = tiny_root
     run(params, tmp_path, n_jobs=2)
     assert digest(tmp_path) == digest(root.parent)
-
-
-# A world build that frees 200 MB of 1 MB temporaries (below the mmap threshold: heap memory), under the Makefile's
-# malloc settings, which keep freed heap memory for reuse; the resident size before the build, after it, and after
-# giving back by hand what was still resident.
-BUILD_RSS = textwrap.dedent("""
-    import psutil, numpy as np
-    from poseintegrity.scenes import dataset
-    rss = lambda: psutil.Process().memory_info().rss / 1e6
-    def build(*args):
-        temporaries = [np.ones(125_000) for _ in range(200)]
-        del temporaries
-        return "world"
-    dataset._build_world = build
-    before = rss()
-    dataset.world(dataset.GenerateParams.model_construct(), dataset.ProtocolParams.model_construct(), 0, "arc")
-    after = rss()
-    dataset.give_back_freed_memory()
-    print(before, after, rss())
-""")
-
-
-def test_building_a_world_gives_its_temporaries_back_to_the_kernel():
-    """loky restarts a worker whose memory grew by 300 MB past its first task; the temporaries of a world build
-    (~130 MB at paper scale) used to stay resident under the Makefile's malloc settings, and every stage-01 run lost
-    both render workers that way (dataset.give_back_freed_memory)."""
-    env = os.environ | {"MALLOC_MMAP_THRESHOLD_": "33554432", "MALLOC_TRIM_THRESHOLD_": "1073741824"}
-    run = subprocess.run([sys.executable, "-c", BUILD_RSS], env=env, capture_output=True, text=True, check=True)
-    before, after, trimmed = map(float, run.stdout.split())
-    assert after - before < 50 and after - trimmed < 20  # MB: the 200 MB are not resident after the build
 
 
 @pytest.mark.pipeline  # tiny_root: stage 01 on the tiny parameters

@@ -7,9 +7,9 @@ import pytest
 import trimesh
 
 from poseintegrity.config import ParamsError, load_params, parse_params, read_raw
-from poseintegrity.scenes.dataset import WorldError, check_world
 from poseintegrity.mesh_file import MeshError, check_mesh, read_mesh
 from poseintegrity.scenes.scapula import scapula_mesh
+from poseintegrity.scenes.world_checks import WorldError, check_world
 
 ROOT = Path(__file__).resolve().parents[2]
 

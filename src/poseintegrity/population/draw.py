@@ -8,7 +8,7 @@ reordering ``population.worlds`` changes no other world. Values are rounded as a
 1 deg of tilt, 0.01 of a light).
 
 A lab only records a scene its robot can serve: a scene whose targets leave a model view, or which the world's robot
-reaches from none of its base placements (:func:`~poseintegrity.scenes.dataset.arc_problem`, the checks stage 01
+reaches from none of its base placements (:func:`~poseintegrity.scenes.world_checks.arc_problem`, the checks stage 01
 makes, before any board is planned), is drawn again (``attempt`` + 1, at most MAX_ATTEMPTS times). The population is
 therefore the declared distribution conditioned on scenes the robot serves; the world's file names every scene drawn
 again and why.
@@ -29,7 +29,7 @@ import yaml
 from poseintegrity.config import load_params, merge, parse_params, read_raw
 from poseintegrity.errors import ArgumentError, PoseIntegrityError
 from poseintegrity.params.population import PopulationParams, WorldDraw
-from poseintegrity.scenes.dataset import arc_problem
+from poseintegrity.scenes.world_checks import arc_problem
 from poseintegrity.seeding import keyed_rng
 
 MAX_ATTEMPTS = 20  # draws of one scene before the world is refused: its ranges leave the robot almost nothing

@@ -36,7 +36,13 @@ Ground truth: ``board`` (IV-C): the ArUco board is detected in every image and i
 model image 0, which places the target model in the board frame. ``poses``: the tables' T_cam_ref are the truth
 (an external tracker), and model image 0's pose places the target model in the reference frame.
 
-Modules: :mod:`.reader` (read and check a folder, every problem by file and field), :mod:`.geometry` (theta, x and
-the relative pose from poses), :mod:`.materialize` (into stage 02's layout, atomically), :mod:`.export` (stage-01
-datasets to this format), ``python -m poseintegrity.recorded`` (validate, export).
+Modules:
+
+    reader.py       read and check a folder, every problem by file and field
+    geometry.py     theta, x and the model pair's relative pose from the poses
+    model_pair.py   how well the model pair can triangulate the target (its depth error), before any run
+    materialize.py  a recorded folder into stage 02's layout, atomically
+    export.py       stage-01 datasets to this format
+    rosbag.py       a ROS bag (images, camera_info, poses) into a recorded folder
+    __main__.py     ``python -m poseintegrity.recorded``: validate, export, import a bag
 """

@@ -25,7 +25,7 @@ from pathlib import Path
 from poseintegrity.config import ParamsError, load_params
 from poseintegrity.errors import PoseIntegrityError
 from poseintegrity.recorded.reader import RecordedFormatError, range_problems, read_recorded
-from poseintegrity.timing import usage_error
+from poseintegrity.stage_timing import usage_error
 
 
 def validate(folders: list[Path], params_path: Path | None = None) -> int:

@@ -17,9 +17,9 @@ from pathlib import Path
 import numpy as np
 import yaml
 
+from poseintegrity.atomic_write import check_new_folder, staged
 from poseintegrity.localization.dataset import load_dataset, load_index
 from poseintegrity.recorded.reader import write_table
-from poseintegrity.staging import check_new_folder, staged
 
 
 def _pose_text(values) -> str:
@@ -57,7 +57,7 @@ def export_dataset(data_dir: str | Path, folder: str | Path, out: str | Path) ->
 
 def export_all(data_dir: str | Path, out: str | Path) -> list[Path]:
     """Every dataset of ``data_dir/datasets/index.parquet`` exported into ``out`` (:func:`export_dataset`), all or
-    nothing: ``out`` must be a new or empty folder (:func:`~poseintegrity.staging.check_new_folder`, checked before
+    nothing: ``out`` must be a new or empty folder (:func:`~poseintegrity.atomic_write.check_new_folder`, checked before
     any work), the datasets are written into its staging folder, which becomes ``out`` when every one is written and
     is removed on any error (a broken dataset leaves no export at all). Returns the datasets' folders."""
     out = check_new_folder(out)

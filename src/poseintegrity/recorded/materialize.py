@@ -21,10 +21,10 @@ import cv2
 import numpy as np
 import pandas as pd
 
+from poseintegrity.atomic_write import staged
 from poseintegrity.lens import write_camera_yaml
-from poseintegrity.protocol import ProtocolParams
+from poseintegrity.params.protocol import ProtocolParams
 from poseintegrity.recorded.reader import Recorded, RecordedFormatError, range_problems, read_image, read_recorded
-from poseintegrity.staging import staged
 
 
 def _write_image(source: Path, target: Path) -> None:
@@ -86,7 +86,7 @@ def materialize(folders: list[str | Path], data_dir: str | Path, protocol: Proto
     Two folders of the same name (the dataset's name) are refused likewise.
     """
     if protocol is None:
-        from poseintegrity.defaults import published
+        from poseintegrity.config import published
 
         protocol = published("protocol")
     datasets, problems = [], []

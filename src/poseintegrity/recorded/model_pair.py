@@ -20,9 +20,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from poseintegrity.localization.features import detect_features
-from poseintegrity.params.extract import ExtractParams
 from poseintegrity.localization.target_model import build_target_model
-from poseintegrity.protocol import ProtocolParams
+from poseintegrity.params.extract import ExtractParams
+from poseintegrity.params.protocol import ProtocolParams
 from poseintegrity.recorded.reader import Recorded, read_image
 
 MIN_POINTS = 5  # fewer triangulated target points give no distance to speak of (and a model PnP cannot use)

@@ -3,7 +3,7 @@
 :func:`problems` lists everything wrong, one line each naming the file and field (and line of a table);
 :func:`read_recorded` returns the checked :class:`Recorded` or raises :class:`RecordedFormatError` holding those
 lines. Checked: dataset.yaml's fields; camera.yaml (:func:`poseintegrity.lens.read_camera_yaml`: positive focal
-lengths, a known distortion model, ...); board.yaml (:class:`~poseintegrity.localization.dataset.BoardMeta`);
+lengths, a known distortion model, ...); board.yaml (:class:`~poseintegrity.dataset_meta.BoardMeta`);
 model.csv and stops.csv (columns, numbers, rigid poses, stops that never go back and whose positions increase);
 every image (listed, present, decodable, 8/16-bit mono or colour, of camera.yaml's size; no image left unlisted);
 the board detected in model image 0 (IV-C: it places the target model in the board frame).
@@ -22,13 +22,13 @@ import numpy as np
 import yaml
 from pydantic import ValidationError
 
+from poseintegrity.boards import board_description
+from poseintegrity.dataset_meta import BoardMeta, pose_problem
 from poseintegrity.errors import PoseIntegrityError, read_text_file
 from poseintegrity.grayscale import as_gray8
 from poseintegrity.lens import Camera, read_camera_yaml
-from poseintegrity.boards import board_description
-from poseintegrity.localization.dataset import BoardMeta, pose_problem
 from poseintegrity.localization.ground_truth import board_pose
-from poseintegrity.protocol import ProtocolParams
+from poseintegrity.params.protocol import ProtocolParams
 from poseintegrity.recorded.geometry import camera_centre, distance_mm, relative_pose, viewing_angle_deg
 
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".tif", ".tiff")

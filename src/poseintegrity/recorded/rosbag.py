@@ -24,10 +24,10 @@ import cv2
 import numpy as np
 import yaml
 
+from poseintegrity.atomic_write import check_new_folder, staged
 from poseintegrity.errors import PoseIntegrityError, read_text_file
 from poseintegrity.lens import DISTORTION_MODELS, Camera, write_camera_yaml
 from poseintegrity.recorded.reader import TRAJECTORIES, RecordedFormatError, read_table, write_table
-from poseintegrity.staging import check_new_folder, staged
 
 IMAGE_TYPES = ("sensor_msgs/msg/Image", "sensor_msgs/msg/CompressedImage")
 INFO_TYPE = "sensor_msgs/msg/CameraInfo"

@@ -1,127 +1,40 @@
 """Where a lab stood the ground-truth board before issue 39's plan (``generate.board.placement: facing_camera``,
-:mod:`.board_plan` for ``planned``), and the image geometry both share (projections, the targets' grown silhouettes,
-whether clutter covers a board). Issue 30's rule: the board stands on a post beside
-the target, facing the model camera, where along every trajectory of its scene no target covers the board, the board
-and its post cover no target, and most of the board stays in the image. A target's edge over a marker is what put the
-ArUco ground truth millimetres off (a partly hidden marker is still decoded, one corner pixels off); a board seen
-face-on keeps its corners sharp where a board lying flat was seen at 50-79 deg at the arcs' far ends. Part of a
+:mod:`.board_plan` for ``planned``). Issue 30's rule: the board stands on a post beside the target
+(:mod:`.board_stand`), facing the model camera, where along every trajectory of its scene no target covers the board,
+the board and its post cover no target, and most of the board stays in the image. A target's edge over a marker is what
+put the ArUco ground truth millimetres off (a partly hidden marker is still decoded, one corner pixels off); a board
+seen face-on keeps its corners sharp where a board lying flat was seen at 50-79 deg at the arcs' far ends. Part of a
 ChArUco board is enough for a pose: where the scene leaves no room for all of it along every trajectory (the lines'
 model view, 220 mm from the target, sees 208 x 131 mm), the place keeping most of it in view at its worst pose wins.
 
-The candidates are board centres on a grid in the frame of the model camera about the aim point (GRID_*: right, up
-in the image, towards the camera), the board's plane facing the model camera, turned by a multiple of 90 deg so that
-its origin (board x = y = 0, where E_t is measured, IV-C) is the corner nearest the first target. Each candidate is
-projected by the pinhole of the true intrinsics (a lab looks at its camera's live image) at every commanded pose of
-the scene's trajectories, beside the convex hulls of the targets' projected vertices, which contain their
-silhouettes. Kept: candidates whose board and post overlap no hull (with CLEARANCE_PX to spare) at any pose, whose
-corners stay above the table, and which keep at least MIN_IN_VIEW of the board in the image at every pose. Chosen:
-the one with the most of the board in view at its worst pose (to 1 %), then the shortest lever arm from the board
-origin to the target. (Preferring the whole board at the model pair instead, whose board pose places M_t, left less
-of it in view late in the arcs: R11's p99 0.78 mm against 0.61 mm, studies/board_options.py.) Deterministic: no
+The candidates are board centres on a grid in the frame of the model camera about the aim point (GRID_*: right, up in
+the image, towards the camera), the board's plane facing the model camera, turned by a multiple of 90 deg so that its
+origin (board x = y = 0, where E_t is measured, IV-C) is the corner nearest the first target. Each candidate is
+projected by the pinhole of the true intrinsics (a lab looks at its camera's live image) at every commanded pose of the
+scene's trajectories, beside the convex hulls of the targets' projected vertices, which contain their silhouettes
+(:mod:`.image_polygons`). Kept: candidates whose board and post overlap no hull (with CLEARANCE_PX to spare) at any
+pose, whose corners stay above the table, and which keep at least MIN_IN_VIEW of the board in the image at every pose.
+Chosen: the one with the most of the board in view at its worst pose (to 1 %), then the shortest lever arm from the
+board origin to the target. (Preferring the whole board at the model pair instead, whose board pose places M_t, left
+less of it in view late in the arcs: R11's p99 0.78 mm against 0.61 mm, studies/board_options.py.) Deterministic: no
 random draw.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
-import cv2
 import numpy as np
 from scipy.spatial import ConvexHull
 
-from poseintegrity.errors import PoseIntegrityError
 from poseintegrity.poses import inverse, pose_matrix
-from poseintegrity.scenes import trajectories
+from poseintegrity.scenes.board_stand import (
+    GRID_RIGHT_MM, GRID_UP_MM, POST_BEHIND_MM, POST_RADIUS_MM, TABLE_CLEARANCE_MM, BoardPlacement, PlacementError,
+)
+from poseintegrity.scenes.image_polygons import (
+    CLEARANCE_PX, NEAR_MM, hits, hull, near_targets, pixels, project, vertices_inside,
+)
 
-GRID_RIGHT_MM = np.arange(-200.0, 201.0, 20.0)
-GRID_UP_MM = np.arange(-120.0, 121.0, 20.0)
 GRID_TOWARDS_MM = (-60.0, -30.0, 0.0, 30.0)
 MIN_IN_VIEW = 0.25  # share of the board's area inside the image at every pose, at least
-CLEARANCE_PX = 6.0  # between the board (or its post) and a target's silhouette hull, in the image
-TABLE_CLEARANCE_MM = 5.0  # the board's lowest corner above the table
-POST_RADIUS_MM = 8.0
-POST_BEHIND_MM = 3.0  # the post's top behind the paper beyond its own radius (at 3 mm its top poked through the board)
-NEAR_MM = 20.0
-BOUNDING = 1.3  # a clutter box of 2 r x up to 1.5 r lies within a cylinder of 1.25 r about its centre
-
-
-class PlacementError(PoseIntegrityError):
-    """No candidate place keeps the board in view and clear of the targets along every trajectory."""
-
-
-@dataclass(frozen=True)
-class BoardPlacement:
-    """T_world_board (4, 4, mm: board x right and y down as printed, z into the board) and the post holding it: from
-    ``post_foot`` (3,) on the table up to ``post_top`` (3,) behind the board's centre. ``in_view``: the share of the
-    board inside the image at its worst pose."""
-
-    T_world_board: np.ndarray
-    post_foot: np.ndarray
-    post_top: np.ndarray
-    in_view: float
-
-
-def arc_trajectories(aim: np.ndarray, view_dir: np.ndarray, distance_mm: float, baseline_mm: float,
-                     azimuths_deg: list[float], span_deg: float, n_stops: int
-                     ) -> tuple[list[np.ndarray], list[list[np.ndarray]]]:
-    """A scene's arcs session: its model pair (T_world_cam (4, 4) each) and per arc (one per azimuth) the commanded
-    T_world_cam of its stops (:mod:`.trajectories`; the first is model image 0's)."""
-    pair = trajectories.model_pair(aim, view_dir, distance_mm, baseline_mm)
-    return pair, [[stop.T_world_cam for stop in trajectories.arc(pair[0], aim, az, span_deg, n_stops)]
-                  for az in azimuths_deg]
-
-
-def line_trajectories(aim: np.ndarray, view_dir: np.ndarray, distance_mm: float, baseline_mm: float,
-                      offsets_deg: list[float], length_mm: float, n_stops: int
-                      ) -> tuple[list[np.ndarray], list[list[np.ndarray]]]:
-    """The lines session: its model pair and per line (one per offset) the commanded T_world_cam of its stops."""
-    pair = trajectories.model_pair(aim, view_dir, distance_mm, baseline_mm)
-    return pair, [[stop.T_world_cam for stop in trajectories.line(pair[0], aim, offset, length_mm, n_stops)]
-                  for offset in offsets_deg]
-
-
-def project(points: np.ndarray, T_cam_world: np.ndarray, K: np.ndarray) -> np.ndarray:
-    """(n, 2) pixels of world points (n, 3) in front of the camera (those nearer than NEAR_MM are left out)."""
-    cam = points @ T_cam_world[:3, :3].T + T_cam_world[:3, 3]
-    cam = cam[cam[:, 2] > NEAR_MM]
-    return (cam[:, :2] / cam[:, 2:3]) @ K[:2, :2].T + K[:2, 2]
-
-
-def near_targets(hulls: list[np.ndarray], width: int, height: int, clearance_px: float) -> np.ndarray:
-    """(height, width) bool: the pixels within ``clearance_px`` of the targets' silhouette hulls (their hulls grown by
-    a square of that half-width: a disc would do, the square errs on the side of clearance and is 20 x faster)."""
-    mask = np.zeros((height, width), np.uint8)
-    for hull in hulls:
-        cv2.fillConvexPoly(mask, np.round(hull).astype(np.int32), 1)
-    size = 2 * int(np.ceil(clearance_px)) + 1
-    return cv2.dilate(mask, cv2.getStructuringElement(cv2.MORPH_RECT, (size, size))).astype(bool)
-
-
-def pixels(points: np.ndarray, T_cam_world: np.ndarray, K: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Pixels (..., 2) of world points (..., 3) and whether each lies in front of the camera (...)."""
-    cam = points @ T_cam_world[:3, :3].T + T_cam_world[:3, 3]
-    front = cam[..., 2] > NEAR_MM
-    z = np.where(front, cam[..., 2], 1.0)
-    return np.stack([K[0, 0] * cam[..., 0] / z + K[0, 2], K[1, 1] * cam[..., 1] / z + K[1, 2]], axis=-1), front
-
-
-def hits(points: np.ndarray, front: np.ndarray, near: np.ndarray) -> np.ndarray:
-    """(n,) whether any of each candidate's points (n, k, 2) in front of the camera and inside the image falls on
-    ``near`` (:func:`near_targets`)."""
-    height, width = near.shape
-    u, v = np.round(points[..., 0]).astype(np.int64), np.round(points[..., 1]).astype(np.int64)
-    inside = front & (u >= 0) & (u < width) & (v >= 0) & (v < height)
-    hit = np.zeros(u.shape, bool)
-    hit[inside] = near[v[inside], u[inside]]
-    return hit.any(axis=1)
-
-
-def vertices_inside(quads: np.ndarray, points: np.ndarray) -> np.ndarray:
-    """(n,) whether any of ``points`` (m, 2) lies inside each convex quad (n, 4, 2) (either winding)."""
-    edges = np.roll(quads, -1, axis=1) - quads  # (n, 4, 2)
-    rel = points[None, None, :, :] - quads[:, :, None, :]  # (n, 4, m, 2)
-    cross = edges[:, :, None, 0] * rel[..., 1] - edges[:, :, None, 1] * rel[..., 0]  # (n, 4, m)
-    return (np.all(cross >= 0, axis=1) | np.all(cross <= 0, axis=1)).any(axis=1)
 
 
 def place_board(size_mm: tuple[float, float], margin_mm: float, targets: list[np.ndarray], aim: np.ndarray,
@@ -174,7 +87,7 @@ def place_board(size_mm: tuple[float, float], margin_mm: float, targets: list[np
         if not keep.any():
             break
         view = inverse(poses[k])
-        hulls = [cv2.convexHull(project(v, view, K).astype(np.float32)).reshape(-1, 2) for v in targets]
+        hulls = [hull(project(v, view, K)) for v in targets]
         distance = np.linalg.norm(poses[k][:3, 3] - aim)
         near_board = near_targets(hulls, width, height, CLEARANCE_PX)
         near_post = near_targets(hulls, width, height, CLEARANCE_PX + POST_RADIUS_MM * K[0, 0] / distance)
@@ -199,26 +112,3 @@ def place_board(size_mm: tuple[float, float], margin_mm: float, targets: list[np
     best = min(np.flatnonzero(keep), key=lambda i: (-round(worst[i], 2), lever[i], i))
     R = np.column_stack([x_b[best], y_b[best], forward])
     return BoardPlacement(pose_matrix(R, origins[best]), feet[best], tops[best], float(worst[best]))
-
-
-def covers(xy: np.ndarray, radius: float, height: float, paper: np.ndarray, poses: list[np.ndarray],
-           K: np.ndarray) -> bool:
-    """Whether an object standing on the table within a cylinder (centre ``xy`` (2,), ``radius`` x BOUNDING, up to
-    ``height``, mm) would cover part of the board's paper (4, 3) seen from any of ``poses`` (T_world_cam): their
-    images overlap and the object's centre is nearer the camera than the board's."""
-    angles = np.linspace(0.0, 2 * np.pi, 8, endpoint=False)
-    ring = np.column_stack([xy[0] + BOUNDING * radius * np.cos(angles), xy[1] + BOUNDING * radius * np.sin(angles)])
-    solid = np.vstack([np.column_stack([ring, np.zeros(8)]), np.column_stack([ring, np.full(8, height)])])
-    centre = np.array([*xy, height / 2])
-    for T in poses:
-        view = inverse(T)
-        if (view[2, :3] @ centre + view[2, 3]) >= (view[2, :3] @ paper.mean(axis=0) + view[2, 3]):
-            continue  # behind the board
-        seen = project(solid, view, K)
-        if len(seen) < 3:
-            continue  # behind the camera
-        hull = cv2.convexHull(seen.astype(np.float32)).reshape(-1, 2)
-        area, _ = cv2.intersectConvexConvex(project(paper, view, K).astype(np.float32), hull)
-        if area > 0:
-            return True
-    return False

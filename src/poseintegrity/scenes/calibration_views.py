@@ -19,16 +19,16 @@ import cv2
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from poseintegrity.lens import Camera, write_camera_yaml
+from poseintegrity.atomic_write import staged
 from poseintegrity.boards import Charuco
 from poseintegrity.calibration import Calibration, calibrate
+from poseintegrity.lens import Camera, write_camera_yaml
+from poseintegrity.params.generate import GenerateParams
 from poseintegrity.poses import pose_matrix
-from poseintegrity.staging import staged
 from poseintegrity.scenes import mesh, optics, renderer
 from poseintegrity.scenes.camera import true_camera
-from poseintegrity.scenes.catalog import measured_scale, print_errors
 from poseintegrity.scenes.foam import ReliefVolume
-from poseintegrity.params.generate import GenerateParams
+from poseintegrity.scenes.printed_boards import measured_scale, print_errors
 from poseintegrity.scenes.textures import build_atlas, to_u8
 from poseintegrity.seeding import keyed_rng
 
@@ -96,7 +96,7 @@ def view_pose(camera: Camera, spec: Charuco, distance_mm: tuple[float, float], m
 
 def render_view(params: GenerateParams, T_cam_board: np.ndarray, rng: np.random.Generator) -> np.ndarray:
     """One calibration image (h, w) uint8: the board at T_cam_board through the true lens (focused mid-range) and
-    sensor, as a dataset image is made (scenes/dataset.py)."""
+    sensor, as a dataset image is made (scenes/shots.py)."""
     camera = true_camera(params.camera)
     K_canvas, width, height = camera.canvas
     scale, sag_mm = print_errors(params, "charuco", params.printed_boards.calibration_sag_std_mm)

@@ -8,36 +8,37 @@ from ``generate.seed``), arranged differently per scene:
   scene's ``glenoid_tilt_deg`` (a surgeon's camera looks at the glenoid, never quite en face);
 - ``block_print`` / ``block_mosaic``: boxes printed on their sides (faint lids), set corner-on to the model camera.
 
-Clutter mixes printed boxes and cylinders (some printed like the blocks) with bone-foam offcuts (a block and a shaft
-of the phantoms' material): real scenes hold look-alikes that make false matches. World frame: table top z = 0,
-z up, millimetres.
+The ground-truth boards lie beside the targets or stand on posts (:mod:`.scene_boards`), each as the lab printed and
+measured it (:mod:`.printed_boards`). Clutter mixes printed boxes and cylinders (some printed like the blocks) with
+bone-foam offcuts (a block and a shaft of the phantoms' material): real scenes hold look-alikes that make false
+matches. World frame: table top z = 0, z up, millimetres.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from functools import lru_cache
 
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from poseintegrity.boards import Board
-from poseintegrity.seeding import keyed_rng
-from poseintegrity.scenes import board_placement, board_plan
+from poseintegrity.params.generate import TEXTURE_NAMES, BoneFoamParams, GenerateParams, SceneSpec
+from poseintegrity.params.protocol import ProtocolParams
+from poseintegrity.poses import pose_matrix
+from poseintegrity.scenes import board_plan, board_stand
 from poseintegrity.scenes import mesh as meshes
 from poseintegrity.scenes import textures as tex
-from poseintegrity.poses import pose_matrix
-from poseintegrity.protocol import ProtocolParams
-from poseintegrity.params.generate import TEXTURE_NAMES, BoneFoamParams, GenerateParams, SceneSpec
 from poseintegrity.scenes.camera import Intrinsics
+from poseintegrity.scenes.printed_boards import measured_board
 from poseintegrity.scenes.scapula import scapula_mesh
+from poseintegrity.scenes.scene_boards import SceneBoard, board_texture_name, drawings, flat_board, standing_boards
+from poseintegrity.seeding import keyed_rng
 
 PRINTED_CLUTTER = ("clutter_a", "clutter_b", "clutter_c", "clutter_print")
 BLOCK_SIZE_MM = (72.0, 64.0, 58.0)
 STAND_RADIUS_MM = 8.0
 PHANTOM_CLEARANCE_MM = 20.0  # lowest point of a held phantom above the table
 CLUTTER_MAX_HEIGHT_MM = 160.0  # the tallest clutter object
-BOARD_BELOW_AIM_MM = 60.0  # the board's pedestal brings it this far below the aim point (never below the table)
 
 
 @lru_cache(maxsize=len(TEXTURE_NAMES))
@@ -88,20 +89,6 @@ def target_mesh(name: str, params: "GenerateParams") -> meshes.Mesh:
         bone = scapula_mesh(params.scapula, drilled=name == "scapula_drilled")
         return meshes.from_trimesh(bone, foam_material(params.bone_foam))
     return meshes.box(BLOCK_SIZE_MM, name, material=meshes.Material(specular=0.08, shininess=30.0))
-
-
-@dataclass(frozen=True)
-class SceneBoard:
-    """One ground-truth board of a scene: as printed from its drawing (``drawing``, :mod:`poseintegrity.boards`) and
-    as the lab measured it (``board``, :func:`measured_board`), its frame T_world_board (4, 4, mm), where it stands
-    (``placement``; None when it lies flat) and its worst predicted sigma_t (mm) over the stops it serves (planned
-    boards; NaN otherwise)."""
-
-    drawing: Board
-    board: Board
-    T_world_board: np.ndarray
-    placement: board_placement.BoardPlacement | None = None
-    sigma_t_mm: float = float("nan")
 
 
 @dataclass
@@ -209,7 +196,7 @@ def build_scene(spec: "SceneSpec", index: int, params: "GenerateParams", protoco
     session: its arcs (``"arc"``) or, on the lines' scene, its lines (``"line"``). Each session has its own model pair
     (IV-D), and the lab stands the ground-truth boards where that session's trajectories (``protocol``) keep them in
     view; targets, their stands and the table are the same in both, the clutter keeps clear of the boards' sight lines.
-    A board that fits nowhere raises :class:`~.board_placement.PlacementError`; ``plan``: the boards' plan found by an
+    A board that fits nowhere raises :class:`~.board_stand.PlacementError`; ``plan``: the boards' plan found by an
     earlier call for the same session (the search is skipped: workers rebuild a scene the main process laid out)."""
     arranged = arrange(spec, index, params)
     rng, yaw, view_dir, placed, target_poses, aim = (arranged.rng, arranged.yaw, arranged.view_dir,
@@ -218,14 +205,14 @@ def build_scene(spec: "SceneSpec", index: int, params: "GenerateParams", protoco
     n_trajectories = len(params.arcs.azimuths_deg) if session == "arc" else len(params.lines.offsets_deg)
     if params.board.placement == "flat":
         drawing = params.board.drawing()
-        T_world_board, board_objects, board_centre = _flat_board(params, drawing, board_yaw, target_poses[0], yaw, aim,
-                                                                 view_dir)
+        T_world_board, board_objects, board_centre = flat_board(params, drawing, board_yaw, target_poses[0], yaw, aim,
+                                                                view_dir)
         boards, board_of, sight = (SceneBoard(drawing, measured_board(params, drawing), T_world_board),), None, None
         feet = [board_centre]
     else:
-        plan, board_objects, sight = _standing_boards(params, protocol, spec, session, placed, aim, view_dir, plan)
+        plan, board_objects, sight = standing_boards(params, protocol, spec, session, placed, aim, view_dir, plan)
         boards = tuple(SceneBoard(drawing, measured_board(params, drawing), b.placement.T_world_board, b.placement,
-                                  b.sigma_t_mm) for b, drawing in zip(plan.boards, _drawings(params, plan)))
+                                  b.sigma_t_mm) for b, drawing in zip(plan.boards, drawings(params, plan)))
         board_of, feet = plan.board_of, [b.placement.post_foot[:2] for b in plan.boards]
     placed += board_objects
     placed += _clutter(spec, params, rng, aim, view_dir[:2] / np.linalg.norm(view_dir[:2]), feet, sight)
@@ -233,155 +220,6 @@ def build_scene(spec: "SceneSpec", index: int, params: "GenerateParams", protoco
     light_dir = np.array([rng.uniform(-0.5, 0.5), rng.uniform(-0.5, 0.3), 1.0])
     return Scene(spec.name, placed, tuple(spec.targets), target_poses[0], boards, board_of or (0,) * n_trajectories,
                  aim, view_dir, light_dir, plan if params.board.placement != "flat" else None)
-
-
-def _drawings(params: "GenerateParams", plan: board_plan.BoardPlan) -> list[Board]:
-    """The drawing of each board of a plan: the params' board printed at its square size, ids from its first."""
-    return [params.board.drawing(square_mm=b.square_mm, first_id=b.first_id) for b in plan.boards]
-
-
-def board_texture_name(k: int) -> str:
-    """The texture of a scene's k-th board (the first: ``board``)."""
-    return "board" if k == 0 else f"board_{k + 1}"
-
-
-def _board_sheet(params: "GenerateParams", board: Board, k: int = 0) -> meshes.Mesh:
-    """The printed board (its drawing) in its own frame (x right, y down, facing -z, origin at the pattern's top-left
-    corner), as printed: scaled and bowed (:func:`print_errors`), textured with the scene's k-th board texture
-    (:func:`board_texture_name`). The plane spans the texture's texel centres (the renderer maps texture coordinates
-    0 and 1 onto its edges): a plane of the print's full size would stretch the board by n / (n - 1) texels
-    (calibration_views.py)."""
-    bw, bh = board.size_mm
-    n_x, n_y = tex.board_texture(board, params.board.px_per_mm, params.board.margin_mm).shape[::-1]
-    sheet = meshes.plane((n_x - 1) / params.board.px_per_mm, (n_y - 1) / params.board.px_per_mm, 12, 9,
-                         board_texture_name(k), material=meshes.Material(0.02, 10.0))
-    # plane() faces +z with texture v along -y; flip about x so it faces -z (the printed side) with v along +y
-    sheet = sheet.transformed(pose_matrix(np.diag([1.0, -1.0, -1.0]), [bw / 2, bh / 2, 0.0]))
-    return meshes.printed_sheet(sheet, np.array([bw / 2, bh / 2]), (n_x - 1) / params.board.px_per_mm / 2,
-                                *print_errors(params, printed_name(params, board),
-                                              params.printed_boards.board_sag_std_mm))
-
-
-def _flat_board(params: "GenerateParams", board: Board, board_yaw: float, T_world_target: np.ndarray, yaw: float,
-                aim: np.ndarray, view_dir: np.ndarray) -> tuple[np.ndarray, list[tuple[str, meshes.Mesh]], np.ndarray]:
-    """Placement ``flat`` (the layout before issue 30): the board lies beside the target, printed side up (board z
-    points down), on the table or, beside a held phantom, on a pedestal BOARD_BELOW_AIM_MM below the aim point; board x
-    points away from the target, so that its origin (the model origin, where E_t is measured) is a corner of the edge
-    facing the target. Returns T_world_board, the meshes, the board's centre on the table (2,)."""
-    bw, bh = board.size_mm
-    m = params.board.margin_mm
-    x_b = np.array([np.cos(board_yaw), np.sin(board_yaw), 0.0])
-    R_world_board = np.column_stack([x_b, np.cross([0.0, 0.0, -1.0], x_b), [0.0, 0.0, -1.0]])
-    toward_cam = view_dir[:2] / np.linalg.norm(view_dir[:2])
-    board_centre = T_world_target[:2, 3] - 92.0 * np.array([np.cos(yaw), np.sin(yaw)]) + 20.0 * toward_cam
-    height = max(aim[2] - BOARD_BELOW_AIM_MM, 0.0)
-    objects = []
-    if height > 0:
-        pedestal = meshes.box((bw + 2 * m, bh + 2 * m, height), "clutter_b", n_sub=4)
-        objects.append(("board_pedestal", pedestal.transformed(pose_matrix(R_world_board @ np.diag([1.0, -1.0, -1.0]),
-                                                                             [*board_centre, height / 2]))))
-    origin = np.append(board_centre, height + 0.4) - R_world_board @ np.array([bw / 2, bh / 2, 0.0])
-    T_world_board = pose_matrix(R_world_board, origin)
-    objects.append(("board", _board_sheet(params, board).transformed(T_world_board)))
-    return T_world_board, objects, board_centre
-
-
-def _standing_boards(params: "GenerateParams", protocol: "ProtocolParams", spec: "SceneSpec", session: str,
-                     placed: list[tuple[str, meshes.Mesh]], aim: np.ndarray, view_dir: np.ndarray,
-                     plan: board_plan.BoardPlan | None):
-    """Placements ``planned`` (:mod:`.board_plan`) and ``facing_camera`` (:mod:`.board_placement`): boards on posts,
-    facing the session's model camera, clear of the targets along every trajectory of the session (``plan``, when
-    given, is where they were found). Returns the plan, the meshes (boards, posts) and what clutter must keep clear
-    of: each board's paper corners (4, 3) and the session's poses."""
-    cam = Intrinsics.from_params(params.camera)
-    if session == "line":
-        lines = params.lines
-        focus = lines.focus_mm(protocol.line_length_mm)
-        pair, trajectories = board_placement.line_trajectories(aim, view_dir, lines.distance_mm,
-                                                               params.model_baseline_mm, lines.offsets_deg,
-                                                               protocol.line_length_mm, lines.n_stops)
-    else:
-        focus = spec.distance_mm
-        pair, trajectories = board_placement.arc_trajectories(aim, view_dir, focus, params.model_baseline_mm,
-                                                              params.arcs.azimuths_deg, protocol.arc_span_deg,
-                                                              params.arcs.n_stops)
-    if plan is None:
-        plan = _plan(params, spec, placed, aim, pair, trajectories, cam, focus)
-    objects, papers = [], []
-    m = params.board.margin_mm
-    for k, (planned, drawing) in enumerate(zip(plan.boards, _drawings(params, plan))):
-        T, where = planned.placement.T_world_board, planned.placement
-        post = meshes.cylinder(board_placement.POST_RADIUS_MM, float(where.post_top[2]), "clutter_c")
-        suffix = "" if k == 0 else f"_{k + 1}"
-        objects += [(f"board{suffix}", _board_sheet(params, drawing, k).transformed(T)),
-                    (f"board_post{suffix}", post.transformed(pose_matrix(np.eye(3), where.post_foot)))]
-        bw, bh = drawing.size_mm
-        papers.append((T[:3, :3] @ np.array([[-m, -m, 0], [bw + m, -m, 0], [bw + m, bh + m, 0], [-m, bh + m, 0]]).T
-                       ).T + T[:3, 3])
-    poses = [*pair] + [T for trajectory in trajectories for T in trajectory]
-    return plan, objects, (papers, poses)
-
-
-def _plan(params: "GenerateParams", spec: "SceneSpec", placed: list[tuple[str, meshes.Mesh]], aim: np.ndarray,
-          pair: list[np.ndarray], trajectories: list[list[np.ndarray]], cam: Intrinsics,
-          focus_mm: float) -> board_plan.BoardPlan:
-    """Where the session's boards stand: :func:`.board_plan.plan_boards` (``planned``) or one board of the params'
-    size where most of it stays in view (``facing_camera``, :func:`.board_placement.place_board`)."""
-    targets = [mesh.vertices for name, mesh in placed if name in spec.targets]
-    where = f"scene {spec.name}"
-    board = params.board
-    if board.placement == "facing_camera":
-        poses = [*pair] + [T for trajectory in trajectories for T in trajectory]
-        placement = board_placement.place_board(board.drawing().size_mm, board.margin_mm, targets, aim, poses[0],
-                                                poses, cam.K, cam.width, cam.height, where)
-        return board_plan.BoardPlan((board_plan.PlannedBoard(board.square_mm, 0, placement, float("nan")),),
-                                    (0,) * len(trajectories), (0,) * len(trajectories))
-    obstacles = [board_plan.Obstacle(v, True) for v in targets] + [
-        board_plan.Obstacle(mesh.vertices, False) for name, mesh in placed
-        if name.endswith("_stand") and name.removesuffix("_stand") in spec.targets]
-    cells = board.drawing().cv_board().getDictionary().markerSize + 2  # its bits and the black border
-    return board_plan.plan_boards(board.sizes_mm, (board.squares_x, board.squares_y), board.marker_mm / board.square_mm,
-                                  cells, board.margin_mm, board.max_boards, board.plan_sigma_t_mm, obstacles,
-                                  targets[0].mean(axis=0), aim, pair, trajectories, cam.K, cam.width, cam.height,
-                                  focus_mm,
-                                  params.camera, params.sensor.blur_sigma_px, where)
-
-
-def measured_board(params: "GenerateParams", drawing: Board | None = None) -> Board:
-    """A ground-truth board as the lab knows it: its drawing (default: ``generate.board``'s) scaled by the printed
-    size the lab measured (:func:`measured_scale`)."""
-    drawing = params.board.drawing() if drawing is None else drawing
-    scale = measured_scale(params, printed_name(params, drawing), drawing)
-    return replace(drawing, scale=scale)
-
-
-def printed_name(params: "GenerateParams", drawing: Board) -> str:
-    """The key of a printed ground-truth board's draws (:func:`print_errors`, :func:`measured_scale`): "aruco" for
-    the params' own drawing (the board of every scene before issue 39), else one of its size and first id: each
-    board the lab prints is one physical board in every scene that uses it."""
-    if drawing == params.board.drawing():
-        return "aruco"
-    return f"aruco_{drawing.size_mm[0]:g}x{drawing.size_mm[1]:g}_{getattr(drawing, 'first_id', 0)}"
-
-
-def measured_scale(params: "GenerateParams", board: str, drawing: Board) -> tuple[float, float]:
-    """The printed size over the drawn size of ``board`` ("aruco": the ground truth's, "charuco": the calibration
-    board) as the lab measured it with calipers along x and y (``printed_boards.caliper_std_mm`` on the drawing's
-    width and height), drawn from ``keyed_rng(seed, "caliper", board)`` around the printer's true scale
-    (:func:`print_errors`); (1, 1), the drawing, when the lab does not measure (null)."""
-    if params.printed_boards.caliper_std_mm is None:
-        return 1.0, 1.0
-    scale, _ = print_errors(params, board, 0.0)
-    error = params.printed_boards.caliper_std_mm * keyed_rng(params.seed, "caliper", board).standard_normal(2)
-    return float(scale[0] + error[0] / drawing.size_mm[0]), float(scale[1] + error[1] / drawing.size_mm[1])
-
-
-def print_errors(params: "GenerateParams", board: str, sag_std_mm: float) -> tuple[tuple[float, float], float]:
-    """(scale (x, y), sag mm) of one printed board of the world, drawn from ``keyed_rng(seed, "print", board)``:
-    the same physical board in every scene (``generate.printed_boards``)."""
-    rng = keyed_rng(params.seed, "print", board)
-    scale = 1.0 + params.printed_boards.scale_std * rng.standard_normal(2)
-    return (float(scale[0]), float(scale[1])), float(sag_std_mm * rng.standard_normal())
 
 
 def scene_textures(scene: Scene, params: "GenerateParams") -> dict[str, np.ndarray]:
@@ -416,8 +254,8 @@ def _clutter(spec: "SceneSpec", params: "GenerateParams", rng: np.random.Generat
             continue
         if any(np.linalg.norm(xy - c) < radius + rc for c, rc in occupied):
             continue
-        if sight is not None and any(board_placement.covers(xy, radius, CLUTTER_MAX_HEIGHT_MM, paper, sight[1],
-                                                            Intrinsics.from_params(params.camera).K)
+        if sight is not None and any(board_stand.covers(xy, radius, CLUTTER_MAX_HEIGHT_MM, paper, sight[1],
+                                                        Intrinsics.from_params(params.camera).K)
                                      for paper in sight[0]):
             continue
         occupied.append((xy, radius))

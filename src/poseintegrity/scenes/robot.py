@@ -19,8 +19,8 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from poseintegrity import kinematics
+from poseintegrity.denavit_hartenberg import DH, UR5E
 from poseintegrity.errors import PoseIntegrityError
-from poseintegrity.kinematics import DH, UR5E
 from poseintegrity.poses import inverse as inverse_pose
 from poseintegrity.poses import pose_errors, pose_matrix, rotation_angle_deg
 from poseintegrity.scenes.trajectories import Stop
@@ -216,7 +216,7 @@ class PlacedRobot:
 
 
 class Trip(Protocol):
-    """What the robot does for one dataset (:class:`.dataset.Trip` is one): visits its model pair, then its
+    """What the robot does for one dataset (:class:`.trips.Trip` is one): visits its model pair, then its
     stops."""
 
     model_views: Sequence[np.ndarray]

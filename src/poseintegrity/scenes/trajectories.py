@@ -78,3 +78,22 @@ def line(T_model: np.ndarray, aim: np.ndarray, offset_deg: float, length_mm: flo
         T[:3, 3] -= x_mm * start[:3, 2]
         stops.append(Stop(T, float(offset_deg), float(x_mm)))
     return stops
+
+
+def arc_trajectories(aim: np.ndarray, view_dir: np.ndarray, distance_mm: float, baseline_mm: float,
+                     azimuths_deg: list[float], span_deg: float, n_stops: int
+                     ) -> tuple[list[np.ndarray], list[list[np.ndarray]]]:
+    """A scene's arcs session: its model pair (T_world_cam (4, 4) each) and per arc (one per azimuth) the commanded
+    T_world_cam of its stops (the first is model image 0's)."""
+    pair = model_pair(aim, view_dir, distance_mm, baseline_mm)
+    return pair, [[stop.T_world_cam for stop in arc(pair[0], aim, az, span_deg, n_stops)]
+                  for az in azimuths_deg]
+
+
+def line_trajectories(aim: np.ndarray, view_dir: np.ndarray, distance_mm: float, baseline_mm: float,
+                      offsets_deg: list[float], length_mm: float, n_stops: int
+                      ) -> tuple[list[np.ndarray], list[list[np.ndarray]]]:
+    """The lines session: its model pair and per line (one per offset) the commanded T_world_cam of its stops."""
+    pair = model_pair(aim, view_dir, distance_mm, baseline_mm)
+    return pair, [[stop.T_world_cam for stop in line(pair[0], aim, offset, length_mm, n_stops)]
+                  for offset in offsets_deg]
