@@ -25,11 +25,11 @@ from scipy.stats import exponnorm
 
 from poseintegrity.artifact_models import EMG, emg, fig2_rmse, fit_mlp, fits_metrics, status_counts
 from poseintegrity.artifact_models.mlp import initial_weights
-from poseintegrity.params.fit import MLPParams
 from poseintegrity.artifact_models.synthetic import synthetic_artifacts
 from poseintegrity.config import load_section
-from poseintegrity.parallel import Workers, worker_count
-from timing import paired_medians  # benchmarks/timing.py
+from poseintegrity.params.fit import MLPParams
+from poseintegrity.workers import Workers, worker_count
+from paired_timing import paired_medians  # benchmarks/paired_timing.py
 
 
 def report(label: str, seconds: float, reference: float, target: float | None = None) -> None:

@@ -31,13 +31,14 @@ from pathlib import Path
 import cv2
 import numpy as np
 
+from poseintegrity.boards import board_from_dict
 from poseintegrity.config import load_section
 from poseintegrity.localization.dataset import DatasetError, load_dataset, load_index
 from poseintegrity.localization.evidence import correspondences, frame_evidence, model_digest
-from poseintegrity.localization.extract import dataset_model, frame_seed, iteration_cap, localize
 from poseintegrity.localization.features import detect_features, read_gray
-from poseintegrity.boards import board_from_dict
+from poseintegrity.localization.frame_rows import frame_seed, iteration_cap, localize
 from poseintegrity.localization.ground_truth import board_pose
+from poseintegrity.localization.model_store import dataset_model
 from poseintegrity.localization.pnp import CLASSIC_FLAGS, solve_pnp_ransac
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -34,7 +34,8 @@ import numpy as np
 
 from poseintegrity.config import load_params
 from poseintegrity.localization import extract_all
-from poseintegrity.parallel import ParallelParams, Workers
+from poseintegrity.params.parallel import ParallelParams
+from poseintegrity.workers import Workers
 
 BACKENDS = {"local": ParallelParams(backend="local", n_jobs=2), "dask": ParallelParams(backend="dask", n_jobs=2)}
 ROOT = Path(__file__).resolve().parents[1]

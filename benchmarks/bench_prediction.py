@@ -29,10 +29,10 @@ from poseintegrity.artifact_models import emg, fit_model
 from poseintegrity.artifact_models.series import dataset_series
 from poseintegrity.artifact_models.synthetic import synthetic_artifacts
 from poseintegrity.config import load_section
-from poseintegrity.parallel import Workers, worker_count
 from poseintegrity.prediction import boundaries, fit_status_shares, loso, loso_folds, sweep
 from poseintegrity.prediction.metrics import with_metrics
-from timing import paired_medians  # benchmarks/timing.py
+from poseintegrity.workers import Workers, worker_count
+from paired_timing import paired_medians  # benchmarks/paired_timing.py
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 from scalar_boundary import envelope_boundary  # noqa: E402 (the scalar reference of the tests)

@@ -54,7 +54,7 @@ from poseintegrity.localization import extract as E
 from poseintegrity.localization.dataset import load_dataset, load_index
 
 params_path, data_dir, features_dir, n_frames, out = sys.argv[1:]
-cv2.setNumThreads(1)  # as in a worker task (poseintegrity.parallel)
+cv2.setNumThreads(1)  # as in a worker task (poseintegrity.workers)
 params = load_section(params_path, "extract").model_copy(update={"features_dir": features_dir})
 datasets = [load_dataset(data_dir, row.path, row.dataset) for row in load_index(data_dir).itertuples()]
 sizes = np.cumsum([0] + [len(d.frames) for d in datasets])

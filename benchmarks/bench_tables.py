@@ -1,4 +1,4 @@
-"""Cost of checking the stage tables: poseintegrity.tables' hand-written checks against pandera, on a paper-scale
+"""Cost of checking the stage tables: poseintegrity.table_checks' hand-written checks against pandera, on a paper-scale
 artifacts table (60 datasets x 21 stops x 10 images x 6 PnP methods = 75 600 rows), in one run.
 
 Prints the import time of each (a fresh interpreter each, median of 5) and the time to validate the table (median of
@@ -15,7 +15,7 @@ import time
 import numpy as np
 import pandas as pd
 
-from poseintegrity.tables import ARTIFACT_KEYS, TRAJECTORIES, check_artifacts
+from poseintegrity.table_checks import ARTIFACT_KEYS, TRAJECTORIES, check_artifacts
 
 
 def artifacts_table(rng: np.random.Generator) -> pd.DataFrame:
@@ -65,9 +65,9 @@ def pandera_schema():
 def main() -> None:
     table = artifacts_table(np.random.default_rng(0))
     ours = median_s(lambda: check_artifacts(table))
-    ours_import = import_s("import poseintegrity.tables")
+    ours_import = import_s("import poseintegrity.table_checks")
     print(f"artifacts table: {len(table)} rows")
-    print(f"poseintegrity.tables  import {ours_import * 1e3:7.0f} ms beyond pandas   check {ours * 1e3:7.1f} ms")
+    print(f"poseintegrity.table_checks  import {ours_import * 1e3:7.0f} ms beyond pandas   check {ours * 1e3:7.1f} ms")
     try:
         schema = pandera_schema()
     except ImportError:

@@ -32,8 +32,10 @@ from poseintegrity.errors import ArgumentError
 from poseintegrity.lens import Camera
 from poseintegrity.localization.dataset import Dataset, load_dataset, load_index
 from poseintegrity.localization.evidence import correspondences
-from poseintegrity.localization.extract import _cache_root, dataset_model, frame_seed, iteration_cap
+from poseintegrity.localization.extract import _cache_root
 from poseintegrity.localization.features import cached_features, read_gray
+from poseintegrity.localization.frame_rows import frame_seed, iteration_cap
+from poseintegrity.localization.model_store import dataset_model
 from poseintegrity.localization.pnp import solve_checked
 from poseintegrity.localization.pose_covariance import propagated_covariance
 from poseintegrity.localization.target_model import TargetModel, build_target_model

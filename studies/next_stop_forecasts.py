@@ -34,11 +34,11 @@ import pandas as pd
 
 from poseintegrity.artifact_models.series import Series, dataset_series
 from poseintegrity.config import load_params
-from poseintegrity.localization.pnp import MIN_CORRESPONDENCES
 from poseintegrity.params.fit import FitParams
+from poseintegrity.params.protocol import ProtocolParams
+from poseintegrity.pose_correspondences import MIN_CORRESPONDENCES
 from poseintegrity.prediction.error_predictors import CountTrend, observed_scale
 from poseintegrity.prediction.predictors import fit_rng, fit_stops, stop_positions
-from poseintegrity.protocol import ProtocolParams
 
 COUNT_FORECASTS = ("eq1", "trend", "last")
 WINDOWS = {"unscaled": 0, "last 1": 1, "last 2": 2, "last 3": 3, "last 5": 5, "all": None}  # observed-scale windows

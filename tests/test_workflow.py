@@ -259,7 +259,7 @@ def test_the_pnp_cache_stage_05_adds_to_stage_02s_output_is_ignored_by_dvc():
 
     from dvc.repo import Repo
 
-    from poseintegrity.localization.extract import FrameTask
+    from poseintegrity.localization.frame_rows import FrameTask
 
     evidence = ROOT / "data" / "features" / "main_arc_0" / "images" / "s00_i00.evidence.npz"
     pnp = FrameTask.pnp_path.fget(SimpleNamespace(evidence_path=evidence))

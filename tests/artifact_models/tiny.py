@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 
 from poseintegrity.config import Params, load_params
-from poseintegrity.parallel import Workers
+from poseintegrity.workers import Workers
 
 TINY_PARAMS = Path(__file__).resolve().parents[1] / "params_tiny.yaml"
 

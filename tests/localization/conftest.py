@@ -16,7 +16,7 @@ import loc_synthetic as synthetic  # noqa: E402
 
 from poseintegrity.config import load_params  # noqa: E402
 from poseintegrity.params.extract import ExtractParams  # noqa: E402
-from poseintegrity.parallel import Workers  # noqa: E402
+from poseintegrity.workers import Workers  # noqa: E402
 from repository import ROOT  # noqa: E402
 
 TINY_PARAMS = ROOT / "tests" / "params_tiny.yaml"

@@ -10,9 +10,11 @@ import loc_synthetic as synthetic
 from poseintegrity import cache_entry as C
 from poseintegrity.localization import extract as E
 from poseintegrity.localization.dataset import DatasetError, load_dataset
-from poseintegrity.poses import pose_errors
 from poseintegrity.localization.envelope import envelopes
-from poseintegrity.protocol import FAILED_FRAME_RULES
+from poseintegrity.localization.frame_rows import usable
+from poseintegrity.localization.model_store import dataset_model
+from poseintegrity.params.protocol import FAILED_FRAME_RULES
+from poseintegrity.poses import pose_errors
 
 METHODS = ["usac_magsac", "epnp"]
 
@@ -58,7 +60,7 @@ def test_an_exact_robot_observes_the_error_against_the_placed_board(table, synth
     rows = table[(table.dataset == "arc_a") & (table.method == "usac_magsac") & (table.status == "ok")]
     assert len(rows) == 8
     dataset = load_dataset(synthetic_data_dir, "datasets/arc_a")
-    _, anchor = E.dataset_model(dataset, extract_params, synthetic_data_dir / extract_params.features_dir / "arc_a")
+    _, anchor = dataset_model(dataset, extract_params, synthetic_data_dir / extract_params.features_dir / "arc_a")
     T_true0 = np.asarray(dataset.meta["model"]["exact_T_cam_board"][0])
     truth = dataset.frames.set_index(["stop", "image"]).T_cam_board
     placed = np.stack([np.reshape(truth[(row.stop, row.image)], (4, 4)) @ np.linalg.inv(T_true0) @ anchor.T_cam_board
@@ -184,7 +186,7 @@ def test_bad_frames_give_flagged_rows_not_crashes(synthetic_data_dir, extract_pa
     assert text.n_inliers == 0 and np.isnan(text.E_t_mm) and text.board_status == "bad_image"
     assert no_truth.status == "bad_pose" and "NaN" in no_truth.reason and np.isnan(no_truth.E_t_mm)
     assert no_truth.n_inliers > 100 and no_truth.board_status == "ok"  # localized: only the exact pose is damaged
-    assert set(E.usable(rows)["image"]) == {0, 1, 2}
+    assert set(usable(rows)["image"]) == {0, 1, 2}
     assert (rows.loc[rows.status != "ok", "reason"] != "").all()  # every row without a pose says why
     assert "SIFT found no keypoints" in blank.reason and "matches, a pose needs 4" in few_blobs.reason
     consensus = ["consensus_t_mm", "consensus_r_deg", "consensus_elsewhere", "consensus_rerun_t_mm"]

@@ -26,7 +26,7 @@ def test_features_equal_opencv_sift_on_the_clahe_image(image, settings):
                                sift.sigma)
     keypoints, descriptors = detector.detectAndCompute(equalized, None)
     ours = F.detect_features(image, clahe, sift)
-    np.testing.assert_allclose(ours.points, [k.pt for k in keypoints])
+    np.testing.assert_allclose(ours.points, [keypoint.pt for keypoint in keypoints])
     np.testing.assert_array_equal(ours.descriptors, descriptors)
     assert ours.n_keypoints > 100
 

@@ -89,8 +89,8 @@ def _two_boards(boards, at_mm, flipped=(), hidden=None) -> np.ndarray:
         tile = board.cv_board().generateImage(tuple(round(s * PLANE_PX) for s in board.size_mm))
         v, u = texel(x, y)
         plane[v:v + tile.shape[0], u:u + tile.shape[1]] = tile
-    for k, marker, (row, col) in flipped:
-        board, (x, y) = boards[k], at_mm[k]
+    for index, marker, (row, col) in flipped:
+        board, (x, y) = boards[index], at_mm[index]
         cell = board.cv_board().getMarkerLength() / 6  # a 4 x 4 code and its border bits
         corner = board.cv_board().getObjPoints()[marker][0]
         (v0, u0), (v1, u1) = (texel(x + corner[0] + (col + i) * cell, y + corner[1] + (row + i) * cell) for i in (0, 1))
@@ -162,9 +162,9 @@ def test_boards_sharing_one_marker_detection_find_what_each_finds_alone(boards, 
         assert all(len(points) == len(alone[0][0]) > 0 for points, _, _ in alone)
     for order in ((0, 1), (1, 0)):
         markers = ImageMarkers(image)
-        for k in order:
-            shared = detect_board_points(image, boards[k], markers)
-            assert all(np.array_equal(a, b) for a, b in zip(shared, alone[k]))
+        for index in order:
+            shared = detect_board_points(image, boards[index], markers)
+            assert all(np.array_equal(a, b) for a, b in zip(shared, alone[index]))
     markers = ImageMarkers(image)
     shared_poses = [board_pose(image, board, TWO_BOARD_CAMERA, CHECKS, markers) for board in boards]
     monkeypatch.setattr(ground_truth, "detect_board_points", lambda image, board, markers=None: _found_alone(
@@ -198,7 +198,7 @@ def test_board_built_from_meta_matches_the_reference_board():
 
 
 @pytest.mark.parametrize("spec, named", [
-    ({k: v for k, v in synthetic.BOARD.items() if k != "separation_mm"}, "separation_mm"),
+    ({key: value for key, value in synthetic.BOARD.items() if key != "separation_mm"}, "separation_mm"),
     ({"type": "charuco", "dictionary": "DICT_4X4_50", "squares_x": 7, "squares_y": 5, "square_mm": 15.0}, "marker_mm"),
     ({**synthetic.BOARD, "type": "chessboard"}, "board.type"),
 ])

@@ -6,7 +6,8 @@ import shutil
 import pytest
 
 from poseintegrity.localization import extract_all
-from poseintegrity.parallel import ParallelParams, Workers
+from poseintegrity.params.parallel import ParallelParams
+from poseintegrity.workers import Workers
 
 pytestmark = pytest.mark.pipeline  # stage 02 on two backends
 

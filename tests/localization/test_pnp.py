@@ -6,8 +6,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from poseintegrity.poses import pose_errors
 from poseintegrity.errors import PoseIntegrityError
+from poseintegrity.poses import pose_errors
 from poseintegrity.localization.pnp import (
     CLASSIC_FLAGS, EPNP_KERNEL, FAILURES, METHODS, reprojection_errors, solve_checked, solve_methods, solve_pnp_ransac,
 )
@@ -207,7 +207,7 @@ def assert_same_result(shared, alone, label):
 @settings(deadline=None, max_examples=40)
 @given(seed=st.integers(0, 10_000), n=st.integers(4, 150), outlier_fraction=st.floats(0.0, 0.95),
        noise_px=st.floats(0.0, 2.0), threshold_px=st.floats(0.5, 3.0), cap=st.integers(1, 150),
-       methods=st.permutations(METHODS).flatmap(lambda order: st.integers(1, len(order)).map(lambda k: order[:k])))
+       methods=st.permutations(METHODS).flatmap(lambda order: st.integers(1, len(order)).map(lambda n: order[:n])))
 def test_shared_ransac_gives_each_method_its_own_result(seed, n, outlier_fraction, noise_px, threshold_px, cap,
                                                         methods):
     """solve_methods (one classic RANSAC for EPnP, SQPnP and iterative, each refit on its consensus) against one

@@ -11,12 +11,12 @@ from poseintegrity.localization.truth_accuracy import R11_BAR, truth_accuracy
 def table(E_t_truth, statuses, method_rows=2):
     """One row per frame and PnP method (the board does not depend on the method): frames of two datasets."""
     rows = []
-    for k, (error, status) in enumerate(zip(E_t_truth, statuses)):
+    for i, (error, status) in enumerate(zip(E_t_truth, statuses)):
         for method in range(method_rows):
-            rows.append(dict(dataset=f"d{k % 2}", stop=k, image=0, method=f"m{method}", board_status=status,
-                             board_n_dropped=int(k == 0), board_rms_px=0.05, board_sigma_t_mm=0.1,
+            rows.append(dict(dataset=f"d{i % 2}", stop=i, image=0, method=f"m{method}", board_status=status,
+                             board_n_dropped=int(i == 0), board_rms_px=0.05, board_sigma_t_mm=0.1,
                              board_sigma_r_deg=0.05, board_n_points=20, E_t_truth_mm=error, E_r_truth_deg=error / 4,
-                             E_t_placement_mm=0.2 + 0.1 * (k % 2), E_r_placement_deg=0.05))
+                             E_t_placement_mm=0.2 + 0.1 * (i % 2), E_r_placement_deg=0.05))
     return pd.DataFrame(rows)
 
 

@@ -12,7 +12,7 @@ import pandas as pd
 from scalar_boundary import envelope_boundary
 from poseintegrity.artifact_models.base_functions import emg
 from poseintegrity.artifact_models.synthetic import synthetic_artifacts
-from poseintegrity.protocol import FAILED_FRAME_RULES, ProtocolParams
+from poseintegrity.params.protocol import FAILED_FRAME_RULES, ProtocolParams
 
 FAILURE_COUNTS = (60.0, 40.0)  # true inlier count at which localization fails, per tolerance (tighter first)
 

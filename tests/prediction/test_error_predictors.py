@@ -1,12 +1,11 @@
-"""The error predictors (issue 38) on series whose predicted error follows its growth law exactly, the combined
-variant, the per-tolerance scoring, and the ceiling with its share, against known answers."""
+"""The error predictors (prediction/error_predictors.py, issue 38) on series whose predicted error follows its growth
+law exactly, against known answers."""
 
 from __future__ import annotations
 
 from dataclasses import replace
 
 import numpy as np
-import pandas as pd
 import pytest
 from scipy.optimize import brentq
 
@@ -14,19 +13,17 @@ from poseintegrity.artifact_models.base_functions import emg
 from poseintegrity.artifact_models.fitted import FALLBACK, OK
 from poseintegrity.artifact_models.series import Series
 from poseintegrity.errors import ArgumentError
-from poseintegrity.localization.pnp import MIN_CORRESPONDENCES
-from poseintegrity.prediction.ceiling import ceiling, ceiling_share
+from poseintegrity.pose_correspondences import MIN_CORRESPONDENCES
 from poseintegrity.prediction.error_predictors import (
     CountTrend, error_long_range, error_next_step, fit_growth, growth_regressor, observed_scale,
 )
 from poseintegrity.prediction.predictors import fit_stops, next_step
-from poseintegrity.prediction.sweeps import COLUMNS, attach_envelopes, combined_rows
 
 ALPHA, K, MU = 3000.0, 8.0, -1.0  # exact eq. 1, as tests/prediction/test_predictors.py
 THETA_STOPS = 2.25 * np.arange(20)
 A_T, B_T, A_R, B_R = 4.0, 700.0, 0.4, 40.0  # sigma^2 n = a + b sin^2 theta (mm^2; deg^2), stage 02's magnitudes
 TOLERANCE = (2.0, 3.0)
-FACTORS = np.geomspace(0.2, 10.0, 41)
+SAFETY_FACTORS = np.geomspace(0.2, 10.0, 41)
 
 
 def exact_sigma(theta, a, b):
@@ -75,12 +72,12 @@ def test_no_pose_is_predicted_where_the_count_falls_below_four(tiny_fit):
 
 
 def test_error_long_range_stops_where_k_sigma_reaches_the_tolerance(tiny_fit):
-    found, status, _ = error_long_range(error_series(), 4, "emg", FACTORS, TOLERANCE, tiny_fit,
+    found, status, _ = error_long_range(error_series(), 4, "emg", SAFETY_FACTORS, TOLERANCE, tiny_fit,
                                         np.random.default_rng(0), 256)
     assert status == OK
     root = found.status == "root"
     assert root.sum() > 20
-    np.testing.assert_allclose(found.theta_p[root], [true_crossing(k) for k in FACTORS[root]], atol=0.02)
+    np.testing.assert_allclose(found.theta_p[root], [true_crossing(k) for k in SAFETY_FACTORS[root]], atol=0.02)
     assert np.all(np.diff(found.theta_p) <= 1e-9)  # a larger safety factor never lets the robot go further
 
 
@@ -130,9 +127,9 @@ def test_error_next_step_follows_iii_e_rule():
         below = np.flatnonzero(margin < k)
         return theta[below[0]] if below.size else np.nan
 
-    step = error_next_step(series, 4, FACTORS, TOLERANCE, 256)
+    step = error_next_step(series, 4, SAFETY_FACTORS, TOLERANCE, 256)
     assert (step.prediction.status == "stopped").sum() > 20
-    for k, theta_p, status in zip(FACTORS, step.prediction.theta_p, step.prediction.status):
+    for k, theta_p, status in zip(SAFETY_FACTORS, step.prediction.theta_p, step.prediction.status):
         true = crossing(k)
         if status == "stopped" and true > THETA_STOPS[3]:
             assert theta_p < true + 0.01 and true - theta_p <= 2.25 + 0.01
@@ -166,7 +163,7 @@ def test_error_next_step_observed_is_the_plain_one_on_the_scaled_error():
     """With observed errors 3 x (t) and 2 x (r) the predicted ones at every stop, the observed variant stops where the
     plain one stops on errors scaled so; with observed errors below the predicted, where the plain one stops."""
     series = error_series()
-    args = (4, FACTORS, TOLERANCE, 256)
+    args = (4, SAFETY_FACTORS, TOLERANCE, 256)
     scaled = error_next_step(replace(series, sigma_t=3.0 * series.sigma_t, sigma_r=2.0 * series.sigma_r), *args)
     ours = error_next_step(observed(series, 3.0, 2.0), *args, observed=True)
     np.testing.assert_array_equal(ours.prediction.theta_p, scaled.prediction.theta_p)
@@ -183,11 +180,11 @@ def test_no_predicted_error_is_a_flagged_fit_not_an_error(tiny_fit):
     series = error_series(sigma_t=np.full(60, np.nan))
     growth, status, reason = eq1_growth(series, np.arange(4), tiny_fit)
     assert status == FALLBACK and "no predicted error" in reason
-    found, _, _ = error_long_range(series, 4, "emg", FACTORS, TOLERANCE, tiny_fit, np.random.default_rng(0), 256)
+    found, _, _ = error_long_range(series, 4, "emg", SAFETY_FACTORS, TOLERANCE, tiny_fit, np.random.default_rng(0), 256)
     assert np.all(found.theta_p == 0.0)  # an unknown error is no licence to move
     without = Series("scene_1_arc000", "arc", series.stop, series.theta, series.n_inliers, 45.0)
     with pytest.raises(ArgumentError, match="series: dataset scene_1_arc000"):
-        error_long_range(without, 4, "emg", FACTORS, TOLERANCE, tiny_fit, np.random.default_rng(0), 256)
+        error_long_range(without, 4, "emg", SAFETY_FACTORS, TOLERANCE, tiny_fit, np.random.default_rng(0), 256)
 
 
 def test_the_supervision_loop_is_the_papers(tiny_fit):
@@ -202,49 +199,3 @@ def test_the_supervision_loop_is_the_papers(tiny_fit):
 def test_growth_regressor_per_trajectory():
     np.testing.assert_allclose(growth_regressor("arc", [0.0, 30.0, 90.0]), [0.0, 0.25, 1.0], atol=1e-12)
     np.testing.assert_allclose(growth_regressor("line", [0.0, 70.0]), [0.0, 70.0])
-
-
-def sweep_rows(predictor, theta_p, operating_point, tolerance=""):
-    return pd.DataFrame({"predictor": predictor, "model": "emg", "method": "usac_magsac", "trajectory": "arc",
-                         "dataset": "scene_1_arc000", "operating_point": operating_point, "theta_p": theta_p,
-                         "status": "root", "fit_status": OK, "reason": predictor, "tolerance": tolerance},
-                        columns=COLUMNS)
-
-
-def test_combined_takes_the_earlier_stop_at_the_chosen_n_t():
-    theta_p = pd.concat([sweep_rows("next_step", [30.0, 20.0, 10.0], [5.0, 10.0, 15.0]),
-                         sweep_rows("error_next_step", [25.0, 15.0], [1.0, 2.0], "2mm_3deg"),
-                         sweep_rows("error_next_step", [40.0, 35.0], [1.0, 2.0], "4mm_10deg")])
-    best = pd.DataFrame({"predictor": "next_step", "method": "usac_magsac", "trajectory": "arc",
-                         "tolerance": ["2mm_3deg", "4mm_10deg"], "max_mean_spl": 1.0, "best_operating_point": [10, 15]})
-    rows = combined_rows(theta_p, best).sort_values(["tolerance", "operating_point"])
-    np.testing.assert_allclose(rows.theta_p, [20.0, 15.0, 10.0, 10.0])  # min(err(k), n_i at n_t 10 | 15)
-    assert list(rows.reason) == ["next_step", "error_next_step", "next_step", "next_step"]
-    assert set(rows.predictor) == {"error_combined"}
-
-
-def envelopes_of(theta_a: dict[str, float]) -> pd.DataFrame:
-    return pd.DataFrame({"world": "main", "dataset": "scene_1_arc000", "trajectory": "arc", "method": "usac_magsac",
-                         "tolerance": list(theta_a), "theta_a": list(theta_a.values()), "censored": False})
-
-
-def test_a_row_made_for_one_tolerance_is_scored_on_it_alone(protocol):
-    theta_p = pd.concat([sweep_rows("long_range", [12.0], [10.0]),
-                         sweep_rows("error_long_range", [30.0], [1.0], "4mm_10deg")])
-    table = attach_envelopes(theta_p, envelopes_of({"2mm_3deg": 20.0, "4mm_10deg": 25.0}), protocol)
-    assert sorted(table[table.predictor == "long_range"].tolerance) == ["2mm_3deg", "4mm_10deg"]
-    error = table[table.predictor == "error_long_range"]
-    assert list(error.tolerance) == ["4mm_10deg"] and list(error.incursion) == [1.0] and list(error.spl) == [25.0]
-
-
-def test_ceiling_and_share_known_answers():
-    table = pd.DataFrame({"dataset": ["a", "b", "c", "c"], "trajectory": "arc", "method": "m",
-                          "tolerance": ["t", "t", "t", "t"], "theta_a": [10.0, 20.0, 30.0, 30.0]})
-    best = pd.DataFrame({"predictor": ["static"], "trajectory": ["arc"], "method": ["m"], "tolerance": ["t"],
-                         "max_mean_spl": [9.5]})
-    limits = ceiling(table, best, "m", ["t", "u"])
-    assert limits["t"] == {"n_arcs": 3, "mean_theta_a": 20.0, "min_theta_a": 10.0, "static_spl": 9.5, "gain": 1.0}
-    assert limits["u"]["n_arcs"] == 0 and np.isnan(limits["u"]["gain"])
-    assert ceiling_share(20.0, limits["t"]) == pytest.approx(1.0)  # knew every envelope
-    assert ceiling_share(9.5, limits["t"]) == 0.0 and ceiling_share(4.25, limits["t"]) == pytest.approx(-0.5)
-    assert np.isnan(ceiling_share(np.nan, limits["t"])) and np.isnan(ceiling_share(15.0, limits["u"]))

@@ -8,7 +8,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from poseintegrity.prediction.tables import deciding_datasets
+from poseintegrity.prediction.paper_tables import deciding_datasets
 from poseintegrity.prediction import (
     best_operating_point,
     incursion,

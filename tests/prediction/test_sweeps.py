@@ -1,5 +1,6 @@
 """The whole operating-point sweep on synthetic stage-02 tables: shape, invariants, fit statuses, bad datasets,
-metrics keys, and the same answers on any number of workers."""
+metrics keys, and the same answers on any number of workers; the combined error predictor's rows and the
+per-tolerance scoring on rows whose answers are known."""
 
 from __future__ import annotations
 
@@ -10,8 +11,9 @@ import pandas as pd
 import pytest
 
 from poseintegrity.artifact_models import FIT_STATUSES
+from poseintegrity.artifact_models.fitted import OK
 from poseintegrity.artifact_models.series import dataset_series
-from poseintegrity.parallel import Workers
+from poseintegrity.workers import Workers
 from poseintegrity.prediction import (
     FITTED_PREDICTORS,
     FREE_WIDTH_PREDICTORS,
@@ -19,6 +21,7 @@ from poseintegrity.prediction import (
     PAPER_PREDICTORS,
     attach_envelopes,
     best_table,
+    combined_rows,
     fit_status_shares,
     headline_metrics,
     live_trials,
@@ -29,6 +32,7 @@ from poseintegrity.prediction import (
     with_pnp_variants,
 )
 from poseintegrity.prediction.predictors import fit_rng
+from poseintegrity.prediction.sweeps import COLUMNS
 from poseintegrity.report.metrics import json_ready
 
 
@@ -59,10 +63,11 @@ def test_relative_thresholds_are_fractions_of_the_first_stop_mean(swept, tables,
     theta_p, _, _ = swept
     series = next(s for s in dataset_series(tables[0], "usac_magsac", protocol) if s.dataset == "scene_2_arc01")
     first_mean = series.n_inliers[series.stop == 0].mean()
-    k = protocol.stops_sampled("arc")
+    n_sampled_stops = protocol.stops_sampled("arc")
     fractions = tiny_predict.relative_thresholds
-    direct = long_range(series, k, tiny_predict.models.long_range, fractions * first_mean, tiny_fit,
-                        fit_rng(tiny_predict.seed, "usac_magsac", series, k), tiny_predict.n_grid)  # fmt: skip
+    direct = long_range(series, n_sampled_stops, tiny_predict.models.long_range, fractions * first_mean, tiny_fit,
+                        fit_rng(tiny_predict.seed, "usac_magsac", series, n_sampled_stops),
+                        tiny_predict.n_grid)  # fmt: skip
     rows = theta_p[(theta_p.dataset == "scene_2_arc01") & (theta_p.predictor == "long_range_relative")]
     np.testing.assert_allclose(rows.sort_values("operating_point")["theta_p"], direct.prediction.theta_p)
     assert set(rows.fit_status) == {direct.fitted.status} and set(rows.reason) == {direct.fitted.reason}
@@ -73,10 +78,11 @@ def test_every_row_says_what_its_fit_was_worth(swept, tables, tiny_predict, tiny
     assert set(theta_p.fit_status) <= {*FIT_STATUSES, NO_FIT}
     assert set(theta_p[theta_p.predictor == "static"].fit_status) == {NO_FIT}
     for series in dataset_series(tables[0], "usac_magsac", protocol):  # the long range and MLP rows: their one fit
-        k = protocol.stops_sampled(series.trajectory)
+        n_sampled_stops = protocol.stops_sampled(series.trajectory)
         for predictor, model in (("long_range", tiny_predict.models.long_range), ("mlp", tiny_predict.models.mlp)):
-            fitted = long_range(series, k, model, tiny_predict.thresholds, tiny_fit,
-                                fit_rng(tiny_predict.seed, "usac_magsac", series, k), tiny_predict.n_grid).fitted
+            fitted = long_range(series, n_sampled_stops, model, tiny_predict.thresholds, tiny_fit,
+                                fit_rng(tiny_predict.seed, "usac_magsac", series, n_sampled_stops),
+                                tiny_predict.n_grid).fitted
             rows = theta_p[(theta_p.dataset == series.dataset) & (theta_p.predictor == predictor)
                            & (theta_p.method == "usac_magsac")]  # fmt: skip
             assert set(rows.fit_status) == {fitted.status} and set(rows.reason) == {fitted.reason}
@@ -134,16 +140,6 @@ def test_headline_metrics_have_the_issue_keys_and_are_json(swept, tiny_predict, 
     assert set(metrics["fit_status"]) == set(FITTED_PREDICTORS)
 
 
-def test_live_trials_run_the_static_baseline_at_its_best_size(swept, tiny_predict, protocol):
-    _, table, curves = swept
-    best = best_table(curves)
-    live = live_trials(table, best, tiny_predict, protocol)
-    size = best[(best.predictor == "static") & (best.trajectory == "arc") & (best.method == protocol.pnp_method)
-                & (best.tolerance == tiny_predict.live_tolerance)].best_operating_point.item()  # fmt: skip
-    assert (live.static_size == size).all() and live.static_incursion.sum() == 0  # its zero-incursion size
-    np.testing.assert_allclose(live.static_share, np.minimum(size, live.theta_a) / live.theta_a)
-
-
 def test_bad_datasets_become_flagged_rows(tables, tiny_predict, tiny_fit, protocol, workers):
     artifacts, envelopes = tables
     one = artifacts[(artifacts.dataset == "scene_1_arc00") & (artifacts.method == "usac_magsac")]
@@ -163,8 +159,8 @@ def test_bad_datasets_become_flagged_rows(tables, tiny_predict, tiny_fit, protoc
 
 def test_a_dataset_gets_the_same_answers_alone_as_in_the_whole_sweep(swept, tables, tiny_predict, tiny_fit, protocol,
                                                                      workers):  # fmt: skip
-    # every fit draws from a Generator seeded by (seed, method, dataset, k): a dataset's rows do not depend on the
-    # others nor on the order of work (the MLP draws random weights)
+    # every fit draws from a Generator seeded by (seed, method, dataset, stops fitted): a dataset's rows do not depend
+    # on the others nor on the order of work (the MLP draws random weights)
     theta_p, _, _ = swept
     artifacts = tables[0]
     alone = sweep(artifacts[artifacts.dataset == "scene_2_arc01"], tiny_predict, tiny_fit, protocol, workers,
@@ -174,7 +170,7 @@ def test_a_dataset_gets_the_same_answers_alone_as_in_the_whole_sweep(swept, tabl
 
 
 def test_a_worker_process_gives_the_same_rows(swept, tables, tiny, tiny_predict, tiny_fit, protocol):
-    """The one parallel layer (parallel.py): a local worker process returns what the in-process run returns, to the
+    """The one parallel layer (workers.py): a local worker process returns what the in-process run returns, to the
     bit: every predictor of a dataset, the MLP on the worker's one thread among them. One task (a dataset and PnP
     method), not four: each process that gets one first imports for 4 s (torch, the fitters), and that many tasks come
     back in order, to the byte, is tests/test_parallel.py's to show."""
@@ -261,3 +257,36 @@ def test_an_envelope_stage_02_could_not_read_is_left_out_of_the_scoring_by_name(
     pd.testing.assert_frame_equal(scored, full[full.dataset != envelopes.dataset.iloc[0]].reset_index(drop=True))
     with pytest.raises(ValueError, match="non-finite theta_a"):  # a NaN stage 02 did not flag
         attach_envelopes(theta_p, spoiled.assign(status="ok"), protocol)
+
+
+def sweep_rows(predictor, theta_p, operating_point, tolerance=""):
+    return pd.DataFrame({"predictor": predictor, "model": "emg", "method": "usac_magsac", "trajectory": "arc",
+                         "dataset": "scene_1_arc000", "operating_point": operating_point, "theta_p": theta_p,
+                         "status": "root", "fit_status": OK, "reason": predictor, "tolerance": tolerance},
+                        columns=COLUMNS)
+
+
+def test_combined_takes_the_earlier_stop_at_the_chosen_n_t():
+    theta_p = pd.concat([sweep_rows("next_step", [30.0, 20.0, 10.0], [5.0, 10.0, 15.0]),
+                         sweep_rows("error_next_step", [25.0, 15.0], [1.0, 2.0], "2mm_3deg"),
+                         sweep_rows("error_next_step", [40.0, 35.0], [1.0, 2.0], "4mm_10deg")])
+    best = pd.DataFrame({"predictor": "next_step", "method": "usac_magsac", "trajectory": "arc",
+                         "tolerance": ["2mm_3deg", "4mm_10deg"], "max_mean_spl": 1.0, "best_operating_point": [10, 15]})
+    rows = combined_rows(theta_p, best).sort_values(["tolerance", "operating_point"])
+    np.testing.assert_allclose(rows.theta_p, [20.0, 15.0, 10.0, 10.0])  # min(err(k), n_i at n_t 10 | 15)
+    assert list(rows.reason) == ["next_step", "error_next_step", "next_step", "next_step"]
+    assert set(rows.predictor) == {"error_combined"}
+
+
+def envelopes_of(theta_a: dict[str, float]) -> pd.DataFrame:
+    return pd.DataFrame({"world": "main", "dataset": "scene_1_arc000", "trajectory": "arc", "method": "usac_magsac",
+                         "tolerance": list(theta_a), "theta_a": list(theta_a.values()), "censored": False})
+
+
+def test_a_row_made_for_one_tolerance_is_scored_on_it_alone(protocol):
+    theta_p = pd.concat([sweep_rows("long_range", [12.0], [10.0]),
+                         sweep_rows("error_long_range", [30.0], [1.0], "4mm_10deg")])
+    table = attach_envelopes(theta_p, envelopes_of({"2mm_3deg": 20.0, "4mm_10deg": 25.0}), protocol)
+    assert sorted(table[table.predictor == "long_range"].tolerance) == ["2mm_3deg", "4mm_10deg"]
+    error = table[table.predictor == "error_long_range"]
+    assert list(error.tolerance) == ["4mm_10deg"] and list(error.incursion) == [1.0] and list(error.spl) == [25.0]

@@ -93,8 +93,8 @@ def test_a_shoulder_and_a_cliff_eq1_overshoots_and_the_free_width_emg_does_not(t
         assert metrics["long_range_free_width"][tolerance] == {"n_overshooting": 0, "datasets": []}
     # the figure's refits are the sweep's: the same curves give the same theta_p
     (tail,) = tail_fits(artifacts, table, ["scene_1_arc00"], tiny_predict, tiny_fit, protocol)
-    assert tail.k == protocol.stops_sampled("arc") and tail.theta_a == dict.fromkeys(protocol.tolerance_names,
-                                                                                     pytest.approx(theta_a))
+    assert tail.n_sampled_stops == protocol.stops_sampled("arc")
+    assert tail.theta_a == dict.fromkeys(protocol.tolerance_names, pytest.approx(theta_a))
     for predictor, fitted in tail.fits.items():
         rows = table[(table.predictor == predictor) & (table.tolerance == protocol.tolerance_names[0])]
         again = envelope_prediction(fitted.predict, rows.operating_point.to_numpy(), 0.0, 45.0, tiny_predict.n_grid)

@@ -3,7 +3,7 @@ import pandas as pd
 import pytest
 
 from poseintegrity.prediction.metrics import operating_curves
-from poseintegrity.prediction.tables import best_table
+from poseintegrity.prediction.paper_tables import best_table
 from poseintegrity.prediction.transfer import transfer, transfer_metrics
 
 

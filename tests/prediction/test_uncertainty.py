@@ -25,7 +25,7 @@ def test_parameter_covariance_is_the_least_squares_one(tiny_fit):
     # eq. 1 alpha and mu trade off (rank 2): the pseudo-inverse keeps the band finite along that valley.
     n = noisy()
     fitted = fit_model("emg", THETA, n, theta_end=45.0, params=tiny_fit, rng=np.random.default_rng(0))
-    p = [fitted.params[k] for k in ("alpha", "K", "mu")]
+    p = [fitted.params[name] for name in ("alpha", "K", "mu")]
     J = emg_jacobian(THETA, *p)
     s2 = np.sum((n - emg(THETA, *p)) ** 2) / (THETA.size - 3)
     H = J @ parameter_covariance(fitted, THETA, n) @ J.T / s2

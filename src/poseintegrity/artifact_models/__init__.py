@@ -1,13 +1,14 @@
 """Artifact models f: theta -> n_inliers (Windsor et al. III-D, Fig. 2), fitted to the first stops of a dataset.
 
-    fitted.py          FittedModel: what every fitter returns (status ok / at_bound / non_physical / fallback, reason,
-                       fallback line)
-    base_functions.py  eq. 1 (scaled EMG) and four other decays, fitted by bounded least squares; beside them (ours)
-                       eq. 1 with a free Gaussian width (emg_free_width)
-    mlp.py             the 3 x 10 tanh MLP (IV-E), from scratch or EMG-pretrained + fine-tuned (III-D)
-    models.py          fit_model(name, ...): one entry point for all of them
     series.py          Series: one dataset's samples (theta, n_inliers per image, in stop order)
+    fitted.py          FittedModel: what every fitter returns (status ok / at_bound / non_physical / fallback, reason)
+    base_functions.py  eq. 1 (scaled EMG), four other decays and the free-width EMG (ours), by bounded least squares
+    mlp.py             the 3 x 10 tanh MLP (IV-E), from scratch or EMG-pretrained + fine-tuned (III-D)
+    mlp_net.py         the MLP as a flat parameter vector: forward pass and analytic gradient of its MSE (numba)
+    lbfgs.py           L-BFGS with a strong Wolfe line search on the MLP's MSE: torch.optim.LBFGS in numba
+    models.py          fit_model(name, ...): one entry point for all of them
     fig2.py            the Fig. 2 experiment on the stage-02 artifacts table
+    synthetic.py       a synthetic artifacts table drawn from eq. 1 + noise, with stage 02's schema
 """
 
 import lazy_loader

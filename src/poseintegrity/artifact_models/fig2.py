@@ -16,16 +16,16 @@ from functools import partial
 import numpy as np
 import pandas as pd
 
-from poseintegrity.seeding import keyed_rng
 from poseintegrity.artifact_models.fitted import FIT_STATUSES, OK, FittedModel
 from poseintegrity.artifact_models.models import fit_model
-from poseintegrity.params.model_names import distinct_theta_needed
-from poseintegrity.params.fit import FitParams
 from poseintegrity.artifact_models.series import Series, dataset_series
 from poseintegrity.errors import ArgumentError
-from poseintegrity.tables import check_fig2_rmse
-from poseintegrity.parallel import Workers
-from poseintegrity.protocol import ProtocolParams
+from poseintegrity.params.fit import FitParams
+from poseintegrity.params.model_names import distinct_theta_needed
+from poseintegrity.params.protocol import ProtocolParams
+from poseintegrity.seeding import keyed_rng
+from poseintegrity.table_checks import check_fig2_rmse
+from poseintegrity.workers import Workers
 
 COLUMNS = ["trajectory", "dataset", "k", "model", "rmse", "status", "reason", "n_samples"]  # of fig2_rmse
 
@@ -97,7 +97,7 @@ def fig2_rmse(
 
 def mean_rmse(table: pd.DataFrame) -> pd.DataFrame:
     """Fig. 2's curves: per (trajectory, model, k) the mean RMSE across datasets and the share of fits "ok".
-    ``table`` is checked (:func:`~poseintegrity.tables.check_fig2_rmse`: a repeated row would shift a
+    ``table`` is checked (:func:`~poseintegrity.table_checks.check_fig2_rmse`: a repeated row would shift a
     mean)."""
     check_fig2_rmse(table)
     return (

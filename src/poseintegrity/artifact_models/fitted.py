@@ -29,7 +29,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from poseintegrity.errors import ArgumentError, check_scalar
-from poseintegrity.tables import FIT_STATUSES  # the fits tables' status column: least to most severe
+from poseintegrity.table_checks import FIT_STATUSES  # the fits tables' status column: least to most severe
 
 OK, AT_BOUND, NON_PHYSICAL, FALLBACK = FIT_STATUSES
 LARGEST_LEVEL = 10.0  # largest count level a model may predict or a level parameter take, in largest mean counts

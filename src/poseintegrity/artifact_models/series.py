@@ -11,10 +11,10 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from poseintegrity.errors import ArgumentError, check_array, check_same_length, check_scalar
 from poseintegrity.artifact_models.fitted import MAX_THETA
-from poseintegrity.tables import TableError, check_artifacts
-from poseintegrity.protocol import ProtocolParams
+from poseintegrity.errors import ArgumentError, check_array, check_same_length, check_scalar
+from poseintegrity.params.protocol import ProtocolParams
+from poseintegrity.table_checks import TableError, check_artifacts
 
 VARIABLE = {"arc": "theta_deg", "line": "x_mm"}  # independent variable of the artifact model per trajectory
 
@@ -85,7 +85,7 @@ def dataset_series(artifacts: pd.DataFrame, pnp_method: str, protocol: ProtocolP
     """Split the artifacts table into one :class:`Series` per (trajectory, dataset) for ``pnp_method``, each
     ending where ``protocol`` ends its trajectory type.
 
-    Checked on read (:class:`~poseintegrity.tables.TableError` naming the table, column and row, or
+    Checked on read (:class:`~poseintegrity.table_checks.TableError` naming the table, column and row, or
     ArgumentError naming the dataset): the columns of stage 02's table, rows, one row per (dataset, stop, image,
     method) (a duplicated row would count twice in every fit), integer stops and images, finite positions, counts
     >= 0, a known trajectory type, stops in order of theta, theta inside [0, range end] (a table rendered for

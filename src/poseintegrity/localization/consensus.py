@@ -44,11 +44,12 @@ from scipy.spatial.transform import Rotation
 
 from poseintegrity.cache_entry import Miss, read_entry, write_entry
 from poseintegrity.localization.frame_pnp import pnp_key, stale_entries
-from poseintegrity.localization.pnp import MIN_CORRESPONDENCES, PnPResult, solve_methods
+from poseintegrity.localization.pnp import PnPResult, solve_methods
 from poseintegrity.params.extract import ConsensusParams, ExtractParams
+from poseintegrity.pose_correspondences import MIN_CORRESPONDENCES
 from poseintegrity.poses import pose_errors, pose_from_rvec_tvec
 from poseintegrity.seeding import keyed_rng
-from poseintegrity.tables import CONSENSUS_COLUMNS, STOP_SPREAD_COLUMNS
+from poseintegrity.table_checks import CONSENSUS_COLUMNS, STOP_SPREAD_COLUMNS
 
 STOP_KEYS = ["dataset", "method", "stop"]
 MIN_RESAMPLES = 4  # an RMS of fewer solved resamples says little
@@ -65,7 +66,7 @@ def bootstrap_dispersion(
     resamples of the inliers against ``T_cam_model`` (module docstring).
 
     object_points : (n, 3) mm; image_points : (n, 2) px (undistorted); K : (3, 3) px; T_cam_model : (4, 4) mm, the
-    pose the inliers were found with; inliers : (k,) int indices into the points. NaN with fewer than
+    pose the inliers were found with; inliers : (m,) int indices into the points. NaN with fewer than
     :data:`MIN_RESAMPLES` solved resamples (n_bootstrap 0 among them).
     """
     rvec0, _ = cv2.Rodrigues(T_cam_model[:3, :3])
@@ -191,7 +192,7 @@ def stop_spread(table: pd.DataFrame) -> pd.DataFrame:
     count = np.bincount(g, minlength=n_groups)
     spread = count >= 2
     T_mean = np.tile(np.eye(4), (n_groups, 1, 1))
-    t_sum = np.stack([np.bincount(g, T[:, k, 3], n_groups) for k in range(3)], axis=1)
+    t_sum = np.stack([np.bincount(g, T[:, axis, 3], n_groups) for axis in range(3)], axis=1)
     T_mean[spread, :3, 3] = t_sum[spread] / count[spread, None]
     T_mean[spread, :3, :3] = chordal_mean(Rotation.from_matrix(T[:, :3, :3]).as_quat(), g, n_groups)[spread]
     E_t, E_r = pose_errors(T, T_mean[g])

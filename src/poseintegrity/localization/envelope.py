@@ -35,7 +35,8 @@ at the unmeasured stop (our first reading) made the envelope end where nothing w
 measured stops say: an optimistic envelope. A criterion not measured before the stop where it fails, or at no stop at
 all, leaves no envelope to read: theta_a is then NaN (``censored`` False, ``status`` ``not_measured``), warned about
 naming the dataset, unless the first stop already fails; the prediction stage leaves such a dataset out of the
-scoring, naming it (prediction.sweeps.attach_envelopes), and any other NaN theta_a is refused (tables.check_envelopes).
+scoring, naming it (prediction.sweeps.attach_envelopes), and any other NaN theta_a is refused
+(table_checks.check_envelopes).
 
 Each tolerance is judged by the board poses fine enough for it (:func:`judged_errors`, ours, issue 39): the trust
 rule's limits keep the ground truth's error within a quarter of the tightest tolerance (R11), and a tolerance k_t
@@ -54,8 +55,8 @@ import numpy as np
 import pandas as pd
 
 from poseintegrity.errors import ArgumentError, check_array, check_increasing, check_same_length
-from poseintegrity.protocol import FAILED_FRAME_RULES, EnvelopeParams, tolerance_name
-from poseintegrity.tables import NOT_MEASURED
+from poseintegrity.params.protocol import FAILED_FRAME_RULES, EnvelopeParams, tolerance_name
+from poseintegrity.table_checks import NOT_MEASURED, check_artifacts
 
 ENVELOPE_INPUT = ("world", "dataset", "trajectory", "stop", "image", "theta_deg", "x_mm", "method", "status",
                   "E_t_mm", "E_r_deg")  # what envelopes reads of an artifacts table
@@ -100,9 +101,9 @@ def actual_envelope(theta: np.ndarray, criteria: np.ndarray, bounds: np.ndarray)
         exceeded = values > bounds  # (m, b); NaN never exceeds
     measured = ~np.isnan(values)
     failing = exceeded.any(axis=1)
-    k = int(np.argmax(failing)) if failing.any() else len(theta)  # first failing stop (m: none)
-    unmeasured = tuple(float(t) for t in theta[:k][~measured[:k].all(axis=1)])
-    if k == 0:
+    first_failing_stop = int(np.argmax(failing)) if failing.any() else len(theta)  # m: none fails
+    unmeasured = tuple(float(t) for t in theta[:first_failing_stop][~measured[:first_failing_stop].all(axis=1)])
+    if first_failing_stop == 0:
         return Envelope(float(theta[0]), False, (), int(np.argmax(exceeded[0])))
     ends = []  # (position, censored, criterion) per criterion: its crossing, or how far it was measured to pass
     for c, bound in enumerate(bounds):
@@ -113,8 +114,9 @@ def actual_envelope(theta: np.ndarray, criteria: np.ndarray, bounds: np.ndarray)
         j = int(passed[-1])  # the criterion's last measured stop before it fails
         if not len(fails):
             # A criterion that never fails ends the envelope (censored) only when none fails: when another crosses
-            # between stops k - 1 and k, what this one is after stop k - 1 is not read (no pose there, say).
-            if k == len(theta):
+            # between the first failing stop and the stop before it, what this one is past that stop is not read
+            # (no pose there, say).
+            if first_failing_stop == len(theta):
                 ends.append((float(theta[j]), True, -1))
             continue
         after = int(fails[0])
@@ -134,7 +136,7 @@ LOOSE_ERRORS = ("E_t_loose_mm", "E_r_loose_deg")  # against poses refused by the
 TRUTH_SCALES = ("truth_scale_t", "truth_scale_r")  # their predicted uncertainty over those limits
 
 
-def loosening(tolerance: tuple[float, float], tolerances: list[tuple[float, float]]) -> np.ndarray:
+def tolerance_loosening(tolerance: tuple[float, float], tolerances: list[tuple[float, float]]) -> np.ndarray:
     """(2,) how many times looser ``tolerance`` is than the tightest of ``tolerances`` in E_t and in E_r (their
     smallest E_t, their smallest E_r), at least 1: its ground truth may be that many times as uncertain (module
     docstring)."""
@@ -142,15 +144,16 @@ def loosening(tolerance: tuple[float, float], tolerances: list[tuple[float, floa
     return np.maximum(1.0, np.asarray(tolerance, dtype=float) / tightest)
 
 
-def judges(frames: pd.DataFrame, k: np.ndarray) -> np.ndarray:
-    """(n,) whether each frame's board pose is fine enough for a tolerance ``k`` (:func:`loosening`) times the
-    tightest: trusted (board status "ok"), or refused by the trust rule's limits alone with truth scales within k
-    (NaN scales never are; a table without the TRUTH_SCALES columns has the trusted ones alone)."""
+def judges(frames: pd.DataFrame, loosening: np.ndarray) -> np.ndarray:
+    """(n,) whether each frame's board pose is fine enough for a tolerance ``loosening`` (2,) times the tightest in
+    E_t and E_r (:func:`tolerance_loosening`): trusted (board status "ok"), or refused by the trust rule's limits
+    alone with truth scales within ``loosening`` (NaN scales never are; a table without the TRUTH_SCALES columns has
+    the trusted ones alone)."""
     trusted = (frames["board_status"] == "ok").to_numpy()
     if not set(TRUTH_SCALES) <= set(frames.columns):
         return trusted
-    return trusted | ((frames[TRUTH_SCALES[0]].to_numpy(dtype=float) <= k[0])
-                      & (frames[TRUTH_SCALES[1]].to_numpy(dtype=float) <= k[1]))
+    return trusted | ((frames[TRUTH_SCALES[0]].to_numpy(dtype=float) <= loosening[0])
+                      & (frames[TRUTH_SCALES[1]].to_numpy(dtype=float) <= loosening[1]))
 
 
 def judged_errors(frames: pd.DataFrame, tolerance: tuple[float, float],
@@ -158,10 +161,10 @@ def judged_errors(frames: pd.DataFrame, tolerance: tuple[float, float],
     """``frames`` with E_t_mm and E_r_deg as ``tolerance`` is judged (module docstring): where they are NaN, the
     errors against a pose (refused by the trust rule's limits alone) that :func:`judges` it. Unchanged for the tightest
     tolerance, or without the LOOSE_ERRORS and TRUTH_SCALES columns (a table written before them)."""
-    k = loosening(tolerance, tolerances)
-    if np.all(k == 1.0) or not {*LOOSE_ERRORS, *TRUTH_SCALES} <= set(frames.columns):
+    loosening = tolerance_loosening(tolerance, tolerances)
+    if np.all(loosening == 1.0) or not {*LOOSE_ERRORS, *TRUTH_SCALES} <= set(frames.columns):
         return frames
-    fine = frames["E_t_mm"].isna().to_numpy() & judges(frames, k)
+    fine = frames["E_t_mm"].isna().to_numpy() & judges(frames, loosening)
     return frames.assign(E_t_mm=np.where(fine, frames["E_t_loose_mm"], frames["E_t_mm"]),
                          E_r_deg=np.where(fine, frames["E_r_loose_deg"], frames["E_r_deg"]))
 
@@ -201,12 +204,10 @@ def envelopes(table: pd.DataFrame, tolerances: list[tuple[float, float]], envelo
     :data:`COLUMNS`; theta_a in deg for arcs (``theta_deg``), mm for lines (``x_mm``)), the errors of the ``errors``
     columns (:data:`GROUND_TRUTH_ERRORS`, the paper's; :data:`EXACT_ERRORS`, against the exact pose: a diagnostic).
 
-    table : usable artifact rows (:func:`~poseintegrity.localization.extract.usable`), checked
-        (:func:`~poseintegrity.tables.check_artifacts`: columns, one row per frame and method, ...)
+    table : usable artifact rows (:func:`~poseintegrity.localization.frame_rows.usable`), checked
+        (:func:`~poseintegrity.table_checks.check_artifacts`: columns, one row per frame and method, ...)
     A theta_a that cannot be read (a criterion never measured, :func:`actual_envelope`) is NaN and warned about.
     """
-    from poseintegrity.tables import check_artifacts  # noqa: PLC0415 (tables imports this module)
-
     check_artifacts(table, "the artifacts table given to envelopes", columns=tuple(dict.fromkeys((*ENVELOPE_INPUT, *errors))))
     rows = []
     for (world, dataset, trajectory, method), frames in table.groupby(["world", "dataset", "trajectory", "method"],

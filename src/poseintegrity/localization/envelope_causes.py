@@ -12,7 +12,7 @@ headline PnP method and failed-frame rule:
   was trusted). If it exceeds the bound too, the envelope ended on the estimate (``estimate``). If it stays within, the ground truth moved the criterion across the
   bound by ``truth_shift`` (criterion against the ground truth minus against the exact pose): by more than the
   ground truth's own accuracy bar (R11, :data:`~poseintegrity.localization.truth_accuracy.R11_BAR`, scaled for a
-  looser tolerance as its ground truth is, :func:`~.envelope.loosening`) that is a fault of
+  looser tolerance as its ground truth is, :func:`~.envelope.tolerance_loosening`) that is a fault of
   the ground truth (``ground_truth``); by no more, the ground truth was as good as R11 asks and the estimate's error
   lay within its resolution of the bound (``resolution``): no ground truth of that accuracy can say on which side of
   the bound that stop falls. Recorded data have no exact pose: the board's own consistency at that stop stands in
@@ -34,9 +34,9 @@ import numpy as np
 import pandas as pd
 
 from poseintegrity.localization.envelope import (CRITERIA, EXACT_ERRORS, GROUND_TRUTH_ERRORS, actual_envelope,
-                                                 judged_errors, judges, loosening, stop_criteria)
+                                                 judged_errors, judges, stop_criteria, tolerance_loosening)
 from poseintegrity.localization.truth_accuracy import R11_BAR
-from poseintegrity.protocol import EnvelopeParams, tolerance_name
+from poseintegrity.params.protocol import EnvelopeParams, tolerance_name
 
 CAUSES = ("estimate", "ground_truth", "resolution", "no_pose", "censored", "unmeasured")  # every value of ``cause``
 COLUMNS = ["world", "dataset", "trajectory", "tolerance", "theta_a", "censored", "theta_a_exact", "limit", "cause",
@@ -76,13 +76,14 @@ def envelope_causes(table: pd.DataFrame, tolerances: list[tuple[float, float]], 
                        n_inliers_at_theta_a=float(np.interp(theta_a, theta, n_inliers)) if np.isfinite(theta_a)
                        else float("nan"),
                        unmeasured_stops=int(np.isnan(criteria[: failing + 1, :2]).all(axis=1).sum()),
-                       board_untrusted_share=float((~judges(at_stop, loosening(tolerance, tolerances))).mean()),
+                       board_untrusted_share=float((~judges(at_stop, tolerance_loosening(tolerance,
+                                                                                          tolerances))).mean()),
                        board_dropped_share=float((at_stop["board_n_dropped"] > 0).mean()),
                        board_sigma_t_mm=float(at_stop["board_sigma_t_mm"].median()),
                        E_t_at_end=float(at_stop["E_t_mm"].mean()),
                        sigma_t_pred_at_end=float(at_stop["sigma_t_pred_mm"].mean()) if "sigma_t_pred_mm" in at_stop
                        else float("nan"))  # a table without the predicted error (written before issue 38)
-            bar = loosening(tolerance, tolerances) * np.asarray(R11_BAR)  # R11's bar for this tolerance
+            bar = tolerance_loosening(tolerance, tolerances) * np.asarray(R11_BAR)  # R11's bar for this tolerance
             row["limit"], row["cause"], row["truth_shift"] = _limit_and_cause(theta_a, censored, criterion, failing,
                                                                               criteria, bounds, same_frames, row, bar)
             rows.append(row)

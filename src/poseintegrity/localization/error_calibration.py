@@ -37,9 +37,9 @@ def calibration_frames(artifacts: pd.DataFrame, envelopes: pd.DataFrame, method:
     return rows[rows["position"] < rows["theta_a"]]
 
 
-def _share_within(measured: pd.Series, sigma: pd.Series, k: float) -> float:
+def _share_within(measured: pd.Series, sigma: pd.Series, n_sigma: float) -> float:
     known = measured.notna() & sigma.notna()
-    return float((measured[known] <= k * sigma[known]).mean()) if known.any() else float("nan")
+    return float((measured[known] <= n_sigma * sigma[known]).mean()) if known.any() else float("nan")
 
 
 def _spearman(a: pd.Series, b: pd.Series) -> float:

@@ -31,8 +31,8 @@ from poseintegrity.localization.features import (
 )
 from poseintegrity.localization.ground_truth import BoardPose, ImageMarkers, board_from_dict, board_pose, no_pose
 from poseintegrity.localization.matching import match_ratio_test
-from poseintegrity.params.extract import ExtractParams
 from poseintegrity.localization.target_model import TargetModel
+from poseintegrity.params.extract import ExtractParams
 
 EVIDENCE_VERSION = 6  # bump when the cached content or its layout changes (3: the checked board pose, issue 30;
 # 4: the matched model points' indices, whose covariances the predicted error needs, issue 38; 5: the board poses'
@@ -44,9 +44,9 @@ class FrameEvidence:
     """The method-independent evidence of one frame.
 
     image_problem : why the image is unusable ("" if it is fine; then nothing else was computed)
-    object_points : (k, 3) float64, M_t points of the k ratio-test matches, board frame, mm
-    model_index : (k,) int, their indices in M_t (whose covariances they carry)
-    image_points : (k, 2) float64, the frame's keypoints of those matches, undistorted (ideal pinhole px of K)
+    object_points : (m, 3) float64, M_t points of the m ratio-test matches, board frame, mm
+    model_index : (m,) int, their indices in M_t (whose covariances they carry)
+    image_points : (m, 2) float64, the frame's keypoints of those matches, undistorted (ideal pinhole px of K)
     n_keypoints : SIFT keypoints in the frame
     board : the board's checked pose (the ground truth, :mod:`~poseintegrity.localization.ground_truth`)
     handover : the checked poses of the dataset's handover boards, in meta.json's order (their ``board`` 1, 2, ...)
@@ -86,8 +86,8 @@ def evidence_key(features_key_: str, digest: str, params: ExtractParams, board: 
 def correspondences(features, model: TargetModel, ratio: float, camera: Camera) -> tuple[np.ndarray, np.ndarray]:
     """2D-3D correspondences of a frame: ratio-test matches of its descriptors to M_t (III-B).
 
-    Returns the matched points' indices in M_t (k,) and image points (k, 2), undistorted by ``camera`` (ideal
-    pinhole px of its K); the object points are ``model.points[index]`` (k, 3, board frame, mm).
+    Returns the matched points' indices in M_t (m,) and image points (m, 2), undistorted by ``camera`` (ideal
+    pinhole px of its K); the object points are ``model.points[index]`` (m, 3, board frame, mm).
     """
     pairs = match_ratio_test(features.descriptors, model.descriptors, ratio)
     return pairs[:, 1].astype(np.intp), camera.undistort(features.points[pairs[:, 0]])
@@ -100,7 +100,7 @@ def _load(path: Path, key: str) -> FrameEvidence | None:
         return None
     return FrameEvidence("", stored["object_points"], stored["model_index"].astype(np.intp), stored["image_points"],
                          int(stored["n_keypoints"]), _stored_pose(stored, "board"),
-                         tuple(_stored_pose(stored, f"handover{k}", k + 1) for k in range(int(stored["n_handover"]))))
+                         tuple(_stored_pose(stored, f"handover{n}", n + 1) for n in range(int(stored["n_handover"]))))
 
 
 def _pose_arrays(prefix: str, pose: BoardPose) -> dict[str, Any]:
@@ -115,8 +115,8 @@ def _pose_arrays(prefix: str, pose: BoardPose) -> dict[str, Any]:
 def _stored_pose(stored, prefix: str, board: int = 0) -> BoardPose:
     """The board pose :func:`_pose_arrays` stored."""
     return BoardPose(stored[f"{prefix}_T_cam_board"], str(stored[f"{prefix}_status"]), str(stored[f"{prefix}_reason"]),
-                     *(int(stored[f"{prefix}_{k}"]) for k in ("n_points", "n_dropped")),
-                     *(float(stored[f"{prefix}_{k}"]) for k in ("rms_px", "sigma_t_mm", "sigma_r_deg")),
+                     *(int(stored[f"{prefix}_{name}"]) for name in ("n_points", "n_dropped")),
+                     *(float(stored[f"{prefix}_{name}"]) for name in ("rms_px", "sigma_t_mm", "sigma_r_deg")),
                      stored[f"{prefix}_covariance"], board, bool(stored[f"{prefix}_consistent"]))
 
 
@@ -148,9 +148,9 @@ def frame_evidence(
     truth = (board_pose(image, board_from_dict(board), camera, params.ground_truth, markers) if board is not None
              else no_pose("no_board", "recorded poses are the ground truth"))  # no board: recorded poses instead
     handover = tuple(replace(board_pose(image, board_from_dict(other), camera, params.ground_truth, markers),
-                             board=k + 1) for k, other in enumerate(handover_boards))
+                             board=n + 1) for n, other in enumerate(handover_boards))
     write_entry(evidence_path, key, dict(
         object_points=object_points, model_index=model_index, image_points=image_points,
         n_keypoints=features.n_keypoints, n_handover=len(handover), **_pose_arrays("board", truth),
-        **{k: v for n, pose in enumerate(handover) for k, v in _pose_arrays(f"handover{n}", pose).items()}))
+        **{key: value for n, pose in enumerate(handover) for key, value in _pose_arrays(f"handover{n}", pose).items()}))
     return FrameEvidence("", object_points, model_index, image_points, features.n_keypoints, truth, handover)

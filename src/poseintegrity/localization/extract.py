@@ -1,8 +1,8 @@
 """Stage 02/05 driver: every frame of the datasets through the localization pipeline, one row per PnP method.
 
 Before any work: the index, each dataset's meta.json and frames.parquet are checked (:mod:`dataset`), a
-:class:`~poseintegrity.localization.dataset.DatasetError` naming the dataset and file otherwise. Then, on the
-workers of the ``parallel`` section (:class:`~poseintegrity.parallel.Workers`):
+:class:`~poseintegrity.dataset_meta.DatasetError` naming the dataset and file otherwise. Then, on the
+workers of the ``parallel`` section (:class:`~poseintegrity.workers.Workers`):
 
 1. per dataset, M_t from the two model images (III-B); a model image or mask that is not the 8-bit gray image of
    camera.yaml's image size stops the stage naming it. M_t is stored beside the SIFT cache, and every frame task
@@ -35,312 +35,30 @@ A frame whose image is unusable gives rows with status ``bad_image``, one whose 
 finite rigid transform rows with status ``bad_pose`` (a damaged file: no error is reported); a frame without a pose
 gives its PnP status; a recorded frame whose pose is not known (None in frames.parquet, board ground truth) is not
 flagged and its ``_exact`` errors are NaN. The ``reason`` column says why for every row whose status is not "ok"
-(empty otherwise). Neither is evidence about localization: :func:`usable` drops them before
+(empty otherwise). Neither is evidence about localization: :func:`~.frame_rows.usable` drops them before
 envelopes and summaries.
 """
 
 from __future__ import annotations
 
 from collections import Counter
-from dataclasses import dataclass, replace
-from functools import lru_cache, partial
+from functools import partial
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pandas as pd
 
-from poseintegrity.cache_entry import Miss, describe, read_entry, read_whole, tallied, write_entry
-from poseintegrity.lens import Camera
-from poseintegrity.seeding import keyed_rng
-from poseintegrity.localization.dataset import Dataset, DatasetError, load_dataset, load_index, pose_problem
-from poseintegrity.localization.evidence import FrameEvidence, frame_evidence, model_digest
-from poseintegrity.localization.features import cached_features, read_gray
-from poseintegrity.localization.frame_artifacts import frame_artifacts
-from poseintegrity.localization.consensus import CONSENSUS_COLUMNS, frame_consensus, stop_spread
-from poseintegrity.localization.frame_pnp import frame_pnp
-from poseintegrity.localization.kinematic_consistency import kinematic_errors, reported_pose
-from poseintegrity.localization.ground_truth import (
-    BoardPose, board_from_dict, board_pose, handed_over, handover, no_pose, truth_error, truth_scale,
-)
+from poseintegrity.atomic_write import remove_staging_files
+from poseintegrity.cache_entry import describe, tallied
+from poseintegrity.dataset_meta import DatasetError
+from poseintegrity.localization.consensus import stop_spread
+from poseintegrity.localization.dataset import Dataset, load_dataset, load_index
+from poseintegrity.localization.frame_rows import DATA_FLAGS, FrameTask, frame_rows, judged
+from poseintegrity.localization.ground_truth import BoardPose, handed_over, handover
+from poseintegrity.localization.model_store import ModelTask, StoredModel, store_model
 from poseintegrity.params.extract import ExtractParams
-from poseintegrity.localization.pnp import PnPResult, failed, solve_checked
-from poseintegrity.ransac import minimal_sample_size, ransac_iterations
-from poseintegrity.poses import NAN_POSE, pose_errors
-from poseintegrity.localization.target_model import TargetModel, build_target_model
-from poseintegrity.parallel import Workers
-from poseintegrity.staging import remove_staging_files
-
-FRAME_COLUMNS = ["world", "dataset", "trajectory", "stop", "image", "theta_deg", "x_mm"]
-DATA_FLAGS = ("bad_image", "bad_pose")  # statuses of rows whose frame (not its localization) is at fault
-NO_CONSENSUS = dict.fromkeys(CONSENSUS_COLUMNS, np.nan)  # the consensus columns of a row without a pose
-
-
-def usable(table: pd.DataFrame) -> pd.DataFrame:
-    """The rows of an artifacts table whose frame was usable: without the ``DATA_FLAGS`` statuses."""
-    return table[~table["status"].isin(DATA_FLAGS)]
-
-
-def frame_seed(seed: int, dataset: str, stop: int, image: int) -> int:
-    """RANSAC seed of one frame, drawn from a Generator seeded by (params seed, dataset, stop, image)."""
-    rng = keyed_rng(seed, dataset, stop, image)
-    return int(rng.integers(0, 2**31 - 1))
-
-
-def localize(
-    object_points: np.ndarray, image_points: np.ndarray, point_covariances: np.ndarray, n_keypoints: int,
-    model_size: int, K: np.ndarray, method: str, params: ExtractParams, seed: int,
-) -> tuple[np.ndarray, dict[str, Any], str, str]:
-    """PnP-RANSAC of one frame's correspondences with one method: (T_cam_board estimate (4, 4), artifacts, status,
-    reason).
-
-    Status "no_keypoints" when SIFT found nothing, else the PnP status ("too_few_matches", ...); the reason says why
-    a frame has no pose ("" when it has one). The classic methods' iteration cap is sized for
-    ``params.ransac_budget_inlier_ratio`` at ``params.ransac_confidence`` (ransac.py).
-    """
-    result = solve_checked(  # K of a checked Camera, points of checked features: no per-frame checks
-        object_points, image_points, K, method, params.reprojection_threshold_px, params.ransac_confidence,
-        iteration_cap(method, params), seed, params.usac_refine_lm,
-    )
-    return located(result, object_points, image_points, point_covariances, n_keypoints, model_size, K,
-                   params.reprojection_threshold_px)
-
-
-def located(
-    result: PnPResult, object_points: np.ndarray, image_points: np.ndarray, point_covariances: np.ndarray,
-    n_keypoints: int, model_size: int, K: np.ndarray, threshold_px: float,
-) -> tuple[np.ndarray, dict[str, Any], str, str]:
-    """What :func:`localize` returns for a PnP result of its correspondences (point_covariances : (k, 3, 3) mm^2,
-    the matched model points' covariances; threshold_px: RANSAC's inlier threshold)."""
-    artifacts = frame_artifacts(result, object_points, image_points, K, n_keypoints, model_size, point_covariances,
-                                threshold_px)
-    if n_keypoints == 0:
-        return result.T_cam_model, artifacts, "no_keypoints", "SIFT found no keypoints in the frame"
-    return result.T_cam_model, artifacts, result.status, result.reason
-
-
-def iteration_cap(method: str, params: ExtractParams) -> int:
-    """RANSAC iterations ``method`` may draw at most: usac_max_iterations for USAC; for classic RANSAC the count that
-    reaches ransac_confidence at ransac_budget_inlier_ratio with the method's samples (ransac.py)."""
-    if method == "usac_magsac":
-        return params.usac_max_iterations
-    return ransac_iterations(params.ransac_confidence, params.ransac_budget_inlier_ratio, minimal_sample_size(method))
-
-
-@dataclass(frozen=True)
-class ModelTask:
-    """Build M_t of one dataset and store it at ``path``."""
-
-    dataset: Dataset
-    cache_dir: Path
-    params: ExtractParams
-
-    @property
-    def path(self) -> Path:
-        return self.cache_dir / "model" / "M_t.npz"
-
-
-@dataclass(frozen=True)
-class StoredModel:
-    """Where a dataset's M_t is stored, its digest (part of every evidence key), size and the model pair's measured
-    pixel noise; ``anchor``: the board's checked pose in model image 0 that placed M_t in the board frame (status
-    ``no_board`` with recorded poses); ``handover_anchors``: the handover boards' checked poses there."""
-
-    path: Path
-    digest: str
-    size: int
-    anchor: BoardPose
-    pixel_noise_px: float
-    handover_anchors: tuple[BoardPose, ...] = ()
-
-@dataclass(frozen=True)
-class FrameTask:
-    """One frame of a dataset: everything a worker needs, M_t by reference."""
-
-    frame: dict[str, Any]  # FRAME_COLUMNS, file and T_cam_board of frames.parquet
-    image_path: Path
-    features_path: Path
-    evidence_path: Path
-    model: StoredModel
-    board: dict[str, Any] | None
-    camera: Camera
-    methods: tuple[str, ...]
-    params: ExtractParams
-    ground_truth: str = "board"  # meta.json's ground_truth: "board" (IV-C) or "poses" (frames.parquet's)
-    T_cam0_board_exact: np.ndarray | None = None  # model image 0's exact board pose (rendered data: R11)
-    T_base_board_robot: np.ndarray | None = None  # where the model view placed the board, in the robot's base frame
-    handover_boards: tuple[dict[str, Any], ...] = ()  # meta.json's: boards that judge a frame its own board cannot
-    consensus: bool = True  # compute the consensus columns (else NaN): see extract_datasets
-
-    @property
-    def pnp_path(self) -> Path:
-        """The cache of the frame's PnP results (:mod:`frame_pnp`), beside its evidence."""
-        return beside_evidence(self.evidence_path, ".pnp.npz")
-
-    @property
-    def consensus_path(self) -> Path:
-        """The cache of the frame's consensus columns (:mod:`consensus`), beside its evidence."""
-        return beside_evidence(self.evidence_path, ".consensus.npz")
-
-
-def beside_evidence(evidence_path: Path, suffix: str) -> Path:
-    """A per-frame cache file beside the frame's evidence: ``<image>.evidence.npz`` -> ``<image><suffix>``."""
-    return evidence_path.with_name(evidence_path.name.removesuffix(".evidence.npz") + suffix)
-
-
-def dataset_model(dataset: Dataset, params: ExtractParams, cache_dir: Path) -> tuple[TargetModel, BoardPose]:
-    """M_t of a dataset from its two model images (features cached like frames), and the board pose in model image
-    0 that placed it. Each image and mask must be the 8-bit gray image of camera.yaml's size:
-    :class:`~poseintegrity.localization.features.ImageReadError` naming the dataset and the file otherwise. A board
-    that gives no pose in model image 0 stops the stage naming the dataset; one whose pose fails its checks
-    (``bad_ground_truth``) still places M_t, and the anchor's status says so (artifacts.json)."""
-    model = dataset.meta["model"]
-    try:
-        images = [read_gray(dataset.path(image), dataset.image_size) for image in model["images"]]
-        masks = tuple(read_gray(dataset.path(mask), dataset.image_size) for mask in model["masks"])
-    except DatasetError as error:
-        raise type(error)(f"dataset {dataset.name}, model pair: {error}") from None
-    features = tuple(
-        cached_features(dataset.path(name), cache_dir / "model" / f"{index}.npz", params.clahe, params.sift, image=image)
-        for index, (name, image) in enumerate(zip(model["images"], images))
-    )
-    if dataset.meta.get("ground_truth", "board") == "poses":  # recorded: M_t in the external system's frame
-        T_cam0_ref = np.asarray(dataset.meta["model"]["T_cam0_ref"], dtype=np.float64)
-        return build_target_model(features, masks, dataset.model_baseline(), T_cam0_ref, dataset.camera,
-                                  params.ratio_test, params.model_max_reprojection_px), no_pose("no_board", "")
-    anchor = board_pose(images[0], board_from_dict(dataset.meta["board"], f"dataset {dataset.name}: meta.json board"),
-                        dataset.camera, params.ground_truth)  # IV-C: M_t in the board frame
-    if anchor.status not in ("ok", "bad_ground_truth"):
-        raise DatasetError(f"dataset {dataset.name}: the ArUco board is not found in model image "
-                           f"{model['images'][0]} ({anchor.status}: {anchor.reason}), so the target model cannot be "
-                           f"placed in the board frame (IV-C)")
-    return build_target_model(features, masks, dataset.model_baseline(), anchor.T_cam_board, dataset.camera,
-                              params.ratio_test, params.model_max_reprojection_px), anchor
-
-
-def handover_anchors(dataset: Dataset, params: ExtractParams) -> tuple[BoardPose, ...]:
-    """The checked poses of meta.json's handover boards in model image 0 (``board`` 1, 2, ...; ground_truth.py)."""
-    others = dataset.meta.get("handover_boards") or []
-    if not others:
-        return ()
-    image = read_gray(dataset.path(dataset.meta["model"]["images"][0]), dataset.image_size)
-    return tuple(replace(board_pose(image, board_from_dict(other, f"dataset {dataset.name}: meta.json handover_boards["
-                                                                  f"{k}]"), dataset.camera, params.ground_truth),
-                         board=k + 1) for k, other in enumerate(others))
-
-
-def store_model(task: ModelTask) -> StoredModel:
-    """Build M_t of a dataset (a worker task) and store it for the frame tasks (unless stored already)."""
-    model, anchor = dataset_model(task.dataset, task.params, task.cache_dir)
-    digest = model_digest(model)
-    stored = read_entry(task.path, digest)  # the covariances do not enter the digest (no evidence depends on them)
-    if isinstance(stored, Miss) or not np.array_equal(stored["covariances"], model.covariances):
-        write_entry(task.path, digest, dict(points=model.points, descriptors=model.descriptors,
-                                            covariances=model.covariances, pixel_noise_px=model.pixel_noise_px))
-    return StoredModel(task.path, digest, model.size, anchor, model.pixel_noise_px,
-                       handover_anchors(task.dataset, task.params))
-
-
-@lru_cache(maxsize=4)
-def load_model(path: Path, digest: str) -> TargetModel:
-    """M_t stored by :func:`store_model`, loaded once per worker process (``digest``: the one expected)."""
-    stored = read_whole(path, digest)  # checked (and counted) by store_model
-    if isinstance(stored, Miss):
-        raise DatasetError(f"target model {path} is {stored.reason} since this stage stored it (another run on the "
-                           f"same data?): re-run the stage")
-    return TargetModel(stored["points"], stored["descriptors"], stored["covariances"], float(stored["pixel_noise_px"]))
-
-
-def frame_rows(task: FrameTask) -> tuple[list[dict[str, Any]], tuple[BoardPose, ...]]:
-    """All rows (one per method) of one frame, judged by the dataset's own board, and the frame's checked board
-    poses (its own, then its handover boards'); runs in a worker."""
-    frame, model = task.frame, task.model
-    M_t = load_model(model.path, model.digest)
-    evidence: FrameEvidence = frame_evidence(
-        task.image_path, task.features_path, task.evidence_path, M_t, model.digest, task.board, task.camera,
-        task.params, frame["file"], task.handover_boards,
-    )
-    point_covariances = M_t.covariances[evidence.model_index]
-    known = frame["T_cam_board"] is not None  # None: a recorded frame without a pose (board ground truth)
-    truth_problem = pose_problem(frame["T_cam_board"]) if known else None
-    T_cam_board = exact_pose(frame)
-    if evidence.image_problem:
-        status, reason = "bad_image", evidence.image_problem
-    elif truth_problem:
-        status, reason = "bad_pose", f"ground truth T_cam_board of frames.parquet {truth_problem}"
-    else:
-        status, reason = None, ""
-    seed = frame_seed(task.params.seed, frame["dataset"], int(frame["stop"]), int(frame["image"]))
-    T_base_cam = reported_pose(frame.get("T_base_cam_robot"))
-    T_base_board = NAN_POSE if task.T_base_board_robot is None else task.T_base_board_robot
-    caps = {method: iteration_cap(method, task.params) for method in task.methods}
-    results = {} if evidence.image_problem else frame_pnp(  # cached per frame; the classic RANSAC shared
-        task.pnp_path, evidence.object_points, evidence.image_points, task.camera.K, model.digest, task.methods, caps,
-        task.params, seed)
-    consensus = {} if evidence.image_problem or not task.consensus else frame_consensus(  # cached per frame
-        task.consensus_path, evidence.object_points, evidence.image_points, task.camera.K, model.digest, results, caps,
-        task.params, seed)
-    rows = []
-    for method in task.methods:
-        if evidence.image_problem:
-            T_est, artifacts = NAN_POSE.copy(), frame_artifacts(failed("bad_image", reason), evidence.object_points,
-                                                                evidence.image_points, task.camera.K, 0,
-                                                                model.size, point_covariances,
-                                                                task.params.reprojection_threshold_px)
-        else:
-            T_est, artifacts, pnp_status, pnp_reason = located(
-                results[method], evidence.object_points, evidence.image_points, point_covariances,
-                evidence.n_keypoints, model.size, task.camera.K, task.params.reprojection_threshold_px,
-            )
-        E_t_exact_mm, E_r_exact_deg = map(float, pose_errors(T_est, T_cam_board))
-        E_t_kinematic_mm, E_r_kinematic_deg = map(float, kinematic_errors(T_base_cam, T_est, T_base_board))
-        row = ({key: frame[key] for key in FRAME_COLUMNS}
-               | dict(method=method, status=status or pnp_status, reason=reason or pnp_reason, model_size=model.size,
-                      model_pixel_noise_px=model.pixel_noise_px)
-               | artifacts
-               | consensus.get(method, NO_CONSENSUS)
-               | dict(E_t_exact_mm=E_t_exact_mm, E_r_exact_deg=E_r_exact_deg, E_t_kinematic_mm=E_t_kinematic_mm,
-                      E_r_kinematic_deg=E_r_kinematic_deg, T_cam_board_est=T_est.ravel().tolist()))
-        rows.append(row | judged(row, evidence.board, task))
-    return rows, (evidence.board, *evidence.handover)
-
-
-def exact_pose(frame: dict[str, Any]) -> np.ndarray:
-    """(4, 4) mm: the frame's pose of frames.parquet (exact when rendered, the external system's when recorded);
-    NaN when it is None or not a finite rigid transform."""
-    pose = frame["T_cam_board"]
-    if pose is None or pose_problem(pose):
-        return NAN_POSE
-    return np.asarray(pose, dtype=np.float64).reshape(4, 4)
-
-
-def judged(row: dict[str, Any], board: BoardPose, task: FrameTask) -> dict[str, Any]:
-    """The columns of a row that its ground truth decides, the checked board pose ``board`` (IV-C; the frame's poses
-    of frames.parquet with ``ground_truth: poses``): E_t and E_r (NaN without a trusted pose, and on a flagged row),
-    the board's columns, and what the board pose adds to E_t and E_r (R11)."""
-    T_cam_board = exact_pose(task.frame)
-    poses = task.ground_truth == "poses"
-    truth = T_cam_board if poses else (board.T_cam_board if board.trusted else NAN_POSE)
-    loose = T_cam_board if poses else (board.T_cam_board if board.consistent else NAN_POSE)
-    T_est = np.asarray(row["T_cam_board_est"], dtype=np.float64).reshape(4, 4)
-    E_t_mm, E_r_deg = map(float, pose_errors(T_est, truth))  # IV-C: the board is the truth (or the poses)
-    E_t_loose_mm, E_r_loose_deg = map(float, pose_errors(T_est, loose))  # judges the looser tolerances
-    scale_t, scale_r = truth_scale(board, task.params.ground_truth)
-    if row["status"] in DATA_FLAGS:  # a flagged frame is no evidence: no error is reported for it
-        E_t_mm = E_r_deg = E_t_loose_mm = E_r_loose_deg = np.nan
-    E_t_board_exact_mm, E_r_board_exact_deg = map(float, pose_errors(board.T_cam_board, T_cam_board))
-    exact_0 = NAN_POSE if task.T_cam0_board_exact is None else task.T_cam0_board_exact
-    anchor = task.model.anchor
-    E_t_truth_mm, E_r_truth_deg = truth_error(board.T_cam_board, T_cam_board, anchor.T_cam_board, exact_0)
-    E_t_placement_mm, E_r_placement_deg = map(float, pose_errors(anchor.T_cam_board, exact_0))
-    return dict(E_t_mm=E_t_mm, E_r_deg=E_r_deg, E_t_loose_mm=E_t_loose_mm, E_r_loose_deg=E_r_loose_deg,
-                truth_scale_t=scale_t, truth_scale_r=scale_r,
-                board_status=board.status, board_reason=board.reason,
-                board_n_points=board.n_points, board_n_dropped=board.n_dropped, board_rms_px=board.rms_px,
-                board_sigma_t_mm=board.sigma_t_mm, board_sigma_r_deg=board.sigma_r_deg, truth_board=board.board,
-                E_t_board_exact_mm=E_t_board_exact_mm, E_r_board_exact_deg=E_r_board_exact_deg,
-                E_t_truth_mm=E_t_truth_mm, E_r_truth_deg=E_r_truth_deg, anchor_status=anchor.status,
-                E_t_placement_mm=E_t_placement_mm, E_r_placement_deg=E_r_placement_deg)
+from poseintegrity.workers import Workers
 
 
 def handed_over_rows(tasks: list[FrameTask], results: list[tuple[list[dict[str, Any]], tuple[BoardPose, ...]]],
@@ -355,10 +73,10 @@ def handed_over_rows(tasks: list[FrameTask], results: list[tuple[list[dict[str, 
     for task, frame, (_, boards) in zip(tasks, rows, results):
         if boards[0].trusted or not frame or frame[0]["status"] in DATA_FLAGS:
             continue
-        for k, link in enumerate(links, start=1):
-            if link is None or not boards[k].trusted:
+        for board, link in enumerate(links, start=1):
+            if link is None or not boards[board].trusted:
                 continue
-            carried = handed_over(boards[k], link, params.ground_truth, k)
+            carried = handed_over(boards[board], link, params.ground_truth, board)
             if carried.trusted:
                 frame[:] = [row | judged(row, carried, task) for row in frame]
                 break
@@ -402,8 +120,8 @@ def extract_datasets(
         print(cache_report(tallies, unfinished), flush=True)
     rows = []
     for dataset in datasets:
-        mine = [k for k, task in enumerate(tasks) if task.frame["dataset"] == dataset.name]
-        rows += handed_over_rows([tasks[k] for k in mine], [results[k] for k in mine], params)
+        mine = [i for i, task in enumerate(tasks) if task.frame["dataset"] == dataset.name]
+        rows += handed_over_rows([tasks[i] for i in mine], [results[i] for i in mine], params)
     table = pd.DataFrame(rows)
     return table.join(stop_spread(table)) if rows else table
 

@@ -16,7 +16,7 @@ import cv2
 import numpy as np
 
 from poseintegrity.cache_entry import Miss, read_entry, write_entry
-from poseintegrity.defaults import published
+from poseintegrity.config import published
 from poseintegrity.grayscale import as_gray8
 from poseintegrity.localization.dataset import DatasetError
 from poseintegrity.params.extract import ClaheParams, SiftParams

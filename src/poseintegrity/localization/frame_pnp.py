@@ -23,8 +23,8 @@ from pathlib import Path
 import numpy as np
 
 from poseintegrity.cache_entry import Miss, count, read_entry, write_entry
-from poseintegrity.params.extract import ExtractParams
 from poseintegrity.localization.pnp import PnPResult, solve_methods
+from poseintegrity.params.extract import ExtractParams
 
 PNP_CACHE_VERSION = 2  # bump when the cached content or its layout changes (2: OpenCV and numpy in the file's key)
 FILE_KEY = f"pnp results, layout {PNP_CACHE_VERSION}"  # each method's entry carries its own key (pnp_key)
@@ -38,7 +38,7 @@ def pnp_key(
 ) -> str:
     """Hash of everything the PnP result of ``method`` on these correspondences depends on (module docstring).
 
-    object_points : (k, 3) float64 mm; image_points : (k, 2) float64 px; K : (3, 3) px; digest : M_t's
+    object_points : (m, 3) float64 mm; image_points : (m, 2) float64 px; K : (3, 3) px; digest : M_t's
     """
     settings = [PNP_CACHE_VERSION, method, digest, np.asarray(K, np.float64).tolist(), len(object_points),
                 params.reprojection_threshold_px, params.ransac_confidence, max_iterations, seed,
@@ -92,7 +92,7 @@ def frame_pnp(
     """The PnP result of every method of ``methods`` on one frame's correspondences: from the cache file ``path``
     for each method whose key matches, computed for the others (and added to the file).
 
-    object_points : (k, 3) float64 mm, image_points : (k, 2) float64 px (undistorted), K : (3, 3) px, of checked
+    object_points : (m, 3) float64 mm, image_points : (m, 2) float64 px (undistorted), K : (3, 3) px, of checked
     evidence; digest : M_t's; max_iterations : each method's iteration cap; seed : the frame's RANSAC seed.
     """
     keys = {method: pnp_key(method, object_points, image_points, K, digest, params, max_iterations[method], seed)

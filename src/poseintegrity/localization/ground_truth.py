@@ -35,8 +35,8 @@ would not: on the synthetic two-board scene of tests/localization/test_extract.p
 error it predicts there, sqrt(sigma_B(p)^2 + sigma_B0(p)^2), p = A's origin in B's frame, sigma_B(p) and
 sigma_B0(p) what the covariances of B's pose in the frame and in model image 0 predict for p (:func:`sigma_t_at`,
 which at p = 0 is sigma_t), and the rotation's, the two poses' sigma_r combined alike, stay within
-``max_sigma_t_mm`` and ``max_sigma_r_deg``. The frame then says which board judged it (``board``: 0 its own, k its
-k-th handover board). B must be trusted in model image 0.
+``max_sigma_t_mm`` and ``max_sigma_r_deg``. The frame then says which board judged it (``board``: 0 its own, n its
+n-th handover board). B must be trusted in model image 0.
 
 **Per tolerance** (issue 39). Step 3's limits keep the ground truth's own error within R11's bar, a quarter of the
 tightest tolerance (docs/references.md, "The trust rule and R11's bar"). A tolerance k_t times looser in E_t and k_r
@@ -55,7 +55,7 @@ import cv2
 import numpy as np
 
 from poseintegrity.boards import Board, Charuco, board_from_dict, scaled
-from poseintegrity.defaults import published
+from poseintegrity.config import published
 from poseintegrity.errors import ArgumentError
 from poseintegrity.grayscale import as_gray8
 from poseintegrity.lens import Camera
@@ -79,7 +79,7 @@ class BoardPose:
     rms_px : RMS reprojection residual of the final fit; sigma_t_mm, sigma_r_deg : its predicted uncertainty at the
         board origin (NaN without a fit); covariance : (6, 6) of (rvec, tvec) (rad, mm), s^2 (J^T J)^-1 (NaN without
         a fit)
-    board : which board gave the pose: 0 the dataset's own, k > 0 its k-th handover board (module docstring)
+    board : which board gave the pose: 0 the dataset's own, n > 0 its n-th handover board (module docstring)
     consistent : checks 1 and 2 passed (a pose refused by step 3 alone judges looser tolerances, :func:`truth_scale`)
     """
 
@@ -332,7 +332,7 @@ def sigma_t_at(pose: BoardPose, point: np.ndarray) -> float:
     """RMS error (mm) of a board-frame point (3,) mm, in the camera frame, that the pose's covariance predicts:
     sqrt(trace(J C J^T)), J = [d(R(rvec) p) / d rvec, I] (3, 6) (OpenCV's Rodrigues Jacobian); sigma_t at p = 0."""
     rvec, _ = cv2.Rodrigues(np.asarray(pose.T_cam_board[:3, :3], np.float64))
-    _, dR = cv2.Rodrigues(rvec)  # (3, 9): row k is d vec(R) / d rvec_k, R row-major
+    _, dR = cv2.Rodrigues(rvec)  # (3, 9): row j is d vec(R) / d rvec_j, R row-major
     J = np.hstack([(dR.reshape(3, 3, 3) @ np.asarray(point, np.float64)).T, np.eye(3)])
     return float(np.sqrt(max(np.trace(J @ pose.covariance @ J.T), 0.0)))
 

@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-from poseintegrity.localization.dataset import pose_problem
+from poseintegrity.dataset_meta import pose_problem
 from poseintegrity.poses import NAN_POSE, pose_errors
 
 

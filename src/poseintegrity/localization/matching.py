@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from poseintegrity.defaults import published
+from poseintegrity.config import published
 from poseintegrity.errors import ArgumentError, check_scalar
 
 MAX_DESCRIPTOR = 1e6  # SIFT components are at most 512 (OpenCV scales the unit vector by 512 and clips at 0.2 of it)
@@ -36,7 +36,7 @@ def match_ratio_test(query: np.ndarray, train: np.ndarray, ratio: float | None =
     A query descriptor is kept when its nearest train descriptor is closer than ``ratio`` times the second
     nearest (Lowe 2004, section 7.1), L2 distance; ratio None takes ``extract.ratio_test`` of the published
     defaults (params.yaml).
-    Returns (k, 2) int: rows of (query index, train index); (0, 2) when the query is empty or the train
+    Returns (p, 2) int: rows of (query index, train index); (0, 2) when the query is empty or the train
     set has fewer than the 2 descriptors a ratio test needs.
     Refused (:class:`~poseintegrity.errors.ArgumentError` naming the argument): descriptors that are not a 2-D array
     of finite real numbers, query and train of different descriptor lengths, a ratio outside (0, 1].

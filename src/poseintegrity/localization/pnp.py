@@ -42,8 +42,9 @@ import cv2
 import numpy as np
 
 from poseintegrity.errors import ArgumentError, check_array, check_intrinsics, check_scalar, check_same_length
-from poseintegrity.ransac import minimal_sample_size
+from poseintegrity.pose_correspondences import MIN_CORRESPONDENCES
 from poseintegrity.poses import NAN_POSE, pose_from_rvec_tvec
+from poseintegrity.ransac import minimal_sample_size
 
 # names of docs/references.md, "OpenCV 5" (OpenCV 5 renumbered the flags: never use the integers)
 CLASSIC_FLAGS = {
@@ -72,7 +73,6 @@ METHODS = ("usac_magsac", *CLASSIC_FLAGS)
 #      gives one pose whenever it returns (solvePnPGeneric), so a leader's "no pose" means no consensus; SQPnP's
 #      can give none (solvePnPRansac then returns false).
 EPNP_KERNEL = ("iterative", "epnp", "sqpnp")  # in leading order
-MIN_CORRESPONDENCES = 4  # a unique pose needs 4 points; P3P with 3 leaves up to 4 solutions
 FAILURES = (
     "too_few_matches",    # fewer than MIN_CORRESPONDENCES matches
     "degenerate_points",  # collinear or coincident model points: no pose is defined
@@ -88,7 +88,7 @@ class PnPResult:
     """Outcome of one PnP-RANSAC run.
 
     T_cam_model : (4, 4) float, model (board) -> camera, mm; all NaN on failure
-    inliers : (k,) int, indices of correspondences reprojecting within the threshold under T_cam_model
+    inliers : (n_i,) int, indices of correspondences reprojecting within the threshold under T_cam_model
     n_inliers_reported : int, size of OpenCV's own inlier set
     status : "ok" or one of :data:`FAILURES`
     reason : why it failed, with its numbers ("" when ok)

@@ -15,9 +15,9 @@ from scipy.stats import spearmanr
 
 from poseintegrity.artifact_models.base_functions import BASE_FUNCTIONS
 from poseintegrity.localization.envelope import headline
-from poseintegrity.params.extract import RealismParams
 from poseintegrity.localization.truth_accuracy import truth_accuracy
-from poseintegrity.protocol import ProtocolParams, tolerance_name
+from poseintegrity.params.extract import RealismParams
+from poseintegrity.params.protocol import ProtocolParams, tolerance_name
 
 
 DESCRIPTION_ONLY = ("recorded data: these values describe the recordings; the bars are properties of the paper's data "
@@ -74,8 +74,8 @@ def realism_metrics(
       arcs whose theta_a lies within 0.01 deg of a stop, <= 0.5
     - R11 (a measurement finer than what it judges) ``truth_accuracy``
       (:func:`~poseintegrity.localization.truth_accuracy.truth_accuracy`): what the board's ground truth adds to E_t
-      and E_r, 99th percentile <= 0.5 mm and 0.5 deg over the frames whose board pose is trusted, and k times that
-      over the frames judging a tolerance k times looser
+      and E_r, 99th percentile <= 0.5 mm and 0.5 deg over the frames whose board pose is trusted, and as many times
+      that over the frames judging a tolerance that many times looser
     ``n_bars_passed`` / ``n_bars`` count the bars of ``passed``.
 
     recorded : the rows are recorded data (:mod:`poseintegrity.recorded`), not a rendered world: the same values
@@ -137,7 +137,7 @@ def realism_metrics(
         min_abs_spearman=_nanmin([-rho for rho in spearman.values()]),  # a one-stop dataset has no rho
         spearman_to_failure=spearman_to_failure,
         min_abs_spearman_to_failure=_nanmin([-rho for rho in spearman_to_failure.values()]),
-        first_stop_mean_inliers={k: float(v) for k, v in first_stop.items()},
+        first_stop_mean_inliers={dataset: float(n) for dataset, n in first_stop.items()},
         min_first_stop_mean_inliers=float(first_stop.min()) if len(first_stop) else float("nan"),
         median_E_t_mm_low_inliers=float(median_low),
         median_E_t_mm_high_inliers=float(median_high),
@@ -153,8 +153,8 @@ def realism_metrics(
         median_inliers_at_theta_a_4mm10deg=_nanmedian(list(at_failure_loose.values())),
         p90_inliers_at_theta_a_2mm3deg=_nanquantile(list(at_failure_strict.values()), 0.9),
         p90_inliers_at_theta_a_4mm10deg=_nanquantile(list(at_failure_loose.values()), 0.9),
-        theta_a_2mm3deg={k: float(v) for k, v in strict["theta_a"].items()},
-        theta_a_4mm10deg={k: float(v) for k, v in loose["theta_a"].items()},
+        theta_a_2mm3deg={dataset: float(theta_a) for dataset, theta_a in strict["theta_a"].items()},
+        theta_a_4mm10deg={dataset: float(theta_a) for dataset, theta_a in loose["theta_a"].items()},
         rmse_by_base_function=rmse,
         emg_rmse_ratio=float(rmse["emg"] / min(others.values())) if others else float("nan"),
         theta_a_2mm3deg_within_sampling=within_sampling,

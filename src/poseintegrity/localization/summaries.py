@@ -7,7 +7,7 @@ import pandas as pd
 
 from poseintegrity.localization.pnp import FAILURES
 
-FAILURE_STATUSES = ("no_keypoints", *FAILURES)  # no_keypoints: SIFT found nothing in the frame (extract.localize)
+FAILURE_STATUSES = ("no_keypoints", *FAILURES)  # no_keypoints: SIFT found nothing in the frame (frame_rows.localize)
 
 
 def method_summary(table: pd.DataFrame, envelope_table: pd.DataFrame) -> pd.DataFrame:

@@ -19,8 +19,8 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from poseintegrity.localization.envelope import TRUTH_SCALES, judges, loosening
-from poseintegrity.protocol import tolerance_name
+from poseintegrity.localization.envelope import TRUTH_SCALES, judges, tolerance_loosening
+from poseintegrity.params.protocol import tolerance_name
 
 R11_BAR = (0.5, 0.5)  # mm, deg: a quarter of the tightest tolerance (2 mm / 3 deg), rounded down in rotation
 FRAME_KEYS = ["dataset", "stop", "image"]
@@ -29,12 +29,13 @@ FRAME_KEYS = ["dataset", "stop", "image"]
 def truth_accuracy(table: pd.DataFrame, tolerances: list[tuple[float, float]] = ()) -> dict[str, Any]:
     """R11 and the board's checks over an artifacts table's frames (one row per frame is used: the board does not
     depend on the PnP method). ``tolerances``: the protocol's, whose looser ones are checked too (``by_tolerance``:
-    per tolerance name its ``k`` (k_t, k_r), ``judged_share`` of the frames, ``p99_E_t_truth_mm``,
-    ``p99_E_r_truth_deg``, ``bar`` and ``passed``). Keys: ``n_frames``; ``trusted_share`` (board status "ok"); ``status_shares``;
-    ``untrusted_share_by_dataset``; ``dropped_share`` (frames whose check dropped a marker or corner);
-    ``median_rms_px``, ``median_sigma_t_mm``, ``median_sigma_r_deg``, ``median_points``; with exact poses:
-    ``median_E_t_truth_mm``, ``p99_E_t_truth_mm``, ``max_E_t_truth_mm`` and the same in deg, ``placement_*`` (median
-    and max over datasets), ``r11_passed``; without them (recorded data) those are NaN and ``r11_passed`` None."""
+    per tolerance name ``k``, its loosening (k_t, k_r) (:func:`~.envelope.tolerance_loosening`), ``judged_share``
+    of the frames, ``p99_E_t_truth_mm``, ``p99_E_r_truth_deg``, ``bar`` and ``passed``). Keys: ``n_frames``;
+    ``trusted_share`` (board status "ok"); ``status_shares``; ``untrusted_share_by_dataset``; ``dropped_share``
+    (frames whose check dropped a marker or corner); ``median_rms_px``, ``median_sigma_t_mm``,
+    ``median_sigma_r_deg``, ``median_points``; with exact poses: ``median_E_t_truth_mm``, ``p99_E_t_truth_mm``,
+    ``max_E_t_truth_mm`` and the same in deg, ``placement_*`` (median and max over datasets), ``r11_passed``; without
+    them (recorded data) those are NaN and ``r11_passed`` None."""
     frames = table.drop_duplicates(FRAME_KEYS)
     trusted = frames[frames["board_status"] == "ok"]
     exact = bool(trusted["E_t_truth_mm"].notna().any())
@@ -48,8 +49,9 @@ def truth_accuracy(table: pd.DataFrame, tolerances: list[tuple[float, float]] = 
     result = dict(
         n_frames=int(len(frames)),
         trusted_share=float(len(trusted) / len(frames)) if len(frames) else float("nan"),
-        status_shares={str(k): float(v) for k, v in frames["board_status"].value_counts(normalize=True).items()},
-        untrusted_share_by_dataset={str(k): float(v) for k, v in
+        status_shares={str(status): float(share) for status, share in
+                       frames["board_status"].value_counts(normalize=True).items()},
+        untrusted_share_by_dataset={str(dataset): float(share) for dataset, share in
                                     per_dataset["board_status"].apply(lambda s: (s != "ok").mean()).items()},
         dropped_share=float((frames["board_n_dropped"] > 0).mean()) if len(frames) else float("nan"),
         median_rms_px=float(trusted["board_rms_px"].median()),
@@ -67,15 +69,15 @@ def truth_accuracy(table: pd.DataFrame, tolerances: list[tuple[float, float]] = 
     )
     result["by_tolerance"] = {}
     for tolerance in tolerances:
-        k = loosening(tolerance, tolerances)
-        if np.all(k == 1.0) or not set(TRUTH_SCALES) <= set(frames.columns):
+        loosening = tolerance_loosening(tolerance, tolerances)
+        if np.all(loosening == 1.0) or not set(TRUTH_SCALES) <= set(frames.columns):
             continue
-        judging = frames[judges(frames, k)]
+        judging = frames[judges(frames, loosening)]
         p99 = [float(judging[c].dropna().quantile(0.99)) if judging[c].notna().any() else float("nan")
                for c in ("E_t_truth_mm", "E_r_truth_deg")]
-        bar = (float(k[0] * R11_BAR[0]), float(k[1] * R11_BAR[1]))
+        bar = (float(loosening[0] * R11_BAR[0]), float(loosening[1] * R11_BAR[1]))
         result["by_tolerance"][tolerance_name(tolerance)] = dict(
-            k=k.tolist(), judged_share=float(len(judging) / len(frames)) if len(frames) else float("nan"),
+            k=loosening.tolist(), judged_share=float(len(judging) / len(frames)) if len(frames) else float("nan"),
             p99_E_t_truth_mm=p99[0], p99_E_r_truth_deg=p99[1], bar=list(bar),
             passed=bool(p99[0] <= bar[0] and p99[1] <= bar[1]) if exact else None)
     result["r11_passed"] = (bool(result["p99_E_t_truth_mm"] <= R11_BAR[0] and result["p99_E_r_truth_deg"] <= R11_BAR[1]

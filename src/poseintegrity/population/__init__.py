@@ -6,6 +6,8 @@ point, and a headline moves by tens of points with it. Here the worlds are drawn
 main pipeline, on its own params file): a predictor is then judged by how its share of the ceiling spreads over the
 worlds, at its own operating point and at points chosen on other worlds, as a held-out test set judges a model.
 
-    draw.py     a world's params from the declared distribution (``python -m poseintegrity.population draw``)
-    judge.py    every predictor across the worlds: own and transferred operating points, paired comparisons
+    draw.py      a world's params from the declared distribution
+    judge.py     every predictor across the worlds: own and transferred operating points, paired comparisons
+    hazard.py    the failure hazard trained on the other worlds and judged on each held-out one
+    __main__.py  ``python -m poseintegrity.population draw``: a world of the population as a params file
 """

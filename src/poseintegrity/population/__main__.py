@@ -15,7 +15,7 @@ from pathlib import Path
 
 from poseintegrity.errors import PoseIntegrityError
 from poseintegrity.population.draw import write_world
-from poseintegrity.timing import usage_error
+from poseintegrity.stage_timing import usage_error
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -25,7 +25,7 @@ import numpy as np
 import pandas as pd
 
 from poseintegrity.localization.envelope import headline
-from poseintegrity.parallel import Progress
+from poseintegrity.params.protocol import ProtocolParams
 from poseintegrity.population.judge import arc_curves, chosen_on
 from poseintegrity.prediction.hazard.applied import LONG_RANGE, NEXT_STEP, HazardSet, arc_rows
 from poseintegrity.prediction.hazard.model import HazardFitError, HazardModel, brier_score, fit_hazard, reliability
@@ -34,9 +34,9 @@ from poseintegrity.prediction.hazard.risk_sets import long_range_rows, next_step
 from poseintegrity.prediction.hazard.stop_evidence import EVIDENCE, stop_evidence
 from poseintegrity.prediction.metrics import operating_curves, with_metrics
 from poseintegrity.prediction.transfer import DECIMALS
-from poseintegrity.protocol import ProtocolParams
 from poseintegrity.resampling import cluster_weights, percentile_interval
 from poseintegrity.seeding import keyed_rng
+from poseintegrity.workers import Progress
 
 FEATURES = {NEXT_STEP: EVIDENCE, LONG_RANGE: LONG_RANGE_COLUMNS}
 ONE_COLUMN = {"error_alone": ("predicted_error",), "inliers_alone": ("log_inliers",)}  # the Brier comparisons
@@ -55,9 +55,9 @@ class World:
                          & (envelopes["tolerance"] == tolerance_name)]
         self.envelopes = arcs.assign(world=name)
         self.evidence = stop_evidence(self.artifacts, protocol.pnp_method, tolerance)
-        k = protocol.stops_sampled("arc")
-        self.rows = {NEXT_STEP: next_step_rows(self.evidence, self.envelopes, k),
-                     LONG_RANGE: long_range_rows(self.evidence, self.envelopes, k)}
+        n_sampled_stops = protocol.stops_sampled("arc")
+        self.rows = {NEXT_STEP: next_step_rows(self.evidence, self.envelopes, n_sampled_stops),
+                     LONG_RANGE: long_range_rows(self.evidence, self.envelopes, n_sampled_stops)}
 
 
 def _fit(worlds: list[World], predictor: str, features: tuple[str, ...], C: float, folds: int) -> HazardModel:

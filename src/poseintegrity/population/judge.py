@@ -35,8 +35,8 @@ from scipy.stats import binomtest
 
 from poseintegrity.prediction.ceiling import ceiling, ceiling_share
 from poseintegrity.prediction.intervals import PAIRED
+from poseintegrity.prediction.paper_tables import best_table
 from poseintegrity.prediction.sweeps import CONSERVATIVE_HIGH
-from poseintegrity.prediction.tables import best_table
 from poseintegrity.prediction.transfer import DECIMALS
 
 # the paper's predictors and ours (issue 38). Not error_combined: its next-step half stops at the n_t each world's own

@@ -1,18 +1,20 @@
 """Localization-envelope predictors of Windsor et al. (III-E, III-F, IV-A, IV-E, V) and what goes past them.
 
-    predictors.py   theta_p for all n_t at once; long range, next-step (III-E) and static (IV-A) predictors
-    metrics.py      SPL (eq. 3), R_i (eq. 4), SPL vs R_i curves, max mean SPL at zero incursion (Tables I-III)
-    sweeps.py       the whole operating-point sweep over datasets, predictors, tolerances, PnP methods (V)
-    tables.py       Tables I-III and the metrics of predictors.json; Tables I-III per failed-frame rule of theta_a
-    live_trials.py  the simulated live trials (V-C) at the paper's fixed n_t, and ours with n_t chosen on other scenes
-    transfer.py     operating points chosen on the main world, applied unchanged to the validation world
-    loso.py         n_t from a target incursion rate by leave-one-scene-out cross-validation (VI, future work), pooled
-    tails.py        ours: the arcs whose long range theta_p overshoots theta_a at every n_t (eq. 1's long tail)
-    error_predictors.py  ours: long range / next step on the predicted localization error, operating point k
-    hazard/         ours: the failure hazard from evidence without ground truth, and the predictors on it (h)
-    ceiling.py      ours: the ceiling of any predictor's gain over static, and each predictor's share of it
-    uncertainty.py  a prediction interval on theta_p (fit covariance or bootstrap) and its lower bound
-    supervisor.py   NextStepSupervisor: the next-step predictor as a component of a robot loop
+    predictors.py         theta_p for all n_t at once; long range, next-step (III-E) and static (IV-A) predictors
+    metrics.py            SPL (eq. 3), R_i (eq. 4), SPL vs R_i curves, max mean SPL at zero incursion (Tables I-III)
+    sweeps.py             the whole operating-point sweep over datasets, predictors, tolerances, PnP methods (V)
+    paper_tables.py       Tables I-III and the metrics of predictors.json, per failed-frame rule of theta_a too
+    intervals.py          ours: scene-clustered bootstrap and leave-one-arc-out intervals on every headline
+    live_trials.py        the simulated live trials (V-C) at fixed n_t (and k), and ours chosen on other scenes
+    transfer.py           operating points chosen on the main world, applied unchanged to the validation world
+    loso.py               n_t from a target incursion rate by leave-one-scene-out cross-validation (VI), pooled
+    model_choice.py       ours: each least squares base function as the long range predictor's model, scored
+    tails.py              ours: the arcs whose long range theta_p overshoots theta_a at every n_t (eq. 1's long tail)
+    error_predictors.py   ours: long range / next step on the predicted localization error, safety factor k
+    hazard/               ours: the failure hazard from evidence without ground truth, and the predictors on it (h)
+    ceiling.py            ours: the ceiling of any predictor's gain over static, and each predictor's share of it
+    uncertainty.py        a prediction interval on theta_p (fit covariance or bootstrap) and its lower bound
+    supervisor.py         NextStepSupervisor: the next-step predictor as a component of a robot loop
     predictor_figures.py  stage 04's figures: the SPL vs R_i curves (Figs. 5-8) and every predictor beside the ceiling
 """
 
@@ -40,8 +42,11 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "ERROR_PREDICTORS", "FITTED_PREDICTORS", "FREE_WIDTH_PREDICTORS", "PAPER_PREDICTORS", "RELATIVE_PREDICTORS",
             "attach_envelopes", "combined_rows", "predict_dataset", "sweep", "with_pnp_variants",
         ],
-        "tables": ["best_table", "fit_status_shares", "headline_metrics", "rule_metrics", "table_metrics"],
-        "live_trials": ["heldout_interval", "heldout_live_trials", "heldout_metrics", "live_trials", "trial_figures"],
+        "paper_tables": ["best_table", "fit_status_shares", "headline_metrics", "rule_metrics", "table_metrics"],
+        "live_trials": [
+            "heldout_interval", "heldout_live_trials", "heldout_metrics", "live_safety_factor", "live_trials",
+            "trial_figures",
+        ],
         "transfer": ["transfer", "transfer_metrics"],
         "uncertainty": ["Interval", "bootstrap_interval", "covariance_interval", "prediction_interval"],
     },

@@ -23,7 +23,7 @@ def ceiling(table: pd.DataFrame, best: pd.DataFrame, method: str, tolerances: li
     """``<tolerance>.{n_arcs, mean_theta_a, min_theta_a, static_spl, gain}`` of one world (module docstring).
 
     table : prediction rows of one world (dataset, trajectory, method, tolerance, theta_a; the scored ones)
-    best : :func:`~poseintegrity.prediction.tables.best_table` of the same world (the static baseline's max mean SPL
+    best : :func:`~poseintegrity.prediction.paper_tables.best_table` of the same world (the static baseline's max mean SPL
         at zero incursion). NaN figures (and n_arcs 0) where the world has no such datasets.
     """
     rows = table[(table["trajectory"] == trajectory) & (table["method"] == method)]

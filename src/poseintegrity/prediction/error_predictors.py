@@ -17,8 +17,8 @@ is fitted by non-negative least squares to the sampled images with a pose, for E
 count forecast n(theta): sigma(theta) = sqrt((a + b h(theta)) / n(theta)). The count carries what n_i says (a falling
 count raises the error as 1 / sqrt(n_i)); the propagation adds what it cannot see (the model points' errors
 entering the image as the view turns). Where the forecast count falls below the 4 correspondences a pose needs
-(pnp.MIN_CORRESPONDENCES) there is no pose to have an error: the predicted error is infinite (a frame without a
-pose fails every tolerance, IV-C).
+(MIN_CORRESPONDENCES, :mod:`poseintegrity.pose_correspondences`) there is no pose to have an error: the predicted
+error is infinite (a frame without a pose fails every tolerance, IV-C).
 
 Which count forecast. Long range extrapolates over the whole arc from four stops: it takes the paper's artifact
 model (eq. 1, fitted to the same stops), the only curve that says how a count decays that far. Next step needs the
@@ -32,11 +32,11 @@ fit did not. On the validation world (149 forecasts): 0.18 against 0.35, 1 false
 forecast any of the three stops that lost their poses. The main world chose it; the predictors' scores played no
 part.
 
-    error_long_range   fit the first k stops (4 on arcs, 5 on lines, as the long range predictor); theta_p where
+    error_long_range   fit the sampled stops (4 on arcs, 5 on lines, as the long range predictor); theta_p where
                        k x sigma(theta) first reaches the tolerance (III-E's search, :func:`envelope_prediction`)
-    error_next_step    refit at every stop from the k-th on, the count from its trend (:class:`CountTrend`), and
-                       stop where the robot stands once theta_p is less than one step ahead: III-E's rule
-                       (:func:`~poseintegrity.prediction.predictors.supervise`)
+    error_next_step    refit at every stop from the last sampled one on, the count from its trend
+                       (:class:`CountTrend`), and stop where the robot stands once theta_p is less than one step
+                       ahead: III-E's rule (:func:`~poseintegrity.prediction.predictors.supervise`)
     error_next_step_observed
                        the same, with the predicted error scaled by how much the estimates of the last
                        SCALE_STOPS stops have disagreed with the robot's kinematics beyond it
@@ -71,11 +71,11 @@ from typing import Protocol
 import numpy as np
 from scipy.optimize import nnls
 
-from poseintegrity.params.fit import FitParams
-from poseintegrity.errors import ArgumentError, check_array
 from poseintegrity.artifact_models.fitted import FALLBACK, OK
 from poseintegrity.artifact_models.series import Series
-from poseintegrity.localization.pnp import MIN_CORRESPONDENCES
+from poseintegrity.errors import ArgumentError, check_array
+from poseintegrity.params.fit import FitParams
+from poseintegrity.pose_correspondences import MIN_CORRESPONDENCES
 from poseintegrity.prediction.predictors import (
     Boundaries, NextStep, envelope_prediction, fit_stops, flagged, stop_positions, supervise,
 )
@@ -183,30 +183,32 @@ def fit_growth(series: Series, stops: np.ndarray, inliers: CountModel, status: s
     return ErrorGrowth(series.trajectory, coefficients[0], coefficients[1], inliers), status, reason
 
 
-def _checked(series: Series, factors: object) -> np.ndarray:
-    """The safety factors (F,) float, once a series with a predicted error is given (ArgumentError naming the
+def _checked(series: Series, safety_factors: object) -> np.ndarray:
+    """The safety factors k (F,) float, once a series with a predicted error is given (ArgumentError naming the
     argument otherwise; a NaN factor is flagged "bad_threshold", not refused)."""
     if series.sigma_t is None or series.sigma_r is None:
         raise ArgumentError(f"series: dataset {series.dataset}: the series carries no predicted error (stage 02's "
                             f"sigma_t_pred_mm, sigma_r_pred_deg)")
-    factors = np.atleast_1d(check_array("factors", factors, finite=False))
-    if factors.ndim != 1:
-        raise ArgumentError(f"factors: expected a number or a (F,) array of safety factors, got shape {factors.shape}")
-    return factors
+    safety_factors = np.atleast_1d(check_array("safety_factors", safety_factors, finite=False))
+    if safety_factors.ndim != 1:
+        raise ArgumentError(f"safety_factors: expected a number or a (F,) array of safety factors, got shape "
+                            f"{safety_factors.shape}")
+    return safety_factors
 
 
-def error_long_range(series: Series, k: int, model: str, factors: np.ndarray, tolerance: tuple[float, float],
-                     fit: FitParams, rng: np.random.Generator, n_grid: int) -> tuple[Boundaries, str, str]:
-    """theta_p for every safety factor of ``factors`` (F,) from the growth fitted to the first k stops, for one
-    tolerance (E_t mm, E_r deg): (Boundaries, fit status, fit reason). "too_few_stops" (NaN) with fewer than k
-    stops with a valid inlier count."""
-    factors = _checked(series, factors)
+def error_long_range(series: Series, n_sampled_stops: int, model: str, safety_factors: np.ndarray,
+                     tolerance: tuple[float, float], fit: FitParams, rng: np.random.Generator, n_grid: int
+                     ) -> tuple[Boundaries, str, str]:
+    """theta_p for every safety factor k of ``safety_factors`` (F,) from the growth fitted to the first
+    ``n_sampled_stops`` stops, for one tolerance (E_t mm, E_r deg): (Boundaries, fit status, fit reason).
+    "too_few_stops" (NaN) with fewer than ``n_sampled_stops`` stops with a valid inlier count."""
+    safety_factors = _checked(series, safety_factors)
     stops, theta_stops = stop_positions(series)
-    if stops.size < k:
-        return flagged(factors, "too_few_stops"), "no_fit", "too few stops"
-    fitted, _, _ = fit_stops(series, stops[:k], model, fit, rng)
-    growth, status, reason = fit_growth(series, stops[:k], fitted, fitted.status, fitted.reason)
-    found = envelope_prediction(lambda theta: growth.margin(theta, tolerance), factors, theta_stops[0],
+    if stops.size < n_sampled_stops:
+        return flagged(safety_factors, "too_few_stops"), "no_fit", "too few stops"
+    fitted, _, _ = fit_stops(series, stops[:n_sampled_stops], model, fit, rng)
+    growth, status, reason = fit_growth(series, stops[:n_sampled_stops], fitted, fitted.status, fitted.reason)
+    found = envelope_prediction(lambda theta: growth.margin(theta, tolerance), safety_factors, theta_stops[0],
                                 series.theta_end, n_grid)
     return found, status, reason
 
@@ -226,15 +228,15 @@ def observed_scale(series: Series, stops: np.ndarray, window: int | None = SCALE
     return scales[0], scales[1]
 
 
-def error_next_step(series: Series, k0: int, factors: np.ndarray, tolerance: tuple[float, float], n_grid: int,
-                    observed: bool = False) -> NextStep:
-    """The next-step predictor of III-E on the predicted error: from the k0-th stop on, the growth is refitted on
-    all stops so far, the count continued from its trend (:class:`CountTrend`), and the robot stops where it stands
-    for every safety factor whose theta_p < theta_i + theta_b
-    (:func:`~poseintegrity.prediction.predictors.supervise`). ``observed``: each refit on the predicted errors
-    scaled by :func:`observed_scale` of the last stops (``error_next_step_observed``; a series without observed
-    errors is refused, ArgumentError naming it)."""
-    factors = _checked(series, factors)
+def error_next_step(series: Series, n_sampled_stops: int, safety_factors: np.ndarray, tolerance: tuple[float, float],
+                    n_grid: int, observed: bool = False) -> NextStep:
+    """The next-step predictor of III-E on the predicted error: from the last of the ``n_sampled_stops`` sampled
+    stops on, the growth is refitted on all stops so far, the count continued from its trend (:class:`CountTrend`),
+    and the robot stops where it stands for every safety factor k of ``safety_factors`` (F,) whose theta_p <
+    theta_i + theta_b (:func:`~poseintegrity.prediction.predictors.supervise`). ``observed``: each refit on the
+    predicted errors scaled by :func:`observed_scale` of the last stops (``error_next_step_observed``; a series
+    without observed errors is refused, ArgumentError naming it)."""
+    safety_factors = _checked(series, safety_factors)
     if observed and (series.observed_t is None or series.observed_r is None):
         raise ArgumentError(f"series: dataset {series.dataset}: the series carries no observed error (stage 02's "
                             f"E_t_kinematic_mm, E_r_kinematic_deg: the robot's poses, T_base_cam_robot)")
@@ -250,7 +252,7 @@ def error_next_step(series: Series, k0: int, factors: np.ndarray, tolerance: tup
                                     series.theta_end, n_grid)
         return found.theta_p, status, reason
 
-    return supervise(series, k0, factors, boundary)
+    return supervise(series, n_sampled_stops, safety_factors, boundary)
 
 
 def combined(theta_p_error: np.ndarray, theta_p_inliers: float) -> np.ndarray:

@@ -230,8 +230,9 @@ def world_intervals(table: pd.DataFrame, predictors: tuple[str, ...], tolerances
 
 def live_intervals(rows: pd.DataFrame, predictor: str, point: float, n_draws: int, level: float,
                    rng: np.random.Generator) -> dict:
-    """The simulated live trials (V-C, :func:`~.tables.live_trials`) resampled by scene: ``predictor`` at the fixed
-    operating point ``point`` against the static baseline at its best zero-incursion size, chosen again in each draw.
+    """The simulated live trials (V-C, :func:`~.live_trials.live_trials`) resampled by scene: ``predictor`` at the
+    fixed operating point ``point`` against the static baseline at its best zero-incursion size, chosen again in each
+    draw.
 
     rows : the prediction table's rows of the live trials' method, arcs and tolerance. Returns ``{envelope_share_gain,
     relative_gain}``: intervals of (mean SPL / theta_a of ``predictor``) - (static's), and of their ratio - 1, the
@@ -284,7 +285,7 @@ def fixed_point_interval(rows: pd.DataFrame, predictor: str, point: float, n_dra
 
 def rate_bands(rows: pd.DataFrame, predictors: tuple[str, ...], rates: np.ndarray, n_draws: int, level: float,
                rng: np.random.Generator) -> pd.DataFrame:
-    """The SPL vs R_i figure's bands: per predictor and incursion rate r of ``rates`` (k,), the max mean SPL at
+    """The SPL vs R_i figure's bands: per predictor and incursion rate r of ``rates`` (R,), the max mean SPL at
     R_i <= r (:func:`select`) of all the arcs (``max_mean_spl``) and its interval over scene-resampled draws
     (``low``, ``high``: the selection repeated in each draw, NaN where no operating point is that safe). ``rows``:
     the prediction table's rows of one method, trajectory and tolerance (static's among them)."""

@@ -3,6 +3,8 @@ where the predictor says the envelope ends, against the static baseline.
 
     live_trials          the paper's protocol: one fixed n_t (``predict.live_n_t``, the paper's 15 from its Table
                          III) and static at its best zero-incursion size, both on the arcs they run on
+    live_safety_factor   ours: the safety factor k error_next_step's trials run at (``predict.error.live_k``, or
+                         Table III's k at the live tolerance), as live_n_t is next step's n_t
     heldout_live_trials  ours: nothing chosen on the arcs a trial runs on. For each scene, next step's n_t and static's
                          size are chosen on the other scenes (the largest mean SPL at zero incursion, as
                          :mod:`.loso` chooses), then run on that scene's arcs
@@ -21,8 +23,8 @@ import pandas as pd
 
 from poseintegrity.artifact_models.fitted import OK
 from poseintegrity.params.predict import PredictParams
+from poseintegrity.params.protocol import ProtocolParams
 from poseintegrity.prediction.loso import loso_folds, scene_of
-from poseintegrity.protocol import ProtocolParams
 from poseintegrity.resampling import cluster_weights, percentile_interval
 from poseintegrity.seeding import keyed_rng
 
@@ -56,7 +58,7 @@ def live_trials(table: pd.DataFrame, best: pd.DataFrame, predict: PredictParams,
     """The simulated live trials (V-C): next-step at n_t = live_n_t vs the static baseline at its best size; for
     ``predictor`` "error_next_step" (ours) at the safety factor ``operating_point``.
 
-    best : :func:`~.tables.best_table`; the static baseline runs at its largest zero-incursion size on the arcs of
+    best : :func:`~.paper_tables.best_table`; the static baseline runs at its largest zero-incursion size on the arcs of
     ``protocol.pnp_method`` at ``predict.live_tolerance`` (the paper's comparison; NaN rows if it has none).
     One row per arc dataset of ``protocol.pnp_method`` at ``predict.live_tolerance`` (:data:`TRIAL_COLUMNS`):
     theta_a, the stop angle and its incursion, the share of the actual envelope used (SPL / theta_a), the status of
@@ -69,6 +71,18 @@ def live_trials(table: pd.DataFrame, best: pd.DataFrame, predict: PredictParams,
     point = predict.live_n_t if operating_point is None else operating_point
     trials = _trials(rows, predictor, pd.Series(point, index=rows.index), pd.Series(size, index=rows.index))
     return trials.assign(static_size=size)  # NaN rows of static when it has no zero-incursion size
+
+
+def live_safety_factor(best: pd.DataFrame, predict: PredictParams, protocol: ProtocolParams) -> float:
+    """The safety factor k of the simulated live trials of "error_next_step" (ours): ``predict.error.live_k`` as
+    given; null (None) takes Table III's k, the best operating point of error_next_step on the arcs of
+    ``protocol.pnp_method`` at ``predict.live_tolerance`` in ``best`` (:func:`~.paper_tables.best_table` of the main
+    world), as the paper took its n_t 15 from its Table III. NaN when null and ``best`` has no such row."""
+    if predict.error.live_k is not None:
+        return predict.error.live_k
+    chosen = best[(best["predictor"] == "error_next_step") & (best["trajectory"] == "arc")
+                  & (best["method"] == protocol.pnp_method) & (best["tolerance"] == predict.live_tolerance)]
+    return float(chosen["best_operating_point"].iloc[0]) if len(chosen) else float("nan")
 
 
 def heldout_live_trials(table: pd.DataFrame, predict: PredictParams, protocol: ProtocolParams,

@@ -7,7 +7,7 @@ incursion (eq. 4) against the actual envelopes:
 
 - in-sample: the maximum mean SPL at zero incursion and its n_t (Tables I-III's figure);
 - held out: n_t chosen on every scene but one for R_i <= the first of ``predict.loso_target_rates`` and scored on the
-  held-out scene, pooled over folds (:mod:`.loso`). A dataset named without a scene (``scene_<k>_arc...``), as a
+  held-out scene, pooled over folds (:mod:`.loso`). A dataset named without a scene (``scene_<n>_arc...``), as a
   recorded one is, is its own scene: the folds then leave one dataset out.
 
 Fig. 2's RMSE of each base function (stage 03, fits.json) is its fitting error beside these. ``predict.models`` then
@@ -21,15 +21,15 @@ from functools import partial
 import numpy as np
 import pandas as pd
 
-from poseintegrity.params.fit import FitParams
 from poseintegrity.artifact_models.series import Series, dataset_series
-from poseintegrity.parallel import Workers
+from poseintegrity.params.fit import FitParams
+from poseintegrity.params.predict import PredictParams
+from poseintegrity.params.protocol import ProtocolParams
 from poseintegrity.prediction.loso import loso, pooled
 from poseintegrity.prediction.metrics import best_operating_point, operating_curves
-from poseintegrity.params.predict import PredictParams
 from poseintegrity.prediction.predictors import fit_rng, long_range
 from poseintegrity.prediction.sweeps import fit_of, prediction_rows
-from poseintegrity.protocol import ProtocolParams
+from poseintegrity.workers import Workers
 
 PREDICTOR = "long_range"  # the predictor the candidate models are compared on
 CHOICE_COLUMNS = [
@@ -44,10 +44,11 @@ def candidate_predictions(series: Series, method: str, predict: PredictParams, f
     :data:`poseintegrity.prediction.sweeps.COLUMNS`, ``model`` naming the base function). Each fit draws from the
     same generator as the sweep's long range predictor, so the rows of ``predict.models.long_range`` equal the
     sweep's."""
-    n_t, k = predict.thresholds, protocol.stops_sampled(series.trajectory)
+    n_t, n_sampled_stops = predict.thresholds, protocol.stops_sampled(series.trajectory)
     tables = []
     for model in predict.model_choice:
-        answer = long_range(series, k, model, n_t, fit, fit_rng(predict.seed, method, series, k), predict.n_grid)
+        answer = long_range(series, n_sampled_stops, model, n_t, fit,
+                            fit_rng(predict.seed, method, series, n_sampled_stops), predict.n_grid)
         tables.append(prediction_rows(PREDICTOR, model, method, series, n_t, answer.prediction, *fit_of(answer)))
     return pd.concat(tables, ignore_index=True)
 

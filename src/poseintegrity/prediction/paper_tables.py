@@ -26,8 +26,8 @@ from poseintegrity.prediction.sweeps import (
     CONSERVATIVE_HIGH, ERROR_PREDICTORS, FITTED_PREDICTORS, HAZARD_PREDICTORS, FREE_WIDTH_PREDICTORS, OPERATING_POINT_KEY,
     PAPER_COUNTERPART, PAPER_PREDICTORS, RELATIVE_PREDICTORS, attach_envelopes,
 )
+from poseintegrity.params.protocol import FAILED_FRAME_RULES, ProtocolParams
 from poseintegrity.prediction.tails import tail_metrics
-from poseintegrity.protocol import FAILED_FRAME_RULES, ProtocolParams
 from poseintegrity.seeding import keyed_rng
 
 
@@ -124,7 +124,7 @@ def table_metrics(table: pd.DataFrame, curves: pd.DataFrame, predict: PredictPar
     arcs = spread(predictors, protocol.pnp_method, "arc", tolerances)
     metrics: dict = {"ceiling": limits, "intervals": {
         "method": INTERVAL_METHOD, "n_draws": draws.n_draws, "level": draws.level,
-        **{t: {k: arcs[t].get(k) for k in ("n_arcs", "n_scenes", "pairs")} for t in tolerances}}}
+        **{t: {key: arcs[t].get(key) for key in ("n_arcs", "n_scenes", "pairs")} for t in tolerances}}}
     for predictor in predictors:
         point_key = OPERATING_POINT_KEY.get(predictor, "best_n_t")
         entry: dict = {}
@@ -183,15 +183,16 @@ def table_metrics(table: pd.DataFrame, curves: pd.DataFrame, predict: PredictPar
 
 def headline_metrics(
     table: pd.DataFrame, curves: pd.DataFrame, loso: pd.DataFrame, live: pd.DataFrame, predict: PredictParams,
-    protocol: ProtocolParams, error_live: pd.DataFrame | None = None, error_live_k: float = np.nan,
+    protocol: ProtocolParams, error_live: pd.DataFrame | None = None, error_live_safety_factor: float = np.nan,
     heldout_live: pd.DataFrame | None = None,
 ) -> dict:
     """The content of ``reports/metrics/predictors.json``, of the main world: :func:`table_metrics`, and
     loso.<predictor>.<tolerance>.{heldout_incursion_rate, heldout_mean_spl, ceiling_share, ...} at the first target
     rate (the held-out mean SPL's share of the world's ceiling); live.{n_t, incursions, n_trials, envelope_share,
     n_flagged_fits, static_*} (V-C), and live.error_next_step.{k, incursions, n_trials, envelope_share,
-    n_flagged_fits} for ``error_live`` (:func:`~.live_trials.live_trials` of "error_next_step" at ``error_live_k``,
-    ours); each with ``interval``, the live trials resampled by scene (:func:`.intervals.live_intervals`, ours); and
+    n_flagged_fits} for ``error_live`` (:func:`~.live_trials.live_trials` of "error_next_step" at the safety factor
+    ``error_live_safety_factor``, ours); each with ``interval``, the live trials resampled by scene
+    (:func:`.intervals.live_intervals`, ours); and
     live.heldout.{n_t, static_size (per scene), n_trials, incursions, envelope_share, static_envelope_share,
     static_incursions, n_flagged_fits, interval} for ``heldout_live`` (:func:`~.live_trials.heldout_live_trials`,
     every operating point chosen on the other scenes; ours)."""
@@ -215,8 +216,8 @@ def headline_metrics(
 
     metrics["live"]["interval"] = live_spread("next_step", predict.live_n_t)
     if error_live is not None:
-        metrics["live"]["error_next_step"] = {"k": float(error_live_k), **trial_figures(error_live),
-                                              "interval": live_spread("error_next_step", error_live_k)}
+        metrics["live"]["error_next_step"] = {"k": float(error_live_safety_factor), **trial_figures(error_live),
+                                              "interval": live_spread("error_next_step", error_live_safety_factor)}
     if heldout_live is not None and len(heldout_live):
         metrics["live"]["heldout"] = heldout_metrics(heldout_live, predict)
     return metrics

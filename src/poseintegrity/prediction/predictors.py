@@ -1,7 +1,7 @@
 """The localization-envelope predictors of Windsor et al. (III-E, IV-A) and the static baseline.
 
     boundaries        theta_p for every inlier threshold n_t at once from one fitted artifact model (III-E)
-    long_range        fit the first k stops (4 on arcs, 5 on lines), theta_p per n_t (III-E, V-A)
+    long_range        fit the sampled stops (4 on arcs, 5 on lines), theta_p per n_t (III-E, V-A)
     next_step         refit at every stop from the 4th on; stop where the robot is when theta_p < theta_i + theta_b
                       (III-E, IV-A, V-B)
     static_baseline   one envelope size for every dataset (IV-A)
@@ -32,12 +32,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from poseintegrity.errors import ArgumentError, check_array, check_increasing, check_scalar
-from poseintegrity.seeding import keyed_rng
 from poseintegrity.artifact_models import FIT_STATUSES, FittedModel, fit_model
-from poseintegrity.params.fit import FitParams
 from poseintegrity.artifact_models.fitted import MAX_THETA, OK
 from poseintegrity.artifact_models.series import Series
+from poseintegrity.errors import ArgumentError, check_array, check_increasing, check_scalar
+from poseintegrity.params.fit import FitParams
+from poseintegrity.seeding import keyed_rng
 
 BISECTION_XTOL = 1e-9  # theta units; the root refinement of :func:`boundaries`
 NO_FIT = "no_fit"  # fit status of an answer without a fit (too few stops, a bad threshold, the static baseline)
@@ -131,9 +131,10 @@ def stop_positions(series: Series) -> tuple[np.ndarray, np.ndarray]:
     return stops, theta
 
 
-def fit_rng(seed: int, method: str, series: Series, k: int) -> np.random.Generator:
-    """The Generator of one fit: the same for any number of workers, order of work and other datasets in the table."""
-    return keyed_rng(seed, f"{method}/{series.trajectory}/{series.dataset}", k)
+def fit_rng(seed: int, method: str, series: Series, n_fitted_stops: int) -> np.random.Generator:
+    """The Generator of one fit (of ``series``' first ``n_fitted_stops`` stops): the same for any number of workers,
+    order of work and other datasets in the table."""
+    return keyed_rng(seed, f"{method}/{series.trajectory}/{series.dataset}", n_fitted_stops)
 
 
 def fit_stops(
@@ -147,20 +148,24 @@ def fit_stops(
 
 
 def envelope_prediction(
-    predict: Callable[[np.ndarray], np.ndarray], thresholds: np.ndarray, theta_1: float, theta_end: float, n_grid: int
+    predict: Callable[[np.ndarray], np.ndarray], operating_points: np.ndarray, theta_1: float, theta_end: float,
+    n_grid: int,
 ) -> Boundaries:
-    """theta_p per threshold from a fitted curve (e.g. ``FittedModel.predict``), searched from the first stop (III-E).
+    """theta_p per operating point from a fitted curve, searched from the first stop (III-E): where the curve falls
+    to it, the search of :func:`boundaries`. operating_points : (T,) float, n_t of an inlier count curve
+    (``FittedModel.predict``) or safety factors k of a safety margin curve (:mod:`.error_predictors`).
 
     The robot starts inside the envelope (III-E) and the model vouches for nothing before its first sample,
-    so the search starts at theta_1; a curve already at or below n_t there predicts failure at once: 0.
+    so the search starts at theta_1; a curve already at or below the operating point there predicts failure at
+    once: 0.
     """
-    found = boundaries(predict, thresholds, theta_1, theta_end, n_grid)
+    found = boundaries(predict, operating_points, theta_1, theta_end, n_grid)
     return Boundaries(np.where(found.status == "below_at_start", 0.0, found.theta_p), found.status)
 
 
-def flagged(thresholds: np.ndarray, status: str) -> Boundaries:
-    """Every threshold flagged with ``status`` and theta_p NaN."""
-    return Boundaries(np.full(np.shape(thresholds), np.nan), np.full(np.shape(thresholds), status))
+def flagged(operating_points: np.ndarray, status: str) -> Boundaries:
+    """Every operating point (n_t, k or h) flagged with ``status`` and theta_p NaN."""
+    return Boundaries(np.full(np.shape(operating_points), np.nan), np.full(np.shape(operating_points), status))
 
 
 @dataclass(frozen=True)
@@ -174,17 +179,18 @@ class LongRange:
 
 
 def long_range(
-    series: Series, k: int, model: str, thresholds: np.ndarray, fit: FitParams, rng: np.random.Generator, n_grid: int
+    series: Series, n_sampled_stops: int, model: str, thresholds: np.ndarray, fit: FitParams, rng: np.random.Generator,
+    n_grid: int,
 ) -> LongRange:
-    """Long range predictor (III-E, V-A): fit the first k stops once, theta_p for every n_t.
+    """Long range predictor (III-E, V-A): fit the first ``n_sampled_stops`` stops once, theta_p for every n_t.
 
-    "too_few_stops" (theta_p NaN) when fewer than k stops have a valid inlier count, e.g. all-NaN counts.
-    The fit's status (``fitted.status``) holds for every threshold.
+    "too_few_stops" (theta_p NaN) when fewer than ``n_sampled_stops`` stops have a valid inlier count, e.g. all-NaN
+    counts. The fit's status (``fitted.status``) holds for every threshold.
     """
     stops, theta_stops = stop_positions(series)
-    if stops.size < k:
+    if stops.size < n_sampled_stops:
         return LongRange(flagged(thresholds, "too_few_stops"), None, np.empty(0), np.empty(0))
-    fitted, theta, n_inliers = fit_stops(series, stops[:k], model, fit, rng)
+    fitted, theta, n_inliers = fit_stops(series, stops[:n_sampled_stops], model, fit, rng)
     prediction = envelope_prediction(fitted.predict, thresholds, theta_stops[0], series.theta_end, n_grid)
     return LongRange(prediction, fitted, theta, n_inliers)
 
@@ -218,18 +224,20 @@ class NextStep:
 
 
 def next_step(
-    series: Series, k0: int, model: str, thresholds: np.ndarray, fit: FitParams, seed: int, method: str, n_grid: int
+    series: Series, n_sampled_stops: int, model: str, thresholds: np.ndarray, fit: FitParams, seed: int, method: str,
+    n_grid: int,
 ) -> NextStep:
     """Next-step predictor (III-E, IV-A, V-B) run over a recorded dataset for every threshold at once.
 
-    The robot samples the first k0 stops (IV-A: "the first 4 sampling positions ... to generate initial artifact
-    models"); from the k0-th stop on, at every stop i the model is refitted on all stops so far and theta_p(n_t)
-    found; a threshold whose theta_p < theta_i + theta_b (theta_b: the sampling interval, IV-A) stops the robot
-    where it is, so its SPL position is theta_i (V-B: "the viewing angle where the predictor would stop the
-    robot"). Thresholds never stopped reach the last stop ("end_of_path"); a non-finite n_t is flagged
+    The robot samples the first ``n_sampled_stops`` stops (IV-A: "the first 4 sampling positions ... to generate
+    initial artifact models"); from the last of them on, at every stop i the model is refitted on all stops so far
+    and theta_p(n_t) found; a threshold whose theta_p < theta_i + theta_b (theta_b: the sampling interval, IV-A)
+    stops the robot where it is, so its SPL position is theta_i (V-B: "the viewing angle where the predictor would
+    stop the robot"). Thresholds never stopped reach the last stop ("end_of_path"); a non-finite n_t is flagged
     "bad_threshold". Fits stop once every threshold has stopped. A threshold's fit status is the most severe
     status among the fits it went by (up to and including the one that stopped it): its path relied on each.
     """
+    thresholds = _thresholds(thresholds)
     _, theta_stops = stop_positions(series)
 
     def boundary(stops: np.ndarray, moving: np.ndarray) -> tuple[np.ndarray, str, str]:
@@ -237,33 +245,36 @@ def next_step(
         return (envelope_prediction(fitted.predict, moving, theta_stops[0], series.theta_end, n_grid).theta_p,
                 fitted.status, fitted.reason)
 
-    return supervise(series, k0, thresholds, boundary)
+    return supervise(series, n_sampled_stops, thresholds, boundary)
 
 
-def supervise(series: Series, k0: int, thresholds: np.ndarray,
+def supervise(series: Series, n_sampled_stops: int, operating_points: np.ndarray,
               boundary: Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, str, str]]) -> NextStep:
     """III-E's next-step supervision for every operating point at once, whatever predicts the boundary.
 
+    operating_points : (T,) float, checked by the caller: :func:`next_step`'s n_t, or the safety factors k of
+    :func:`~.error_predictors.error_next_step`; a non-finite one is flagged "bad_threshold"
     boundary(stops, operating_points) -> (theta_p (T',), fit status, fit reason): the boundary predicted from the
-    samples of ``stops`` (all stops so far) for each operating point still moving. From the k0-th stop on, an
-    operating point whose theta_p < theta_i + theta_b stops the robot at theta_i (:func:`next_step`)."""
-    thresholds = _thresholds(thresholds)
+    samples of ``stops`` (all stops so far) for each operating point still moving. From the last of the
+    ``n_sampled_stops`` sampled stops on, an operating point whose theta_p < theta_i + theta_b stops the robot at
+    theta_i (:func:`next_step`)."""
     stops, theta_stops = stop_positions(series)
-    no_fit = np.full(np.shape(thresholds), NO_FIT)
-    if stops.size < max(k0, 2):
-        nan = np.full(np.shape(thresholds), np.nan)
-        return NextStep(flagged(thresholds, "too_few_stops"), nan, no_fit, np.full(nan.shape, "too few stops"), 0)
+    no_fit = np.full(np.shape(operating_points), NO_FIT)
+    if stops.size < max(n_sampled_stops, 2):
+        nan = np.full(np.shape(operating_points), np.nan)
+        return NextStep(flagged(operating_points, "too_few_stops"), nan, no_fit, np.full(nan.shape, "too few stops"),
+                        0)
     theta_b = sampling_interval(theta_stops)
-    stop_at = np.full(np.shape(thresholds), theta_stops[-1])
-    boundary_at = np.full(np.shape(thresholds), np.nan)
-    moving = np.isfinite(thresholds)
-    severity = np.zeros(np.shape(thresholds), dtype=int)  # index into FIT_STATUSES
-    fit_reason = np.full(np.shape(thresholds), OK, dtype=object)
+    stop_at = np.full(np.shape(operating_points), theta_stops[-1])
+    boundary_at = np.full(np.shape(operating_points), np.nan)
+    moving = np.isfinite(operating_points)
+    severity = np.zeros(np.shape(operating_points), dtype=int)  # index into FIT_STATUSES
+    fit_reason = np.full(np.shape(operating_points), OK, dtype=object)
     n_fits = 0
-    for i in range(k0 - 1, stops.size):
+    for i in range(n_sampled_stops - 1, stops.size):
         if not moving.any():
             break
-        theta_p, status, reason = boundary(stops[: i + 1], thresholds[moving])
+        theta_p, status, reason = boundary(stops[: i + 1], operating_points[moving])
         n_fits += 1
         worse = moving & (FIT_STATUSES.index(status) > severity)
         severity[worse], fit_reason[worse] = FIT_STATUSES.index(status), f"fit on {i + 1} stops: {reason}"
@@ -272,7 +283,7 @@ def supervise(series: Series, k0: int, thresholds: np.ndarray,
         stop_at[index], boundary_at[index] = theta_stops[i], theta_p[stop]
         moving[index] = False
     status = np.where(moving, "end_of_path", "stopped").astype(object)
-    bad = ~np.isfinite(thresholds)
+    bad = ~np.isfinite(operating_points)
     stop_at[bad], status[bad] = np.nan, "bad_threshold"
     fit_status = np.where(bad, NO_FIT, np.array(FIT_STATUSES)[severity])
     fit_reason[bad] = "bad threshold"

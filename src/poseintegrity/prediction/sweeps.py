@@ -4,7 +4,7 @@
                       (n_t = n_t_min .. n_t_max; static sizes 0 .. 45 deg / 0 .. 150 mm), fitted once per
                       dataset (and stop for the next-step predictor), one task per dataset and method on the workers
     attach_envelopes  joins the actual envelopes theta_a per tolerance (checked against the protocol) and adds SPL
-                      (eq. 3), incursion (eq. 4); Tables I-III and the metrics come from it in :mod:`.tables`
+                      (eq. 3), incursion (eq. 4); Tables I-III and the metrics come from it in :mod:`.paper_tables`
 
 Predictors (column ``predictor``): "long_range", "long_range_lower" (stops on the lower bound of the
 prediction interval, :mod:`.uncertainty`), "mlp", "next_step", "static", and beyond the paper
@@ -36,15 +36,15 @@ from functools import partial
 import numpy as np
 import pandas as pd
 
-from poseintegrity.params.fit import FitParams
 from poseintegrity.artifact_models.fitted import OK
 from poseintegrity.artifact_models.series import REQUIRED_COLUMNS, Series, dataset_series
-from poseintegrity.parallel import Workers
-from poseintegrity.tables import TableError, check_artifacts, check_envelopes
-from poseintegrity.prediction.metrics import with_metrics
+from poseintegrity.params.fit import FitParams
+from poseintegrity.params.predict import PredictParams
 from poseintegrity.prediction.error_predictors import COUNT_TREND, combined, error_long_range, error_next_step
 from poseintegrity.prediction.hazard.applied import HAZARD_PREDICTORS, HazardSet, hazard_rows
-from poseintegrity.params.predict import PredictParams
+from poseintegrity.prediction.metrics import with_metrics
+from poseintegrity.table_checks import TableError, check_artifacts, check_envelopes
+from poseintegrity.workers import Workers
 from poseintegrity.prediction.predictors import (
     NO_FIT,
     Boundaries,
@@ -55,8 +55,8 @@ from poseintegrity.prediction.predictors import (
     relative_thresholds,
     static_baseline,
 )
+from poseintegrity.params.protocol import ProtocolParams
 from poseintegrity.prediction.uncertainty import prediction_interval
-from poseintegrity.protocol import ProtocolParams
 
 COLUMNS = [
     "predictor", "model", "method", "trajectory", "dataset", "operating_point", "theta_p", "status", "fit_status",
@@ -113,12 +113,13 @@ def predict_dataset(
     The absolute thresholds n_t and the relative ones (fraction x first-stop mean n_i) go through one fit of each
     predictor: the fit does not depend on the threshold.
     """
-    n_t, k, models = predict.thresholds, protocol.stops_sampled(series.trajectory), predict.models
+    n_t, n_sampled_stops, models = predict.thresholds, protocol.stops_sampled(series.trajectory), predict.models
     fractions = predict.relative_thresholds
     both = np.concatenate([n_t, relative_thresholds(series, fractions)])
     sizes = predict.static_sizes(series.theta_end)
     tables = [prediction_rows("static", "", method, series, sizes, static_baseline(sizes), NO_FIT, "no fit: one size for all")]
-    answer = long_range(series, k, models.long_range, both, fit, fit_rng(predict.seed, method, series, k), predict.n_grid)
+    answer = long_range(series, n_sampled_stops, models.long_range, both, fit,
+                        fit_rng(predict.seed, method, series, n_sampled_stops), predict.n_grid)
     absolute, relative = _split(answer.prediction, n_t.size)
     fit_status, reason = fit_of(answer)
     tables.append(prediction_rows("long_range", models.long_range, method, series, n_t, absolute, fit_status, reason))
@@ -131,16 +132,17 @@ def predict_dataset(
     interval = prediction_interval(
         models.long_range, answer.fitted, answer.theta, answer.n_inliers, n_t,
         theta_end=series.theta_end, fit=fit, uncertainty=predict.uncertainty,
-        rng=fit_rng(predict.seed + 1, method, series, k), n_grid=predict.n_grid,
+        rng=fit_rng(predict.seed + 1, method, series, n_sampled_stops), n_grid=predict.n_grid,
     )  # fmt: skip
     no_interval = np.isnan(interval.lower) & ~np.isnan(absolute.theta_p)
     lower = Boundaries(interval.lower, np.where(no_interval, "no_interval", absolute.status))
     lower_reason = interval.reason if fit_status == OK else f"{reason}; interval: {interval.reason}"
     tables.append(prediction_rows("long_range_lower", models.long_range, method, series, n_t, lower, fit_status, lower_reason))
     for predictor, model in (("mlp", models.mlp), ("long_range_free_width", models.long_range_free_width)):
-        other = long_range(series, k, model, n_t, fit, fit_rng(predict.seed, method, series, k), predict.n_grid)
+        other = long_range(series, n_sampled_stops, model, n_t, fit,
+                           fit_rng(predict.seed, method, series, n_sampled_stops), predict.n_grid)
         tables.append(prediction_rows(predictor, model, method, series, n_t, other.prediction, *fit_of(other)))
-    step = next_step(series, k, models.next_step, both, fit, predict.seed, method, predict.n_grid)
+    step = next_step(series, n_sampled_stops, models.next_step, both, fit, predict.seed, method, predict.n_grid)
     step_absolute, step_relative = _split(step.prediction, n_t.size)
     status_absolute, status_relative = _split(step.fit_status, n_t.size)
     reason_absolute, reason_relative = _split(step.fit_reason, n_t.size)
@@ -148,7 +150,8 @@ def predict_dataset(
                         reason_absolute))  # fmt: skip
     tables.append(prediction_rows("next_step_relative", models.next_step, method, series, fractions, step_relative,
                         status_relative, reason_relative))  # fmt: skip
-    free = next_step(series, k, models.next_step_free_width, n_t, fit, predict.seed, method, predict.n_grid)
+    free = next_step(series, n_sampled_stops, models.next_step_free_width, n_t, fit, predict.seed, method,
+                     predict.n_grid)
     tables.append(prediction_rows("next_step_free_width", models.next_step_free_width, method, series, n_t, free.prediction,
                         free.fit_status, free.fit_reason))  # fmt: skip
     return pd.concat(tables, ignore_index=True)
@@ -160,19 +163,22 @@ def error_rows(series: Series, method: str, predict: PredictParams, fit: FitPara
     artifacts table carries no predicted error, e.g. one written before issue 38)."""
     if series.sigma_t is None or series.sigma_r is None:
         return []
-    factors, k, models, rows = predict.error.factors, protocol.stops_sampled(series.trajectory), predict.models, []
+    safety_factors, models, rows = predict.error.safety_factors, predict.models, []
+    n_sampled_stops = protocol.stops_sampled(series.trajectory)
     for tolerance, name in zip(protocol.tolerances, protocol.tolerance_names):
-        found, status, reason = error_long_range(series, k, models.long_range, factors, tolerance, fit,
-                                                 fit_rng(predict.seed, method, series, k), predict.n_grid)
-        rows.append(prediction_rows("error_long_range", models.long_range, method, series, factors, found, status,
-                                    reason, name))
+        found, status, reason = error_long_range(series, n_sampled_stops, models.long_range, safety_factors, tolerance,
+                                                 fit, fit_rng(predict.seed, method, series, n_sampled_stops),
+                                                 predict.n_grid)
+        rows.append(prediction_rows("error_long_range", models.long_range, method, series, safety_factors, found,
+                                    status, reason, name))
         if with_next_step:
-            step = error_next_step(series, k, factors, tolerance, predict.n_grid)
-            rows.append(prediction_rows("error_next_step", COUNT_TREND, method, series, factors,
+            step = error_next_step(series, n_sampled_stops, safety_factors, tolerance, predict.n_grid)
+            rows.append(prediction_rows("error_next_step", COUNT_TREND, method, series, safety_factors,
                                         step.prediction, step.fit_status, step.fit_reason, name))
             if series.observed_t is not None and series.observed_r is not None:
-                step = error_next_step(series, k, factors, tolerance, predict.n_grid, observed=True)
-                rows.append(prediction_rows("error_next_step_observed", COUNT_TREND, method, series, factors,
+                step = error_next_step(series, n_sampled_stops, safety_factors, tolerance, predict.n_grid,
+                                       observed=True)
+                rows.append(prediction_rows("error_next_step_observed", COUNT_TREND, method, series, safety_factors,
                                             step.prediction, step.fit_status, step.fit_reason, name))
     return rows
 
@@ -215,7 +221,7 @@ def combined_rows(theta_p: pd.DataFrame, best: pd.DataFrame, error: str = "error
                   inliers: str = "next_step") -> pd.DataFrame:
     """The rows of "error_combined" (ours, issue 38): per dataset, method, tolerance and safety factor k, the earlier
     stop of ``error``'s theta_p(k) and of ``inliers``' theta_p at the n_t chosen for that tolerance, method and
-    trajectory in ``best`` (the first world's Tables I-III, :func:`~.tables.best_table`), each guarding what the
+    trajectory in ``best`` (the first world's Tables I-III, :func:`~.paper_tables.best_table`), each guarding what the
     other cannot see (:func:`~.error_predictors.combined`). Its status and fit are those of the predictor that
     stops first. No rows where ``best`` has no zero-incursion n_t."""
     chosen = best.loc[best["predictor"] == inliers, ["method", "trajectory", "tolerance", "best_operating_point"]]
@@ -239,7 +245,7 @@ def with_pnp_variants(
 
     A method already in ``artifacts`` keeps stage 02's rows; an envelope (dataset, trajectory, tolerance, method
     and, when the tables have one, failed-frame rule) present in both keeps stage 02's. Each of the four tables is
-    checked first (:mod:`poseintegrity.tables`: a duplicated row inside one of them is refused naming
+    checked first (:mod:`poseintegrity.table_checks`: a duplicated row inside one of them is refused naming
     it, never silently dropped or counted twice).
     """
     check_artifacts(artifacts, "the artifacts table (stage 02)", columns=REQUIRED_COLUMNS)
@@ -266,7 +272,7 @@ def attach_envelopes(theta_p: pd.DataFrame, envelopes: pd.DataFrame, protocol: P
     (a duplicated row would count a dataset twice in every curve), their tolerances are those of ``protocol`` (a
     tolerance the params name would otherwise find no row, and its figures would silently be NaN), theta_a in
     [0, range end], and an envelope for every (dataset, trajectory, method) of ``theta_p`` (one missing would
-    drop that dataset from every curve): :class:`~poseintegrity.tables.TableError` naming them. A sweep row that names
+    drop that dataset from every curve): :class:`~poseintegrity.table_checks.TableError` naming them. A sweep row that names
     a tolerance (the error predictors') is scored on that tolerance's envelope only. An envelope stage 02
     could not read (theta_a NaN, status ``not_measured``) is left out of the scoring with a warning naming its
     datasets: there is nothing to score a prediction against.

@@ -10,7 +10,7 @@ the free-width EMG (artifact_models.base_functions.emg_free_width), and refits t
 
     overshooting_arcs  the arcs whose theta_p > theta_a at every swept n_t <= ``predict.tail_n_t_max``
     tail_metrics       ``tails.<predictor>.<tolerance>.{n_overshooting, datasets}`` of predictors.json
-    tail_fits          what the figure shows of those arcs: samples, the first k stops, each predictor's fit, theta_a
+    tail_fits          what the figure shows of those arcs: samples, the sampled stops, each predictor's fit, theta_a
 """
 
 from __future__ import annotations
@@ -19,13 +19,13 @@ from dataclasses import dataclass
 
 import pandas as pd
 
-from poseintegrity.errors import ArgumentError
 from poseintegrity.artifact_models import FittedModel
-from poseintegrity.params.fit import FitParams
 from poseintegrity.artifact_models.series import Series, dataset_series
+from poseintegrity.errors import ArgumentError
+from poseintegrity.params.fit import FitParams
 from poseintegrity.params.predict import PredictParams
+from poseintegrity.params.protocol import ProtocolParams
 from poseintegrity.prediction.predictors import fit_rng, long_range
-from poseintegrity.protocol import ProtocolParams
 
 TAIL_PREDICTORS = ("long_range", "long_range_free_width")  # eq. 1 and the free-width EMG (predict.models)
 KEYS = ["predictor", "tolerance", "dataset"]
@@ -57,7 +57,7 @@ def overshooting_arcs(
     rows = _arc_rows(table, method, predictors)
     columns = [*KEYS, "theta_a", "censored", *(shown_column(n) for n in shown), "n_t_first_safe"]
     within = rows[rows["operating_point"] <= n_t_max]
-    overshoot = (within["theta_p"] > within["theta_a"]).groupby([within[k] for k in KEYS]).all()
+    overshoot = (within["theta_p"] > within["theta_a"]).groupby([within[key] for key in KEYS]).all()
     listed = overshoot[overshoot].index
     if listed.empty:
         return pd.DataFrame(columns=columns)
@@ -93,14 +93,15 @@ def tail_metrics(table: pd.DataFrame, predict: PredictParams, protocol: Protocol
 
 @dataclass(frozen=True)
 class TailFit:
-    """One arc of the tail figure: its samples, the k stops fitted, each predictor's fit, theta_a per tolerance.
+    """One arc of the tail figure: its samples, the stops fitted, each predictor's fit, theta_a per tolerance.
 
+    n_sampled_stops : the first stops of ``series`` every fit was fitted to
     fits : predictor -> the fitted model its theta_p came from (None: too few stops to fit)
     theta_a : tolerance -> theta_a, deg
     """
 
     series: Series
-    k: int
+    n_sampled_stops: int
     fits: dict[str, FittedModel | None]
     theta_a: dict[str, float]
 
@@ -120,16 +121,16 @@ def tail_fits(
     missing = [d for d in datasets if d not in series]
     if missing:
         raise ArgumentError(f"datasets {missing} are not arcs of {method!r} in the artifacts table")
-    k = protocol.stops_sampled("arc")
+    n_sampled_stops = protocol.stops_sampled("arc")
     thresholds = predict.thresholds
     result = []
     for dataset in datasets:
         one = series[dataset]
-        fits = {predictor: long_range(one, k, getattr(predict.models, predictor), thresholds, fit,
-                                      fit_rng(predict.seed, method, one, k), predict.n_grid).fitted
+        fits = {predictor: long_range(one, n_sampled_stops, getattr(predict.models, predictor), thresholds, fit,
+                                      fit_rng(predict.seed, method, one, n_sampled_stops), predict.n_grid).fitted
                 for predictor in predictors}  # fmt: skip
         rows = table[(table["dataset"] == dataset) & (table["method"] == method)]
         theta_a = rows.groupby("tolerance")["theta_a"].first()
-        result.append(TailFit(one, k, fits, {str(t): float(v) for t, v in theta_a.items()}))
+        result.append(TailFit(one, n_sampled_stops, fits, {str(t): float(v) for t, v in theta_a.items()}))
     return result
 

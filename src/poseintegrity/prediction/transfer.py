@@ -21,7 +21,7 @@ DECIMALS = 9  # operating points of both worlds come from the same grids; roundi
 def transfer(best: pd.DataFrame, curves: pd.DataFrame) -> pd.DataFrame:
     """The other world's curve read at each operating point chosen on the first.
 
-    best : :func:`~poseintegrity.prediction.tables.best_table` of the world the points were chosen on
+    best : :func:`~poseintegrity.prediction.paper_tables.best_table` of the world the points were chosen on
     curves : :func:`~poseintegrity.prediction.metrics.operating_curves` of the world they are applied to
     Returns one row per row of ``best`` (keys, ``operating_point``, ``chosen_mean_spl``: the mean SPL where it was
     chosen) with that world's ``incursion_rate``, ``mean_spl`` and ``n`` at the same operating point; NaN where the

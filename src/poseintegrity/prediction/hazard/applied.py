@@ -20,13 +20,13 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from poseintegrity.atomic_write import write_text_atomically
 from poseintegrity.errors import ArgumentError
+from poseintegrity.params.protocol import ProtocolParams
 from poseintegrity.prediction.hazard.model import HazardModel
 from poseintegrity.prediction.hazard.risk_sets import long_range_features
 from poseintegrity.prediction.hazard.stop_evidence import stop_evidence
 from poseintegrity.prediction.hazard.stopping import stop_on_failure_probability, stop_on_next_hazard
-from poseintegrity.protocol import ProtocolParams
-from poseintegrity.staging import write_text_atomically
 
 NEXT_STEP, LONG_RANGE = "hazard_next_step", "hazard_long_range"
 HAZARD_PREDICTORS = (NEXT_STEP, LONG_RANGE)
@@ -112,14 +112,15 @@ def arc_rows(evidence: pd.DataFrame, models: dict[str, HazardModel], protocol: P
              levels: np.ndarray) -> pd.DataFrame:
     """The rows of :func:`hazard_rows` for one tolerance, from its stop evidence (:func:`~.stop_evidence.
     stop_evidence`) and its model per predictor."""
-    k, tables = protocol.stops_sampled("arc"), []
+    n_sampled_stops, tables = protocol.stops_sampled("arc"), []
     evidence = evidence.assign(hazard_next=models[NEXT_STEP].predict(evidence))
     for dataset, arc in evidence.groupby("dataset", sort=True):
         theta = arc["theta_deg"].to_numpy()
-        step = stop_on_next_hazard(theta, arc["hazard_next"].to_numpy(), k, levels)
-        sampled = len(theta) >= max(k, 2)
-        hazards = models[LONG_RANGE].predict(long_range_features(arc.iloc[k - 1], theta[1:])) if sampled else None
-        ahead = stop_on_failure_probability(theta, hazards, k, levels)
+        step = stop_on_next_hazard(theta, arc["hazard_next"].to_numpy(), n_sampled_stops, levels)
+        sampled = len(theta) >= max(n_sampled_stops, 2)
+        hazards = (models[LONG_RANGE].predict(long_range_features(arc.iloc[n_sampled_stops - 1], theta[1:]))
+                   if sampled else None)
+        ahead = stop_on_failure_probability(theta, hazards, n_sampled_stops, levels)
         for predictor, found in ((NEXT_STEP, step), (LONG_RANGE, ahead)):
             tables.append(pd.DataFrame({
                 "predictor": predictor, "model": MODEL, "method": protocol.pnp_method, "trajectory": "arc",

@@ -14,6 +14,7 @@ import yaml
 import loc_synthetic as synthetic
 from poseintegrity.localization import extract as E
 from poseintegrity.localization.dataset import DatasetError
+from poseintegrity.localization.frame_rows import usable
 from sift_cache import copy_sift_features
 
 METHODS = ["usac_magsac"]
@@ -115,7 +116,7 @@ def test_a_bad_frame_gives_flagged_rows(data_dir, extract_params, workers, case)
     assert np.isnan(bad.E_t_mm) and np.isnan(bad.E_r_deg)  # never "ok" with an error nobody can trust
     others = rows.drop(bad.name)
     assert (others.status == "ok").all() and (others.reason == "").all()
-    assert len(E.usable(rows)) == len(rows) - 1
+    assert len(usable(rows)) == len(rows) - 1
 
 
 def missing_frame_image(d):
