@@ -29,11 +29,11 @@ from scipy.spatial.transform import Rotation  # noqa: E402
 
 import poseintegrity  # noqa: E402
 from poseintegrity.config import load_section  # noqa: E402
-from poseintegrity.tracking.experiments.timing import detect_match_kabsch  # noqa: E402
-from poseintegrity.tracking.simulation.frames import draw_phantoms, intrinsics, render_frame  # noqa: E402
-from poseintegrity.tracking.markers.geometry import MARKER_DIAMETER_M, transform_points  # noqa: E402
+from poseintegrity.tracking.experiments.compute_time import detect_match_kabsch  # noqa: E402
 from poseintegrity.tracking.filter.srukf import SquareRootUKF  # noqa: E402
 from poseintegrity.tracking.filter.tracker import MarkerTracker  # noqa: E402
+from poseintegrity.tracking.markers.geometry import MARKER_DIAMETER_M, transform_points  # noqa: E402
+from poseintegrity.tracking.simulation.frames import draw_phantoms, intrinsics, render_frame  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 

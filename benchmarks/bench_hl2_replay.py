@@ -32,10 +32,11 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests"))  # the recorders' test writers
 
 from poseintegrity.config import load_section  # noqa: E402
-from poseintegrity.tracking.experiments.timing import detect_match_kabsch  # noqa: E402
-from poseintegrity.tracking.simulation.frames import intrinsics  # noqa: E402
+from poseintegrity.tracking.experiments.compute_time import detect_match_kabsch  # noqa: E402
+from poseintegrity.tracking.filter.recording_replay import track_recording  # noqa: E402
 from poseintegrity.tracking.io.hl2_recordings import convert_stream_recorder  # noqa: E402
-from poseintegrity.tracking.io.recording import RecordingWriter, read_recording, track_recording  # noqa: E402
+from poseintegrity.tracking.io.recording import RecordingWriter, read_recording  # noqa: E402
+from poseintegrity.tracking.simulation.frames import intrinsics  # noqa: E402
 from tracking.hl2_writers import simulated_frames, write_stream_recorder  # noqa: E402
 
 cv2.setNumThreads(1)

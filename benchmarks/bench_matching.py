@@ -4,7 +4,7 @@ The frames are those stage 06 matches: a simulated accuracy recording (params.ya
 frames with their phantoms), each frame as the tracker matched it in run_filter (with the filter's prediction) and as
 run_no_filter matches it (no prediction), plus the stress recording (motion (b)).  The reference is
 tests/tracking/reference_matching.py (the numpy pipeline before compilation).  Both are timed alternately over all
-frames (paired medians, benchmarks/timing.py); the assignments are compared on every frame first.
+frames (paired medians, benchmarks/paired_timing.py); the assignments are compared on every frame first.
 
 Run: .venv/bin/python benchmarks/bench_matching.py [--duration 10] [--repeats 7] (from the repository root)
 """
@@ -28,7 +28,7 @@ from poseintegrity.config import load_section  # noqa: E402
 from poseintegrity.tracking.filter import tracker  # noqa: E402
 from poseintegrity.tracking.markers.correspondence import match_markers_unchecked  # noqa: E402
 from poseintegrity.tracking.simulation.simulate import run_filter, simulate  # noqa: E402
-from timing import paired_medians  # noqa: E402
+from paired_timing import paired_medians  # noqa: E402
 from tracking import reference_matching  # noqa: E402
 
 

@@ -23,7 +23,7 @@
    turns of motion (a) (:func:`reference_full_turns`).
 7. The whole study (run_study, every experiment of stage 06) at success_frames = --study-frames, one process:
    CPU-seconds of the code at --reference (a commit, extracted with git archive) and of this tree, each after a
-   warm-up run that fills numba's cache, and whether their metrics agree (timings left out).
+   warm-up run that fills numba's cache, and whether their metrics agree.
 
 Run: .venv/bin/python benchmarks/bench_tracking.py [--study-frames 1000] [--reference 38937b0] (from the repository
 root, with MALLOC_MMAP_THRESHOLD_=33554432 MALLOC_TRIM_THRESHOLD_=1073741824 as the stages run)
@@ -49,23 +49,23 @@ import numpy as np  # noqa: E402
 
 from poseintegrity.config import load_section  # noqa: E402
 from poseintegrity.report.metrics import metrics_differences  # noqa: E402
-from poseintegrity.tracking.markers import detection  # noqa: E402
-from poseintegrity.tracking.filter.cholesky import lower_factor  # noqa: E402
-from poseintegrity.tracking.experiments.timing import TIMING_METRICS, detect_match_kabsch  # noqa: E402
-from poseintegrity.tracking.simulation.motion import full_turns  # noqa: E402
-from poseintegrity.tracking.filter.srukf import _square_root_of_spread  # noqa: E402
-from poseintegrity.tracking.filter.unscented import _sigma_points_kernel  # noqa: E402
-from poseintegrity.tracking.filter.model import process_model_kernel, noise_sqrt_kernel  # noqa: E402
-from poseintegrity.tracking.simulation.frames import draw_phantoms, intrinsics, render_frame  # noqa: E402
-from poseintegrity.tracking.markers.geometry import MARKER_DIAMETER_M  # noqa: E402
+from poseintegrity.tracking.experiments.compute_time import detect_match_kabsch  # noqa: E402
 from poseintegrity.tracking.experiments.peers import filter_speed  # noqa: E402
-from poseintegrity.tracking.simulation.simulate import run_filter, simulate  # noqa: E402
+from poseintegrity.tracking.filter.cholesky import lower_factor  # noqa: E402
+from poseintegrity.tracking.filter.model import process_model_kernel, noise_sqrt_kernel  # noqa: E402
+from poseintegrity.tracking.filter.srukf import _square_root_of_spread  # noqa: E402
 from poseintegrity.tracking.filter.srukf import SquareRootUKF  # noqa: E402
-from poseintegrity.tracking.filter.ukf import UnscentedKalmanFilter  # noqa: E402
-from poseintegrity.tracking.markers.kabsch import kabsch, kabsch_unchecked  # noqa: E402
 from poseintegrity.tracking.filter.tracker import MarkerTracker  # noqa: E402
+from poseintegrity.tracking.filter.ukf import UnscentedKalmanFilter  # noqa: E402
+from poseintegrity.tracking.filter.unscented import _sigma_points_kernel  # noqa: E402
+from poseintegrity.tracking.markers import detection  # noqa: E402
+from poseintegrity.tracking.markers.geometry import MARKER_DIAMETER_M  # noqa: E402
+from poseintegrity.tracking.markers.kabsch import kabsch, kabsch_unchecked  # noqa: E402
+from poseintegrity.tracking.simulation.frames import draw_phantoms, intrinsics, render_frame  # noqa: E402
+from poseintegrity.tracking.simulation.motion import full_turns  # noqa: E402
+from poseintegrity.tracking.simulation.simulate import run_filter, simulate  # noqa: E402
 from srukf_reference import StepwiseSquareRootUKF  # noqa: E402
-from timing import paired_medians  # noqa: E402
+from paired_timing import paired_medians  # noqa: E402
 
 RUN_DURATION_S = 20.0  # a third of the accuracy recording; a run costs the same per second of recording
 REFERENCE_COMMIT = "38937b0"  # stage 06 before the per-frame speed-up (section 7)
@@ -326,8 +326,8 @@ STUDY = """
 import json, sys, tempfile, time
 from pathlib import Path
 from poseintegrity.config import load_section
-from poseintegrity.parallel import Workers
 from poseintegrity.report.metrics import json_ready
+from poseintegrity.workers import Workers
 try:
     from poseintegrity.tracking.experiments.study import run_study
 except ModuleNotFoundError:  # a commit from before the tracking package was split into sub-packages
@@ -363,10 +363,10 @@ def whole_study(frames: int, reference: str) -> None:
             study_cpu_seconds(src, 25, folder / "warm.json")  # numba compiles and caches the kernels of that source
             runs[name] = study_cpu_seconds(src, frames, folder / f"{name}.json")
     old, new = runs["reference"]["cpu_s"], runs["this tree"]["cpu_s"]
-    differences = metrics_differences(runs["reference"]["metrics"], runs["this tree"]["metrics"], TIMING_METRICS)
+    differences = metrics_differences(runs["reference"]["metrics"], runs["this tree"]["metrics"])  # no time in a metrics file
     print(f"whole study (run_study, success_frames {frames}, one process): CPU-seconds {reference} {old:.1f} s, this tree {new:.1f} s: "
           f"{new / old:.0%} of the reference ({old / new:.2f}x)")
-    print(f"  metrics (timings left out): {'identical' if not differences else f'{len(differences)} differ, e.g. ' + differences[0]}")
+    print(f"  metrics: {'identical' if not differences else f'{len(differences)} differ, e.g. ' + differences[0]}")
 
 
 def check_overhead(params, geometry, rng):
@@ -383,7 +383,7 @@ def check_overhead(params, geometry, rng):
         "kabsch (4 points)": (lambda: kabsch_unchecked(markers, geometry), lambda: kabsch(markers, geometry)),
         "SR-UKF predict_steps(1)": (lambda: f._predict_steps(1, params.filter.dt, None), lambda: f.predict_steps(1, params.filter.dt)),
         "SR-UKF update (4 markers + gyro)": (lambda: f._update(z, observed, True), lambda: f.update(z, observed, True)),
-        "tracker frame (4 markers)": (lambda: tracker._frame(float(next(clock)), markers), lambda: tracker.frame(float(next(clock)), markers)),
+        "tracker frame (4 markers)": (lambda: tracker.frame_unchecked(float(next(clock)), markers), lambda: tracker.frame(float(next(clock)), markers)),
     }
     print("argument checks: checked public call / unchecked inner call (paired medians, same run)")
     for name, (inner, public) in pairs.items():

@@ -168,7 +168,7 @@ TRACKER_ACCEPTS = {"points": {"one_element", "one_fewer", "nan", "inf", "huge"}}
 
 
 def _entries() -> list[EntryPoint]:
-    from poseintegrity import boards, config, lens, poses, tables, timing
+    from poseintegrity import boards, config, lens, poses, stage_timing, table_checks
     from poseintegrity.artifact_models.models import fit_model
     from poseintegrity.localization import (dataset, envelope, features, ground_truth, matching, pnp, pose_covariance,
                                             target_model)
@@ -176,7 +176,7 @@ def _entries() -> list[EntryPoint]:
     from poseintegrity.recorded import __main__ as recorded_cli, export, geometry, materialize, reader, rosbag
     from poseintegrity.tracking import replay
     from poseintegrity.tracking.io import hl2_recordings, recording
-    from poseintegrity.tracking.filter import multi_tool
+    from poseintegrity.tracking.filter import multi_tool, recording_replay
     from poseintegrity.tracking.io import tool_files
     from poseintegrity.tracking.markers import correspondence, detection
     from poseintegrity.tracking.markers.kabsch import kabsch as kabsch_fit
@@ -382,8 +382,8 @@ def _entries() -> list[EntryPoint]:
                    # 8/16-bit frames, any clock; a NaN rate is kept and flagged bad_gyro when tracked
                    accepts={"ir": {"uint16"}, "depth_mm": {"uint16"}, "t": {"negative"}, "gyro": {"nan"}}),
         EntryPoint("tracking.track_recording",
-                   lambda a: recording.track_recording(recording.read_recording(a["file"].parents[1]),
-                                                       {"probe": tracking_frame()["geometry"]}, P().track),
+                   lambda a: recording_replay.track_recording(recording.read_recording(a["file"].parents[1]),
+                                                              {"probe": tracking_frame()["geometry"]}, P().track),
                    lambda tmp: {"file": _recording_dir(tmp) / "ir" / "000001.png"}, {"file": "file"},
                    names={"file": "000001.png"}, flagged=_any_flag),
         # ---- HoloLens 2 recordings, converted (a frame without a headset pose is flagged in camera_poses.csv)
@@ -439,15 +439,15 @@ def _entries() -> list[EntryPoint]:
                      flagged=_cli_listed)
           for name in RECORDED_FILES],
         # ---- stage tables and the files they are written to
-        EntryPoint("tables.check_envelopes", lambda a: tables.check_envelopes(a["table"]),
+        EntryPoint("table_checks.check_envelopes", lambda a: table_checks.check_envelopes(a["table"]),
                    lambda tmp: {"table": _envelope_table()}, {"table": "table"}),
-        EntryPoint("tables.check_artifacts", lambda a: tables.check_artifacts(a["table"]),
+        EntryPoint("table_checks.check_artifacts", lambda a: table_checks.check_artifacts(a["table"]),
                    lambda tmp: {"table": _artifacts_table()}, {"table": "table"}),
-        EntryPoint("tables.read_envelopes", lambda a: tables.read_envelopes(a["path"]),
+        EntryPoint("table_checks.read_envelopes", lambda a: table_checks.read_envelopes(a["path"]),
                    lambda tmp: {"path": _parquet(tmp, "envelopes.parquet", _envelope_table())}, {"path": "file"}),
-        EntryPoint("tables.read_fig2_rmse", lambda a: tables.read_fig2_rmse(a["path"]),
+        EntryPoint("table_checks.read_fig2_rmse", lambda a: table_checks.read_fig2_rmse(a["path"]),
                    lambda tmp: {"path": _parquet(tmp, "fig2_rmse.parquet", _fig2_table())}, {"path": "file"}),
-        EntryPoint("tables.read_artifacts", lambda a: tables.read_artifacts(a["path"]),
+        EntryPoint("table_checks.read_artifacts", lambda a: table_checks.read_artifacts(a["path"]),
                    lambda tmp: {"path": _parquet(tmp, "artifacts.parquet", _artifacts_table())}, {"path": "file"}),
         # ---- command lines: one line naming the file, exit status 2, no traceback
         EntryPoint("python -m poseintegrity.tracking.replay",  # the recording stays where it is (checked first)
@@ -456,7 +456,7 @@ def _entries() -> list[EntryPoint]:
                                   a["tools"]),
                    lambda tmp: {"recording": _recording_dir(tmp), "tools": _tools_json(tmp)}, {"tools": "text_file"},
                    flagged=_cli_refused),
-        EntryPoint("python -m poseintegrity.timing", lambda a: _cli(timing.main, [str(a["path"].parent)], a["path"]),
+        EntryPoint("python -m poseintegrity.stage_timing", lambda a: _cli(stage_timing.main, [str(a["path"].parent)], a["path"]),
                    lambda tmp: {"path": _timing_file(tmp)}, {"path": "file"}, flagged=_cli_refused,
                    accepts={"path": {"missing"}}),  # a folder without timing files yet: said, exit 0
     ]
@@ -688,7 +688,7 @@ def _artifacts_table() -> pd.DataFrame:
 
 
 def _timing_file(tmp: Path) -> Path:
-    from poseintegrity.timing import StageTiming
+    from poseintegrity.stage_timing import StageTiming
 
     folder = tmp / "timing"
     folder.mkdir(parents=True, exist_ok=True)

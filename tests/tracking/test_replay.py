@@ -13,9 +13,10 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from poseintegrity.tracking.io.recording import RecordingWriter, read_recording, track_recording
-from poseintegrity.tracking.replay import main, replay_summary
+from poseintegrity.tracking.filter.recording_replay import track_recording
+from poseintegrity.tracking.io.recording import RecordingWriter, read_recording
 from poseintegrity.tracking.io.tool_files import write_tools
+from poseintegrity.tracking.replay import main, replay_summary
 
 from tracking.hl2_writers import simulated_frames, write_hl2ss, write_stream_recorder
 from tracking.track_section import TINY as PARAMS

@@ -11,3 +11,4 @@ ROOT = Path(__file__).resolve().parents[2]
 TRACK = load_section(ROOT / "params.yaml", "track")  # paper scale
 TINY = load_section(ROOT / "tests" / "params_tiny.yaml", "track")  # params.yaml shrunk by the tiny overlay
 GEOMETRY = np.array(TRACK.markers_body)  # (4, 3) m, the marker body of docs/references.md
+SECOND = np.array(TRACK.evaluation.second_tool)  # (4, 3) m, the second tool of the two-tool runs

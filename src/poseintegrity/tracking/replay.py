@@ -13,7 +13,7 @@ recording folder first,
 beside the output and deleted afterwards (:mod:`~poseintegrity.tracking.io.hl2_recordings`, about 1 MB per frame;
 convert once with its functions to replay a recording often).
 The table (one row per frame and tool: t_s, frame, tool, flag, n_points, n_matched, x/y/z_mm, qx..qw, in the
-camera frame; :func:`~poseintegrity.tracking.io.recording.track_recording`) is written to ``--out`` through a
+camera frame; :func:`~poseintegrity.tracking.filter.recording_replay.track_recording`) is written to ``--out`` through a
 temporary file and a rename; a progress bar runs on stderr and a summary per tool is printed: tracked (flag ok or
 initialized), gated (the innovation gate refused the match), lost (no_points, no_markers, stale, restart,
 diverged) and bad_frame (an undecodable frame).  ``--params``: a params file whose ``track`` section is used
@@ -37,13 +37,14 @@ from pathlib import Path
 import pandas as pd
 from tqdm import tqdm
 
+from poseintegrity.atomic_write import check_new_file
 from poseintegrity.config import load_section
-from poseintegrity.defaults import published
+from poseintegrity.config import published
 from poseintegrity.errors import PoseIntegrityError
-from poseintegrity.staging import check_new_file
-from poseintegrity.timing import usage_error
+from poseintegrity.stage_timing import usage_error
+from poseintegrity.tracking.filter.recording_replay import track_recording
 from poseintegrity.tracking.io.hl2_recordings import HL2SS_MAGIC, STREAM_RECORDER_SENSOR, convert_hl2ss, convert_stream_recorder
-from poseintegrity.tracking.io.recording import RecordingError, read_recording, track_recording
+from poseintegrity.tracking.io.recording import RecordingError, read_recording
 from poseintegrity.tracking.io.tool_files import read_tools
 
 FORMATS = ("folder", "stream-recorder", "hl2ss")

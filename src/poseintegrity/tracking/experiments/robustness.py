@@ -7,13 +7,14 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from poseintegrity.tracking.simulation.frames import intrinsics, unit_plane_lut
-from poseintegrity.tracking.markers.geometry import transform_points
 from poseintegrity.params.track import TrackParams
-from poseintegrity.tracking.io.recording import RecordingWriter, read_recording, track_recording
-from poseintegrity.tracking.simulation.simulate import Simulation, run_filter, simulate
-from poseintegrity.tracking.filter.tracker import MarkerTracker
 from poseintegrity.tracking.experiments.filter_runs import experiment_rng
+from poseintegrity.tracking.filter.recording_replay import track_recording
+from poseintegrity.tracking.filter.tracker import MarkerTracker
+from poseintegrity.tracking.io.recording import RecordingWriter, read_recording
+from poseintegrity.tracking.markers.geometry import transform_points
+from poseintegrity.tracking.simulation.frames import intrinsics, unit_plane_lut
+from poseintegrity.tracking.simulation.simulate import Simulation, run_filter, simulate
 
 
 def ten_metre_jump(sim: Simulation, params: TrackParams, jump_at_s: float = 2.0, jump_m: float = 10.0) -> dict:

@@ -3,7 +3,7 @@
 Each experiment draws from its own generator, ``keyed_rng(params.seed, name)`` (:mod:`poseintegrity.seeding`), so the
 experiments do not depend on each other's order and the per-frame tables are bit-identical for one seed
 (timings are the only non-deterministic outputs and are kept apart).  That lets :func:`run_study` run them as
-independent tasks on :class:`~poseintegrity.parallel.Workers`: first the recordings (render + detect + the
+independent tasks on :class:`~poseintegrity.workers.Workers`: first the recordings (render + detect + the
 no-filter chain) and the self-contained scenes, then every distinct filter run over those recordings once
 (:class:`~.filter_runs.FilterRun`; an experiment that needs a run another already made reuses it), then the timings
 in the calling process, alone on the machine.
@@ -19,22 +19,22 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from poseintegrity.tracking.experiments.small_blobs import small_blob_sweep, sweep_summary
-from poseintegrity.parallel import Workers
 from poseintegrity.paper_results import BLACK_RESULTS
 from poseintegrity.params.track import TrackParams
-from poseintegrity.tracking.experiments.peers import filter_speed, pykalman_time_update
 from poseintegrity.tracking.experiments.filter_runs import experiment_rng, study_filter_runs, run_filter_task
+from poseintegrity.tracking.experiments.peers import filter_speed, pykalman_time_update
+from poseintegrity.tracking.experiments.small_blobs import small_blob_sweep, sweep_summary
+from poseintegrity.workers import Workers
 from poseintegrity.tracking.experiments.accuracy import (
     accuracy_frames, accuracy_recording, accuracy_and_occlusion, noise_against_lag, published_against_our_sigmas,
 )
 from poseintegrity.tracking.experiments.success import (
     SuccessRun, success_runs, success_recording, success_rates, two_tools_success,
 )
-from poseintegrity.tracking.experiments.robustness import ten_metre_jump, recording_replay
-from poseintegrity.tracking.experiments.timing import timing_table
+from poseintegrity.tracking.experiments.compute_time import timing_table
 from poseintegrity.tracking.experiments.intervals import mean_rate_interval, rate_interval, rms_interval
 from poseintegrity.tracking.experiments.paper_pace import pace_recording, paper_pace
+from poseintegrity.tracking.experiments.robustness import ten_metre_jump, recording_replay
 from poseintegrity.tracking.simulation.pace import trajectory_pace
 
 
@@ -56,7 +56,7 @@ class Study:
 
 
 def call(task: Callable[[], object]) -> object:
-    """task(): what :meth:`~poseintegrity.parallel.Workers.map` runs for a list of heterogeneous tasks
+    """task(): what :meth:`~poseintegrity.workers.Workers.map` runs for a list of heterogeneous tasks
     (``functools.partial`` of module-level functions)."""
     return task()
 

@@ -5,10 +5,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from poseintegrity.defaults import published
-from poseintegrity.tracking.filter.tracker import FrameResult, MarkerTracker, check_points, check_rates, check_timestamp
-from poseintegrity.tracking.markers.tools import ToolError, check_tools
+from poseintegrity.config import published
 from poseintegrity.params.track import FilterParams, MatchingParams
+from poseintegrity.tracking.filter.tracker import FrameResult, MarkerTracker, check_points, check_rates
+from poseintegrity.tracking.io.timestamps import check_timestamp
+from poseintegrity.tracking.markers.tools import ToolError, check_tools
 
 
 class MultiToolTracker:
@@ -37,14 +38,15 @@ class MultiToolTracker:
     def frame(self, t: float, points: np.ndarray) -> dict[str, FrameResult]:
         """Results per tool for one frame of points (n, 3), metres, world frame; ArgumentError for a bad
         timestamp or points that are not (n, 3) (checked once here for all tools)."""
-        return self._frame(check_timestamp(t), check_points(points))
+        return self.frame_unchecked(check_timestamp(t), check_points(points))
 
-    def _frame(self, t: float, points: np.ndarray) -> dict[str, FrameResult]:
+    def frame_unchecked(self, t: float, points: np.ndarray) -> dict[str, FrameResult]:
+        """:meth:`frame` on checked arguments (t as :func:`check_timestamp` returns it, points float (n, 3) metres)."""
         free = np.ones(len(points), dtype=bool)
         results = {}
         for name, tracker in self.trackers.items():
             index = np.flatnonzero(free)
-            result = tracker._frame(t, points[index])
+            result = tracker.frame_unchecked(t, points[index])
             assignment = result.assignment.copy()
             hit = assignment >= 0
             assignment[hit] = index[assignment[hit]]  # back to rows of points (no hit: nothing to index)
@@ -54,7 +56,8 @@ class MultiToolTracker:
 
     def gyro(self, t: float, omega_body: np.ndarray) -> dict[str, str]:
         """A gyro sample (rad/s, body frame of gyro_tool): fused by that tool's filter; the others only advance."""
-        return self._gyro(check_timestamp(t), check_rates(omega_body))
+        return self.gyro_unchecked(check_timestamp(t), check_rates(omega_body))
 
-    def _gyro(self, t: float, omega_body: np.ndarray) -> dict[str, str]:
-        return {name: tracker._gyro(t, omega_body) for name, tracker in self.trackers.items()}
+    def gyro_unchecked(self, t: float, omega_body: np.ndarray) -> dict[str, str]:
+        """:meth:`gyro` on checked arguments (t as :func:`check_timestamp` returns it, omega_body float (3,) rad/s)."""
+        return {name: tracker.gyro_unchecked(t, omega_body) for name, tracker in self.trackers.items()}

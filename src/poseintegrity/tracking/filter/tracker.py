@@ -34,26 +34,18 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
-from poseintegrity.defaults import published
-from poseintegrity.errors import check_array, check_scalar
+from poseintegrity.config import published
+from poseintegrity.errors import check_array
+from poseintegrity.params.track import FilterParams, MatchingParams
 from poseintegrity.poses import NAN_POSE
+from poseintegrity.tracking.filter.srukf import SquareRootUKF
+from poseintegrity.tracking.filter.unscented import UnscentedMarkerFilter
+from poseintegrity.tracking.io.timestamps import check_timestamp
 from poseintegrity.tracking.markers.correspondence import match_markers_unchecked
 from poseintegrity.tracking.markers.geometry import transform_points
 from poseintegrity.tracking.markers.kabsch import pose_from_points_unchecked
-from poseintegrity.params.track import FilterParams, MatchingParams
-from poseintegrity.tracking.filter.srukf import SquareRootUKF
-from poseintegrity.tracking.filter.unscented import UnscentedMarkerFilter
 
-MAX_ABS_TIME_S = 1e12  # a timestamp beyond +-1e12 s (31 700 years) is not a clock reading
 MAX_RATE_RAD_S = 100.0  # beyond any MEMS gyro's range (2000 deg/s = 35 rad/s): a sample above it is bad_gyro
-
-
-def check_timestamp(t: object, name: str = "t") -> float:
-    """t as a float, or :class:`~poseintegrity.errors.ArgumentError` naming ``name`` if it is not a finite
-    number of seconds within +-MAX_ABS_TIME_S (None, text, bool, NaN, 1e300 are refused)."""
-    if type(t) is float and -MAX_ABS_TIME_S <= t <= MAX_ABS_TIME_S:  # the common case, without a call
-        return t
-    return check_scalar(name, t, low=-MAX_ABS_TIME_S, high=MAX_ABS_TIME_S)
 
 
 def check_points(points: object, name: str = "points") -> np.ndarray:
@@ -139,10 +131,11 @@ class MarkerTracker:
     def gyro(self, t: float, omega_body: np.ndarray) -> str:
         """A gyro sample at t: omega_body (3,) rad/s in the body frame.  Returns "ok" or a flag (module
         docstring); a bad timestamp or a sample that is not 3 numbers raises ArgumentError."""
-        return self._gyro(check_timestamp(t), check_rates(omega_body))
+        return self.gyro_unchecked(check_timestamp(t), check_rates(omega_body))
 
-    def _gyro(self, t: float, omega_body: np.ndarray) -> str:
-        """:meth:`gyro` on checked arguments (t a finite float, omega_body float (3,))."""
+    def gyro_unchecked(self, t: float, omega_body: np.ndarray) -> str:
+        """:meth:`gyro` on checked arguments (t as :func:`check_timestamp` returns it, omega_body float (3,) rad/s):
+        the per-sample path of callers whose samples are known to be good."""
         if t < self.t - 1e-9:
             return "stale"
         if not np.all(np.abs(omega_body) <= MAX_RATE_RAD_S):  # also False for NaN
@@ -165,10 +158,11 @@ class MarkerTracker:
         """A marker frame at t: measured points (n, 3), metres, world frame (may be empty, NaN rows ignored).
         Returns a :class:`FrameResult` whose flag says whether (and why not) the frame was used; a bad timestamp
         or points that are not an (n, 3) array raise ArgumentError."""
-        return self._frame(check_timestamp(t), check_points(points))
+        return self.frame_unchecked(check_timestamp(t), check_points(points))
 
-    def _frame(self, t: float, points: np.ndarray) -> FrameResult:
-        """:meth:`frame` on checked arguments (t a finite float, points float (n, 3))."""
+    def frame_unchecked(self, t: float, points: np.ndarray) -> FrameResult:
+        """:meth:`frame` on checked arguments (t as :func:`check_timestamp` returns it, points float (n, 3) metres):
+        the per-frame path of callers whose frames are known to be good."""
         if t < self.t - 1e-9:
             return FrameResult(np.full(self.filter.n, -1), NAN_POSE, self.pose(), "stale")
         flag = self.advance(t)

@@ -30,10 +30,13 @@ import cv2
 import numba
 import numpy as np
 
-from poseintegrity.defaults import published
+from poseintegrity.config import published
 from poseintegrity.errors import ArgumentError, PoseIntegrityError, check_intrinsics, check_pose
-from poseintegrity.tracking.markers.geometry import transform_points
 from poseintegrity.params.track import DetectionParams
+from poseintegrity.tracking.markers.blob_shape import blob_pixels, blob_shape
+from poseintegrity.tracking.markers.blob_split import split_by_depth, split_two_discs
+from poseintegrity.tracking.markers.depth_readings import compiled_depth, small_median, valid_depth_range, window_medians
+from poseintegrity.tracking.markers.geometry import transform_points
 
 MIN_METRES_DEPTH_MM = 10.0  # a median depth below this is metres, not millimetres (AHAT depth is 100-1000 mm)
 MAX_UNIT_PLANE = 20.0  # |x|, |y| of a pixel ray on the unit plane: 20 is a field of view of 174 deg, beyond any depth camera
@@ -85,228 +88,6 @@ def validate_frame(ir: np.ndarray, depth_mm: np.ndarray, unproject: np.ndarray) 
     return ""
 
 
-def small_median(values: np.ndarray) -> float:
-    """``np.median`` of a 1-D float array (NaN if empty) without its overhead: the middle of the sorted values,
-    or the mean of the two middle ones, (a + b) / 2, as np.median computes it (same bits)."""
-    ordered = np.sort(values)
-    k = len(ordered) // 2
-    if len(ordered) == 0:
-        return float("nan")
-    return float(ordered[k]) if len(ordered) % 2 else float((ordered[k - 1] + ordered[k]) / 2)
-
-
-def blob_shape(contour: np.ndarray, measure: str) -> tuple[float, float, float]:
-    """(area px^2, circularity, convexity) of one external contour (k, 1, 2) int.
-
-    measure "contour": the polygon through the boundary pixel centres (their public code);
-    "pixel": each pixel a unit square (module docstring).  Circularity is area over the area of the
-    minimum enclosing circle, convexity area over the convex hull's area.
-    """
-    area = cv2.contourArea(contour)
-    _, radius = cv2.minEnclosingCircle(contour)
-    hull = cv2.convexHull(contour)
-    hull_area = cv2.contourArea(hull)
-    if measure == "pixel":
-        area += len(contour) / 2.0 + 1.0  # Pick: pixels = interior + boundary = A + B/2 + 1
-        radius += 0.5
-        hull_area += cv2.arcLength(hull, True) / 2.0 + 1.0
-    circularity = area / (np.pi * radius * radius) if radius > 0 else 0.0
-    convexity = area / hull_area if hull_area > 0 else 0.0
-    return area, circularity, convexity
-
-
-def blob_pixels(contour: np.ndarray) -> np.ndarray:
-    """Pixel coordinates (k, 2) int (u, v) inside an external contour (k, 1, 2), its boundary included."""
-    x0, y0, w, h = cv2.boundingRect(contour)
-    mask = np.zeros((h, w), np.uint8)
-    cv2.drawContours(mask, [contour - [x0, y0]], -1, 1, thickness=cv2.FILLED)
-    v, u = np.nonzero(mask)
-    return np.column_stack([u + x0, v + y0])
-
-
-def fit_circle(points: np.ndarray) -> tuple[np.ndarray, float, float]:
-    """Least-squares circle (Kasa) through points (k, 2): (centre (2,), radius, RMS radial residual), px."""
-    A = np.column_stack([2.0 * points, np.ones(len(points))])
-    b = (points**2).sum(axis=1)
-    (cx, cy, c), *_ = np.linalg.lstsq(A, b, rcond=None)
-    centre = np.array([cx, cy])
-    radius = float(np.sqrt(max(c + cx * cx + cy * cy, 0.0)))
-    residual = float(np.sqrt(np.mean((np.linalg.norm(points - centre, axis=1) - radius) ** 2)))
-    return centre, radius, residual
-
-
-def lens_area(d: float, R1: float, R2: float) -> float:
-    """Area of the overlap of two discs of radii R1, R2 whose centres are d apart (px^2)."""
-    if d >= R1 + R2:
-        return 0.0
-    if d <= abs(R1 - R2):
-        return float(np.pi * min(R1, R2) ** 2)
-    a1 = R1 * R1 * np.arccos((d * d + R1 * R1 - R2 * R2) / (2 * d * R1))
-    a2 = R2 * R2 * np.arccos((d * d + R2 * R2 - R1 * R1) / (2 * d * R2))
-    return float(a1 + a2 - 0.5 * np.sqrt(max((-d + R1 + R2) * (d + R1 - R2) * (d - R1 + R2) * (d + R1 + R2), 0.0)))
-
-
-def split_two_discs(contour: np.ndarray, detection: DetectionParams) -> np.ndarray:
-    """Centres (2, 2) px of two touching discs whose union is this blob, or (0, 2) if it is not such a union.
-
-    Boundary points start split along the blob's principal axis and are then reassigned to the circle whose
-    radius they fit better until the split settles (k-means with circles as centres).  Accepted when both
-    circles fit within split_max_residual_px, their radii agree within a factor 2, their centres are apart by
-    more than half the smaller radius, the discs touch, 97 % of the blob's pixels lie in one of them, the
-    area of their union is the blob's within 30 %, and the blob narrows between the centres (a neck at most
-    0.85 times as wide as the blob through either centre: an elongated reflection is a bar, not two discs).
-    """
-    points = contour.reshape(-1, 2).astype(float)
-    if len(points) < 8:
-        return np.zeros((0, 2))
-    mean = points.mean(axis=0)
-    _, _, Vt = np.linalg.svd(points - mean, full_matrices=False)
-    side = (points - mean) @ Vt[0] > 0
-    for _ in range(10):
-        if side.sum() < 4 or (~side).sum() < 4:
-            return np.zeros((0, 2))
-        fits = [fit_circle(points[s]) for s in (side, ~side)]
-        gaps = np.stack([np.abs(np.linalg.norm(points - c, axis=1) - r) for c, r, _ in fits], axis=1)
-        new_side = gaps[:, 0] < gaps[:, 1]
-        if np.array_equal(new_side, side):
-            break
-        side = new_side
-    (c1, r1, e1), (c2, r2, e2) = fits
-    d = float(np.linalg.norm(c1 - c2))
-    if max(e1, e2) > detection.split_max_residual_px or not (0.5 < r1 / max(r2, 1e-9) < 2.0) or d < 0.5 * min(r1, r2):
-        return np.zeros((0, 2))
-    R1, R2 = r1 + 0.5, r2 + 0.5  # boundary pixel centres lie half a pixel inside the disc edge
-    if d > R1 + R2 + 0.5:  # the images of two markers touch or overlap; separate blobs would not be one contour
-        return np.zeros((0, 2))
-    pixels = blob_pixels(contour).astype(float)
-    inside = (np.linalg.norm(pixels - c1, axis=1) <= R1 + 0.5) | (np.linalg.norm(pixels - c2, axis=1) <= R2 + 0.5)
-    union = np.pi * (R1 * R1 + R2 * R2) - lens_area(d, R1, R2)
-    if inside.mean() < 0.97 or abs(union - len(pixels)) > 0.3 * len(pixels):  # the blob is the union of the discs
-        return np.zeros((0, 2))
-    axis = (c2 - c1) / max(d, 1e-9)
-    along, across = (pixels - c1) @ axis, (pixels - c1) @ np.array([-axis[1], axis[0]])
-
-    def width(at: float) -> float:  # extent of the blob across the axis, in a one-pixel slab
-        slab = np.abs(along - at) <= 0.5
-        return float(np.ptp(across[slab]) + 1.0) if slab.any() else 0.0
-
-    if width(d / 2) > 0.85 * min(width(0.0), width(d)):  # two discs have a neck between them; a bar does not
-        return np.zeros((0, 2))
-    return np.stack([c1, c2])
-
-
-def split_by_depth(pixels: np.ndarray, depth_mm: np.ndarray, detection: DetectionParams) -> tuple[np.ndarray, np.ndarray]:
-    """Markers one partly in front of the other: (centres (m, 2) px, depths (m,) mm), m = 0, 1 or 2.
-
-    pixels : (k, 2) int (u, v) of one blob.  Two markers whose images overlap lie nearly on one ray, so their
-    depths differ by a good part of their distance (tens of mm) while one sphere's visible surface spans at most
-    its radius (5.5 mm) plus noise.  If the sorted valid depths of the blob have a gap of at least
-    depth_split_mm, the blob is cut there: the front set is a whole disc (its pixel centroid is its centre); the
-    back set is the visible crescent of the hidden marker, whose disc has the front disc's radius scaled by the
-    depth ratio and reaches to the crescent's farthest pixel, which places its centre even when only a sliver
-    shows.  Depths are the medians of each set.  A set smaller than min_area is left out.  m = 0: no depth gap.
-    """
-    gap = _largest_depth_gap(compiled_depth(depth_mm), np.ascontiguousarray(pixels, dtype=np.int64), float(detection.depth_min_mm), float(detection.depth_max_mm))
-    if not gap >= detection.depth_split_mm:
-        return np.zeros((0, 2)), np.zeros(0)  # one marker (nearly every blob): decided in one compiled call
-    d_all = np.asarray(depth_mm[pixels[:, 1], pixels[:, 0]], dtype=float)
-    valid = np.isfinite(d_all) & (d_all >= detection.depth_min_mm) & (d_all <= detection.depth_max_mm)
-    ordered = np.sort(d_all[valid])
-    i = int(np.argmax(np.diff(ordered)))
-    cut = 0.5 * (ordered[i] + ordered[i + 1])
-    front, back = valid & (d_all <= cut), valid & (d_all > cut)
-    centres, depths = [], []
-    if front.sum() >= detection.min_area:
-        c_front = pixels[front].mean(axis=0)
-        d_front, d_back = small_median(d_all[front]), small_median(d_all[back])
-        centres.append(c_front)
-        depths.append(d_front)
-        if back.sum() >= detection.min_area:
-            # the hidden marker's disc: radius from the front disc's (pixel count = pi r^2) scaled by the depth
-            # ratio of the sphere centres; it reaches exactly to the farthest visible pixel of the crescent
-            r_back = np.sqrt(front.sum() / np.pi) * (d_front + detection.depth_offset_mm) / (d_back + detection.depth_offset_mm)
-            offset = pixels[back].mean(axis=0) - c_front
-            u = offset / max(np.linalg.norm(offset), 1e-9)
-            reach = float(((pixels[back] - c_front) @ u).max()) + 0.5  # edge of the farthest pixel
-            centres.append(c_front + u * max(reach - r_back, 0.0))
-            depths.append(d_back)
-    elif back.sum() >= detection.min_area:
-        centres.append(pixels[back].mean(axis=0))
-        depths.append(small_median(d_all[back]))
-    return np.array(centres, dtype=float).reshape(-1, 2), np.array(depths)
-
-
-@numba.njit(cache=True, nogil=True, inline="always")
-def _is_valid_depth(d, depth_min_mm, depth_max_mm):  # pragma: no cover - compiled
-    """A depth reading (float) that is finite and within [depth_min_mm, depth_max_mm]."""
-    return np.isfinite(d) and d >= depth_min_mm and d <= depth_max_mm
-
-
-@numba.njit(cache=True, nogil=True)
-def _largest_depth_gap(depth_mm, pixels, depth_min_mm, depth_max_mm):  # pragma: no cover - compiled
-    """Largest gap (mm) between consecutive sorted valid depths of a blob's pixels (k, 2) (u, v); -inf with
-    fewer than two valid readings.  What :func:`split_by_depth` cuts at (the same subtractions, so the same bits)."""
-    values = np.empty(len(pixels))
-    n = 0
-    for i in range(len(pixels)):
-        d = float(depth_mm[pixels[i, 1], pixels[i, 0]])
-        if _is_valid_depth(d, depth_min_mm, depth_max_mm):
-            values[n] = d
-            n += 1
-    ordered = np.sort(values[:n])
-    gap = -np.inf
-    for i in range(n - 1):
-        gap = max(gap, ordered[i + 1] - ordered[i])
-    return gap
-
-
-@numba.njit(cache=True, nogil=True)
-def _valid_depth_range(depth_mm, x0, y0, w, h, depth_min_mm, depth_max_mm):  # pragma: no cover - compiled
-    """max - min (mm) of the valid depth readings in the rectangle [x0, x0 + w) x [y0, y0 + h); -inf with fewer than
-    two.  A blob inside the rectangle has no larger gap between its sorted readings (:func:`_largest_depth_gap`):
-    its readings are a subset and rounded subtraction is monotone, so below depth_split_mm it cannot be split."""
-    low, high, n = np.inf, -np.inf, 0
-    for v in range(y0, y0 + h):
-        for u in range(x0, x0 + w):
-            d = float(depth_mm[v, u])
-            if _is_valid_depth(d, depth_min_mm, depth_max_mm):
-                low, high, n = min(low, d), max(high, d), n + 1
-    return high - low if n >= 2 else -np.inf
-
-
-@numba.njit(cache=True, nogil=True)
-def _window_medians(depth_mm, uv_int, w, depth_min_mm, depth_max_mm):  # pragma: no cover - compiled
-    """:func:`lookup_depth` on rounded centres uv_int (k, 2) int: per centre the median of the valid readings
-    in its (2w+1)^2 window, as :func:`small_median` computes it (the middle one or (a + b) / 2), NaN if none."""
-    H, W = depth_mm.shape
-    out = np.full(len(uv_int), np.nan)
-    values = np.empty((2 * w + 1) * (2 * w + 1))
-    for k in range(len(uv_int)):
-        u, v = uv_int[k, 0], uv_int[k, 1]
-        if not (0 <= u < W and 0 <= v < H):
-            continue
-        n = 0
-        for r in range(max(v - w, 0), min(v + w + 1, H)):
-            for c in range(max(u - w, 0), min(u + w + 1, W)):
-                d = float(depth_mm[r, c])
-                if _is_valid_depth(d, depth_min_mm, depth_max_mm):
-                    values[n] = d
-                    n += 1
-        ordered = np.sort(values[:n])
-        if n:
-            out[k] = ordered[n // 2] if n % 2 else (ordered[n // 2 - 1] + ordered[n // 2]) / 2
-    return out
-
-
-COMPILED_DEPTH_TYPES = frozenset(np.dtype(t) for t in (np.uint8, np.uint16, np.uint32, np.int16, np.int32, np.int64, np.float32, np.float64))
-
-
-def compiled_depth(depth_mm: np.ndarray) -> np.ndarray:
-    """depth_mm as the compiled readers take it: unchanged if its dtype is one of COMPILED_DEPTH_TYPES (native byte
-    order), else as float64 (what the readers convert every reading to anyway)."""
-    return depth_mm if depth_mm.dtype in COMPILED_DEPTH_TYPES and depth_mm.dtype.isnative else depth_mm.astype(np.float64)
-
-
 def raw_threshold(detection: DetectionParams, dtype: np.dtype) -> float:
     """The IR value a pixel of this dtype must exceed to be part of a blob: ``threshold`` for uint8 (already 8-bit),
     else raw reflectivity clipped at ir_clip and scaled to 8 bit, ``threshold * ir_clip / 255``."""
@@ -349,7 +130,7 @@ def detect_blobs_each(ir: np.ndarray, detections: list[DetectionParams], depth_m
             if not (d.min_area <= area <= 2.0 * d.max_area):
                 continue
             # the depth split needs the blob's pixels, unless the readings of its bounding box already span less than a cut
-            if readable is not None and _valid_depth_range(readable, *cv2.boundingRect(contour), *depth_range) >= d.depth_split_mm:
+            if readable is not None and valid_depth_range(readable, *cv2.boundingRect(contour), *depth_range) >= d.depth_split_mm:
                 uv, dd = split_by_depth(blob_pixels(contour), depth_mm, d)
                 if len(uv):
                     centres.extend(map(tuple, uv))
@@ -383,7 +164,7 @@ def lookup_depth(depth_mm: np.ndarray, uv: np.ndarray, detection: DetectionParam
     Valid means finite and inside [depth_min_mm, depth_max_mm] (zero, NaN and far readings are rejected).
     """
     uv_int = np.ascontiguousarray(np.rint(uv).astype(np.int64).reshape(-1, 2))
-    return _window_medians(compiled_depth(depth_mm), uv_int, int(detection.depth_window), float(detection.depth_min_mm), float(detection.depth_max_mm))
+    return window_medians(compiled_depth(depth_mm), uv_int, int(detection.depth_window), float(detection.depth_min_mm), float(detection.depth_max_mm))
 
 
 def unit_plane_coordinates(uv: np.ndarray, unproject: np.ndarray) -> np.ndarray:

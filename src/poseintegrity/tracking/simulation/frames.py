@@ -16,7 +16,7 @@ import numba
 import numpy as np
 from scipy.special import ndtri
 
-from poseintegrity.params.track import CameraParams, FrameParams
+from poseintegrity.params.track import AhatCameraParams, FrameParams
 
 
 @dataclass(frozen=True)
@@ -35,7 +35,7 @@ class Phantom:
     depth_mm: float
 
 
-def intrinsics(camera: CameraParams) -> np.ndarray:
+def intrinsics(camera: AhatCameraParams) -> np.ndarray:
     """Pinhole K (3, 3), principal point at the image centre."""
     return np.array(
         [[camera.focal_px, 0.0, (camera.width - 1) / 2.0], [0.0, camera.focal_px, (camera.height - 1) / 2.0], [0.0, 0.0, 1.0]]
@@ -51,7 +51,7 @@ def unit_plane_lut(K: np.ndarray, width: int, height: int) -> np.ndarray:
     return np.stack([(u - K[0, 2]) / K[0, 0], (v - K[1, 2]) / K[1, 1]], axis=-1)
 
 
-def draw_phantoms(n: int, camera: CameraParams, frames: FrameParams, round_fraction: float, rng: np.random.Generator) -> list[Phantom]:
+def draw_phantoms(n: int, camera: AhatCameraParams, frames: FrameParams, round_fraction: float, rng: np.random.Generator) -> list[Phantom]:
     """n random reflections; a share ``round_fraction`` of them round (they pass the circularity test)."""
     phantoms = []
     for _ in range(n):
@@ -150,7 +150,7 @@ def _compose(depth, brightness, origin, v, u, depth_mm, ir):
 def render_frame(
     markers_cam: np.ndarray,
     phantoms: list[Phantom],
-    camera: CameraParams,
+    camera: AhatCameraParams,
     frames: FrameParams,
     marker_radius_m: float,
     rng: np.random.Generator,

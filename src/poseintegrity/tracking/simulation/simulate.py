@@ -14,14 +14,14 @@ import numpy as np
 import pandas as pd
 from tqdm import tqdm  # text bar: tqdm.auto warns "IProgress not found" in every kernel (no ipywidgets here)
 
+from poseintegrity.poses import NAN_POSE, pose_matrix
 from poseintegrity.tracking.markers.correspondence import match_markers_unchecked
 from poseintegrity.tracking.markers.detection import detect_markers_each, raw_threshold
-from poseintegrity.tracking.simulation.errors import error_columns
-from poseintegrity.tracking.simulation.frames import background_quantiles, draw_phantoms, intrinsics, render_frame
-from poseintegrity.parallel import in_worker_task
-from poseintegrity.poses import NAN_POSE, pose_matrix
 from poseintegrity.tracking.markers.geometry import MARKER_DIAMETER_M, transform_points
 from poseintegrity.tracking.markers.kabsch import pose_from_points_unchecked
+from poseintegrity.tracking.simulation.errors import error_columns
+from poseintegrity.tracking.simulation.frames import background_quantiles, draw_phantoms, intrinsics, render_frame
+from poseintegrity.workers import in_worker_task
 from poseintegrity.tracking.simulation.motion import (
     SensorTimeline,
     Trajectory,
@@ -200,10 +200,10 @@ def run_filter(
     flags, n_matched, poses = [], np.full(len(grid), -1), np.empty((len(grid), 4, 4))
     for e in range(len(grid)):
         if is_gyro[e]:
-            flags.append(tracker._gyro(float(t[e]), tl.gyro[k[e]]))  # simulated: already good, unchecked
+            flags.append(tracker.gyro_unchecked(float(t[e]), tl.gyro[k[e]]))  # simulated: already good, unchecked
             poses[e] = tracker.pose()
         else:
-            result = tracker._frame(float(t[e]), sim.points[k[e]])
+            result = tracker.frame_unchecked(float(t[e]), sim.points[k[e]])
             flags.append(result.flag)
             n_matched[e] = int((result.assignment >= 0).sum())
             poses[e] = result.T_filtered

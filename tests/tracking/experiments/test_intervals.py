@@ -7,7 +7,7 @@ import pytest
 
 from poseintegrity.tracking.experiments.filter_runs import experiment_rng
 from poseintegrity.tracking.experiments.intervals import block_weights, lag_interval, mean_rate_interval, rate_interval, rms_interval
-from poseintegrity.tracking.experiments.lag import block_lag_sums, filter_lag_ms, lag_from_ncc, ncc_from_sums, normalized_lag_ms
+from poseintegrity.tracking.experiments.lag import filter_lag_ms
 from tracking.track_section import TRACK
 
 
@@ -64,18 +64,6 @@ def test_the_mean_rates_interval_is_the_mean_of_recordings_resampled_by_the_same
         means.append(np.mean(shares))
     assert [low, high] == pytest.approx(list(np.quantile(means, [0.05, 0.95], method="inverted_cdf")), rel=1e-12)
     assert low < np.mean([df.correct.mean() for df in tables]) < high
-
-
-def test_block_sums_give_the_lag_and_correlation_of_the_whole_recording():
-    rng = np.random.default_rng(6)
-    t = np.arange(0.0, 23.0, 0.001)
-    signal = np.convolve(rng.standard_normal(len(t)), np.ones(300) / 300, mode="same")
-    delayed = np.interp(t - 0.120, t, signal) + 0.002 * rng.standard_normal(len(t))
-    sums = block_lag_sums(signal, delayed, np.floor(t / 5.0).astype(int), 300)
-    ncc = ncc_from_sums(sums.sum(axis=0))
-    for lag in (0, 77, 120, 299):  # Pearson's correlation of a[:L - lag] and b[lag:], computed directly
-        assert ncc[lag] == pytest.approx(np.corrcoef(signal[: len(t) - lag], delayed[lag:])[0, 1], rel=1e-9)
-    assert lag_from_ncc(ncc) == normalized_lag_ms(t, signal, t, delayed, 300) == 120
 
 
 def test_the_lag_interval_holds_a_known_lag():

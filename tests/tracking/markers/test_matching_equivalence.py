@@ -1,7 +1,8 @@
 """The compiled matchers give the assignments of the numpy code they replaced (reference_matching.py), element for
 element: random frames of the real marker body (params.yaml) in random poses with 0.5 mm noise, phantoms near and far,
 dropped markers, NaN rows, duplicated points (exact ties), the body's near-symmetric permutation (4, 3, 2, 1) and
-predictions near, far or permuted.  ``PYTHONPATH=src:tests python tests/tracking/test_matching_equivalence.py 200000`` runs a larger draw.
+predictions near, far or permuted.
+``PYTHONPATH=src:tests python tests/tracking/markers/test_matching_equivalence.py 200000`` runs a larger draw.
 """
 
 import sys
@@ -10,8 +11,11 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from poseintegrity.tracking.markers import correspondence as compiled
-from poseintegrity.tracking.markers.kabsch import kabsch_residuals
+from poseintegrity.tracking.markers.brute_force import match_brute_force
+from poseintegrity.tracking.markers.consistency import is_consistent
+from poseintegrity.tracking.markers.correspondence import match_markers_unchecked
+from poseintegrity.tracking.markers.gated import match_gated
+from poseintegrity.tracking.markers.voting import match_voting
 from tracking import reference_matching as reference
 from tracking.track_section import GEOMETRY, TRACK
 
@@ -69,71 +73,35 @@ def differences(n_cases: int, seed: int) -> list[int]:
         points, geometry, markers, predicted = random_frame(rng)
         matching = random_matching(rng)
         tol, gate = matching.tolerance_m, matching.gate_m
-        same = np.array_equal(compiled.match_markers_unchecked(points, geometry, predicted, matching),
+        same = np.array_equal(match_markers_unchecked(points, geometry, predicted, matching),
                               reference.match_markers_unchecked(points, geometry, predicted, matching))
-        voted, outlier = compiled.match_voting(points, geometry, tolerance_m=tol)
+        voted, outlier = match_voting(points, geometry, tolerance_m=tol)
         voted_ref, outlier_ref = reference.match_voting(points, geometry, tolerance_m=tol)
         same &= np.array_equal(voted, voted_ref) and np.array_equal(outlier, outlier_ref)
         if predicted is not None:
-            same &= np.array_equal(compiled.match_gated(points, predicted, gate_m=gate), reference.match_gated(points, predicted, gate_m=gate))
+            same &= np.array_equal(match_gated(points, predicted, gate_m=gate), reference.match_gated(points, predicted, gate_m=gate))
         if rng.random() < 0.3:  # brute force on its own: fixed matches, candidates, fewer markers required
             fixed = np.where(rng.random(len(geometry)) < 0.5, voted_ref, -1)
             candidates = ~outlier_ref if rng.random() < 0.5 else None
             min_markers = int(rng.integers(1, len(geometry) + 1))
             same &= np.array_equal(
-                compiled.match_brute_force(points, geometry, fixed=fixed, candidates=candidates, tolerance_m=tol, min_markers=min_markers),
+                match_brute_force(points, geometry, fixed=fixed, candidates=candidates, tolerance_m=tol, min_markers=min_markers),
                 reference.match_brute_force(points, geometry, fixed=fixed, candidates=candidates, tolerance_m=tol, min_markers=min_markers))
         assignment = reference.match_markers_unchecked(points, geometry, None, matching)
         for guess in (assignment, np.where(rng.random(len(geometry)) < 0.5, assignment, -1)):
-            same &= compiled.is_consistent(points, geometry, guess, tol) == reference.is_consistent(points, geometry, guess, tol)
+            same &= is_consistent(points, geometry, guess, tol) == reference.is_consistent(points, geometry, guess, tol)
         if not same:
             differ.append(case)
     return differ
 
 
-# 500 cases a seed: of 23 mutants of correspondence.py's compiled matchers (a comparison flipped, a tie broken the other
+# 500 cases a seed: of 23 mutants of the compiled matchers (a comparison flipped, a tie broken the other
 # way, a uniqueness check, a fallback or the outlier filter dropped), the 15 that change an assignment in 3000 cases
 # (1500 a seed, as before) change 4 or more of these 1000, the rarest (outliers left to brute force) 15 of the 3000;
 # the other 8 change none of the 3000. The 2000 more cases cost 4.3 s of every run; the larger draw by hand goes on.
 @pytest.mark.parametrize("seed", [0, 1])
 def test_compiled_matchers_equal_the_numpy_reference(seed):
     assert differences(500, seed) == []
-
-
-def test_gated_ties_and_crowded_gates_go_to_scipy_as_before():
-    """Points within the gate of two markers, markers with two points in the gate, exact ties (a point midway, a
-    duplicated point) and predictions beyond every gate: the cases the compiled matcher hands to scipy."""
-    rng = np.random.default_rng(2)
-    for _ in range(2000):
-        m, n = int(rng.integers(1, 6)), int(rng.integers(0, 8))
-        predicted = rng.normal(0.0, 0.02, (m, 3))
-        points = np.vstack([predicted[rng.integers(m, size=n)] + rng.normal(0.0, rng.choice([0.0, 0.005, 0.02]), (n, 3)),
-                            (predicted[:1] + predicted[-1:]) / 2])
-        if rng.random() < 0.3:
-            points = np.vstack([points, points[:1]])
-        gate = float(rng.choice([0.005, 0.02, 0.05, 2e6]))
-        np.testing.assert_array_equal(compiled.match_gated(points, predicted, gate_m=gate), reference.match_gated(points, predicted, gate_m=gate))
-
-
-def test_kabsch_residuals_equal_numpys():
-    """The compiled residuals round the fitted points' 3-term products with one fused multiply-add each, as the
-    OpenBLAS kernels numpy called on the development machine did (equal to the bit there).  Another CPU's BLAS
-    kernel may round them otherwise, so the check here is to 1e-15 m (the residuals are ~1e-2 m)."""
-    rng = np.random.default_rng(3)
-    for k in (1, 2, 3, 4, 7, 9):
-        body = rng.normal(0.0, 0.03, (k, 3))
-        world = rng.normal(0.0, 0.03, (50, k, 3)) + rng.normal(0.0, 1.0, 3)
-        for body_arg in (body, body + rng.normal(0.0, 0.001, (50, k, 3))):
-            np.testing.assert_allclose(kabsch_residuals(world, body_arg), reference.kabsch_residuals(world, body_arg), rtol=0, atol=1e-15)
-        np.testing.assert_allclose(kabsch_residuals(world[0], body), reference.kabsch_residuals(world[0], body), rtol=0, atol=1e-15)
-
-
-def test_the_sum_of_squares_is_numpys_for_long_bodies():
-    """Alg. 3's error is summed as numpy sums (pairwise beyond 8 terms, in halves beyond 128)."""
-    rng = np.random.default_rng(4)
-    for n in (0, 1, 7, 8, 9, 16, 17, 127, 128, 129, 300, 1025, 5000):
-        a = rng.random(n) ** 4
-        assert compiled._numpy_sum(a) == a.sum()
 
 
 if __name__ == "__main__":  # a larger draw by hand (PYTHONPATH=src:tests), e.g. 200000 cases [seed]

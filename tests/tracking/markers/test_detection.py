@@ -6,11 +6,14 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from poseintegrity.errors import ArgumentError
+from poseintegrity.tracking.markers.blob_shape import blob_pixels
+from poseintegrity.tracking.markers.blob_split import split_by_depth
+from poseintegrity.tracking.markers.depth_readings import valid_depth_range
 from poseintegrity.tracking.markers.detection import (
-    _valid_depth_range, blob_pixels, detect_markers, detect_markers_each, points_along_rays, raw_threshold, split_by_depth, validate_frame,
+    detect_markers, detect_markers_each, points_along_rays, raw_threshold, validate_frame,
 )
-from poseintegrity.tracking.simulation.frames import Phantom, intrinsics, render_frame, unit_plane_lut
 from poseintegrity.tracking.markers.geometry import MARKER_DIAMETER_M
+from poseintegrity.tracking.simulation.frames import Phantom, intrinsics, render_frame, unit_plane_lut
 
 from tracking.track_section import GEOMETRY, TRACK
 
@@ -201,7 +204,7 @@ def test_a_blob_whose_box_spans_less_than_a_depth_cut_has_no_depth_split():
     for ir, depth in _crowded_frames():
         mask = cv2.compare(ir, raw_threshold(DETECTION, ir.dtype), cv2.CMP_GT)
         for contour in cv2.findContours(mask, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)[0]:
-            spread = _valid_depth_range(depth, *cv2.boundingRect(contour), DETECTION.depth_min_mm, DETECTION.depth_max_mm)
+            spread = valid_depth_range(depth, *cv2.boundingRect(contour), DETECTION.depth_min_mm, DETECTION.depth_max_mm)
             centres, _ = split_by_depth(blob_pixels(contour), depth, DETECTION)
             cases[spread < DETECTION.depth_split_mm] += 1
             if spread < DETECTION.depth_split_mm:

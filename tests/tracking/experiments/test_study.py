@@ -3,7 +3,7 @@ of tests/params_tiny.yaml, one process) gives tracking.json as the code before t
 (study_metrics_tiny.json: the stage-06 notebook's output on those parameters, timings left out).
 
 Every experiment draws from its own seeded generator in a fixed order, so the numbers are the same to the bit on one
-machine, and since OpenBLAS runs its Haswell kernels everywhere (poseintegrity.dispatch), on every x86-64 machine. The
+machine, and since OpenBLAS runs its Haswell kernels everywhere (poseintegrity.kernel_pin), on every x86-64 machine. The
 fixture was written before that, on a CPU with other OpenBLAS kernels, and the filters amplify the last-bit
 differences of those kernels over hundreds of steps, so it is compared within their spread. Measured
 on one AMD EPYC (AVX2) under every kernel set it can run (OPENBLAS_CORETYPE Prescott/Core2 = Katmai, Nehalem,
@@ -26,9 +26,9 @@ import json
 from pathlib import Path
 
 from poseintegrity.config import load_section
-from poseintegrity.parallel import Workers
 from poseintegrity.report.metrics import json_ready, metrics_differences
 from poseintegrity.tracking.experiments.study import run_study
+from poseintegrity.workers import Workers
 from tracking.track_section import ROOT, TINY
 
 BEFORE = Path(__file__).with_name("study_metrics_tiny.json")

@@ -4,9 +4,9 @@ from scipy import stats
 from scipy.spatial.transform import Rotation
 
 from poseintegrity.tracking.markers.detection import detect_markers, raw_threshold
-from poseintegrity.tracking.simulation.simulate import background_seen
-from poseintegrity.tracking.simulation.frames import _lit_pixels, background_quantiles, draw_phantoms, intrinsics, render_frame, sensor_ir, skip_raw
 from poseintegrity.tracking.markers.geometry import MARKER_DIAMETER_M
+from poseintegrity.tracking.simulation.frames import _lit_pixels, background_quantiles, draw_phantoms, intrinsics, render_frame, sensor_ir, skip_raw
+from poseintegrity.tracking.simulation.simulate import background_seen
 
 from tracking.track_section import GEOMETRY, TRACK
 

@@ -7,7 +7,6 @@ from poseintegrity.errors import PoseIntegrityError
 from poseintegrity.tracking.experiments.peers import additive_model, correlated_state, filterpy_filter, pykalman_time_update
 from poseintegrity.tracking.filter.srukf import SquareRootUKF
 from poseintegrity.tracking.filter.ukf import UnscentedKalmanFilter
-from poseintegrity.tracking.filter.unscented import unscented_weights
 
 from tracking.track_section import GEOMETRY, TRACK
 
@@ -61,21 +60,6 @@ def test_square_root_ukf_equals_filterpy_on_full_measurements():
         f.update(z, np.ones(4, bool), gyro=True)
         step(z, 0.01)
     np.testing.assert_allclose(f.x, ref.x, rtol=0, atol=1e-8 * np.abs(ref.x).max())
-
-
-def test_weights_and_unscented_transform_of_a_linear_map():
-    Wm, Wc, gamma = unscented_weights(18, 1e-3, 2.0, 3 - 18)
-    assert np.isclose(Wm.sum(), 1.0) and Wm[0] < -1e6  # the paper's alpha gives weights near -6e6
-    rng = np.random.default_rng(0)
-    x, A = rng.normal(size=18), rng.normal(size=(18, 18))
-    S = np.linalg.cholesky(A @ A.T + np.eye(18))
-    X = x[:, None] + gamma * np.hstack([np.zeros((18, 1)), S, -S])
-    M = rng.normal(size=(5, 18))
-    Y = M @ X
-    y_mean = Y @ Wm
-    np.testing.assert_allclose(y_mean, M @ x, atol=1e-6)
-    dy = Y - y_mean[:, None]
-    np.testing.assert_allclose((dy * Wc) @ dy.T, M @ S @ S.T @ M.T, rtol=1e-4)
 
 
 def test_filter_tracks_without_failed_downdates():

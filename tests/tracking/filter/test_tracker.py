@@ -4,15 +4,17 @@ from scipy.spatial.transform import Rotation
 
 from poseintegrity.errors import PoseIntegrityError
 
+from poseintegrity.params.track import PAPER_SIGMAS
+from poseintegrity.tracking.filter.multi_tool import MultiToolTracker
+from poseintegrity.tracking.filter.tracker import MarkerTracker, innovation_gate
 from poseintegrity.tracking.markers.geometry import transform_points
 from poseintegrity.tracking.markers.kabsch import pose_from_points
-from poseintegrity.params.track import PAPER_SIGMAS
-from poseintegrity.tracking.filter.tracker import MarkerTracker, innovation_gate
 
 from tracking.track_section import GEOMETRY, TRACK
 
 FILTER = TRACK.filter.model_copy(update=dict(sigma_r=0.002, sigma_c=3.0, sigma_alpha=30.0))
 MATCHING = TRACK.matching
+POINTS = GEOMETRY + [0.0, 0.0, 0.45]
 
 
 def _pose(t):
@@ -126,3 +128,47 @@ def test_the_compiled_innovation_gate_decides_as_numpys_solve():
     S[0, 0] = np.nan
     assert not innovation_gate(S, x, points, np.ones(n, dtype=bool), 0.003**2, chi2)[0]  # NaN fails the gate
     assert not innovation_gate(np.zeros((N, N)), x, points, np.ones(n, dtype=bool), 0.0, chi2).any()  # C = 0: not positive definite
+
+
+def _tracker():
+    tracker = MarkerTracker(GEOMETRY, TRACK.filter, TRACK.matching)
+    assert tracker.frame(0.0, POINTS).flag == "initialized"
+    return tracker
+
+
+@pytest.mark.parametrize("t, found", [(None, "NoneType"), ("0.1", "str"), (1e300, "1e\\+300"), (float("nan"), "nan"), (True, "bool")])
+def test_bad_timestamps_are_refused_naming_t(t, found):
+    tracker = _tracker()
+    with pytest.raises(PoseIntegrityError, match=f"^t: expected .*{found}"):
+        tracker.frame(t, POINTS)
+    with pytest.raises(PoseIntegrityError, match=f"^t: expected .*{found}"):
+        tracker.gyro(t, np.zeros(3))
+    with pytest.raises(PoseIntegrityError, match="^t: "):
+        MultiToolTracker({"probe": GEOMETRY}, TRACK.filter, TRACK.matching).frame(t, POINTS)
+
+
+def test_time_going_backwards_is_flagged_stale_and_a_long_jump_restarts():
+    tracker = _tracker()
+    x = tracker.filter.x.copy()
+    assert tracker.frame(-0.5, POINTS).flag == "stale" and tracker.gyro(-0.5, np.zeros(3)) == "stale"
+    np.testing.assert_array_equal(tracker.filter.x, x)  # a stale sample changes nothing
+    gyro_tracker = MarkerTracker(GEOMETRY, TRACK.filter, TRACK.matching, use_gyro=True)
+    gyro_tracker.frame(0.0, POINTS)
+    assert gyro_tracker.gyro(1e9, np.zeros(3)) == "restart"  # no 4e11 filter steps for a clock glitch
+    first = MarkerTracker(GEOMETRY, TRACK.filter, TRACK.matching)
+    assert first.frame(-3.0, POINTS).flag == "initialized"  # negative clocks are clocks
+
+
+def test_points_and_gyro_of_the_wrong_shape_are_refused():
+    tracker = _tracker()
+    with pytest.raises(PoseIntegrityError, match=r"points: expected shape \(n, 3\), got \(4, 2\)"):
+        tracker.frame(0.05, POINTS[:, :2])
+    with pytest.raises(PoseIntegrityError, match=r"points: expected shape \(n, 3\), got \(6, 2\)"):
+        tracker.frame(0.05, np.zeros((6, 2)))  # 12 numbers: reshape(-1, 3) used to make 4 points of them
+    with pytest.raises(PoseIntegrityError, match="points: expected an array, got str"):
+        tracker.frame(0.05, "points")
+    for omega in (np.zeros(2), np.zeros(4), np.zeros((1, 3))):
+        with pytest.raises(PoseIntegrityError, match=r"omega_body: expected shape \(3\)"):
+            tracker.gyro(0.05, omega)
+    assert tracker.gyro(0.05, np.array([np.nan, 0.0, 0.0])) == "bad_gyro"  # bad data: a flag
+    assert tracker.frame(0.1, []).flag == "no_points"

@@ -6,8 +6,9 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
+from poseintegrity.tracking.filter.recording_replay import track_recording
 from poseintegrity.tracking.io.hl2_recordings import convert_hl2ss, convert_stream_recorder, decode_pgm
-from poseintegrity.tracking.io.recording import RecordingError, RecordingWriter, read_recording, track_recording
+from poseintegrity.tracking.io.recording import RecordingError, RecordingWriter, read_recording
 
 from tracking.hl2_writers import T0_TICKS, pgm, simulated_frames, write_hl2ss, write_stream_recorder
 from tracking.track_section import TINY as PARAMS

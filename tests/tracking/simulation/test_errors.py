@@ -3,7 +3,7 @@ import pandas as pd
 from scipy.spatial.transform import Rotation
 
 from poseintegrity.poses import pose_errors, pose_matrix
-from poseintegrity.tracking.simulation.errors import EULER_SEQUENCE, axis_errors, error_columns, rms_summary
+from poseintegrity.tracking.simulation.errors import EULER_SEQUENCE, axis_errors, error_columns, rms, rms_summary
 
 
 def _poses(rotvecs, positions):
@@ -40,3 +40,7 @@ def test_missing_poses_give_nan_rows_not_numbers():
     est[1] = np.nan
     columns = error_columns(est, truth)
     assert all(np.isnan(v[1]) and np.isfinite(v[0]) for v in columns.values())
+
+
+def test_rms_leaves_out_nan():
+    assert rms(np.array([3.0, -4.0, np.nan])) == np.sqrt(12.5)

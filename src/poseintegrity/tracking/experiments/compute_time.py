@@ -7,15 +7,17 @@ import time
 import numpy as np
 import pandas as pd
 
-from poseintegrity.tracking.markers.correspondence import match_brute_force, match_markers_unchecked, match_voting
+from poseintegrity.params.track import TrackParams
+from poseintegrity.tracking.experiments.filter_runs import experiment_rng
+from poseintegrity.tracking.filter.tracker import MarkerTracker
+from poseintegrity.tracking.markers.brute_force import match_brute_force
+from poseintegrity.tracking.markers.correspondence import match_markers_unchecked
 from poseintegrity.tracking.markers.detection import detect_markers
-from poseintegrity.tracking.simulation.frames import draw_phantoms, intrinsics, render_frame
 from poseintegrity.tracking.markers.geometry import MARKER_DIAMETER_M, transform_points
 from poseintegrity.tracking.markers.kabsch import kabsch_unchecked, pose_from_points_unchecked
-from poseintegrity.params.track import TrackParams
+from poseintegrity.tracking.markers.voting import match_voting
+from poseintegrity.tracking.simulation.frames import draw_phantoms, intrinsics, render_frame
 from poseintegrity.tracking.simulation.simulate import Simulation, T_world_cam
-from poseintegrity.tracking.filter.tracker import MarkerTracker
-from poseintegrity.tracking.experiments.filter_runs import experiment_rng
 
 
 

@@ -1,8 +1,8 @@
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from poseintegrity.tracking.markers.geometry import pairwise_distances, skew
 from poseintegrity.tracking.filter.model import centred, process_model, process_model_reference, process_noise_sqrt
+from poseintegrity.tracking.markers.geometry import pairwise_distances, skew
 
 from tracking.track_section import GEOMETRY
 
