@@ -26,12 +26,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from poseintegrity import paper_results as paper
-from poseintegrity.report.headlines import ENDINGS
+from poseintegrity.report.headlines.envelope_causes import ENDINGS
 from poseintegrity.report.lookup import MISSING, absent
 from poseintegrity.report.reader import RATE, SHARE, SPL, Reader
 from poseintegrity.report.recorded import recorded_source
 from poseintegrity.report.stage_pages import page_path, section_link
-from poseintegrity.worlds import FIRST, world_order
+from poseintegrity.world_order import FIRST, world_order
 
 TITLE = "What held, where, and by how much"
 VERDICTS = ("reproduced", "undecided", "not reproduced")  # grades 0, 1, 2 of one world

@@ -2,7 +2,7 @@
 
 A headline of Tables I-III is the largest mean SPL at zero incursion; its operating point (n_t, or the static
 envelope size) is held where it is by the arcs that would incur at the next bolder point (``predictors.json`` /
-``validation.json`` ``<predictor>.<tolerance>.decided_by``, :func:`~poseintegrity.prediction.tables.deciding_datasets`).
+``validation.json`` ``<predictor>.<tolerance>.decided_by``, :func:`~poseintegrity.prediction.paper_tables.deciding_datasets`).
 Beside each such arc: how its envelope ends (``artifacts.json`` ``envelope_causes``, of its world and tolerance,
 :mod:`~poseintegrity.localization.envelope_causes`): theta_a against the ground truth and against the exact pose, the
 limit, the cause, what the ground truth moved the criterion by, n_i at theta_a, and how many stops before it had no
@@ -12,7 +12,7 @@ predicted RMS E_t (issue 38: how far the predicted error saw the end coming).
 
 from __future__ import annotations
 
-import math
+from poseintegrity.report.number_cell import number_cell
 
 HEADER = ["| world | tolerance | predictor | max mean SPL (deg) | operating point | decided by | theta_a (deg) | "
           "theta_a, exact pose (deg) | limit | ends on | ground truth moved it by | n_i at theta_a | "
@@ -20,8 +20,9 @@ HEADER = ["| world | tolerance | predictor | max mean SPL (deg) | operating poin
           "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
 
 
-def _number(value, fmt: str = "{:.2f}") -> str:
-    return "-" if value is None or (isinstance(value, float) and math.isnan(value)) else fmt.format(value)
+def _cell(value, fmt: str = "{:.2f}") -> str:
+    """A number of the table: a float by ``fmt`` (two decimals unless told), "-" where there is none."""
+    return number_cell(value, fmt, "-")
 
 
 def _causes(metrics: dict[str, dict], world: str | None) -> dict[tuple[str, str], dict]:
@@ -48,15 +49,15 @@ def deciding_section(metrics: dict[str, dict]) -> list[str]:
                 point = next((entry[key] for key in ("best_n_t", "best_size", "best_k") if entry.get(key) is not None),
                              None)
                 head = (f"| {world or 'main'} | {tolerance} | {predictor} | "
-                        f"{_number(entry['max_mean_spl_zero_incursion'])} | {_number(point, '{:g}')} |")
+                        f"{_cell(entry['max_mean_spl_zero_incursion'])} | {_cell(point, '{:g}')} |")
                 for dataset in entry["decided_by"] or [None]:
                     row = causes.get((dataset, tolerance), {})
-                    lines.append(f"{head} {dataset or 'none'} | {_number(row.get('theta_a'))} | "
-                                 f"{_number(row.get('theta_a_exact'))} | {row.get('limit', '-')} | "
-                                 f"{row.get('cause', '-')} | {_number(row.get('truth_shift'), '{:.3f}')} | "
-                                 f"{_number(row.get('n_inliers_at_theta_a'), '{:.1f}')} | "
-                                 f"{_number(row.get('unmeasured_stops'), '{:d}')} | "
-                                 f"{_number(row.get('E_t_at_end'))} | {_number(row.get('sigma_t_pred_at_end'))} |")
+                    lines.append(f"{head} {dataset or 'none'} | {_cell(row.get('theta_a'))} | "
+                                 f"{_cell(row.get('theta_a_exact'))} | {row.get('limit', '-')} | "
+                                 f"{row.get('cause', '-')} | {_cell(row.get('truth_shift'), '{:.3f}')} | "
+                                 f"{_cell(row.get('n_inliers_at_theta_a'), '{:.1f}')} | "
+                                 f"{_cell(row.get('unmeasured_stops'))} | "
+                                 f"{_cell(row.get('E_t_at_end'))} | {_cell(row.get('sigma_t_pred_at_end'))} |")
     if not lines:
         return []
     return ["### Which arcs decide each headline, and why they end", "",

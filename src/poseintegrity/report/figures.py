@@ -88,10 +88,10 @@ def tail_figure(tails: list[TailFit], n_t_max: int, n_cols: int = 3) -> plt.Figu
         ax.axis("off")
     for ax, tail in zip(axes.ravel(), tails):
         series = tail.series
-        theta_k, n_k = series.first_stops(tail.k)
+        theta_first, n_first = series.first_stops(tail.n_sampled_stops)
         theta = np.linspace(0.0, series.theta_end, 300)
         ax.scatter(series.theta, series.n_inliers, s=6, color="0.7", label="all images")
-        ax.scatter(theta_k, n_k, s=8, color="k", label=f"first {tail.k} stops")
+        ax.scatter(theta_first, n_first, s=8, color="k", label=f"first {tail.n_sampled_stops} stops")
         for predictor, fitted in tail.fits.items():
             if fitted is None:
                 continue

@@ -12,7 +12,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from poseintegrity.staging import write_text_atomically
+from poseintegrity.atomic_write import write_text_atomically
 
 
 def json_ready(value: Any) -> Any:
@@ -32,7 +32,7 @@ def json_ready(value: Any) -> Any:
 
 def write_metrics(path: str | Path, metrics: dict[str, Any]) -> None:
     """Write ``metrics`` (nested dicts / lists of numbers, strings, bools) as indented, key-sorted JSON, atomically
-    (its folder made if missing; a full disk: :class:`~poseintegrity.staging.DiskFullError` naming the file)."""
+    (its folder made if missing; a full disk: :class:`~poseintegrity.atomic_write.DiskFullError` naming the file)."""
     write_text_atomically(path, json.dumps(json_ready(metrics), indent=2, sort_keys=True, allow_nan=False) + "\n")
 
 

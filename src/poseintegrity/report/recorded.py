@@ -12,6 +12,8 @@ from __future__ import annotations
 
 import math
 
+from poseintegrity.report.number_cell import number_cell
+
 UNITS = {"arc": "deg", "line": "mm"}
 PREDICTORS = {"static": "static baseline", "long_range": "long range (eq. 1)", "next_step": "next step"}
 
@@ -20,12 +22,6 @@ def recorded_source(metrics: dict[str, dict]) -> str | None:
     """The recorded folder stage 01 brought in (``generate.json`` ``source``), or None for the rendered world."""
     source = metrics.get("generate", {}).get("source")
     return None if source in (None, "rendered") else str(source)
-
-
-def _number(value, fmt: str = "{:.3g}") -> str:
-    if value is None or (isinstance(value, float) and math.isnan(value)):
-        return "none"
-    return fmt.format(value) if isinstance(value, float) else str(value)
 
 
 def _envelope(row: dict, tolerance: str) -> str:
@@ -65,12 +61,12 @@ def _predictor_lines(predictors: dict, tolerances: list[str], n_arcs: int, n_lin
                 entry = predictors.get(predictor, {}).get(tolerance, {})
                 point = entry.get("best_size") if predictor == "static" else entry.get("best_n_t")
                 label = "size" if predictor == "static" else "n_t"
-                cells.append(f"{_number(entry.get('max_mean_spl_zero_incursion'))}; {label} {_number(point)}")
+                cells.append(f"{number_cell(entry.get('max_mean_spl_zero_incursion'))}; {label} {number_cell(point)}")
             lines.append(f"| {name} | " + " | ".join(cells) + " |")
     line = predictors.get("straight_line", {})
     lines += ["", f"Straight lines ({line.get('tolerance', '-')}): long range "
-                  f"{_number(line.get('long_range_max_mean_spl_zero_incursion'))} mm, static "
-                  f"{_number(line.get('static_max_mean_spl_zero_incursion'))} mm of mean SPL at zero incursion "
+                  f"{number_cell(line.get('long_range_max_mean_spl_zero_incursion'))} mm, static "
+                  f"{number_cell(line.get('static_max_mean_spl_zero_incursion'))} mm of mean SPL at zero incursion "
                   "(none: no operating point without an incursion)." if n_lines else
               "No straight lines in this world: Fig. 7 has nothing to show."]
     return lines
@@ -95,8 +91,8 @@ def _transfer_lines(validation: dict, tolerances: list[str], kinds: list[str]) -
                   "| --- |" + " --- |" * len(tolerances)]
         for predictor, name in predictors.items():
             entry = validation.get(key, {}).get(predictor, {})
-            cells = [f"{_number(entry.get(t, {}).get('incursion_rate'))}; {_number(entry.get(t, {}).get('mean_spl'))}"
-                     for t in tolerances]
+            cells = [f"{number_cell(entry.get(t, {}).get('incursion_rate'))}; "
+                     f"{number_cell(entry.get(t, {}).get('mean_spl'))}" for t in tolerances]
             lines.append(f"| {name} | " + " | ".join(cells) + " |")
         lines.append("")
     return lines[:-1]
@@ -129,8 +125,9 @@ def recorded_section(metrics: dict[str, dict]) -> list[str]:
         for row in rows:
             unit = UNITS.get(row["trajectory"], "")
             lines.append(f"| {row['world']} | {row['dataset']} | {row['trajectory']} | {row['n_frames']} | "
-                         f"{row['n_stops']} | {_number(row['last_stop'])} {unit} | "
-                         f"{_number(row['localized_share'], '{:.0%}')} | {_number(row['first_stop_mean_n_inliers'])} | "
+                         f"{row['n_stops']} | {number_cell(row['last_stop'])} {unit} | "
+                         f"{number_cell(row['localized_share'], '{:.0%}')} | "
+                         f"{number_cell(row['first_stop_mean_n_inliers'])} | "
                          + " | ".join(_envelope(row, t) for t in tolerances) + " |")
         lines.append("")
     else:

@@ -1,12 +1,12 @@
 """The report's detail pages, one per stage (``reports/stages/<stage>.md``), which ``reports/summary.md`` links.
 
-Each page holds the sections of :data:`~poseintegrity.report.headlines.SECTIONS` that its stage's metrics fill: one
-table per section, ours beside the papers' and the target, each target judged pass or fail with its reason
+Each page holds the sections of :data:`~poseintegrity.report.headlines.sections.SECTIONS` that its stage's metrics fill:
+one table per section, ours beside the papers' and the target, each target judged pass or fail with its reason
 (:mod:`~poseintegrity.report.targets`), then what the section shows below its table (its figures, the arcs that decide
 each headline, the boards that cannot judge the tolerance). A stage that has not run yet shows "not run", a key its
-metrics lack "not measured", rather than a stale or invented number. On recorded data no target is judged (the
-rendered world's bars are properties of the paper's data a rendered world is held to) and a row whose key a stage
-that ran did not write is left out.
+metrics lack "not measured", rather than a stale or invented number. On recorded data no target is judged (the rendered
+world's bars are properties of the paper's data a rendered world is held to) and a row whose key a stage that ran did
+not write is left out.
 """
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ from __future__ import annotations
 import re
 
 from poseintegrity.report.deciding import deciding_section
-from poseintegrity.report.headlines import HEADLINES, SECTIONS, Headline, section_heading
+from poseintegrity.report.headlines import HEADLINES, Headline, section_heading
 from poseintegrity.report.lookup import MISSING, absent, lookup
 from poseintegrity.report.population_table import population_lines
 from poseintegrity.report.recorded import recorded_source

@@ -96,6 +96,6 @@ def render_summary(metrics: dict[str, dict]) -> str:
 
 # What README "Same numbers on any x86-64 machine" measured of the figures above
 MACHINE_NOTE = ("OpenCV, numpy, OpenBLAS, torch and numba run capped at AVX2 on every x86-64 machine "
-                "(`poseintegrity/dispatch`), so SIFT and every figure that follows from it are the same on an AVX-512 "
+                "(`poseintegrity/kernel_pin`), so SIFT and every figure that follows from it are the same on an AVX-512 "
                 "machine, and a stage run again with the same params writes the same bytes into every data and metrics "
                 "file.")

@@ -14,8 +14,8 @@ import os
 import platform
 from pathlib import Path
 
-from poseintegrity.parallel import describe_backend
-from poseintegrity.timing import StageTiming
+from poseintegrity.stage_timing import StageTiming
+from poseintegrity.workers import describe_backend
 
 SUBROUTINES = "subroutines"  # the folder of the stages' own timings beside the stage timing files
 TIMING_PAGE = "timing.md"

@@ -7,11 +7,9 @@ import pytest
 
 from poseintegrity.report.headlines import HEADLINES
 from poseintegrity.report.stage_pages import render_pages
-from poseintegrity.report.summary import read_metrics, render_summary
+from poseintegrity.report.summary import render_summary
 from poseintegrity.report.targets import UnjudgeableTarget, bar_holds, judgeable
-from repository import ROOT
-
-COMMITTED = read_metrics(ROOT / "reports" / "metrics")
+from report.metrics_fixtures import COMMITTED
 
 
 @pytest.mark.parametrize("target, value, holds", [
