@@ -1,4 +1,4 @@
-"""Why every worker task runs with one OpenCV thread (:func:`poseintegrity.parallel.run_single_threaded`): stage 02's
+"""Why every worker task runs with one OpenCV thread (:func:`poseintegrity.workers.run_single_threaded`): stage 02's
 CLAHE + SIFT on two worker processes (one per core, as ``parallel.n_jobs: 2`` gives), each with OpenCV's default
 thread pool (one thread per core) vs with one thread, in one run.
 

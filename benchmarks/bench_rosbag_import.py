@@ -1,5 +1,5 @@
 """Throughput of ``import-rosbag`` (poseintegrity.recorded.rosbag) against plain ``cv2.imdecode`` of the same images,
-measured in one run (alternately, benchmarks/timing.py), on bags written by rosbags' own writer.
+measured in one run (alternately, benchmarks/paired_timing.py), on bags written by rosbags' own writer.
 
 Two ROS 2 bags of the same N camera-sized (968 x 608) noisy 8-bit gray images: CompressedImage (the PNG bytes;
 import copies them) and Image mono8 (raw pixels; import encodes each as PNG). The reference decodes the same N PNG
@@ -22,7 +22,7 @@ import numpy as np
 
 sys.path[:0] = [str(Path(__file__).resolve().parent), str(Path(__file__).resolve().parents[1] / "tests" / "recorded")]
 from recorded_tools import write_bag  # noqa: E402 (test helper: rosbags' writers)
-from timing import paired_medians  # noqa: E402
+from paired_timing import paired_medians  # noqa: E402
 
 from poseintegrity.lens import Camera  # noqa: E402
 from poseintegrity.recorded.rosbag import import_rosbag  # noqa: E402

@@ -28,14 +28,14 @@ from pathlib import Path
 import websocket  # websocket-client, a dependency of jupyter_server
 from jupyter_server.services.kernels.connection.base import deserialize_msg_from_ws_v1, serialize_msg_to_ws_v1
 
-from poseintegrity.dispatch import pinned_environment
+from poseintegrity.kernel_pin import pinned_environment
 from repository import ROOT
 
 TINY_PARAMS = ROOT / "tests" / "params_tiny.yaml"
 JUPYTER = Path(sys.executable).parent / "jupyter"  # the venv's, as the README's `.venv/bin/jupyter lab`
 PROTOCOL = "v1.kernel.websocket.jupyter.org"  # what JupyterLab asks the server for
 ANSI = re.compile(r"\x1b\[[0-9;]*m")
-UNPINNED = "loaded before poseintegrity"  # poseintegrity.dispatch's warning
+UNPINNED = "loaded before poseintegrity"  # poseintegrity.kernel_pin's warning
 
 
 class NotebookServer:

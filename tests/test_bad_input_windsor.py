@@ -16,20 +16,20 @@ import loc_synthetic as synthetic  # noqa: E402
 
 from poseintegrity.artifact_models.base_functions import LEAST_SQUARES  # noqa: E402
 from poseintegrity.artifact_models.fitted import valid_samples  # noqa: E402
+from poseintegrity.boards import board_from_dict  # noqa: E402
+from poseintegrity.dataset_meta import BoardMeta  # noqa: E402
 from poseintegrity.errors import PoseIntegrityError  # noqa: E402
 from poseintegrity.lens import Camera  # noqa: E402
 from poseintegrity.localization import envelope as envelope_module  # noqa: E402
-from poseintegrity.localization.dataset import BoardMeta  # noqa: E402
 from poseintegrity.localization.features import ImageReadError, as_gray8, read_gray  # noqa: E402
-from poseintegrity.boards import board_from_dict  # noqa: E402
 from poseintegrity.localization.ground_truth import board_pose  # noqa: E402
 from poseintegrity.localization.pnp import solve_pnp_ransac  # noqa: E402
-from poseintegrity.tables import check_artifacts, check_envelopes, read_envelopes  # noqa: E402
 from poseintegrity.localization.target_model import triangulate  # noqa: E402
 from poseintegrity.poses import pose_errors  # noqa: E402
 from poseintegrity.prediction.metrics import incursion, safe_path_length  # noqa: E402
 from poseintegrity.prediction.predictors import boundaries, next_step_stops, sampling_interval  # noqa: E402
-from poseintegrity.timing import StageTiming  # noqa: E402
+from poseintegrity.stage_timing import StageTiming  # noqa: E402
+from poseintegrity.table_checks import check_artifacts, check_envelopes, read_envelopes  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -117,7 +117,7 @@ def test_unknown_aruco_dictionary_is_refused_on_read():
 ])
 def test_timing_cli_says_one_line_and_exits_2(tmp_path, content, words):
     (tmp_path / "02_extract.json").write_text(content)
-    run = subprocess.run([sys.executable, "-m", "poseintegrity.timing", str(tmp_path)], capture_output=True,
+    run = subprocess.run([sys.executable, "-m", "poseintegrity.stage_timing", str(tmp_path)], capture_output=True,
                          text=True, env={"PYTHONPATH": str(ROOT / "src")})
     assert run.returncode == 2 and "Traceback" not in run.stderr
     assert len(run.stderr.strip().splitlines()) == 1 and str(tmp_path / "02_extract.json") in run.stderr
@@ -208,7 +208,7 @@ def test_unmeasured_errors_are_flagged_not_read_as_within_tolerance():
     failed_at_once = np.column_stack([nothing, np.ones(4)])  # no pose anywhere: fails at the first stop, known
     assert envelope_module.actual_envelope(THETA, failed_at_once, np.append(BOUNDS, 0.5))[:3] == (0.0, False, ())
     frames = _artifacts().assign(E_t_mm=np.nan, E_r_deg=np.nan)
-    from poseintegrity.protocol import EnvelopeParams
+    from poseintegrity.params.protocol import EnvelopeParams
     params = EnvelopeParams.model_validate(dict(failed_frames="fail_fraction", cap_factor=2.0, max_failed_fraction=0.5))
     with pytest.warns(UserWarning, match=r"arc_00.*NaN: not measured up to their end"):
         table = envelope_module.envelopes(frames, [(2.0, 3.0)], params)
@@ -276,7 +276,7 @@ def test_next_step_arguments_are_checked():
 
 
 def test_check_meta_of_stage_01_refuses_what_stage_02_would():
-    from poseintegrity.scenes.dataset import check_meta
+    from poseintegrity.scenes.dataset_files import check_meta
     meta = json.loads(json.dumps(dict(dataset="d", world="main", trajectory="arc", board=synthetic.BOARD,
                                       model=dict(images=["a.png", "b.png"], masks=["c.png", "d.png"],
                                                  T_cam1_cam0=np.eye(4).tolist()))))
