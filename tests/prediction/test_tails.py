@@ -111,7 +111,7 @@ def test_the_tail_figure_shows_both_fits_and_every_theta_a(tiny_predict, tiny_fi
     import matplotlib
 
     matplotlib.use("Agg")
-    from poseintegrity.report.figures import tail_figure
+    from poseintegrity.prediction.predictor_figures import tail_figure
 
     theta = np.repeat(2.25 * np.arange(20), 3)
     artifacts = pd.DataFrame({"world": "main", "dataset": "scene_1_arc00", "trajectory": "arc",

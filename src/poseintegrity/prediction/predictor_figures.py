@@ -4,6 +4,7 @@
                      drawn (deg for arcs, mm for lines), the title saying in which steps R_i moves (1/n of n datasets)
     ceiling_figure   per world and tolerance every predictor's max mean SPL at R_i <= r with its interval, dodged so
                      that the headlines at r = 0 stand apart, each headline in the legend, beside the ceiling
+    tail_figure      the artifact model's tail on the arcs whose long range theta_p overshoots theta_a (:mod:`.tails`)
 """
 
 from __future__ import annotations
@@ -13,6 +14,7 @@ import numpy as np
 import pandas as pd
 import seaborn as sns
 
+from poseintegrity.prediction.tails import TailFit
 from poseintegrity.report.figures import nothing_to_draw
 
 SPL_UNITS = {"arc": "deg", "line": "mm"}  # theta_a, theta_p and SPL of an arc are angles; of a line, distances
@@ -113,5 +115,43 @@ def ceiling_figure(bands: pd.DataFrame, limits: dict[str, dict[str, dict]], leve
     fig.suptitle(f"Max mean SPL at R_i <= r, arcs (at r = 0: the headline). Bars: {level:.0%} of draws resampling the "
                  f"scenes, the operating point chosen again in each; predictors side by side around each r",
                  fontsize=9, y=1.0)
+    fig.tight_layout()
+    return fig
+
+
+TAIL_STYLES = {"long_range": ("eq. 1 (EMG, sigma = 1)", "C0", "-"),
+               "long_range_free_width": ("free-width EMG (ours)", "C3", "--")}  # label, colour, line of each fit
+
+
+def tail_figure(tails: list[TailFit], n_t_max: int, n_cols: int = 3) -> plt.Figure:
+    """The artifact model's tail (:mod:`.tails`): per arc, every image's n_i (grey), the first n_sampled_stops stops
+    fitted (black), the long range predictor's fitted curves (eq. 1 and the free-width EMG) over the whole arc,
+    theta_a per tolerance (vertical lines). ``n_t_max`` : the diagnosis' largest n_t (titles). Without arcs, a
+    titled empty figure."""
+    if not tails:
+        return nothing_to_draw(f"no arc overshoots its theta_a at every n_t <= {n_t_max}")
+    n_rows = -(-len(tails) // n_cols)
+    fig, axes = plt.subplots(n_rows, min(n_cols, len(tails)), figsize=(4.6 * min(n_cols, len(tails)), 3.4 * n_rows),
+                             squeeze=False)  # fmt: skip
+    for ax in axes.ravel()[len(tails):]:
+        ax.axis("off")
+    for ax, tail in zip(axes.ravel(), tails):
+        series = tail.series
+        theta_first, n_first = series.first_stops(tail.n_sampled_stops)
+        theta = np.linspace(0.0, series.theta_end, 300)
+        ax.scatter(series.theta, series.n_inliers, s=6, color="0.7", label="all images")
+        ax.scatter(theta_first, n_first, s=8, color="k", label=f"first {tail.n_sampled_stops} stops")
+        for predictor, fitted in tail.fits.items():
+            if fitted is None:
+                continue
+            label, colour, line = TAIL_STYLES.get(predictor, (predictor, "C2", ":"))
+            status = "" if fitted.status == "ok" else f" ({fitted.status})"
+            ax.plot(theta, fitted.predict(theta), color=colour, linestyle=line, label=label + status)
+        for (tolerance, theta_a), shade in zip(sorted(tail.theta_a.items()), ("0.2", "0.5")):
+            ax.axvline(theta_a, color=shade, linewidth=1, linestyle=":", label=f"theta_a {tolerance}")
+        top = max(float(np.nanmax(series.n_inliers)), 1.0)
+        ax.set(title=series.dataset, xlabel="theta (deg)", ylabel="n_inliers", ylim=(-0.05 * top, 1.3 * top))
+        ax.legend(fontsize=6)
+    fig.suptitle(f"Arcs whose long range theta_p overshoots theta_a at every n_t <= {n_t_max}", y=1.0)
     fig.tight_layout()
     return fig

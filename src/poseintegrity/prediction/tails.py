@@ -6,7 +6,7 @@ Fitted to the first 4 stops of an arc whose n_i has a shoulder and then a cliff,
 long range predictor's theta_p (III-E) lies beyond theta_a (IV-E) at every reasonable n_t, and that one arc forces
 the zero-incursion n_t of Tables I-III up for every arc. This module lists such arcs per tolerance, for eq. 1 and for
 the free-width EMG (artifact_models.base_functions.emg_free_width), and refits their curves for a figure
-(report/figures.py, ``tail_figure``).
+(predictor_figures.py, ``tail_figure``).
 
     overshooting_arcs  the arcs whose theta_p > theta_a at every swept n_t <= ``predict.tail_n_t_max``
     tail_metrics       ``tails.<predictor>.<tolerance>.{n_overshooting, datasets}`` of predictors.json

@@ -3,17 +3,12 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 import cv2
 import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 import seaborn as sns
-
-if TYPE_CHECKING:  # stage 01 imports these figures too: it must not import the predictors (and torch) for a name
-    from poseintegrity.prediction.tails import TailFit
-
 
 def _read(path: Path):
     return cv2.imread(str(path), cv2.IMREAD_GRAYSCALE)
@@ -67,43 +62,6 @@ def appearance_bars(table: pd.DataFrame) -> plt.Figure:
     sns.barplot(long, x="scene", y="keypoints on target", hue="preprocessing", ax=ax)
     ax.set_xlabel("")
     ax.tick_params(axis="x", labelsize=7)
-    fig.tight_layout()
-    return fig
-
-
-TAIL_STYLES = {"long_range": ("eq. 1 (EMG, sigma = 1)", "C0", "-"),
-               "long_range_free_width": ("free-width EMG (ours)", "C3", "--")}  # label, colour, line of each fit
-
-
-def tail_figure(tails: list[TailFit], n_t_max: int, n_cols: int = 3) -> plt.Figure:
-    """The artifact model's tail (prediction/tails.py): per arc, every image's n_i (grey), the first k stops fitted
-    (black), the long range predictor's fitted curves (eq. 1 and the free-width EMG) over the whole arc, theta_a per
-    tolerance (vertical lines). ``n_t_max`` : the diagnosis' largest n_t (titles). Without arcs, a titled empty figure."""
-    if not tails:
-        return nothing_to_draw(f"no arc overshoots its theta_a at every n_t <= {n_t_max}")
-    n_rows = -(-len(tails) // n_cols)
-    fig, axes = plt.subplots(n_rows, min(n_cols, len(tails)), figsize=(4.6 * min(n_cols, len(tails)), 3.4 * n_rows),
-                             squeeze=False)  # fmt: skip
-    for ax in axes.ravel()[len(tails):]:
-        ax.axis("off")
-    for ax, tail in zip(axes.ravel(), tails):
-        series = tail.series
-        theta_first, n_first = series.first_stops(tail.n_sampled_stops)
-        theta = np.linspace(0.0, series.theta_end, 300)
-        ax.scatter(series.theta, series.n_inliers, s=6, color="0.7", label="all images")
-        ax.scatter(theta_first, n_first, s=8, color="k", label=f"first {tail.n_sampled_stops} stops")
-        for predictor, fitted in tail.fits.items():
-            if fitted is None:
-                continue
-            label, colour, line = TAIL_STYLES.get(predictor, (predictor, "C2", ":"))
-            status = "" if fitted.status == "ok" else f" ({fitted.status})"
-            ax.plot(theta, fitted.predict(theta), color=colour, linestyle=line, label=label + status)
-        for (tolerance, theta_a), shade in zip(sorted(tail.theta_a.items()), ("0.2", "0.5")):
-            ax.axvline(theta_a, color=shade, linewidth=1, linestyle=":", label=f"theta_a {tolerance}")
-        top = max(float(np.nanmax(series.n_inliers)), 1.0)
-        ax.set(title=series.dataset, xlabel="theta (deg)", ylabel="n_inliers", ylim=(-0.05 * top, 1.3 * top))
-        ax.legend(fontsize=6)
-    fig.suptitle(f"Arcs whose long range theta_p overshoots theta_a at every n_t <= {n_t_max}", y=1.0)
     fig.tight_layout()
     return fig
 
