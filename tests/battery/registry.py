@@ -272,14 +272,14 @@ def _entries() -> list[EntryPoint]:
                    accepts={"n_inliers": {"nan", "inf", "wrong_ndim"}, "theta": {"nan", "inf", "wrong_ndim"}}),
         # ---- prediction
         EntryPoint("prediction.boundaries",
-                   lambda a: predictors.boundaries(lambda x: 300.0 - 5.0 * x, a["thresholds"], a["theta_start"],
+                   lambda a: predictors.boundaries(lambda x: 300.0 - 5.0 * x, a["levels"], a["theta_start"],
                                                    a["theta_end"], a["n_grid"]),
-                   lambda tmp: {"thresholds": np.array([15.0, 30.0]), "theta_start": 0.0, "theta_end": 60.0,
+                   lambda tmp: {"levels": np.array([15.0, 30.0]), "theta_start": 0.0, "theta_end": 60.0,
                                 "n_grid": 50},
-                   {"thresholds": "array", "theta_start": "scalar", "theta_end": "scalar", "n_grid": "scalar"},
+                   {"levels": "array", "theta_start": "scalar", "theta_end": "scalar", "n_grid": "scalar"},
                    flagged=lambda b: bool(np.isin(b.status, ["non_finite", "bad_threshold"]).any()),
-                   # fewer thresholds: fewer answers; n_t 1e300 lies above every count: below_at_start (documented)
-                   accepts={"thresholds": FEWER | {"huge"}}),
+                   # fewer levels: fewer answers; a level of 1e300 lies above every count: below_at_start (documented)
+                   accepts={"levels": FEWER | {"huge"}}),
         EntryPoint("prediction.safe_path_length", lambda a: metrics.safe_path_length(a["theta_p"], a["theta_a"]),
                    lambda tmp: {"theta_p": np.array([5.0, 9.0]), "theta_a": np.array([7.0, 8.0])},
                    {"theta_p": "array", "theta_a": "array"}, accepts=UNKNOWN_POSITION),

@@ -73,11 +73,11 @@ from scipy.optimize import nnls
 
 from poseintegrity.artifact_models.fitted import FALLBACK, OK
 from poseintegrity.artifact_models.series import Series
-from poseintegrity.errors import ArgumentError, check_array
+from poseintegrity.errors import ArgumentError
 from poseintegrity.params.fit import FitParams
 from poseintegrity.pose_correspondences import MIN_CORRESPONDENCES
 from poseintegrity.prediction.predictors import (
-    Boundaries, NextStep, envelope_prediction, fit_stops, flagged, stop_positions, supervise,
+    Boundaries, NextStep, envelope_prediction, fit_stops, flagged, operating_points, stop_positions, supervise,
 )
 
 NO_ERROR = "no predicted error at the sampled stops"  # fit reason of a dataset without one (a fallback fit)
@@ -189,11 +189,7 @@ def _checked(series: Series, safety_factors: object) -> np.ndarray:
     if series.sigma_t is None or series.sigma_r is None:
         raise ArgumentError(f"series: dataset {series.dataset}: the series carries no predicted error (stage 02's "
                             f"sigma_t_pred_mm, sigma_r_pred_deg)")
-    safety_factors = np.atleast_1d(check_array("safety_factors", safety_factors, finite=False))
-    if safety_factors.ndim != 1:
-        raise ArgumentError(f"safety_factors: expected a number or a (F,) array of safety factors, got shape "
-                            f"{safety_factors.shape}")
-    return safety_factors
+    return operating_points("safety_factors", safety_factors, "safety factors")
 
 
 def error_long_range(series: Series, n_sampled_stops: int, model: str, safety_factors: np.ndarray,

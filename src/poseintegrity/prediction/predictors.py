@@ -51,33 +51,36 @@ class Boundaries:
     status: np.ndarray
 
 
-def _thresholds(thresholds: object) -> np.ndarray:
-    """Thresholds n_t as a float (T,) array (a NaN one is flagged by the predictors, not refused)."""
-    n_t = np.atleast_1d(check_array("thresholds", thresholds, finite=False))
-    if n_t.ndim != 1:
-        raise ArgumentError(f"thresholds: expected a number or a (T,) array of n_t, got shape {n_t.shape}")
-    return n_t
+def operating_points(name: str, values: object, what: str) -> np.ndarray:
+    """``values`` as operating points (T,) float: inlier thresholds n_t, safety factors k or the levels a curve falls
+    to (``what``, in the message); ArgumentError naming ``name`` unless a number or a 1-D array of numbers (a NaN one
+    is flagged "bad_threshold" by the predictors, not refused)."""
+    points = np.atleast_1d(check_array(name, values, finite=False))
+    if points.ndim != 1:
+        raise ArgumentError(f"{name}: expected a number or a (T,) array of {what}, got shape {points.shape}")
+    return points
 
 
 def boundaries(
     predict: Callable[[np.ndarray], np.ndarray],
-    thresholds: np.ndarray,
+    levels: np.ndarray,
     theta_start: float,
     theta_end: float,
     n_grid: int,
 ) -> Boundaries:
-    """theta_p in [theta_start, theta_end] where predict first falls to each threshold n_t (III-E, vectorized).
+    """theta_p in [theta_start, theta_end] where predict first falls to each level (III-E, vectorized): an inlier
+    threshold n_t of a count curve, or a safety factor k of a margin curve (:mod:`.error_predictors`).
 
     The same answers as the scalar reference ``envelope_boundary`` of tests/scalar_boundary.py with ``n_scan = n_grid`` (checked in
-    the tests): f is evaluated once on the grid; the first grid point at or below n_t is found for every
-    threshold through the running minimum of f; each bracketing interval is then refined by a bisection run on
+    the tests): f is evaluated once on the grid; the first grid point at or below a level is found for every
+    level through the running minimum of f; each bracketing interval is then refined by a bisection run on
     all brackets at once (one call of ``predict`` per halving) down to BISECTION_XTOL.
 
-    predict : f, (m,) float -> (m,) float inlier counts;  thresholds : (T,) float n_t
+    predict : f, (m,) float -> (m,) float;  levels : (T,) float
     n_grid : scan points (``predict.n_grid``)
     Refused (:class:`~poseintegrity.errors.ArgumentError` naming the argument): n_grid not an integer >= 2,
-    theta_start or theta_end not finite within 1e6, an empty range, thresholds not a number or (T,) array of numbers;
-    a non-finite n_t is flagged ("bad_threshold"), not refused; no thresholds give an empty answer.
+    theta_start or theta_end not finite within 1e6, an empty range, levels not a number or (T,) array of numbers;
+    a non-finite level is flagged ("bad_threshold"), not refused; no levels give an empty answer.
     """
     if isinstance(n_grid, (bool, np.bool_)) or not isinstance(n_grid, (int, np.integer)) or n_grid < 2:
         raise ArgumentError(f"n_grid: expected an integer >= 2 (scan points), got {n_grid!r}")
@@ -85,32 +88,32 @@ def boundaries(
     check_scalar("theta_end", theta_end, low=-MAX_THETA, high=MAX_THETA)
     if not theta_end > theta_start:
         raise ArgumentError(f"theta_start, theta_end: empty search range [{theta_start}, {theta_end}]")
-    n_t = _thresholds(thresholds)
+    level = operating_points("levels", levels, "levels")
     theta = np.linspace(theta_start, theta_end, n_grid)
     f = np.asarray(predict(theta), dtype=float)
     bad = ~np.isfinite(f)
     first_bad = int(np.argmax(bad)) if bad.any() else n_grid
     running_min = np.minimum.accumulate(f[:first_bad]) if first_bad else np.empty(0)
-    # first grid index with f <= n_t, or first_bad if f stays above n_t on the finite prefix
-    first_below = np.searchsorted(-running_min, -np.nan_to_num(n_t, nan=-np.inf), side="left")
+    # first grid index with f <= level, or first_bad if f stays above it on the finite prefix
+    first_below = np.searchsorted(-running_min, -np.nan_to_num(level, nan=-np.inf), side="left")
 
-    theta_p = np.full(n_t.shape, np.nan)
-    status = np.full(n_t.shape, "root", dtype=object)
+    theta_p = np.full(level.shape, np.nan)
+    status = np.full(level.shape, "root", dtype=object)
     censored = first_below == n_grid
     non_finite = (first_below == first_bad) & ~censored
     at_start = (first_below == 0) & ~non_finite
     theta_p[censored], status[censored] = theta_end, "censored"
     theta_p[non_finite], status[non_finite] = theta[max(first_bad - 1, 0)], "non_finite"
     theta_p[at_start], status[at_start] = theta_start, "below_at_start"
-    bad_n_t = ~np.isfinite(n_t)
-    theta_p[bad_n_t], status[bad_n_t] = np.nan, "bad_threshold"
+    bad_level = ~np.isfinite(level)
+    theta_p[bad_level], status[bad_level] = np.nan, "bad_threshold"
 
     root = (status == "root").nonzero()[0]
     i = first_below[root]
     lo, hi = theta[i - 1], theta[i]
-    exact = f[i] == n_t[root]
+    exact = f[i] == level[root]
     theta_p[root[exact]] = hi[exact]
-    root, lo, hi, target = root[~exact], lo[~exact], hi[~exact], n_t[root[~exact]]
+    root, lo, hi, target = root[~exact], lo[~exact], hi[~exact], level[root[~exact]]
     failed = np.zeros(root.shape, dtype=bool)
     for _ in range(int(np.ceil(np.log2(max((theta[1] - theta[0]) / BISECTION_XTOL, 2.0))))):
         mid = 0.5 * (lo + hi)
@@ -187,6 +190,7 @@ def long_range(
     "too_few_stops" (theta_p NaN) when fewer than ``n_sampled_stops`` stops have a valid inlier count, e.g. all-NaN
     counts. The fit's status (``fitted.status``) holds for every threshold.
     """
+    thresholds = operating_points("thresholds", thresholds, "n_t")
     stops, theta_stops = stop_positions(series)
     if stops.size < n_sampled_stops:
         return LongRange(flagged(thresholds, "too_few_stops"), None, np.empty(0), np.empty(0))
@@ -237,7 +241,7 @@ def next_step(
     "bad_threshold". Fits stop once every threshold has stopped. A threshold's fit status is the most severe
     status among the fits it went by (up to and including the one that stopped it): its path relied on each.
     """
-    thresholds = _thresholds(thresholds)
+    thresholds = operating_points("thresholds", thresholds, "n_t")
     _, theta_stops = stop_positions(series)
 
     def boundary(stops: np.ndarray, moving: np.ndarray) -> tuple[np.ndarray, str, str]:
