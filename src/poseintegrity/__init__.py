@@ -39,6 +39,7 @@ Modules every stage shares, each importing only modules of this list:
     lens.py                   Brown-Conrady distortion, the calibrated camera and its YAML file
     calibration.py            Zhang's calibration from ChArUco images
     boards.py                 the ground-truth boards as a dataset describes them
+    dataset_meta.py           a dataset's meta.json as its types, checked on read (stage 01 writes, 02 reads)
     grayscale.py              the one conversion of an image to OpenCV's 8-bit grey
     mesh_file.py              a closed triangle mesh read from a file, and its check
     ransac.py                 how many samples classic RANSAC draws
