@@ -327,7 +327,10 @@ import json, sys, tempfile, time
 from pathlib import Path
 from poseintegrity.config import load_section
 from poseintegrity.report.metrics import json_ready
-from poseintegrity.workers import Workers
+try:
+    from poseintegrity.workers import Workers
+except ModuleNotFoundError:  # a commit from before parallel.py was named after its workers
+    from poseintegrity.parallel import Workers
 try:
     from poseintegrity.tracking.experiments.study import run_study
 except ModuleNotFoundError:  # a commit from before the tracking package was split into sub-packages
