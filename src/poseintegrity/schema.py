@@ -3,7 +3,7 @@
 Every section model derives from :class:`Section`: unknown keys are refused, values are frozen, every float
 must be finite (NaN and inf are refused wherever a number is expected) and numbers are strict: YAML's ``true``,
 the text ``"3"`` and ``2.0`` for a count are refused, an integer where a float is expected is taken (JSON's rule).
-Every number carries a lower and an upper bound with its reason (tests/test_params_schema.py walks the schema).
+Every number carries a lower and an upper bound with its reason (tests/params/test_every_number_bounded.py walks the schema).
 A tuple field is written as a YAML list: it is marked :data:`FromList` (its entries stay strict). Field types here carry the rules that
 recur across sections (seeds, worker counts, ordered ranges, distinct entries), so that a bad value is refused
 by the field itself and the error names its key. A rule between several keys of one model raises

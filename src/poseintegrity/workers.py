@@ -14,7 +14,7 @@ tasks does not change::
 ``map`` returns a list with one result per task, in the order of the tasks, whatever order they finish in. A
 task and its function must be picklable, and a task draws random numbers only from a generator seeded by the
 task itself (e.g. ``np.random.default_rng(task.seed)``): then both backends return byte-identical results
-(tests/test_parallel.py). Both run one task at a time per worker process with one BLAS/OpenMP thread and one
+(tests/test_workers.py). Both run one task at a time per worker process with one BLAS/OpenMP thread and one
 OpenCV thread (:func:`run_single_threaded`), so that float reductions run in the same order whichever backend runs
 them, and two workers on two cores do not start four threads each. (The local backend with ``n_jobs: 1`` runs
 the tasks one after the other in the calling process, where tracebacks and debuggers work as usual.)

@@ -173,7 +173,7 @@ def test_a_worker_process_gives_the_same_rows(swept, tables, tiny, tiny_predict,
     """The one parallel layer (workers.py): a local worker process returns what the in-process run returns, to the
     bit: every predictor of a dataset, the MLP on the worker's one thread among them. One task (a dataset and PnP
     method), not four: each process that gets one first imports for 4 s (torch, the fitters), and that many tasks come
-    back in order, to the byte, is tests/test_parallel.py's to show."""
+    back in order, to the byte, is tests/test_workers.py's to show."""
     theta_p, _, _ = swept
     one = (tables[0].dataset == "scene_1_arc00") & (tables[0].method == "usac_magsac")
     with Workers(tiny.parallel.model_copy(update={"n_jobs": 2})) as two:  # variation: worker processes

@@ -1,4 +1,5 @@
-"""The candidate ground-truth boards of issue 39's plan (:mod:`.board_plan`), where a lab could stand them.
+"""The candidate ground-truth boards of the board plan (:mod:`.board_plan`, placement planned), where a lab could
+stand them.
 
 Every size of ``generate.board.sizes_mm`` (squares_x x squares_y squares, the markers scaled alike), at board centres
 on a grid in the model camera's frame about the aim point (GRID_RIGHT_MM, GRID_UP_MM in the image, PLAN_TOWARDS_MM

@@ -1,4 +1,4 @@
-"""Which candidate boards serve which poses: criteria 1-3 of issue 39's plan (:mod:`.board_plan`), and the sigma_t
+"""Which candidate boards serve which poses: criteria 1-3 of the board plan (:mod:`.board_plan`, placement planned), and the sigma_t
 each predicts (criterion 4, :mod:`.board_sigma`).
 
 A board serves a pose (model image 0, a stop) where
@@ -10,7 +10,7 @@ A board serves a pose (model image 0, a stop) where
    board cut by the image's edge two squares in gives the 12 corners counted here, OpenCV's detector finds them). The
    plan first asked for the whole pattern in view: on the main world at one image per stop that left 93.5 % of frames
    trusted and every arc whose board stood near the image's edge late unserved, where this rule reaches 97.5 % (R11
-   p99 0.354 mm against 0.419 mm), and stage 02 judges a frame by the corners it finds (issue 39);
+   p99 0.354 mm against 0.419 mm), and stage 02 judges a frame by the corners it finds;
 2. **no target covers it**: where the board and a target (or a target's stand, or another board) overlap in the
    image (its outline, sampled at most OUTLINE_STEP_PX apart, on the other's silhouette hull grown by CLEARANCE_PX,
    or a hull vertex inside it), the nearer of the two covers the other; and the board **never covers a target** or
@@ -18,10 +18,10 @@ A board serves a pose (model image 0, a stop) where
 3. **it is in focus**: the lens is focused once per session (:mod:`.optics`), so the blur of the
    board's nearest or farthest corner, hypot(the lens' own blur, the defocus), must stay within FOCUS_BLUR_PER_CELL of
    a marker's bit cell where the pattern is smallest in the image (far, foreshortened), and a bit cell must span at
-   least MIN_CELL_PX, or its markers are not read (the lines' far stops of issue 30).
+   least MIN_CELL_PX, or its markers are not read (the lines' far stops of the facing_camera placement).
 
 A candidate that fails 1-3 in model image 0 is dropped. The candidates that stay are found first and only they are
-judged at every pose, and an image test runs only where a board's image can reach what it tests (issue 49).
+judged at every pose, and an image test runs only where a board's image can reach what it tests.
 """
 
 from __future__ import annotations
@@ -41,7 +41,7 @@ from poseintegrity.scenes.image_polygons import (
 )
 from poseintegrity.scenes.optics import defocus_sigma_px
 
-# Measured on the renders of studies/board_options.py (ChArUco boards, 960 frames of issue 30's and this plan's
+# Measured on the renders of studies/board_options.py (ChArUco boards, 960 frames of the facing_camera placement's and this plan's
 # boards): boards whose bit cells are 3 px or more and blurred by at most 0.35 of a cell were found with 20 or more
 # corners in 92-100 % of frames; beyond 0.5 of a cell in none.
 FOCUS_BLUR_PER_CELL = 0.35

@@ -1,4 +1,4 @@
-"""How well a board's pose is predicted from its corners: criterion 4 of issue 39's plan (:mod:`.board_plan`).
+"""How well a board's pose is predicted from its corners: criterion 4 of the board plan (:mod:`.board_plan`, placement planned).
 
 The covariance s^2 (J^T J)^-1 of the board pose from the inner corners found (the same prediction as stage 02's
 trust rule, :mod:`poseintegrity.localization.ground_truth`), J the Jacobian of the corners' projections at the
@@ -24,14 +24,14 @@ from scipy.stats import chi2
 
 from poseintegrity.scenes.image_polygons import NEAR_MM, fma, to_camera
 
-# Measured on the renders of studies/board_options.py (ChArUco boards, 960 frames of issue 30's and this plan's
+# Measured on the renders of studies/board_options.py (ChArUco boards, 960 frames of the facing_camera placement's and this plan's
 # boards): the corner noise the trust rule sees, s = sqrt(SSR / (2n - 6)), is 0.055-0.065 px (median) on sharp boards
 # and grows with the blur to 0.10-0.13 px at a blur sigma of 2-2.7 px, as hypot(a, b x blur sigma). With
 # (0.068, 0.038) px the predicted sigma_t is at least the measured one in 95 % of the 506 frames whose board was
 # wholly in view, in focus and found with 20 or more corners (the measured one is 0.51-1.21 x, median 0.76 x, the
 # predicted one).
 CORNER_NOISE_PX = (0.068, 0.038)
-TRUSTED_SHARE = 0.95  # of a served stop's frames stage 02 should trust (issue 39's target share of trusted frames)
+TRUSTED_SHARE = 0.95  # of a served stop's frames stage 02 should trust (the plan's target share of trusted frames)
 SINGULAR_COND = 1e12  # an information matrix this ill-conditioned predicts nothing: sigma_t inf
 
 

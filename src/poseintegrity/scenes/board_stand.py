@@ -1,5 +1,5 @@
 """A ground-truth board standing on a post beside the target, as both placements stand it (:mod:`.board_placement`,
-issue 30; :mod:`.board_plan`, issue 39): where it stands (:class:`BoardPlacement`), the error when no place fits
+facing_camera; :mod:`.board_plan`, planned): where it stands (:class:`BoardPlacement`), the error when no place fits
 (:class:`PlacementError`), its post, the grid of board centres both look for a place on about the aim point (right
 and up in the model camera's image) and whether clutter on the table would cover it (:func:`covers`). World frame:
 table top z = 0, z up, mm.

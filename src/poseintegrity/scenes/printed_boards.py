@@ -22,7 +22,7 @@ def measured_board(params: "GenerateParams", drawing: Board | None = None) -> Bo
 
 def printed_name(params: "GenerateParams", drawing: Board) -> str:
     """The key of a printed ground-truth board's draws (:func:`print_errors`, :func:`measured_scale`): "aruco" for
-    the params' own drawing (the board of every scene before issue 39), else one of its size and first id: each
+    the params' own drawing (the board of the facing_camera and flat placements), else one of its size and first id: each
     board the lab prints is one physical board in every scene that uses it."""
     if drawing == params.board.drawing():
         return "aruco"

@@ -68,7 +68,7 @@ def _board_sheet(params: "GenerateParams", board: Board, k: int = 0) -> meshes.M
 
 def flat_board(params: "GenerateParams", board: Board, board_yaw: float, T_world_target: np.ndarray, yaw: float,
                aim: np.ndarray, view_dir: np.ndarray) -> tuple[np.ndarray, list[tuple[str, meshes.Mesh]], np.ndarray]:
-    """Placement ``flat`` (the layout before issue 30): the board lies beside the target, printed side up (board z
+    """Placement ``flat``: the board lies beside the target, printed side up (board z
     points down), on the table or, beside a held phantom, on a pedestal BOARD_BELOW_AIM_MM below the aim point; board x
     points away from the target, so that its origin (the model origin, where E_t is measured) is a corner of the edge
     facing the target. Returns T_world_board, the meshes, the board's centre on the table (2,)."""

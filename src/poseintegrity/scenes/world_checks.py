@@ -58,7 +58,7 @@ def check_world(params: GenerateParams, protocol: ProtocolParams, world: str = "
                 workers: Workers | None = None, progress: bool = True) -> dict[tuple[int, str], catalog.Scene]:
     """Lay out every scene's sessions before any rendering, naming the key, when one cannot be rendered as the
     protocol needs; returns the scenes by (index, session). Every scene is built (an unreadable mesh or a hole outside
-    the bone raises :class:`~.mesh.MeshError` here, a board with no place a :class:`WorldError`), on ``workers`` when
+    the bone raises :class:`~poseintegrity.mesh_file.MeshError` here, a board with no place a :class:`WorldError`), on ``workers`` when
     given (planning a scene's boards takes seconds); each target must lie mostly inside both model views of its
     session (a mesh scaled far too large or too small, or a distance that puts the target out of the picture). The
     robot's reach is checked by :func:`~.world_plan.drive_scene`."""
