@@ -311,15 +311,15 @@ def _entries() -> list[EntryPoint]:
                    accepts=SERIES_ACCEPTS),
         EntryPoint("prediction.error_long_range",
                    lambda a: error_predictors.error_long_range(
-                       _series(a["theta"], a["n_inliers"], a["sigma_t"]), 4, "emg", a["factors"], (2.0, 3.0), P().fit,
+                       _series(a["theta"], a["n_inliers"], a["sigma_t"]), 4, "emg", a["safety_factors"], (2.0, 3.0), P().fit,
                        np.random.default_rng(0), 64),
                    lambda tmp: {"theta": inlier_series()[0], "n_inliers": inlier_series()[1],
                                 "sigma_t": 0.3 * np.sqrt(inlier_series()[1][0] / inlier_series()[1]),
-                                "factors": np.array([1.0, 3.0])},
-                   {"theta": "array", "n_inliers": "array", "sigma_t": "array", "factors": "array"},
+                                "safety_factors": np.array([1.0, 3.0])},
+                   {"theta": "array", "n_inliers": "array", "sigma_t": "array", "safety_factors": "array"},
                    flagged=lambda r: _boundaries_flagged(r[0]) or r[1] != "ok",
                    accepts=SERIES_ACCEPTS | {"sigma_t": {"nan", "inf", "huge"},  # no usable error at an image
-                                             "factors": FEWER | {"huge"}}),
+                                             "safety_factors": FEWER | {"huge"}}),
         # ---- tracking
         EntryPoint("tracking.detect_markers",
                    lambda a: _warned(detection.detect_markers, a["ir"], a["depth_mm"], a["unproject"],
